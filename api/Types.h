@@ -1,0 +1,100 @@
+#pragma once
+// The vocabulary shared by server, client and renderer. The JSON forms of these types are defined by
+// the schema in api/schema/ (the single source of truth); api/Validate.h turns JSON into these types.
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
+
+namespace radiant::api {
+
+// A user-input error. Maps to a 4xx application/problem+json response whose "pointer" is a JSON
+// pointer (RFC 6901) to the offending field of the request ("/passes/ambient_occlusion/samples").
+struct ApiError : std::runtime_error {
+  int status;           // 400, 404, 413, 415, 422, 503 ...
+  std::string type;     // short slug, becomes "https://radiant.dev/problems/<type>"
+  std::string title;    // short human summary
+  std::string pointer;  // JSON pointer into the request body ("" when not about a field)
+  ApiError(int status, std::string type, std::string title, std::string detail, std::string pointer = "")
+      : std::runtime_error(std::move(detail)), status(status), type(std::move(type)),
+        title(std::move(title)), pointer(std::move(pointer)) {}
+  std::string detail() const { return what(); }
+};
+
+struct SceneRef {
+  enum class Kind { Digest, Builtin, Inline };
+  Kind kind = Kind::Builtin;
+  std::string value;  // "sha256:..." | builtin name | base64 GLB (decoded by the server)
+};
+
+struct CameraOverride {
+  glm::vec3 position{0.f, 1.f, 3.f};
+  glm::vec3 target{0.f, 1.f, 0.f};
+  glm::vec3 up{0.f, 1.f, 0.f};
+  float yfovDegrees = 40.f;
+};
+
+enum class ImageFormat { Exr, Png };
+
+struct OutputSpec {
+  ImageFormat format = ImageFormat::Png;
+  std::vector<std::string> aovs{"beauty"};  // EXR: all listed become channel groups; PNG: exactly one
+  bool halfFloat = true;                    // EXR pixel type
+};
+
+struct CompareSpec {
+  std::string against = "reference";  // "reference" or "sha256:..." of an uploaded EXR
+  std::string aov = "beauty";         // beauty | direct | indirect | ao | ...
+  int spp = 256;                      // reference samples per pixel
+  int maxBounces = 8;
+};
+
+struct RenderRequest {
+  std::string id;  // assigned by the server
+  SceneRef scene;
+  std::optional<CameraOverride> camera;
+  int width = 256, height = 256;
+  // Technique name -> its parameters, complete with defaults filled in from the schema.
+  std::map<std::string, nlohmann::json> passes;
+  std::vector<OutputSpec> outputs{OutputSpec{}};
+  float exposure = 0.f;  // EV; PNG = sRGB(clamp(L * 2^exposure))
+  std::uint64_t seed = 0;
+  glm::vec3 ambient{0.f};  // uniform sky radiance L^a (W/sr/m^2), used by ambient passes
+  std::optional<CompareSpec> compare;
+  bool async = false;
+};
+
+// Timing and counters for one pass that ran.
+struct PassStats {
+  std::string name;
+  double gpuMs = 0.0;
+  double cpuMs = 0.0;
+  std::map<std::string, double> counters;  // beams, photons, samples, ...
+};
+
+struct CacheEvent {
+  std::string what;  // "shadow_map:light0", "bvh", "cube_maps"...
+  bool hit = false;
+};
+
+struct FrameStats {
+  std::vector<PassStats> passes;
+  std::map<std::string, std::string> skipped;  // pass name -> reason
+  std::vector<CacheEvent> cache;
+  double sceneLoadMs = 0, uploadMs = 0, renderMs = 0, readbackMs = 0, encodeMs = 0;
+  std::size_t triangles = 0;
+  int lights = 0;
+  std::map<std::string, std::string> device;  // vendor, renderer, version, device, reason
+  nlohmann::json metrics;  // error metrics when a compare block was given (null otherwise)
+};
+
+void to_json(nlohmann::json& j, const PassStats& s);
+void to_json(nlohmann::json& j, const FrameStats& s);
+
+}  // namespace radiant::api

@@ -1,0 +1,190 @@
+#include "renderer/Renderer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+
+#include "renderer/frame/FramePlanner.h"
+#include "renderer/frame/FrameResources.h"
+#include "renderer/frame/FrameView.h"
+#include "renderer/frame/GpuProfiler.h"
+#include "renderer/frame/GpuScene.h"
+#include "renderer/frame/PassContext.h"
+#include "renderer/gl/ShaderLibrary.h"
+#include "renderer/techniques/Registry.h"
+
+namespace radiant {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+// How an AOV is read back: which resource, which channels.
+struct AovSource {
+  std::string texture;
+  int firstChannel, channels;
+};
+AovSource aovSource(const std::string& aov) {
+  if (aov == "depth") return {"gbuffer_position", 3, 1};  // linear view depth, 0 where no surface
+  if (aov == "ao") return {"ao", 0, 1};
+  return {aov, 0, 3};
+}
+
+// Replaces NaN and Inf by 0 and counts them: output is never NaN or Inf, and the stats say if a pass
+// produced any (which is a bug to fix, not to hide).
+std::size_t sanitize(std::vector<float>& v) {
+  std::size_t bad = 0;
+  for (float& x : v)
+    if (!std::isfinite(x)) { x = 0.f; ++bad; }
+  return bad;
+}
+
+}  // namespace
+
+struct Renderer::Impl {
+  std::unique_ptr<EglDevice> device;
+  gl::ShaderLibrary shaders;
+  FrameResources resources{shaders};
+  GpuProfiler profiler;
+  std::vector<std::unique_ptr<Technique>> techniques = createTechniques();
+  // GPU copies of recently used scenes, most recent last; keyed by digest (or address when unnamed).
+  std::vector<std::pair<std::string, std::unique_ptr<GpuScene>>> gpuScenes;
+  static constexpr std::size_t kGpuSceneCache = 4;
+
+  const GpuScene& gpuScene(const Scene& scene, api::FrameStats& stats) {
+    const std::string key = scene.digest.empty() ? "addr:" + std::to_string(reinterpret_cast<std::uintptr_t>(&scene))
+                                                 : scene.digest;
+    auto it = std::find_if(gpuScenes.begin(), gpuScenes.end(), [&](const auto& e) { return e.first == key; });
+    const bool hit = it != gpuScenes.end();
+    stats.cache.push_back({"gpu_scene", hit});
+    if (hit) {
+      std::rotate(it, it + 1, gpuScenes.end());
+      return *gpuScenes.back().second;
+    }
+    const auto t0 = Clock::now();
+    auto g = std::make_unique<GpuScene>(scene);
+    stats.uploadMs = msSince(t0);
+    if (gpuScenes.size() >= kGpuSceneCache) gpuScenes.erase(gpuScenes.begin());
+    gpuScenes.emplace_back(key, std::move(g));
+    return *gpuScenes.back().second;
+  }
+};
+
+Renderer::Renderer(const DeviceOptions& options) : impl_(std::make_unique<Impl>()) {
+  impl_->device = EglDevice::create(options);
+  // Reversed-Z needs the [0,1] clip-space depth range (FrameView.h).
+  glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+  glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
+  gl::checkError("Renderer::Renderer");
+}
+
+Renderer::~Renderer() = default;
+
+const DeviceInfo& Renderer::device() const { return impl_->device->info(); }
+
+std::vector<TechniqueDescription> Renderer::techniques() {
+  std::vector<TechniqueDescription> out;
+  for (const auto& t : createTechniques())
+    out.push_back({t->info().name, t->info().description, t->info().outputs});
+  return out;
+}
+
+RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& request, const std::atomic<bool>* cancel) {
+  Impl& im = *impl_;
+  im.device->makeCurrent();
+  RenderOutput out;
+  api::FrameStats& stats = out.stats;
+  const DeviceInfo& dev = im.device->info();
+  stats.device = {{"vendor", dev.vendor}, {"renderer", dev.renderer}, {"version", dev.version},
+                  {"platform", dev.platform}, {"reason", dev.reason}};
+  stats.triangles = scene.features.triangles;
+  stats.lights = static_cast<int>(scene.lights.size());
+
+  try {
+    const auto frameStart = Clock::now();
+    const FrameView view = makeFrameView(scene, request);
+    const GpuScene& gpu = im.gpuScene(scene, stats);
+
+    std::vector<Technique*> all;
+    for (auto& t : im.techniques) all.push_back(t.get());
+    FramePlan plan = planFrame(all, scene.features, request);
+    stats.skipped = plan.skipped;
+
+    im.resources.beginFrame(gpu, view, &stats.cache);
+    im.profiler.beginFrame();
+    // PassStats must not move while the profiler holds pointers to them.
+    stats.passes.resize(plan.passes.size());
+    std::vector<Params> params(plan.passes.size());
+    for (std::size_t i = 0; i < plan.passes.size(); ++i) {
+      Technique* t = plan.passes[i];
+      stats.passes[i].name = t->info().name;
+      auto p = request.passes.find(t->info().name);
+      params[i] = Params(p == request.passes.end() ? nlohmann::json::object() : p->second);
+      t->prepare(scene, params[i], im.resources);
+      gl::checkError(("prepare " + t->info().name).c_str());
+    }
+    for (std::size_t i = 0; i < plan.passes.size(); ++i) {
+      if (cancel && cancel->load())
+        throw api::ApiError(409, "cancelled", "Render cancelled", "the render was cancelled before pass " +
+                                                                  plan.passes[i]->info().name);
+      Technique* t = plan.passes[i];
+      gl::DebugGroup group(t->info().name);
+      PassContext ctx{scene, gpu, view, params[i], im.resources, im.shaders, stats.passes[i]};
+      {
+        GpuProfiler::Scope scope(im.profiler, stats.passes[i]);
+        t->execute(ctx);
+      }
+      gl::checkError(("execute " + t->info().name).c_str());
+    }
+
+    // Readback of every AOV the outputs name (beauty always).
+    const auto readStart = Clock::now();
+    std::vector<std::string> aovs{"beauty"};
+    for (const auto& o : request.outputs)
+      for (const auto& a : o.aovs)
+        if (std::find(aovs.begin(), aovs.end(), a) == aovs.end()) aovs.push_back(a);
+    if (request.compare && std::find(aovs.begin(), aovs.end(), request.compare->aov) == aovs.end())
+      aovs.push_back(request.compare->aov);
+    std::vector<float> rgba(static_cast<std::size_t>(view.width) * view.height * 4);
+    std::size_t nonFinite = 0;
+    for (const std::string& aov : aovs) {
+      const AovSource src = aovSource(aov);
+      Image img = Image::make(aov, view.width, view.height, src.channels);
+      if (im.resources.hasTexture(src.texture) && im.resources.written(aov)) {
+        im.resources.texture(src.texture).download(0, GL_RGBA, GL_FLOAT, rgba.data(), rgba.size() * sizeof(float));
+        // GL's row 0 is the bottom row; images are stored top row first.
+        for (int y = 0; y < view.height; ++y) {
+          const float* row = &rgba[static_cast<std::size_t>(view.height - 1 - y) * view.width * 4];
+          for (int x = 0; x < view.width; ++x)
+            for (int c = 0; c < src.channels; ++c) img.at(x, y)[c] = row[x * 4 + src.firstChannel + c];
+        }
+      } else if (aov == "beauty" || aov == "direct") {
+        // Nothing was drawn (no geometry): the frame shows the sky.
+        for (int i = 0; i < view.width * view.height; ++i)
+          for (int c = 0; c < 3; ++c) img.pixels[static_cast<std::size_t>(i) * 3 + c] = view.ambient[c];
+      }
+      nonFinite += sanitize(img.pixels);
+      out.aovs.push_back(std::move(img));
+    }
+    stats.readbackMs = msSince(readStart);
+    im.profiler.resolve();
+    stats.renderMs = msSince(frameStart);
+    if (nonFinite) stats.passes.back().counters["non_finite_pixels_zeroed"] = static_cast<double>(nonFinite);
+    return out;
+  } catch (const api::ApiError&) {
+    im.profiler.beginFrame();
+    throw;
+  } catch (...) {
+    // An environment failure may leave GL objects in any state: drop derived data so the next frame
+    // rebuilds from scratch, and drain the GL error queue.
+    im.profiler = GpuProfiler{};
+    im.resources.clear();
+    im.gpuScenes.clear();
+    while (glGetError() != GL_NO_ERROR) {
+    }
+    throw;
+  }
+}
+
+}  // namespace radiant

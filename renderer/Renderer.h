@@ -1,0 +1,43 @@
+#pragma once
+// The renderer library's one entry point. It owns the EGL context, so create it on the thread that
+// will render, and call render() only from that thread. It knows nothing about HTTP.
+
+#include <atomic>
+#include <memory>
+#include <vector>
+
+#include "api/Types.h"
+#include "renderer/Image.h"
+#include "renderer/platform/EglDevice.h"
+#include "renderer/scene/Scene.h"
+
+namespace radiant {
+
+struct RenderOutput {
+  std::vector<Image> aovs;  // every AOV the request's outputs name (and "beauty" always)
+  api::FrameStats stats;
+};
+
+struct TechniqueDescription {
+  std::string name, description;
+  std::vector<std::string> outputs;  // AOVs it produces
+};
+
+class Renderer {
+public:
+  explicit Renderer(const DeviceOptions& options = {});
+  ~Renderer();
+  const DeviceInfo& device() const;
+  // Renders one frame. Throws api::ApiError for problems with the request that only show up here
+  // (e.g. an unknown receiver node), and gl::GlError / EglError for environment failures; after
+  // either the renderer stays usable. `cancel` is polled between passes.
+  RenderOutput render(const Scene& scene, const api::RenderRequest& request,
+                      const std::atomic<bool>* cancel = nullptr);
+  static std::vector<TechniqueDescription> techniques();
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace radiant

@@ -1,0 +1,92 @@
+#include "renderer/frame/FramePlanner.h"
+
+#include <algorithm>
+#include <set>
+
+namespace radiant {
+
+bool isFrameAov(const std::string& aov) { return aov == "beauty"; }
+
+FramePlan planFrame(const std::vector<Technique*>& techniques, const SceneFeatures& features,
+                    const api::RenderRequest& request) {
+  std::map<std::string, Technique*> byName;
+  std::map<std::string, Technique*> producerOf;
+  for (Technique* t : techniques) {
+    byName[t->info().name] = t;
+    for (const auto& out : t->info().outputs) producerOf.emplace(out, t);
+  }
+
+  std::set<std::string> wantedOutputs;
+  for (std::size_t i = 0; i < request.outputs.size(); ++i)
+    for (std::size_t k = 0; k < request.outputs[i].aovs.size(); ++k) {
+      const std::string& aov = request.outputs[i].aovs[k];
+      if (!isFrameAov(aov) && !producerOf.count(aov))
+        throw api::ApiError(422, "unknown-aov", "Unknown AOV",
+                            "no technique produces the AOV '" + aov + "'",
+                            "/outputs/" + std::to_string(i) + "/aovs/" + std::to_string(k));
+      wantedOutputs.insert(aov);
+    }
+  if (request.compare) wantedOutputs.insert(request.compare->aov == "beauty" ? "beauty" : request.compare->aov);
+  const bool beautyWanted = true;  // every frame has a beauty image
+
+  std::set<Technique*> wanted;
+  for (const auto& [name, params] : request.passes) {
+    auto it = byName.find(name);
+    if (it == byName.end())
+      throw api::ApiError(422, "unknown-pass", "Unknown pass", "no technique is named '" + name + "'",
+                          "/passes/" + name);
+    wanted.insert(it->second);
+  }
+  for (Technique* t : techniques) {
+    const auto& info = t->info();
+    if (beautyWanted && info.onByDefault) wanted.insert(t);
+    for (const auto& out : info.outputs)
+      if (wantedOutputs.count(out)) wanted.insert(t);
+  }
+
+  FramePlan plan;
+  // Evaluate requirements once, then close over inputs until nothing changes.
+  std::map<Technique*, Requirements> req;
+  auto requirement = [&](Technique* t) -> const Requirements& {
+    auto it = req.find(t);
+    if (it == req.end()) it = req.emplace(t, t->requirements(features, request)).first;
+    return it->second;
+  };
+  std::set<Technique*> keep;
+  bool changed = true;
+  while (changed) {
+    changed = false;
+    for (Technique* t : techniques) {
+      if (!wanted.count(t) || keep.count(t) || plan.skipped.count(t->info().name)) continue;
+      const Requirements& r = requirement(t);
+      if (!r.run) {
+        plan.skipped[t->info().name] = r.reason;
+        changed = true;
+        continue;
+      }
+      std::string missing;
+      for (const auto& in : t->info().inputs) {
+        auto p = producerOf.find(in);
+        if (p == producerOf.end()) { missing = "needs '" + in + "', which no technique produces"; break; }
+        if (!requirement(p->second).run) {
+          missing = "needs '" + in + "', which " + p->second->info().name +
+                    " does not produce: " + requirement(p->second).reason;
+          break;
+        }
+        if (!wanted.count(p->second)) { wanted.insert(p->second); changed = true; }
+      }
+      if (!missing.empty()) { plan.skipped[t->info().name] = missing; changed = true; continue; }
+      for (const auto& in : t->info().optionalInputs) {
+        auto p = producerOf.find(in);
+        if (p != producerOf.end() && !wanted.count(p->second)) { wanted.insert(p->second); changed = true; }
+      }
+      keep.insert(t);
+      changed = true;
+    }
+  }
+  for (Technique* t : techniques)
+    if (keep.count(t)) plan.passes.push_back(t);
+  return plan;
+}
+
+}  // namespace radiant

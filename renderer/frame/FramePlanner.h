@@ -1,0 +1,29 @@
+#pragma once
+// Decides which passes run for a request (ARCHITECTURE.md, "A technique"). It starts from the outputs
+// the request asks for and keeps the passes that produce them, plus the passes the request names and
+// the on-by-default beauty contributors; then it pulls in the producers of their inputs. A pass whose
+// requirements() says skip is dropped with its reason; a pass whose required input has no producer is
+// dropped with "needs <input>, which <producer> did not produce: <reason>".
+#include <map>
+#include <string>
+#include <vector>
+
+#include "api/Types.h"
+#include "renderer/frame/Technique.h"
+
+namespace radiant {
+
+struct FramePlan {
+  std::vector<Technique*> passes;              // in execution order
+  std::map<std::string, std::string> skipped;  // pass name -> reason
+};
+
+// AOVs that are not a technique's output but exist in every frame.
+bool isFrameAov(const std::string& aov);
+
+// `techniques` is in the canonical execution order (renderer/techniques/Registry.cpp).
+// Throws api::ApiError (422) for a requested pass or AOV that no technique knows.
+FramePlan planFrame(const std::vector<Technique*>& techniques, const SceneFeatures& features,
+                    const api::RenderRequest& request);
+
+}  // namespace radiant

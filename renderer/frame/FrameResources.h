@@ -1,0 +1,87 @@
+#pragma once
+// Named GPU resources and cached derived data, owned across frames.
+//
+// Textures, framebuffers and buffers are declared by name in a technique's prepare(): a declaration
+// with the same spec as last frame returns the same object, so steady-state frames allocate nothing.
+// Derived data (shadow maps, BVHs, cube maps, photon maps) is cached under a key together with the
+// digest of exactly the inputs it depends on; every lookup is logged as a cache hit or miss.
+#include <functional>
+#include <map>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "api/Types.h"
+#include "renderer/gl/Gl.h"
+#include "renderer/gl/ShaderLibrary.h"
+
+namespace radiant {
+
+class GpuScene;
+struct FrameView;
+
+class FrameResources {
+public:
+  explicit FrameResources(gl::ShaderLibrary& shaders) : shaders_(shaders) {}
+
+  // Called by the Renderer at the start of each frame.
+  void beginFrame(const GpuScene& gpu, const FrameView& view, std::vector<api::CacheEvent>* cacheLog);
+  const GpuScene& gpuScene() const { return *gpu_; }
+  const FrameView& view() const { return *view_; }
+  gl::ShaderLibrary& shaders() { return shaders_; }
+
+  // Declare-or-reuse a texture. Re-declaring with a different spec reallocates.
+  gl::Texture& texture(const std::string& name, GLenum target, GLenum internalFormat, int width,
+                       int height, int depth = 1, int levels = 1);
+  // An already declared texture; throws std::logic_error naming it otherwise.
+  gl::Texture& texture(const std::string& name);
+  bool hasTexture(const std::string& name) const { return textures_.count(name) != 0; }
+  gl::Framebuffer& framebuffer(const std::string& name);
+  gl::Buffer& buffer(const std::string& name, std::size_t bytes, GLbitfield flags = GL_DYNAMIC_STORAGE_BIT);
+  gl::Buffer& buffer(const std::string& name);
+  bool hasBuffer(const std::string& name) const { return buffers_.count(name) != 0; }
+
+  // Outputs written this frame (the planner and readback consult it).
+  void markWritten(const std::string& name) { written_.insert(name); }
+  bool written(const std::string& name) const { return written_.count(name) != 0; }
+
+  // Cached derived data: returns the entry under `key` if it was built from `inputsDigest`, else
+  // builds it with `build` and stores it. Logs "key" as a hit or a miss.
+  template <class T>
+  T& cached(const std::string& key, const std::string& inputsDigest, const std::function<std::unique_ptr<T>()>& build) {
+    auto it = cache_.find(key);
+    const bool hit = it != cache_.end() && it->second.digest == inputsDigest;
+    if (cacheLog_) cacheLog_->push_back({key, hit});
+    if (!hit) {
+      auto value = build();
+      Entry e{inputsDigest, std::shared_ptr<void>(value.release(), [](void* p) { delete static_cast<T*>(p); })};
+      it = cache_.insert_or_assign(key, std::move(e)).first;
+    }
+    return *static_cast<T*>(it->second.value.get());
+  }
+  // Drops every cached entry and resource (after a GL failure the objects may be invalid).
+  void clear();
+
+private:
+  struct TextureSpec {
+    GLenum target, format;
+    int width, height, depth, levels;
+    bool operator==(const TextureSpec&) const = default;
+  };
+  struct Entry {
+    std::string digest;
+    std::shared_ptr<void> value;
+  };
+  gl::ShaderLibrary& shaders_;
+  const GpuScene* gpu_ = nullptr;
+  const FrameView* view_ = nullptr;
+  std::vector<api::CacheEvent>* cacheLog_ = nullptr;
+  std::map<std::string, std::pair<TextureSpec, gl::Texture>> textures_;
+  std::map<std::string, gl::Framebuffer> framebuffers_;
+  std::map<std::string, gl::Buffer> buffers_;
+  std::map<std::string, Entry> cache_;
+  std::set<std::string> written_;
+};
+
+}  // namespace radiant

@@ -1,0 +1,32 @@
+#pragma once
+// Camera matrices for one frame. Depth is reversed-Z with an infinite far plane for perspective
+// cameras (depth = znear / z_view: 1 at the near plane, 0 at infinity), stored in a 32-bit float
+// depth buffer with glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE). Floating-point precision is then
+// nearly uniform in log depth, so scenes at 1e-3 m and 1e4 m scale render alike.
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+#include "api/Types.h"
+#include "renderer/scene/Scene.h"
+
+namespace radiant {
+
+struct FrameView {
+  int width = 0, height = 0;
+  Camera camera;
+  glm::mat4 view{1.f}, proj{1.f}, viewProj{1.f}, invViewProj{1.f};
+  glm::vec3 eye{0.f};
+  float exposure = 0.f;
+  std::uint64_t seed = 0;
+  glm::vec3 ambient{0.f};
+};
+
+// Reversed-Z, infinite far plane (see above).
+glm::mat4 reversedZPerspective(float yfov, float aspect, float znear);
+// Reversed-Z orthographic: depth 1 at znear, 0 at zfar.
+glm::mat4 reversedZOrthographic(float xmag, float ymag, float znear, float zfar);
+// The request's camera override if any, else the scene's camera, with the image's aspect.
+FrameView makeFrameView(const Scene& scene, const api::RenderRequest& request);
+
+}  // namespace radiant

@@ -1,0 +1,132 @@
+#include "renderer/frame/GpuScene.h"
+
+#include <cmath>
+#include <string>
+
+namespace radiant {
+namespace {
+
+gpu::Light toGpuLight(const Light& l) {
+  gpu::Light g{};
+  const int type = l.type == LightType::Directional ? gpu::kLightDirectional
+                 : l.type == LightType::Point       ? gpu::kLightPoint
+                                                    : gpu::kLightSpot;
+  g.positionType = glm::vec4(l.position, static_cast<float>(type));
+  g.directionRange = glm::vec4(glm::normalize(l.direction), l.range);
+  g.radiantIntensity = glm::vec4(l.color * l.intensity, 0.f);
+  // KHR_lights_punctual: the smooth falloff runs between cos(outer) and cos(inner).
+  g.spotCone = glm::vec4(std::cos(l.outerConeAngle), std::cos(l.innerConeAngle), 0.f, 0.f);
+  return g;
+}
+
+template <class T>
+gl::Buffer makeBuffer(const std::string& label, const std::vector<T>& data) {
+  return gl::Buffer(label, data.size() * sizeof(T), data.data(), 0);
+}
+
+}  // namespace
+
+GpuScene::GpuScene(const Scene& scene) {
+  // Textures: colour textures are sampled through sRGB formats so the hardware linearises them.
+  std::map<std::pair<int, bool>, int> textureIndex;
+  auto gpuTexture = [&](const TextureRef& ref, bool srgb) -> int {
+    if (!ref.valid() || ref.texture >= static_cast<int>(scene.textures.size())) return -1;
+    auto key = std::make_pair(ref.texture, srgb);
+    if (auto it = textureIndex.find(key); it != textureIndex.end()) return it->second;
+    const Texture& t = scene.textures[ref.texture];
+    const int levels = 1 + static_cast<int>(std::floor(std::log2(std::max(1, std::max(t.width, t.height)))));
+    gl::Texture tex("scene texture " + t.name, GL_TEXTURE_2D, srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8,
+                    t.width, t.height, 1, levels);
+    // glTF's uv (0,0) is the top-left texel, which is the first row in memory: uploading rows in
+    // file order and sampling with the uv as given is therefore consistent (no flip).
+    tex.upload(0, 0, 0, 0, t.width, t.height, 1, GL_RGBA, GL_UNSIGNED_BYTE, t.rgba8.data());
+    tex.generateMipmaps();
+    const bool mipmapped = t.minFilter == GL_NEAREST_MIPMAP_NEAREST || t.minFilter == GL_LINEAR_MIPMAP_NEAREST ||
+                           t.minFilter == GL_NEAREST_MIPMAP_LINEAR || t.minFilter == GL_LINEAR_MIPMAP_LINEAR;
+    tex.setFilter(mipmapped || t.minFilter == GL_LINEAR || t.minFilter == GL_NEAREST ? static_cast<GLenum>(t.minFilter)
+                                                                                      : GL_LINEAR_MIPMAP_LINEAR,
+                  t.magFilter == GL_NEAREST ? GL_NEAREST : GL_LINEAR);
+    glTextureParameteri(tex.id(), GL_TEXTURE_WRAP_S, t.wrapS);
+    glTextureParameteri(tex.id(), GL_TEXTURE_WRAP_T, t.wrapT);
+    textures.push_back(std::move(tex));
+    textureIndex[key] = static_cast<int>(textures.size()) - 1;
+    return textures.back() ? static_cast<int>(textures.size()) - 1 : -1;
+  };
+
+  std::vector<gpu::Material> mats;
+  auto addMaterial = [&](const Material& m) {
+    gpu::Material g{};
+    g.baseColorFactor = m.baseColorFactor;
+    g.emission = glm::vec4(m.emission(), 0.f);
+    g.metallicRoughness = glm::vec4(m.metallicFactor, m.roughnessFactor, m.transmissionFactor, m.ior);
+    g.scales = glm::vec4(m.normalTexture.scale, m.occlusionTexture.scale, m.alphaCutoff,
+                         static_cast<float>(static_cast<int>(m.alphaMode)));
+    auto uvSet = [](const TextureRef& r) { return r.valid() ? r.texCoord : -1; };
+    g.texturesA = glm::ivec4(uvSet(m.baseColorTexture), uvSet(m.metallicRoughnessTexture),
+                             uvSet(m.normalTexture), uvSet(m.occlusionTexture));
+    g.texturesB = glm::ivec4(uvSet(m.emissiveTexture), m.doubleSided ? 1 : 0, 0, 0);
+    mats.push_back(g);
+  };
+  for (const Material& m : scene.materials) addMaterial(m);
+  const int defaultMaterial = static_cast<int>(mats.size());
+  addMaterial(Material{});
+  materials = makeBuffer("materials", mats);
+
+  for (const MeshInstance& mi : scene.meshes) {
+    GpuMesh g;
+    const std::size_t n = mi.positions.size();
+    const std::string label = "mesh " + mi.name;
+    g.positions = makeBuffer(label + " positions", mi.positions);
+    std::vector<glm::vec3> normals = mi.normals;
+    normals.resize(n, glm::vec3(0.f, 1.f, 0.f));
+    g.normals = makeBuffer(label + " normals", normals);
+    // Absent attributes get zero-filled buffers so every program sees the same vertex layout.
+    std::vector<glm::vec2> uv0 = mi.uv0, uv1 = mi.uv1;
+    uv0.resize(n, glm::vec2(0.f));
+    uv1.resize(n, glm::vec2(0.f));
+    g.uv0 = makeBuffer(label + " uv0", uv0);
+    g.uv1 = makeBuffer(label + " uv1", uv1);
+    std::vector<glm::vec4> tangents = mi.tangents;
+    tangents.resize(n, glm::vec4(1.f, 0.f, 0.f, 1.f));
+    g.tangents = makeBuffer(label + " tangents", tangents);
+    g.indices = makeBuffer(label + " indices", mi.indices);
+    g.indexCount = static_cast<GLsizei>(mi.indices.size());
+    g.vao = gl::VertexArray(label);
+    g.vao.attribute(0, 0, g.positions, 3, sizeof(glm::vec3));
+    g.vao.attribute(1, 1, g.normals, 3, sizeof(glm::vec3));
+    g.vao.attribute(2, 2, g.uv0, 2, sizeof(glm::vec2));
+    g.vao.attribute(3, 3, g.uv1, 2, sizeof(glm::vec2));
+    g.vao.attribute(4, 4, g.tangents, 4, sizeof(glm::vec4));
+    g.vao.elements(g.indices);
+    g.material = mi.material >= 0 && mi.material < defaultMaterial ? mi.material : defaultMaterial;
+    const Material& m = scene.material(mi.material);
+    g.textures[gpu::kSlotBaseColor] = gpuTexture(m.baseColorTexture, true);
+    g.textures[gpu::kSlotMetallicRoughness] = gpuTexture(m.metallicRoughnessTexture, false);
+    g.textures[gpu::kSlotNormal] = gpuTexture(m.normalTexture, false);
+    g.textures[gpu::kSlotOcclusion] = gpuTexture(m.occlusionTexture, false);
+    g.textures[gpu::kSlotEmissive] = gpuTexture(m.emissiveTexture, true);
+    triangles += mi.triangleCount();
+    meshes.push_back(std::move(g));
+  }
+
+  for (const Light& l : scene.lights) lightData.push_back(toGpuLight(l));
+  if (lightData.empty()) lightData.push_back(gpu::Light{});  // a zero-size SSBO is not bindable
+  lights = gl::Buffer("lights", lightData.size() * sizeof(gpu::Light), lightData.data(), 0);
+  gl::checkError("GpuScene upload");
+}
+
+void GpuScene::draw(const gl::Program& program, bool withTextures) const {
+  materials.bindBase(GL_SHADER_STORAGE_BUFFER, kMaterialBinding);
+  const GLint materialLoc = program.uniformLocation("u_material");
+  for (const GpuMesh& m : meshes) {
+    if (materialLoc >= 0) glProgramUniform1i(program.id(), materialLoc, m.material);
+    if (withTextures) {
+      for (int s = 0; s < gpu::kSlotCount; ++s)
+        if (m.textures[s] >= 0) textures[m.textures[s]].bindUnit(gpu::kMaterialTextureUnit0 + s);
+    }
+    m.vao.bind();
+    glDrawElements(GL_TRIANGLES, m.indexCount, GL_UNSIGNED_INT, nullptr);
+  }
+}
+
+}  // namespace radiant

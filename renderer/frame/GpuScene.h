@@ -1,0 +1,41 @@
+#pragma once
+// A Scene uploaded to the GPU: one vertex array per MeshInstance, the materials and lights as std430
+// storage buffers, and the textures (sRGB views for colour). Built once per scene digest and reused
+// by every pass and every frame while the scene is unchanged.
+#include <array>
+#include <map>
+#include <vector>
+
+#include "renderer/frame/GpuTypes.h"
+#include "renderer/gl/Gl.h"
+#include "renderer/scene/Scene.h"
+
+namespace radiant {
+
+struct GpuMesh {
+  gl::Buffer positions, normals, uv0, uv1, tangents, indices;
+  gl::VertexArray vao;
+  GLsizei indexCount = 0;
+  int material = -1;  // index into the materials buffer (the default material is appended last)
+  std::array<int, gpu::kSlotCount> textures{-1, -1, -1, -1, -1};  // index into GpuScene::textures
+};
+
+class GpuScene {
+public:
+  explicit GpuScene(const Scene& scene);
+  std::vector<GpuMesh> meshes;
+  std::vector<gl::Texture> textures;  // one per (scene texture, colour space) actually used
+  gl::Buffer materials;               // gpu::Material[], binding kMaterialBinding
+  gl::Buffer lights;                  // gpu::Light[], binding kLightBinding
+  std::vector<gpu::Light> lightData;  // CPU copy of `lights` (at least one entry: zero-size SSBOs are invalid)
+  std::size_t triangles = 0;
+
+  static constexpr GLuint kMaterialBinding = 0;
+  static constexpr GLuint kLightBinding = 1;
+
+  // Binds the materials buffer and, per draw, the mesh's textures; issues one draw per mesh.
+  // The program must declare `uniform int u_material;`.
+  void draw(const gl::Program& program, bool withTextures) const;
+};
+
+}  // namespace radiant

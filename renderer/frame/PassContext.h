@@ -1,0 +1,22 @@
+#pragma once
+#include "api/Types.h"
+#include "renderer/frame/FrameResources.h"
+#include "renderer/frame/FrameView.h"
+#include "renderer/frame/GpuScene.h"
+#include "renderer/frame/Technique.h"
+#include "renderer/gl/ShaderLibrary.h"
+
+namespace radiant {
+
+// Everything execute() may use. Counters go into stats.counters; timing is the scheduler's job.
+struct PassContext {
+  const Scene& scene;
+  const GpuScene& gpu;
+  const FrameView& view;
+  const Params& params;
+  FrameResources& resources;
+  gl::ShaderLibrary& shaders;
+  api::PassStats& stats;
+};
+
+}  // namespace radiant

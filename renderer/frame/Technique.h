@@ -1,0 +1,71 @@
+#pragma once
+// The one interface every illumination pass implements (see ARCHITECTURE.md, "A technique").
+// Adding a technique never touches another: it registers itself in renderer/techniques/Registry.cpp,
+// declares its parameters in api/schema/techniques/<name>.json and its method in docs/TECHNIQUES.md.
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "api/Types.h"
+#include "renderer/scene/Scene.h"
+
+namespace radiant {
+
+class FrameResources;
+struct PassContext;
+
+struct TechniqueInfo {
+  std::string name;         // as used in the API ("direct", "ambient_occlusion")
+  std::string description;  // one line
+  std::vector<std::string> inputs;    // resources it reads and cannot run without ("depth", "normal")
+  std::vector<std::string> optionalInputs;  // resources it reads when present ("shadow_maps")
+  std::vector<std::string> outputs;   // resources / AOVs it writes ("direct")
+  bool addsToBeauty = false;  // accumulates its result into "beauty"
+  bool onByDefault = false;   // wanted whenever beauty is, unless the request names passes explicitly
+};
+
+// Run or skip, and the reason if skipped. The planner records the reason in the frame stats.
+struct Requirements {
+  bool run = true;
+  std::string reason;
+  static Requirements ok() { return {}; }
+  static Requirements skip(std::string why) { return {false, std::move(why)}; }
+};
+
+// A technique's parameters, already validated against its schema with defaults filled in (api/).
+class Params {
+public:
+  Params() : json_(nlohmann::json::object()) {}
+  explicit Params(nlohmann::json j) : json_(j.is_object() ? std::move(j) : nlohmann::json::object()) {}
+  template <class T>
+  T get(const char* key, T fallback) const {
+    auto it = json_.find(key);
+    return it == json_.end() || it->is_null() ? fallback : it->get<T>();
+  }
+  const nlohmann::json& json() const { return json_; }
+  // Digest of a subset of the parameters: what a cache entry depends on.
+  std::string subsetKey(std::initializer_list<const char*> keys) const {
+    nlohmann::json s = nlohmann::json::object();
+    for (const char* k : keys)
+      if (json_.contains(k)) s[k] = json_[k];
+    return s.dump();
+  }
+private:
+  nlohmann::json json_;
+};
+
+class Technique {
+public:
+  virtual ~Technique() = default;
+  virtual const TechniqueInfo& info() const = 0;
+  // Run or skip for this scene and request. Called by the FramePlanner only.
+  virtual Requirements requirements(const SceneFeatures& features, const api::RenderRequest& request) const = 0;
+  // Allocate or reuse resources; build or fetch cached derived data. No drawing here.
+  virtual void prepare(const Scene& scene, const Params& params, FrameResources& resources) = 0;
+  // The only place GL is issued. Must not allocate GL objects.
+  virtual void execute(PassContext& context) = 0;
+};
+
+}  // namespace radiant

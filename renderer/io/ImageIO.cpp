@@ -1,0 +1,111 @@
+#include "renderer/io/ImageIO.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <stdexcept>
+
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
+
+namespace radiant::io {
+namespace OIIO = OIIO_NAMESPACE;
+
+float linearToSrgb(float v) {
+  v = std::clamp(v, 0.f, 1.f);
+  return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.f / 2.4f) - 0.055f;
+}
+
+float srgbToLinear(float v) {
+  return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+}
+
+namespace {
+
+std::string writeToMemory(const char* nameHint, const OIIO::ImageSpec& spec, OIIO::TypeDesc type, const void* data) {
+  std::vector<unsigned char> bytes;
+  OIIO::Filesystem::IOVecOutput proxy(bytes);
+  auto out = OIIO::ImageOutput::create(nameHint, &proxy);
+  if (!out) throw std::runtime_error(std::string("io: no image writer for ") + nameHint + ": " + OIIO::geterror());
+  if (!out->open(nameHint, spec)) throw std::runtime_error("io: open " + std::string(nameHint) + ": " + out->geterror());
+  if (!out->write_image(type, data)) throw std::runtime_error("io: write " + std::string(nameHint) + ": " + out->geterror());
+  if (!out->close()) throw std::runtime_error("io: close " + std::string(nameHint) + ": " + out->geterror());
+  return std::string(bytes.begin(), bytes.end());
+}
+
+// EXR channel names of one AOV: beauty is the default layer (R,G,B) so viewers show it first.
+std::vector<std::string> channelNames(const Image& img) {
+  static const char* rgb[] = {"R", "G", "B", "A"};
+  std::vector<std::string> names;
+  const std::string prefix = img.aov == "beauty" ? "" : img.aov + ".";
+  if (img.channels == 1) {
+    names.push_back(prefix + (img.aov == "depth" ? "Z" : "Y"));
+  } else {
+    for (int c = 0; c < img.channels; ++c) names.push_back(prefix + rgb[std::min(c, 3)]);
+  }
+  return names;
+}
+
+}  // namespace
+
+std::string encodeExr(const std::vector<Image>& aovs, bool halfFloat) {
+  if (aovs.empty()) throw std::invalid_argument("encodeExr: no AOVs");
+  const int w = aovs[0].width, h = aovs[0].height;
+  int channels = 0;
+  std::vector<std::string> names;
+  for (const Image& a : aovs) {
+    if (a.width != w || a.height != h) throw std::invalid_argument("encodeExr: AOV sizes differ: " + a.aov);
+    for (auto& n : channelNames(a)) names.push_back(n);
+    channels += a.channels;
+  }
+  OIIO::ImageSpec spec(w, h, channels, halfFloat ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
+  spec.channelnames = names;
+  spec.attribute("compression", "zip");
+  // Interleave every AOV's channels into one pixel.
+  std::vector<float> data(static_cast<std::size_t>(w) * h * channels);
+  for (std::size_t p = 0; p < static_cast<std::size_t>(w) * h; ++p) {
+    int off = 0;
+    for (const Image& a : aovs) {
+      for (int c = 0; c < a.channels; ++c) data[p * channels + off + c] = a.pixels[p * a.channels + c];
+      off += a.channels;
+    }
+  }
+  return writeToMemory("frame.exr", spec, OIIO::TypeDesc::FLOAT, data.data());
+}
+
+std::string encodePng(const Image& image, float exposureEV) {
+  const int outChannels = image.channels == 1 ? 1 : 3;
+  OIIO::ImageSpec spec(image.width, image.height, outChannels, OIIO::TypeDesc::UINT8);
+  const float scale = std::exp2(exposureEV);
+  std::vector<unsigned char> data(static_cast<std::size_t>(image.width) * image.height * outChannels);
+  for (std::size_t p = 0; p < static_cast<std::size_t>(image.width) * image.height; ++p)
+    for (int c = 0; c < outChannels; ++c) {
+      float v = image.pixels[p * image.channels + c] * scale;
+      if (!std::isfinite(v)) v = 0.f;
+      // Clamp before quantising: out-of-range values saturate, never wrap.
+      data[p * outChannels + c] = static_cast<unsigned char>(std::lround(linearToSrgb(v) * 255.f));
+    }
+  return writeToMemory("frame.png", spec, OIIO::TypeDesc::UINT8, data.data());
+}
+
+void writeFile(const std::string& path, const std::string& bytes) {
+  std::ofstream f(path, std::ios::binary);
+  if (!f) throw std::runtime_error("io: cannot open " + path + " for writing");
+  f.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  if (!f) throw std::runtime_error("io: short write to " + path);
+}
+
+Image readImage(const std::string& path, const std::string& aov) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) throw std::runtime_error("io: cannot read " + path + ": " + OIIO::geterror());
+  const OIIO::ImageSpec& spec = in->spec();
+  Image img = Image::make(aov, spec.width, spec.height, std::min(spec.nchannels, 3));
+  std::vector<float> all(static_cast<std::size_t>(spec.width) * spec.height * spec.nchannels);
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()))
+    throw std::runtime_error("io: read " + path + ": " + in->geterror());
+  for (std::size_t p = 0; p < static_cast<std::size_t>(spec.width) * spec.height; ++p)
+    for (int c = 0; c < img.channels; ++c) img.pixels[p * img.channels + c] = all[p * spec.nchannels + c];
+  return img;
+}
+
+}  // namespace radiant::io

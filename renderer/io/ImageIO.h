@@ -1,0 +1,25 @@
+#pragma once
+// Image encoding with OpenImageIO. Pure CPU: safe to call from any thread (the server runs it off the
+// render thread so the GPU keeps working while frames are written).
+
+#include <string>
+#include <vector>
+
+#include "renderer/Image.h"
+
+namespace radiant::io {
+
+// A multi-AOV OpenEXR file: each AOV becomes a channel group ("beauty.R", "depth.Z", ...), with
+// beauty as the unprefixed default layer (R, G, B) so viewers show it first. halfFloat selects HALF.
+std::string encodeExr(const std::vector<Image>& aovs, bool halfFloat);
+// 8-bit sRGB PNG of one AOV: value * 2^exposure, clamped to [0,1] (never wrapped), sRGB transfer.
+std::string encodePng(const Image& image, float exposureEV);
+void writeFile(const std::string& path, const std::string& bytes);
+// Reads an EXR/HDR/PNG into float RGB(A) (for compare-against-upload and tests).
+Image readImage(const std::string& path, const std::string& aov = "beauty");
+
+// sRGB transfer of one linear value in [0,1] (IEC 61966-2-1).
+float linearToSrgb(float linear);
+float srgbToLinear(float encoded);
+
+}  // namespace radiant::io

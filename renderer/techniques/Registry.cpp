@@ -1,0 +1,17 @@
+#include "renderer/techniques/Registry.h"
+
+#include "renderer/techniques/direct/Direct.h"
+#include "renderer/techniques/gbuffer/GBuffer.h"
+#include "renderer/techniques/shadow_maps/ShadowMaps.h"
+
+namespace radiant {
+
+std::vector<std::unique_ptr<Technique>> createTechniques() {
+  std::vector<std::unique_ptr<Technique>> t;
+  t.push_back(std::make_unique<GBufferPass>());
+  t.push_back(std::make_unique<ShadowMapsPass>());
+  t.push_back(std::make_unique<DirectPass>());
+  return t;
+}
+
+}  // namespace radiant

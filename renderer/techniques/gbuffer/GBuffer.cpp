@@ -1,0 +1,70 @@
+#include "renderer/techniques/gbuffer/GBuffer.h"
+
+#include "renderer/frame/PassContext.h"
+
+namespace radiant {
+namespace {
+// Resource name -> internal format, in colour attachment order (matches shaders/gbuffer/gbuffer.frag).
+constexpr std::pair<const char*, GLenum> kTargets[] = {
+    {"gbuffer_position", GL_RGBA32F}, {"normal", GL_RGBA16F},   {"albedo", GL_RGBA16F},
+    {"material", GL_RGBA16F},         {"emission", GL_RGBA16F}, {"geometric_normal", GL_RGBA16F},
+};
+}  // namespace
+
+const TechniqueInfo& GBufferPass::info() const {
+  static const TechniqueInfo i{"gbuffer",
+                               "G-buffer: reversed-Z depth, world position, normals, albedo, material, emission",
+                               {},
+                               {},
+                               {"depth_buffer", "gbuffer_position", "depth", "normal", "albedo", "material",
+                                "emission", "geometric_normal"},
+                               false,
+                               false};
+  return i;
+}
+
+Requirements GBufferPass::requirements(const SceneFeatures& f, const api::RenderRequest&) const {
+  return f.triangles > 0 ? Requirements::ok() : Requirements::skip("the scene has no triangles");
+}
+
+void GBufferPass::prepare(const Scene&, const Params&, FrameResources& res) {
+  const int w = res.view().width, h = res.view().height;
+  gl::Framebuffer& fb = res.framebuffer("gbuffer");
+  fb.attach(GL_DEPTH_ATTACHMENT, res.texture("depth_buffer", GL_TEXTURE_2D, GL_DEPTH_COMPONENT32F, w, h));
+  for (std::size_t i = 0; i < std::size(kTargets); ++i) {
+    gl::Texture& t = res.texture(kTargets[i].first, GL_TEXTURE_2D, kTargets[i].second, w, h);
+    t.setFilter(GL_NEAREST, GL_NEAREST);
+    fb.attach(GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(i), t);
+  }
+  fb.setDrawBuffers({GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2, GL_COLOR_ATTACHMENT3,
+                     GL_COLOR_ATTACHMENT4, GL_COLOR_ATTACHMENT5});
+  fb.checkComplete("GBufferPass::prepare");
+}
+
+void GBufferPass::execute(PassContext& ctx) {
+  const auto& view = ctx.view;
+  gl::Framebuffer& fb = ctx.resources.framebuffer("gbuffer");
+  fb.bind();
+  glViewport(0, 0, view.width, view.height);
+  const float zero[4] = {0.f, 0.f, 0.f, 0.f};
+  for (int i = 0; i < static_cast<int>(std::size(kTargets)); ++i) glClearNamedFramebufferfv(fb.id(), GL_COLOR, i, zero);
+  const float depthClear = 0.f;  // reversed-Z: 0 is infinitely far
+  glClearNamedFramebufferfv(fb.id(), GL_DEPTH, 0, &depthClear);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_GREATER);
+  glDepthMask(GL_TRUE);
+  glDisable(GL_CULL_FACE);  // single-sided back faces are discarded in the shader (glTF semantics)
+  glDisable(GL_BLEND);
+
+  const gl::Program& prog = ctx.shaders.program({"gbuffer/gbuffer.vert", "gbuffer/gbuffer.frag"});
+  prog.use();
+  prog.setMat4("u_viewProj", &view.viewProj[0][0]);
+  prog.set("u_eye", &view.eye[0], 3);
+  const glm::vec3 forward = -glm::normalize(glm::vec3(view.camera.world[2]));
+  prog.set("u_viewForward", &forward[0], 3);
+  ctx.gpu.draw(prog, true);
+  ctx.stats.counters["triangles"] = static_cast<double>(ctx.gpu.triangles);
+  for (const auto& out : info().outputs) ctx.resources.markWritten(out);
+}
+
+}  // namespace radiant

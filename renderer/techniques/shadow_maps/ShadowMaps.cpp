@@ -1,0 +1,150 @@
+#include "renderer/techniques/shadow_maps/ShadowMaps.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "renderer/frame/FrameView.h"
+#include "renderer/frame/PassContext.h"
+
+namespace radiant {
+namespace {
+
+struct ShadowMapsCacheEntry {};  // the maps themselves live in FrameResources; the entry marks them valid
+
+glm::vec3 anyPerpendicular(const glm::vec3& d) {
+  return std::abs(d.y) < 0.99f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
+}
+
+}  // namespace
+
+const TechniqueInfo& ShadowMapsPass::info() const {
+  static const TechniqueInfo i{"shadow_maps",
+                               "Shadow maps: cube maps for point lights, 2D maps for spot and directional lights",
+                               {},
+                               {},
+                               {"shadow_maps"},
+                               false,
+                               false};
+  return i;
+}
+
+Requirements ShadowMapsPass::requirements(const SceneFeatures& f, const api::RenderRequest&) const {
+  if (f.lightCount() == 0) return Requirements::skip("the scene has no punctual lights");
+  if (f.triangles == 0) return Requirements::skip("the scene has no triangles to cast shadows");
+  return Requirements::ok();
+}
+
+glm::mat4 ShadowMapsPass::cubeFaceViewProj(const glm::vec3& p, int face, float znear) {
+  // GL cube map face orientation (GL 4.5 spec table 8.19): the up vectors make a lookAt camera's
+  // image match the face's (s,t) layout when rendered with the lower-left origin.
+  static const glm::vec3 dirs[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  static const glm::vec3 ups[6] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
+  return reversedZPerspective(glm::half_pi<float>(), 1.f, znear) * glm::lookAt(p, p + dirs[face], ups[face]);
+}
+
+void ShadowMapsPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
+  size_ = params.get<int>("shadow_map_size", 1024);
+  const float bias = params.get<float>("shadow_bias", 1.0f);
+  const float normalOffset = params.get<float>("normal_offset", 1.5f);
+  const Bounds& b = scene.features.bounds;
+  const float radius = std::max(b.radius(), 1e-6f);
+  const glm::vec3 center = b.center();
+  const float znear = radius * 1e-4f;
+
+  int cubes = 0, maps2d = 0;
+  infos_.assign(std::max<std::size_t>(1, scene.lights.size()), gpu::ShadowInfo{});
+  draws_.clear();
+  for (std::size_t li = 0; li < scene.lights.size(); ++li) {
+    const Light& l = scene.lights[li];
+    gpu::ShadowInfo& si = infos_[li];
+    const glm::vec3 dir = glm::normalize(l.direction);
+    if (l.type == LightType::Point) {
+      // A 90 degree face spans tan(45) = 1 on each side: one texel is 2/size per unit distance.
+      si.params = glm::vec4(gpu::kShadowCube, static_cast<float>(cubes), 2.f / size_, normalOffset);
+      si.params2 = glm::vec4(0.f, bias, 0.f, 0.f);
+      for (int f = 0; f < 6; ++f) draws_.push_back({static_cast<int>(li), cubes * 6 + f, true, cubeFaceViewProj(l.position, f, znear)});
+      ++cubes;
+    } else if (l.type == LightType::Spot) {
+      const float fov = std::min(2.f * l.outerConeAngle + glm::radians(4.f), glm::radians(170.f));
+      si.viewProj = reversedZPerspective(fov, 1.f, znear) * glm::lookAt(l.position, l.position + dir, anyPerpendicular(dir));
+      si.params = glm::vec4(gpu::kShadow2D, static_cast<float>(maps2d), 2.f * std::tan(0.5f * fov) / size_, normalOffset);
+      si.params2 = glm::vec4(0.f, bias, 0.f, 0.f);
+      draws_.push_back({static_cast<int>(li), maps2d, false, si.viewProj});
+      ++maps2d;
+    } else {
+      // Orthographic, fitted to the bounding sphere of the scene; the map stores dot(p, dir).
+      const glm::vec3 eye = center - dir * (2.f * radius);
+      si.viewProj = reversedZOrthographic(radius, radius, 0.f, 4.f * radius) * glm::lookAt(eye, center, anyPerpendicular(dir));
+      si.params = glm::vec4(gpu::kShadow2D, static_cast<float>(maps2d), 2.f * radius / size_, normalOffset);
+      si.params2 = glm::vec4(1.f, bias, 0.f, 0.f);
+      draws_.push_back({static_cast<int>(li), maps2d, false, si.viewProj});
+      ++maps2d;
+    }
+  }
+
+  // Both arrays always exist (samplers must be complete even when unused).
+  gl::Texture& cube = res.texture("shadow_cube", GL_TEXTURE_CUBE_MAP_ARRAY, GL_R32F, size_, size_, 6 * std::max(1, cubes));
+  gl::Texture& flat = res.texture("shadow_2d", GL_TEXTURE_2D_ARRAY, GL_R32F, size_, size_, std::max(1, maps2d));
+  cube.setFilter(GL_NEAREST, GL_NEAREST);
+  flat.setFilter(GL_NEAREST, GL_NEAREST);
+  flat.setWrap(GL_CLAMP_TO_EDGE);
+  res.texture("shadow_depth", GL_TEXTURE_2D, GL_DEPTH_COMPONENT32F, size_, size_);
+  res.framebuffer("shadow");
+  res.buffer("shadow_info", infos_.size() * sizeof(gpu::ShadowInfo));
+
+  // The maps depend on geometry, lights and size only.
+  const std::string digest = scene.digest + "|" + std::to_string(reinterpret_cast<std::uintptr_t>(&res.gpuScene())) +
+                             "|" + std::to_string(size_);
+  bool built = false;
+  res.cached<ShadowMapsCacheEntry>("shadow_maps", digest, [&] {
+    built = true;
+    return std::make_unique<ShadowMapsCacheEntry>();
+  });
+  mapsValid_ = !built;
+}
+
+void ShadowMapsPass::execute(PassContext& ctx) {
+  FrameResources& res = ctx.resources;
+  res.buffer("shadow_info").upload(infos_.data(), infos_.size() * sizeof(gpu::ShadowInfo));
+  res.markWritten("shadow_maps");
+  ctx.stats.counters["maps_rendered"] = mapsValid_ ? 0.0 : static_cast<double>(draws_.size());
+  if (mapsValid_) return;
+
+  gl::Framebuffer& fb = res.framebuffer("shadow");
+  gl::Texture& cube = res.texture("shadow_cube");
+  gl::Texture& flat = res.texture("shadow_2d");
+  gl::Texture& depth = res.texture("shadow_depth");
+  fb.attach(GL_DEPTH_ATTACHMENT, depth);
+  fb.setDrawBuffers({GL_COLOR_ATTACHMENT0});
+  const gl::Program& prog = ctx.shaders.program({"shadow_maps/shadow.vert", "shadow_maps/shadow.frag"});
+  prog.use();
+  glViewport(0, 0, size_, size_);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_GREATER);
+  glDepthMask(GL_TRUE);
+  glDisable(GL_CULL_FACE);  // both faces cast shadows (open meshes, single walls)
+  glDisable(GL_BLEND);
+  const float far[4] = {1e30f, 0.f, 0.f, 0.f};
+  const float depthClear = 0.f;
+  for (const Draw& d : draws_) {
+    const Light& l = ctx.scene.lights[d.light];
+    fb.attach(GL_COLOR_ATTACHMENT0, d.cube ? cube : flat, 0, d.layer);
+    fb.checkComplete("ShadowMapsPass::execute");
+    fb.bind();
+    glClearNamedFramebufferfv(fb.id(), GL_COLOR, 0, far);
+    glClearNamedFramebufferfv(fb.id(), GL_DEPTH, 0, &depthClear);
+    const bool ortho = l.type == LightType::Directional;
+    const glm::vec3 origin = ortho ? glm::vec3(0.f) : l.position;
+    const glm::vec3 dir = glm::normalize(l.direction);
+    prog.setMat4("u_viewProj", &d.viewProj[0][0]);
+    prog.set("u_lightPosition", &origin[0], 3);
+    prog.set("u_lightDirection", &dir[0], 3);
+    prog.set("u_orthographic", ortho ? 1 : 0);
+    ctx.gpu.draw(prog, false);
+  }
+  ctx.stats.counters["map_size"] = size_;
+}
+
+}  // namespace radiant

@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Installs every Debian package Radiant needs to build, test and run. Idempotent:
+# packages already present are skipped, and apt-get update runs only when something is missing.
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config
+  libepoxy-dev libglm-dev libtinygltf-dev libcpp-httplib-dev nlohmann-json3-dev
+  libopenimageio-dev openimageio-tools libembree-dev libtbb-dev
+  libegl-dev libegl-mesa0 libgl1-mesa-dri libgbm1 mesa-utils
+  libgtest-dev libgmock-dev googletest libbenchmark-dev
+  curl gnuplot-nox
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+echo "setup: installing ${missing[*]}"
+$SUDO apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+echo "setup: done"

@@ -1,0 +1,38 @@
+// Mirrors renderer/frame/GpuTypes.h (std430). Keep the two in step; the C++ side static_asserts sizes.
+#ifndef RADIANT_COMMON_SCENE
+#define RADIANT_COMMON_SCENE
+
+#define LIGHT_DIRECTIONAL 0
+#define LIGHT_POINT 1
+#define LIGHT_SPOT 2
+#define SHADOW_NONE 0
+#define SHADOW_CUBE 1
+#define SHADOW_2D 2
+
+struct Material {
+  vec4 baseColorFactor;
+  vec4 emission;           // rgb = emissiveFactor * emissiveStrength
+  vec4 metallicRoughness;  // x metallic, y roughness, z transmission, w ior
+  vec4 scales;             // x normal scale, y occlusion strength, z alpha cutoff, w alpha mode
+  ivec4 texturesA;         // uv set per slot (base, mr, normal, occlusion), -1 = none
+  ivec4 texturesB;         // x emissive uv set, y doubleSided
+};
+
+struct Light {
+  vec4 positionType;
+  vec4 directionRange;
+  vec4 radiantIntensity;
+  vec4 spotCone;  // x cos(outer), y cos(inner)
+};
+
+struct ShadowInfo {
+  mat4 viewProj;
+  vec4 params;   // x kind, y layer, z texel world size (per unit distance if perspective), w normal offset (texels)
+  vec4 params2;  // x orthographic, y constant bias (texels)
+};
+
+layout(std430, binding = 0) readonly buffer Materials { Material materials[]; };
+layout(std430, binding = 1) readonly buffer Lights { Light lights[]; };
+layout(std430, binding = 2) readonly buffer Shadows { ShadowInfo shadows[]; };
+
+#endif

@@ -1,0 +1,260 @@
+// Render-core tests on the real GL device (llvmpipe in CI). Every expected value is fixed by the
+// physics of the scene: glTF light units, the Lambertian BRDF, the KHR_lights_punctual falloffs.
+#include <cmath>
+#include <memory>
+
+#include <gtest/gtest.h>
+
+#include "renderer/Renderer.h"
+#include "renderer/io/ImageIO.h"
+#include "tests/support/SceneBuilder.h"
+
+namespace radiant {
+namespace {
+
+using testing::SceneBuilder;
+using testing::lambertian;
+using testing::topDownPixelToWorld;
+
+Renderer& renderer() {
+  static std::unique_ptr<Renderer> r = std::make_unique<Renderer>();
+  return *r;
+}
+
+api::RenderRequest request(int size, std::vector<std::string> aovs = {"beauty", "direct"}) {
+  api::RenderRequest req;
+  req.width = req.height = size;
+  req.outputs = {api::OutputSpec{api::ImageFormat::Exr, aovs, false}};
+  req.passes["shadow_maps"] = {{"shadow_map_size", 1024}};
+  return req;
+}
+
+const Image& aov(const RenderOutput& out, const std::string& name) {
+  for (const auto& a : out.aovs)
+    if (a.aov == name) return a;
+  throw std::runtime_error("missing aov " + name);
+}
+
+void expectAllFinite(const RenderOutput& out) {
+  for (const auto& a : out.aovs)
+    for (float v : a.pixels) ASSERT_TRUE(std::isfinite(v)) << a.aov;
+}
+
+// A 40 m white plane at y = 0 seen from above.
+SceneBuilder planeScene(float scale = 1.f) {
+  SceneBuilder b;
+  int white = b.material(lambertian());
+  b.quad({0, 0, 0}, {20.f * scale, 0, 0}, {0, 0, -20.f * scale}, white, "floor");  // normal +Y
+  return b;
+}
+
+TEST(RenderCore, PointLightCalibrationAndCosCubedFalloff) {
+  // A point light of intensity pi at height 1: E = I cos(theta) / d^2 = pi cos^3(theta), and a white
+  // Lambertian surface reflects L = E / pi = cos^3(theta): exactly 1.0 at the foot point.
+  const int size = 64;
+  const float half = 1.5f;
+  Scene scene = planeScene().pointLight({0, 1, 0}, glm::pi<float>()).topDownOrtho(5.f, half).build("calib");
+  RenderOutput out = renderer().render(scene, request(size));
+  expectAllFinite(out);
+  const Image& direct = aov(out, "direct");
+  int checked = 0;
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      const glm::vec2 w = topDownPixelToWorld(x, y, size, half);
+      const float d2 = 1.f + glm::dot(w, w);
+      const float expected = std::pow(d2, -1.5f);  // cos^3 theta
+      const float got = direct.at(x, y)[0];
+      if (glm::dot(w, w) < 0.05f * 0.05f) {
+        EXPECT_NEAR(got, 1.0f, 0.01f) << "foot point " << x << "," << y;
+      }
+      EXPECT_NEAR(got / expected, 1.0f, 0.02f) << "pixel " << x << "," << y;
+      ++checked;
+    }
+  EXPECT_EQ(checked, size * size);
+  // Beauty is direct when nothing else runs.
+  EXPECT_FLOAT_EQ(aov(out, "beauty").at(10, 10)[1], direct.at(10, 10)[1]);
+}
+
+TEST(RenderCore, SpotLightConeEdges) {
+  // KHR_lights_punctual smooth falloff: t = clamp((cos a - cos outer) / (cos inner - cos outer)), t^2.
+  const float inner = 0.3f, outer = 0.5f, I = glm::pi<float>();
+  const int size = 96;
+  const float half = 0.7f;
+  Scene scene = planeScene().spotLight({0, 1, 0}, {0, -1, 0}, I, inner, outer).topDownOrtho(5.f, half).build("spot");
+  RenderOutput out = renderer().render(scene, request(size));
+  expectAllFinite(out);
+  const Image& direct = aov(out, "direct");
+  int inside = 0, outside = 0, ramp = 0;
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      const glm::vec2 w = topDownPixelToWorld(x, y, size, half);
+      const float r = glm::length(w);
+      const float a = std::atan(r);  // angle from the spot axis
+      const float cos3 = std::pow(1.f + r * r, -1.5f);
+      float t = (std::cos(a) - std::cos(outer)) / (std::cos(inner) - std::cos(outer));
+      t = std::clamp(t, 0.f, 1.f);
+      const float expected = cos3 * t * t;
+      const float got = direct.at(x, y)[0];
+      if (a < inner - 0.02f) { EXPECT_NEAR(got / cos3, 1.f, 0.02f); ++inside; }
+      else if (a > outer + 0.02f) { EXPECT_EQ(got, 0.f); ++outside; }
+      else if (a > inner + 0.02f && a < outer - 0.02f) { EXPECT_NEAR(got, expected, 0.02f * cos3); ++ramp; }
+    }
+  EXPECT_GT(inside, 100);
+  EXPECT_GT(outside, 100);
+  EXPECT_GT(ramp, 100);
+}
+
+TEST(RenderCore, DirectionalLightIsIrradiance) {
+  // Directional intensity is irradiance on a surface facing it: L = E cos(45 deg) / pi.
+  const float E = 2.f;
+  Scene scene = planeScene().directionalLight({0, -1, -1}, E).topDownOrtho(5.f, 1.f).build("dir");
+  RenderOutput out = renderer().render(scene, request(32));
+  expectAllFinite(out);
+  const float expected = E * std::sqrt(0.5f) / glm::pi<float>();
+  const Image& direct = aov(out, "direct");
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 32; ++x) EXPECT_NEAR(direct.at(x, y)[2], expected, 0.01f * expected);
+}
+
+// A point light at height 1 above the plane and a 0.4 x 0.4 occluder at height 0.5 facing down.
+// Seen from above, the occluder shows its back face, which glTF's single-sided rule discards, so the
+// camera sees the plane through it while the shadow map still sees the occluder. The umbra is the
+// occluder's projection from the light: a 0.8 x 0.8 square.
+Scene umbraScene(float scale, const std::string& digest) {
+  SceneBuilder b = planeScene(scale);
+  int grey = b.material(lambertian(glm::vec3(0.5f)));
+  b.quad(glm::vec3(0, 0.5f, 0) * scale, glm::vec3(0.2f, 0, 0) * scale, glm::vec3(0, 0, 0.2f) * scale, grey, "occluder");  // normal -Y
+  b.pointLight(glm::vec3(0, 1, 0) * scale, glm::pi<float>() * scale * scale);  // same irradiance at every scale
+  b.topDownOrtho(5.f * scale, 1.5f * scale);
+  return b.build(digest);
+}
+
+TEST(RenderCore, UmbraIsBlackAndLitPlaneHasNoAcne) {
+  const int size = 96;
+  const float half = 1.5f;
+  RenderOutput out = renderer().render(umbraScene(1.f, "umbra"), request(size));
+  expectAllFinite(out);
+  const Image& direct = aov(out, "direct");
+  int umbra = 0, lit = 0;
+  double sumRel = 0, sumRel2 = 0;
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      const glm::vec2 w = topDownPixelToWorld(x, y, size, half);
+      const float got = direct.at(x, y)[0];
+      if (std::abs(w.x) < 0.34f && std::abs(w.y) < 0.34f) {  // inside the umbra, away from its edge
+        EXPECT_EQ(got, 0.f) << "umbra pixel " << x << "," << y;
+        ++umbra;
+      } else if (std::abs(w.x) > 0.5f || std::abs(w.y) > 0.5f) {  // fully lit
+        const float rel = got / std::pow(1.f + glm::dot(w, w), -1.5f);
+        sumRel += rel;
+        sumRel2 += rel * rel;
+        ++lit;
+      }
+    }
+  ASSERT_GT(umbra, 400);  // 0.68 m square at 32 px/m: ~21^2 pixels
+  ASSERT_GT(lit, 3000);
+  // Shadow acne would show as dark speckles: the lit plane's radiance relative to the analytic
+  // cos^3 law must have mean 1 and a standard deviation under 0.5%.
+  const double mean = sumRel / lit, var = sumRel2 / lit - mean * mean;
+  EXPECT_NEAR(mean, 1.0, 0.01);
+  EXPECT_LT(std::sqrt(std::max(var, 0.0)), 0.005);
+}
+
+TEST(RenderCore, SceneScaleInvariance) {
+  // The same scene at 1e-3 and 1e4 scale, with the light intensity scaled by s^2, renders the same.
+  const int size = 64;
+  RenderOutput ref = renderer().render(umbraScene(1.f, "scale1"), request(size));
+  for (float s : {1e-3f, 1e4f}) {
+    RenderOutput out = renderer().render(umbraScene(s, "scale" + std::to_string(s)), request(size));
+    expectAllFinite(out);
+    const Image& a = aov(ref, "direct");
+    const Image& b = aov(out, "direct");
+    int differing = 0;
+    for (std::size_t i = 0; i < a.pixels.size(); ++i)
+      if (std::abs(a.pixels[i] - b.pixels[i]) > 0.01f * std::max(a.pixels[i], 0.05f)) ++differing;
+    // Shadow-edge pixels may flip where the penumbra crosses a texel boundary; allow 1% of them.
+    EXPECT_LT(differing, static_cast<int>(a.pixels.size() / 100)) << "scale " << s;
+  }
+}
+
+TEST(RenderCore, StatsTimeEveryPassAndSkipWithReasons) {
+  RenderOutput out = renderer().render(umbraScene(1.f, "stats"), request(32));
+  std::vector<std::string> names;
+  for (const auto& p : out.stats.passes) {
+    names.push_back(p.name);
+    EXPECT_GT(p.gpuMs, 0.0) << p.name;
+    EXPECT_GE(p.cpuMs, 0.0) << p.name;
+  }
+  EXPECT_EQ(names, (std::vector<std::string>{"gbuffer", "shadow_maps", "direct"}));
+  EXPECT_EQ(out.stats.triangles, 4u);
+  EXPECT_EQ(out.stats.lights, 1);
+  EXPECT_FALSE(out.stats.device.at("renderer").empty());
+
+  // No lights: the shadow maps are skipped with a reason and direct still runs.
+  Scene dark = planeScene().topDownOrtho(5.f, 1.f).build("dark");
+  RenderOutput d = renderer().render(dark, request(16));
+  ASSERT_TRUE(d.stats.skipped.count("shadow_maps"));
+  EXPECT_EQ(d.stats.skipped.at("shadow_maps"), "the scene has no punctual lights");
+  for (float v : aov(d, "beauty").pixels) EXPECT_EQ(v, 0.f);
+}
+
+TEST(RenderCore, DerivedDataIsCachedAcrossFrames) {
+  Scene scene = umbraScene(1.f, "cache");
+  renderer().render(scene, request(32));
+  api::RenderRequest moved = request(48);
+  moved.camera = api::CameraOverride{{0.5f, 3.f, 2.f}, {0, 0, 0}, {0, 1, 0}, 50.f};
+  RenderOutput second = renderer().render(scene, moved);
+  bool gpuHit = false, shadowHit = false;
+  for (const auto& c : second.stats.cache) {
+    if (c.what == "gpu_scene") gpuHit = c.hit;
+    if (c.what == "shadow_maps") shadowHit = c.hit;
+  }
+  EXPECT_TRUE(gpuHit);
+  EXPECT_TRUE(shadowHit);
+  for (const auto& p : second.stats.passes)
+    if (p.name == "shadow_maps") EXPECT_EQ(p.counters.at("maps_rendered"), 0.0);
+  // A different map size is a different derived product: rebuilt.
+  moved.passes["shadow_maps"] = {{"shadow_map_size", 512}};
+  RenderOutput third = renderer().render(scene, moved);
+  for (const auto& c : third.stats.cache)
+    if (c.what == "shadow_maps") EXPECT_FALSE(c.hit);
+}
+
+TEST(RenderCore, GrazingViewsStayFinite) {
+  // A camera almost in the plane of the floor: NdotV -> 0 everywhere.
+  Scene scene = planeScene().pointLight({0, 1, 0}, 3.f).build("grazing");
+  api::RenderRequest req = request(64, {"beauty", "direct", "normal", "depth", "albedo"});
+  req.camera = api::CameraOverride{{0, 1e-4f, 15.f}, {0, 0, 0}, {0, 1, 0}, 60.f};
+  RenderOutput out = renderer().render(scene, req);
+  expectAllFinite(out);
+  for (float v : aov(out, "direct").pixels) EXPECT_GE(v, 0.f);
+}
+
+TEST(ImageIO, PngClampsAndExrKeepsLayers) {
+  Image img = Image::make("beauty", 4, 1, 3);
+  const float values[4] = {-1.f, 0.5f, 2.f, 1e30f};
+  for (int x = 0; x < 4; ++x)
+    for (int c = 0; c < 3; ++c) img.at(x, 0)[c] = values[x];
+  const std::string png = io::encodePng(img, 0.f);
+  const std::string path = ::testing::TempDir() + "/clamp.png";
+  io::writeFile(path, png);
+  Image back = io::readImage(path);
+  EXPECT_EQ(back.at(0, 0)[0], 0.f);                                   // negative clamps to 0
+  EXPECT_NEAR(back.at(1, 0)[0], io::linearToSrgb(0.5f), 1.f / 255);  // sRGB transfer
+  EXPECT_EQ(back.at(2, 0)[0], 1.f);                                   // over-range saturates, never wraps
+  EXPECT_EQ(back.at(3, 0)[0], 1.f);
+  // Exposure +1 EV doubles the linear value before the transfer.
+  io::writeFile(path, io::encodePng(img, 1.f));
+  EXPECT_EQ(io::readImage(path).at(1, 0)[0], 1.f);
+
+  Image depth = Image::make("depth", 4, 1, 1);
+  depth.pixels = {1.f, 2.f, 3.f, 4.f};
+  const std::string exrPath = ::testing::TempDir() + "/layers.exr";
+  io::writeFile(exrPath, io::encodeExr({img, depth}, false));
+  Image exr = io::readImage(exrPath);
+  EXPECT_EQ(exr.at(1, 0)[0], 0.5f);  // float EXR is exact
+  EXPECT_EQ(exr.at(2, 0)[1], 2.f);   // and keeps values above 1
+}
+
+}  // namespace
+}  // namespace radiant

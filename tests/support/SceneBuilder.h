@@ -1,0 +1,129 @@
+#pragma once
+// Builds small scenes in code for tests: quads, boxes and spheres with given materials and lights.
+#include <cmath>
+#include <string>
+
+#include <glm/gtc/constants.hpp>
+
+#include "renderer/scene/Scene.h"
+
+namespace radiant::testing {
+
+// A white material that is exactly Lambertian at normal incidence: KHR_materials_ior 1.0 makes the
+// dielectric Fresnel F0 = 0, so the glTF BRDF reduces to baseColor/pi wherever (1 - VdotH)^5 ~ 0.
+inline Material lambertian(glm::vec3 albedo = glm::vec3(1.f)) {
+  Material m;
+  m.name = "lambertian";
+  m.baseColorFactor = glm::vec4(albedo, 1.f);
+  m.metallicFactor = 0.f;
+  m.roughnessFactor = 1.f;
+  m.ior = 1.f;
+  return m;
+}
+
+class SceneBuilder {
+public:
+  SceneBuilder() { scene_.name = "test"; }
+  int material(const Material& m) { scene_.materials.push_back(m); return static_cast<int>(scene_.materials.size()) - 1; }
+
+  // A quad centred at `c` spanned by half-vectors `u` and `v`; its normal is normalize(cross(u, v)).
+  SceneBuilder& quad(glm::vec3 c, glm::vec3 u, glm::vec3 v, int mat, const std::string& name = "quad") {
+    MeshInstance m;
+    m.name = name;
+    m.material = mat;
+    const glm::vec3 n = glm::normalize(glm::cross(u, v));
+    m.positions = {c - u - v, c + u - v, c + u + v, c - u + v};
+    m.normals = {n, n, n, n};
+    m.uv0 = {{0, 1}, {1, 1}, {1, 0}, {0, 0}};
+    m.indices = {0, 1, 2, 0, 2, 3};
+    for (auto& p : m.positions) m.bounds.extend(p);
+    scene_.meshes.push_back(std::move(m));
+    return *this;
+  }
+
+  // A UV sphere with outward normals.
+  SceneBuilder& sphere(glm::vec3 c, float r, int mat, int segments = 48, int rings = 24, const std::string& name = "sphere") {
+    MeshInstance m;
+    m.name = name;
+    m.material = mat;
+    for (int i = 0; i <= rings; ++i) {
+      const float th = glm::pi<float>() * i / rings;
+      for (int j = 0; j <= segments; ++j) {
+        const float ph = glm::two_pi<float>() * j / segments;
+        const glm::vec3 n(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph));
+        m.positions.push_back(c + r * n);
+        m.normals.push_back(n);
+        m.uv0.push_back({static_cast<float>(j) / segments, static_cast<float>(i) / rings});
+      }
+    }
+    for (int i = 0; i < rings; ++i)
+      for (int j = 0; j < segments; ++j) {
+        const unsigned a = i * (segments + 1) + j, b = a + segments + 1;
+        m.indices.insert(m.indices.end(), {a, a + 1, b, a + 1, b + 1, b});
+      }
+    for (auto& p : m.positions) m.bounds.extend(p);
+    scene_.meshes.push_back(std::move(m));
+    return *this;
+  }
+
+  SceneBuilder& pointLight(glm::vec3 p, float intensity, glm::vec3 color = glm::vec3(1.f)) {
+    Light l;
+    l.type = LightType::Point;
+    l.position = p;
+    l.intensity = intensity;
+    l.color = color;
+    scene_.lights.push_back(l);
+    return *this;
+  }
+  SceneBuilder& spotLight(glm::vec3 p, glm::vec3 dir, float intensity, float inner, float outer) {
+    Light l;
+    l.type = LightType::Spot;
+    l.position = p;
+    l.direction = glm::normalize(dir);
+    l.intensity = intensity;
+    l.innerConeAngle = inner;
+    l.outerConeAngle = outer;
+    scene_.lights.push_back(l);
+    return *this;
+  }
+  SceneBuilder& directionalLight(glm::vec3 dir, float intensity) {
+    Light l;
+    l.type = LightType::Directional;
+    l.direction = glm::normalize(dir);
+    l.intensity = intensity;
+    scene_.lights.push_back(l);
+    return *this;
+  }
+  // Orthographic camera looking straight down -Y from height `h`, covering [-half, half]^2 in x,z.
+  SceneBuilder& topDownOrtho(float h, float half) {
+    Camera c;
+    c.projection = ProjectionType::Orthographic;
+    c.xmag = c.ymag = half;
+    c.znear = 0.01f * h;
+    c.zfar = 2.f * h;
+    // Camera -Z looks down -Y; camera +Y (image up) is world -Z.
+    c.world = glm::mat4(glm::vec4(1, 0, 0, 0), glm::vec4(0, 0, -1, 0), glm::vec4(0, 1, 0, 0), glm::vec4(0, h, 0, 1));
+    c.fromFile = true;
+    scene_.camera = c;
+    return *this;
+  }
+  Scene build(const std::string& digest = "") {
+    scene_.digest = digest;
+    scene_.features = computeFeatures(scene_);
+    return scene_;
+  }
+  Scene& scene() { return scene_; }
+
+private:
+  Scene scene_;
+};
+
+// World x,z of the centre of pixel (px, py) for topDownOrtho(h, half) at the given resolution
+// (row 0 = top of the image = world -z).
+inline glm::vec2 topDownPixelToWorld(int px, int py, int size, float half) {
+  const float x = (-1.f + 2.f * (px + 0.5f) / size) * half;
+  const float z = (-1.f + 2.f * (py + 0.5f) / size) * half;
+  return {x, z};
+}
+
+}  // namespace radiant::testing
