@@ -31,8 +31,11 @@ public:
   // Renders one frame. Throws api::ApiError for problems with the request that only show up here
   // (e.g. an unknown receiver node), and gl::GlError / EglError for environment failures; after
   // either the renderer stays usable. `cancel` is polled between passes.
+  // With request.compare, stats.metrics holds the error of the compared AOV and the AOVs gain
+  // "error" (per-pixel error map) and "reference". The ground truth is the reference path tracer, or
+  // `compareTarget` when the request compares against an uploaded image (the server resolves it).
   RenderOutput render(const Scene& scene, const api::RenderRequest& request,
-                      const std::atomic<bool>* cancel = nullptr);
+                      const std::atomic<bool>* cancel = nullptr, const Image* compareTarget = nullptr);
   static std::vector<TechniqueDescription> techniques();
 
 private:

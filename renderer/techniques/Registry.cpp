@@ -2,6 +2,7 @@
 
 #include "renderer/techniques/direct/Direct.h"
 #include "renderer/techniques/gbuffer/GBuffer.h"
+#include "renderer/techniques/reference/ReferencePass.h"
 #include "renderer/techniques/shadow_maps/ShadowMaps.h"
 
 namespace radiant {
@@ -11,6 +12,7 @@ std::vector<std::unique_ptr<Technique>> createTechniques() {
   t.push_back(std::make_unique<GBufferPass>());
   t.push_back(std::make_unique<ShadowMapsPass>());
   t.push_back(std::make_unique<DirectPass>());
+  t.push_back(std::make_unique<ReferencePass>());
   return t;
 }
 

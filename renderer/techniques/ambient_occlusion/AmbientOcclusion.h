@@ -1,0 +1,87 @@
+#pragma once
+// Screen-space ambient occlusion (Umenhoffer's thesis, ch. 4) with its baselines and the modern anchor:
+//   volumetric   thesis eqs. 4.6-4.8 + Algorithm 2: unoccluded fraction of the tangent sphere (radius
+//                R/2) summed over depth-buffer "pipes", normalised by weighted importance sampling.
+//   containment  thesis eq. 4.5: cosine-distributed directions, distances from the falloff's inverse,
+//                binary containment tests against the depth buffer.
+//   crytek       whole-sphere depth-comparison SSAO (the thesis' Fig. 4.8 baseline; 1/2 on open planes).
+//   gtao         Jimenez et al. 2016, cosine-weighted horizon-based ground-truth AO.
+// Writes the `ao` AOV (R32F, [0,1]) and adds L^a * ao * diffuseAlbedo to `beauty` (thesis eq. 4.1 and
+// L^r = a L^a O below it). The method is documented in docs/TECHNIQUES.md, the knobs in
+// api/schema/techniques/ambient_occlusion.json.
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "renderer/frame/Technique.h"
+
+namespace radiant {
+
+namespace ao {
+
+enum class Method { Volumetric, Containment, Crytek, Gtao };
+enum class Falloff { Step, Cubic };  // containment's fuzzy membership mu(r): [r >= R] or (r/R)^3
+
+constexpr int kMaxSamples = 64;
+constexpr int kPatternCells = 16;  // 4x4 interleaved-sampling pattern (thesis 4.1.3)
+
+// std140 uniform block shared with shaders/ambient_occlusion/ao.frag (binding kSampleBinding).
+struct SampleBlock {
+  glm::vec4 samples[kMaxSamples];     // method-specific kernel, see buildSampleBlock()
+  glm::vec4 rotations[kPatternCells];  // (cos a, sin a, jitter in (0,1), 0) per pattern cell
+};
+static_assert(sizeof(SampleBlock) == (kMaxSamples + kPatternCells) * 16, "std140 layout of AoSamples");
+
+// n points on the unit disk with a Poisson-disk (blue-noise) distribution: Mitchell's best-candidate
+// dart throwing, uniform in area (each point stands for 1/n of the disk, as eq. 4.7 assumes).
+// Deterministic (fixed seed), identical on every machine.
+std::vector<glm::vec2> poissonDisk(int n, std::uint32_t seed = 0x5eedu);
+// n points uniform in the unit ball, Poisson-disk distributed the same way (Crytek's sphere kernel).
+std::vector<glm::vec3> poissonBall(int n, std::uint32_t seed = 0x5eedu);
+
+// The kernel uploaded to the shader:
+//   volumetric:  (x_i, y_i, sqrt(1 - x_i^2 - y_i^2), 0), Poisson disk on the unit disk (eq. 4.7).
+//   containment: (X_i, Y_i, Z_i, 0) / R = omega_i r_i / R in the tangent frame (eq. 4.5): omega_i is
+//                cosine distributed (Malley: the Poisson-disk point lifted to the hemisphere) and
+//                r_i = mu^-1(xi_i), xi_i stratified in (0,1): step -> r = R, cubic -> r = R xi^(1/3).
+//   crytek:      points uniform in the unit ball (scaled by R in the shader).
+//   gtao:        unused (horizon marching), zeros.
+// rotations: cell j of the 4x4 pattern rotates the kernel by alpha_j = 2 pi (rank_j + u_j) / 16, rank
+// from a 4x4 Bayer matrix so that neighbouring pixels get distant angles, u_j random (fixed seed).
+SampleBlock buildSampleBlock(Method method, Falloff falloff, int samples);
+
+// GTAO: "samples" depth fetches split into slices x 2 sides x steps.
+struct GtaoLayout {
+  int slices, steps;
+};
+GtaoLayout gtaoLayout(int samples);
+
+Method parseMethod(const std::string& s);
+Falloff parseFalloff(const std::string& s);
+
+}  // namespace ao
+
+class AmbientOcclusionPass final : public Technique {
+public:
+  const TechniqueInfo& info() const override;
+  Requirements requirements(const SceneFeatures&, const api::RenderRequest&) const override;
+  void prepare(const Scene&, const Params&, FrameResources&) override;
+  void execute(PassContext&) override;
+
+private:
+  ao::Method method_ = ao::Method::Volumetric;
+  ao::Falloff falloff_ = ao::Falloff::Step;
+  int samples_ = 16;
+  float radius_ = 0.5f;
+  bool interleave_ = true;
+  bool blur_ = true;
+  int scale_ = 1;  // 1 = full resolution, 2 = half
+  const ao::SampleBlock* block_ = nullptr;  // cached in FrameResources
+  bool blockDirty_ = true;
+  std::string uploadedKey_;
+};
+
+}  // namespace radiant

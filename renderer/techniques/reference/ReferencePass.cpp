@@ -1,0 +1,114 @@
+#include "renderer/techniques/reference/ReferencePass.h"
+
+#include <algorithm>
+#include <climits>
+
+#include <nlohmann/json.hpp>
+
+#include "renderer/frame/PassContext.h"
+
+namespace radiant {
+namespace {
+
+// The BVH owns a copy of the scene: a cache entry must not dangle when the caller's Scene goes away.
+struct ReferenceScene {
+  Scene scene;
+  reference::PathTracer tracer;
+  explicit ReferenceScene(const Scene& s) : scene(s), tracer(scene) {}
+};
+
+std::string sceneKey(const Scene& scene) {
+  return scene.digest.empty() ? "addr:" + std::to_string(reinterpret_cast<std::uintptr_t>(&scene)) : scene.digest;
+}
+
+}  // namespace
+
+const Image& referenceImage(FrameResources& res, const Scene& scene, const FrameView& view,
+                            const ReferenceRequest& r, bool* cacheHit, std::uint64_t* rays) {
+  ReferenceScene& rs = res.cached<ReferenceScene>("reference_bvh", sceneKey(scene),
+                                                  [&] { return std::make_unique<ReferenceScene>(scene); });
+  reference::ReferenceOptions o;
+  o.spp = r.spp;
+  o.maxBounces = r.maxBounces;
+  o.russianRoulette = r.russianRoulette;
+  o.seed = view.seed;
+  o.skyRadiance = view.ambient;
+  if (r.aov == "direct") {
+    o.minPathBounce = 0, o.maxPathBounce = 1;  // what the raster `direct` AOV holds: emission, sky, direct
+  } else if (r.aov == "indirect" || r.aov == "indirect_diffuse") {
+    o.minPathBounce = 2, o.maxPathBounce = INT_MAX;
+  } else if (r.aov == "ao") {
+    o.mode = r.aoDefinition == "volumetric" ? reference::ReferenceOptions::Mode::AoVolumetric
+                                            : reference::ReferenceOptions::Mode::AoCosineStep;
+    o.aoRadius = r.aoRadius;
+  }
+  const glm::mat4& w = view.camera.world;
+  nlohmann::json key = {{"scene", sceneKey(scene)},
+                        {"camera", std::vector<float>(&w[0][0], &w[0][0] + 16)},
+                        {"projection", static_cast<int>(view.camera.projection)},
+                        {"yfov", view.camera.yfov}, {"mag", {view.camera.xmag, view.camera.ymag}},
+                        {"size", {view.width, view.height}}, {"spp", o.spp}, {"max_bounces", o.maxBounces},
+                        {"rr", o.russianRoulette}, {"seed", o.seed}, {"bounces", {o.minPathBounce, o.maxPathBounce}},
+                        {"mode", static_cast<int>(o.mode)}, {"ao_radius", o.aoRadius},
+                        {"sky", {o.skyRadiance.x, o.skyRadiance.y, o.skyRadiance.z}}};
+  bool built = false;
+  Image& img = res.cached<Image>("reference:" + r.aov, key.dump(), [&] {
+    built = true;
+    auto image = std::make_unique<Image>(rs.tracer.render(view.camera, view.width, view.height, o));
+    image->aov = "reference";
+    if (o.mode != reference::ReferenceOptions::Mode::Radiance) {
+      // AO is scalar: keep one channel, like the raster `ao` AOV.
+      Image ao = Image::make("reference", image->width, image->height, 1);
+      for (std::size_t i = 0; i < ao.pixels.size(); ++i) ao.pixels[i] = image->pixels[i * image->channels];
+      *image = std::move(ao);
+    }
+    return image;
+  });
+  if (cacheHit) *cacheHit = !built;
+  if (rays) *rays = built ? rs.tracer.raysTraced() : 0;
+  return img;
+}
+
+const TechniqueInfo& ReferencePass::info() const {
+  static const TechniqueInfo i{"reference",
+                               "CPU reference path tracer (Embree): the ground truth every technique is scored with",
+                               {},
+                               {},
+                               {"reference"},
+                               false,
+                               false};
+  return i;
+}
+
+Requirements ReferencePass::requirements(const SceneFeatures& f, const api::RenderRequest&) const {
+  return f.triangles > 0 ? Requirements::ok() : Requirements::skip("the scene has no triangles");
+}
+
+void ReferencePass::prepare(const Scene&, const Params& params, FrameResources& res) {
+  request_.aov = params.get<std::string>("aov", "beauty");
+  request_.spp = params.get<int>("spp", 64);
+  request_.maxBounces = params.get<int>("max_bounces", 8);
+  request_.russianRoulette = params.get<bool>("russian_roulette", true);
+  request_.aoRadius = params.get<float>("ao_radius", 1.f);
+  request_.aoDefinition = params.get<std::string>("ao_definition", "cosine");
+  res.texture("reference", GL_TEXTURE_2D, GL_RGBA32F, res.view().width, res.view().height);
+}
+
+void ReferencePass::execute(PassContext& ctx) {
+  bool hit = false;
+  std::uint64_t rays = 0;
+  const Image& img = referenceImage(ctx.resources, ctx.scene, ctx.view, request_, &hit, &rays);
+  // Upload as RGBA with GL's bottom-up rows so readback treats it like every other AOV.
+  std::vector<float> rgba(static_cast<std::size_t>(img.width) * img.height * 4, 0.f);
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x)
+      for (int c = 0; c < std::min(img.channels, 3); ++c)
+        rgba[(static_cast<std::size_t>(img.height - 1 - y) * img.width + x) * 4 + c] = img.at(x, y)[c];
+  ctx.resources.texture("reference").upload(0, 0, 0, 0, img.width, img.height, 1, GL_RGBA, GL_FLOAT, rgba.data());
+  ctx.stats.counters["spp"] = request_.spp;
+  ctx.stats.counters["rays"] = static_cast<double>(rays);
+  ctx.stats.counters["cached"] = hit ? 1.0 : 0.0;
+  ctx.resources.markWritten("reference");
+}
+
+}  // namespace radiant

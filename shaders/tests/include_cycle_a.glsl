@@ -1,0 +1,2 @@
+// Test fixture: a -> b -> a include cycle, which the preprocessor must reject.
+#include "tests/include_cycle_b.glsl"
