@@ -1,6 +1,7 @@
 #include "renderer/techniques/direct/Direct.h"
 
 #include "renderer/frame/PassContext.h"
+#include "renderer/techniques/direct/DirectLighting.h"
 
 namespace radiant {
 
@@ -29,12 +30,7 @@ void DirectPass::prepare(const Scene&, const Params& params, FrameResources& res
   fb.attach(GL_COLOR_ATTACHMENT1, res.texture("beauty", GL_TEXTURE_2D, GL_RGBA32F, w, h));
   fb.setDrawBuffers({GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1});
   fb.checkComplete("DirectPass::prepare");
-  // Shadow samplers must be complete even when the scene has no lights (shadow_maps skipped).
-  if (!res.hasTexture("shadow_cube")) {
-    res.texture("shadow_cube", GL_TEXTURE_CUBE_MAP_ARRAY, GL_R32F, 1, 1, 6).setFilter(GL_NEAREST, GL_NEAREST);
-    res.texture("shadow_2d", GL_TEXTURE_2D_ARRAY, GL_R32F, 1, 1, 1).setFilter(GL_NEAREST, GL_NEAREST);
-  }
-  if (!res.hasBuffer("shadow_info")) res.buffer("shadow_info", sizeof(gpu::ShadowInfo));
+  declareDirectLightingResources(res);
 }
 
 void DirectPass::execute(PassContext& ctx) {
@@ -49,17 +45,9 @@ void DirectPass::execute(PassContext& ctx) {
 
   const char* inputs[] = {"gbuffer_position", "normal", "albedo", "material", "emission", "geometric_normal"};
   for (GLuint i = 0; i < std::size(inputs); ++i) res.texture(inputs[i]).bindUnit(i);
-  res.texture("shadow_cube").bindUnit(6);
-  res.texture("shadow_2d").bindUnit(7);
-  ctx.gpu.materials.bindBase(GL_SHADER_STORAGE_BUFFER, GpuScene::kMaterialBinding);
-  ctx.gpu.lights.bindBase(GL_SHADER_STORAGE_BUFFER, GpuScene::kLightBinding);
-  res.buffer("shadow_info").bindBase(GL_SHADER_STORAGE_BUFFER, 2);
-
   const gl::Program& prog = ctx.shaders.program({"common/fullscreen.vert", "direct/direct.frag"});
   prog.use();
-  prog.set("u_lightCount", static_cast<int>(ctx.scene.lights.size()));
-  prog.set("u_hasShadows", res.written("shadow_maps") ? 1 : 0);
-  prog.set("u_pcfRadius", pcfRadius_);
+  bindDirectLighting(prog, res, ctx.gpu, static_cast<int>(ctx.scene.lights.size()), pcfRadius_);
   prog.set("u_eye", &view.eye[0], 3);
   const glm::vec3 forward = -glm::normalize(glm::vec3(view.camera.world[2]));
   prog.set("u_viewForward", &forward[0], 3);

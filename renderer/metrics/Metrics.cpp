@@ -1,0 +1,154 @@
+#include "renderer/metrics/Metrics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+
+namespace radiant::metrics {
+namespace {
+
+void checkCompatible(const Image& test, const Image& reference, const char* who) {
+  auto describe = [](const Image& i) {
+    return std::to_string(i.width) + "x" + std::to_string(i.height) + "x" + std::to_string(i.channels);
+  };
+  if (test.width <= 0 || test.height <= 0 || test.channels <= 0 ||
+      test.pixels.size() != static_cast<size_t>(test.width) * test.height * test.channels)
+    throw std::invalid_argument(std::string(who) + ": test image is empty or malformed (" + describe(test) + ")");
+  if (reference.pixels.size() != static_cast<size_t>(reference.width) * reference.height * reference.channels)
+    throw std::invalid_argument(std::string(who) + ": reference image is malformed (" + describe(reference) + ")");
+  if (test.width != reference.width || test.height != reference.height || test.channels != reference.channels)
+    throw std::invalid_argument(std::string(who) + ": test is " + describe(test) + " but reference is " +
+                                describe(reference));
+}
+
+int colorChannels(const Image& i) { return i.channels >= 3 ? 3 : 1; }
+
+// Tone-mapped luma of every pixel (the SSIM input).
+std::vector<double> toneMappedLuma(const Image& img, float ev) {
+  std::vector<double> y(static_cast<size_t>(img.width) * img.height);
+  for (int py = 0; py < img.height; ++py)
+    for (int px = 0; px < img.width; ++px) {
+      const float* p = img.at(px, py);
+      double v;
+      if (img.channels >= 3)
+        v = 0.2126 * toneMap(p[0], ev) + 0.7152 * toneMap(p[1], ev) + 0.0722 * toneMap(p[2], ev);
+      else
+        v = toneMap(p[0], ev);
+      y[static_cast<size_t>(py) * img.width + px] = v;
+    }
+  return y;
+}
+
+// Wang et al. 2004, eq. 13, with Gaussian-weighted local statistics (eqs. 14-16).
+double ssim(const std::vector<double>& x, const std::vector<double>& y, int w, int h) {
+  const int radius = kSsimWindow / 2;
+  double kernel[kSsimWindow];
+  double ksum = 0.0;
+  for (int i = 0; i < kSsimWindow; ++i) {
+    const double d = i - radius;
+    kernel[i] = std::exp(-d * d / (2.0 * kSsimSigma * kSsimSigma));
+    ksum += kernel[i];
+  }
+  for (double& k : kernel) k /= ksum;
+  const double c1 = (kSsimK1 * 1.0) * (kSsimK1 * 1.0), c2 = (kSsimK2 * 1.0) * (kSsimK2 * 1.0);
+  const bool valid = w >= kSsimWindow && h >= kSsimWindow;
+  const int x0 = valid ? radius : 0, x1 = valid ? w - radius : w;
+  const int y0 = valid ? radius : 0, y1 = valid ? h - radius : h;
+  double total = 0.0;
+  long count = 0;
+  for (int cy = y0; cy < y1; ++cy)
+    for (int cx = x0; cx < x1; ++cx) {
+      double wsum = 0.0, mx = 0.0, my = 0.0, sxx = 0.0, syy = 0.0, sxy = 0.0;
+      for (int dy = -radius; dy <= radius; ++dy) {
+        const int yy = cy + dy;
+        if (yy < 0 || yy >= h) continue;
+        for (int dx = -radius; dx <= radius; ++dx) {
+          const int xx = cx + dx;
+          if (xx < 0 || xx >= w) continue;
+          const double k = kernel[dy + radius] * kernel[dx + radius];
+          const double a = x[static_cast<size_t>(yy) * w + xx], b = y[static_cast<size_t>(yy) * w + xx];
+          wsum += k;
+          mx += k * a;
+          my += k * b;
+          sxx += k * a * a;
+          syy += k * b * b;
+          sxy += k * a * b;
+        }
+      }
+      mx /= wsum; my /= wsum;
+      const double varX = std::max(0.0, sxx / wsum - mx * mx);
+      const double varY = std::max(0.0, syy / wsum - my * my);
+      const double covXY = sxy / wsum - mx * my;
+      total += ((2.0 * mx * my + c1) * (2.0 * covXY + c2)) / ((mx * mx + my * my + c1) * (varX + varY + c2));
+      ++count;
+    }
+  return count > 0 ? total / count : 1.0;
+}
+
+}  // namespace
+
+double toneMap(double linear, float exposureEV) {
+  double v = linear * std::exp2(static_cast<double>(exposureEV));
+  if (!(v > 0.0)) return 0.0;  // also maps NaN to 0
+  v = std::min(v, 1.0);
+  return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
+}
+
+ImageMetrics compareImages(const Image& test, const Image& reference, float exposureEV) {
+  checkCompatible(test, reference, "compareImages()");
+  const int nc = colorChannels(test);
+  const size_t pixels = static_cast<size_t>(test.width) * test.height;
+
+  ImageMetrics m;
+  // Linear absolute and RMS error: OpenImageIO's compare over the colour channels.
+  {
+    const OIIO::ImageSpec spec(test.width, test.height, test.channels, OIIO::TypeDesc::FLOAT);
+    const OIIO::ImageBuf a(spec, const_cast<float*>(test.pixels.data()));
+    const OIIO::ImageBuf b(spec, const_cast<float*>(reference.pixels.data()));
+    const OIIO::ROI roi(0, test.width, 0, test.height, 0, 1, 0, nc);
+    const OIIO::ImageBufAlgo::CompareResults r = OIIO::ImageBufAlgo::compare(a, b, 1e30f, 1e30f, roi, 1);
+    if (r.error) throw std::runtime_error("compareImages(): OIIO::ImageBufAlgo::compare failed");
+    m.rmse = r.rms_error;
+    m.meanAbs = r.meanerror;
+    m.maxAbs = r.maxerror;
+  }
+
+  double relSum = 0.0, toneSum = 0.0;
+  for (size_t i = 0; i < pixels; ++i)
+    for (int c = 0; c < nc; ++c) {
+      const double t = test.pixels[i * test.channels + c], r = reference.pixels[i * reference.channels + c];
+      relSum += (t - r) * (t - r) / (r * r + kRelMseEpsilon);
+      const double d = toneMap(t, exposureEV) - toneMap(r, exposureEV);
+      toneSum += d * d;
+    }
+  const double n = static_cast<double>(pixels) * nc;
+  m.relMse = relSum / n;
+  const double toneMse = toneSum / n;
+  if (toneMse > 0.0) m.psnr = 10.0 * std::log10(1.0 / toneMse);
+  m.ssim = ssim(toneMappedLuma(test, exposureEV), toneMappedLuma(reference, exposureEV), test.width, test.height);
+  return m;
+}
+
+Image errorMap(const Image& test, const Image& reference) {
+  checkCompatible(test, reference, "errorMap()");
+  Image out = Image::make("error", test.width, test.height, 1);
+  for (int y = 0; y < test.height; ++y)
+    for (int x = 0; x < test.width; ++x) {
+      const float* t = test.at(x, y);
+      const float* r = reference.at(x, y);
+      float e;
+      if (test.channels >= 3)
+        e = 0.2126f * std::abs(t[0] - r[0]) + 0.7152f * std::abs(t[1] - r[1]) + 0.0722f * std::abs(t[2] - r[2]);
+      else
+        e = std::abs(t[0] - r[0]);
+      *out.at(x, y) = e;
+    }
+  return out;
+}
+
+}  // namespace radiant::metrics

@@ -1,0 +1,50 @@
+#pragma once
+// Image error metrics: how far a GPU technique's image is from the reference renderer's.
+//
+// All metrics run over the colour channels: the first three channels of an image with >= 3 channels
+// (alpha and extra channels are ignored), or channel 0 of a single-channel image. Both images must have
+// the same size and channel count.
+//
+// - rmse, meanAbs, maxAbs: on linear values, over all pixels and colour channels (computed by
+//   OpenImageIO's ImageBufAlgo::compare).
+// - relMse: relative MSE, mean over pixels and colour channels of (t - r)^2 / (r^2 + eps), eps = 0.01
+//   (Rousselle et al. 2011's relMSE; eps keeps black reference pixels from dominating).
+// - psnr: on tone-mapped values, v' = sRGB(clamp(v * 2^exposureEV, 0, 1)), peak 1:
+//   PSNR = 10 log10(1 / MSE'); nullopt when MSE' == 0 (identical after tone mapping).
+// - ssim: Wang et al. 2004 ("Image quality assessment: from error visibility to structural
+//   similarity"), eq. 13, on the tone-mapped luma Y' = 0.2126 R' + 0.7152 G' + 0.0722 B' (Rec. 709
+//   weights on the tone-mapped channels), with an 11x11 Gaussian window of sigma 1.5 (normalised),
+//   C1 = (K1 L)^2, C2 = (K2 L)^2, K1 = 0.01, K2 = 0.03, L = 1. The SSIM map is evaluated where the
+//   window fits inside the image ("valid" region, as in the authors' reference code) and averaged.
+//   Images smaller than 11 pixels in a dimension use the window clipped at the border and renormalised.
+#include <optional>
+
+#include "renderer/Image.h"
+
+namespace radiant::metrics {
+
+inline constexpr double kRelMseEpsilon = 0.01;
+inline constexpr int kSsimWindow = 11;
+inline constexpr double kSsimSigma = 1.5;
+inline constexpr double kSsimK1 = 0.01, kSsimK2 = 0.03;
+
+struct ImageMetrics {
+  double rmse = 0.0;
+  double relMse = 0.0;
+  std::optional<double> psnr;  // dB; nullopt when the tone-mapped images are identical
+  double ssim = 1.0;
+  double meanAbs = 0.0;
+  double maxAbs = 0.0;
+};
+
+// Throws std::invalid_argument when the sizes or channel counts differ or an image is empty.
+ImageMetrics compareImages(const Image& test, const Image& reference, float exposureEV = 0.f);
+
+// Per-pixel error: Rec. 709 luminance of the per-channel absolute difference |t - r| (linear),
+// one channel, aov "error". Same argument checks as compareImages.
+Image errorMap(const Image& test, const Image& reference);
+
+// The tone map used by psnr and ssim: sRGB transfer (IEC 61966-2-1) of clamp(v * 2^exposureEV, 0, 1).
+double toneMap(double linear, float exposureEV);
+
+}  // namespace radiant::metrics

@@ -1,0 +1,142 @@
+// Image metrics against hand-computed values (numbers below were evaluated by hand / in a calculator
+// from the formulas in Metrics.h).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "renderer/metrics/Metrics.h"
+
+namespace radiant::metrics {
+namespace {
+
+Image constant(int w, int h, float v, int channels = 3) {
+  Image i = Image::make("beauty", w, h, channels);
+  std::fill(i.pixels.begin(), i.pixels.end(), v);
+  return i;
+}
+
+TEST(Metrics, IdenticalImages) {
+  Image a = constant(16, 16, 0.3f);
+  a.at(3, 4)[1] = 7.f;
+  const ImageMetrics m = compareImages(a, a);
+  EXPECT_EQ(m.rmse, 0.0);
+  EXPECT_EQ(m.relMse, 0.0);
+  EXPECT_EQ(m.meanAbs, 0.0);
+  EXPECT_EQ(m.maxAbs, 0.0);
+  EXPECT_FALSE(m.psnr.has_value());
+  EXPECT_NEAR(m.ssim, 1.0, 1e-12);
+}
+
+TEST(Metrics, HandComputedSinglePixelError) {
+  // Reference 0.5 everywhere (2x2 RGB = 12 values); the test differs by 0.5 in one value.
+  const Image ref = constant(2, 2, 0.5f);
+  Image test = ref;
+  test.at(1, 0)[0] = 1.f;
+  const ImageMetrics m = compareImages(test, ref);
+  EXPECT_NEAR(m.rmse, std::sqrt(0.25 / 12), 1e-7);                // 0.1443376
+  EXPECT_NEAR(m.relMse, (0.25 / (0.25 + 0.01)) / 12, 1e-7);       // 0.0801282, eps = 0.01
+  EXPECT_NEAR(m.meanAbs, 0.5 / 12, 1e-7);
+  EXPECT_NEAR(m.maxAbs, 0.5, 1e-7);
+  // Tone mapped: sRGB(1) = 1, sRGB(0.5) = 0.7353570; MSE' = 0.2646430^2 / 12 -> 22.33860 dB.
+  ASSERT_TRUE(m.psnr.has_value());
+  EXPECT_NEAR(*m.psnr, 22.338604, 1e-4);
+  // Exposure +1 EV maps both 0.5 and 1 to >= 1, clamped: identical after tone mapping.
+  const ImageMetrics e = compareImages(test, ref, 1.f);
+  EXPECT_FALSE(e.psnr.has_value());
+  EXPECT_NEAR(e.ssim, 1.0, 1e-12);
+  EXPECT_NEAR(e.rmse, m.rmse, 1e-12);  // linear metrics ignore exposure
+
+  const Image err = errorMap(test, ref);
+  ASSERT_EQ(err.channels, 1);
+  EXPECT_NEAR(*err.at(1, 0), 0.2126f * 0.5f, 1e-7f);
+  EXPECT_EQ(*err.at(0, 0), 0.f);
+}
+
+TEST(Metrics, SsimOfConstantImagesIsTheLuminanceTerm) {
+  // Constant images: sigma = 0, so SSIM = (2 mu_x mu_y + C1) / (mu_x^2 + mu_y^2 + C1), C1 = 1e-4, with
+  // mu = sRGB(0.5) = 0.7353570 and sRGB(0.25) = 0.5370987: 0.9526044.
+  const ImageMetrics m = compareImages(constant(16, 16, 0.25f), constant(16, 16, 0.5f));
+  EXPECT_NEAR(m.ssim, 0.9526044, 1e-6);
+  // Also through the small-image path (clipped window): the same for constant images.
+  EXPECT_NEAR(compareImages(constant(5, 4, 0.25f), constant(5, 4, 0.5f)).ssim, 0.9526044, 1e-6);
+}
+
+// SSIM of one 11x11 window (the whole image), written straight from Wang et al. 2004 eqs. 13-16.
+double ssimSingleWindow(const Image& a, const Image& b) {
+  double w[11], ws = 0;
+  for (int i = 0; i < 11; ++i) { w[i] = std::exp(-(i - 5) * (i - 5) / (2 * 1.5 * 1.5)); ws += w[i]; }
+  double mx = 0, my = 0, sxx = 0, syy = 0, sxy = 0;
+  for (int y = 0; y < 11; ++y)
+    for (int x = 0; x < 11; ++x) {
+      const double k = w[x] * w[y] / (ws * ws);
+      auto luma = [&](const Image& im) {
+        const float* p = im.at(x, y);
+        return 0.2126 * toneMap(p[0], 0) + 0.7152 * toneMap(p[1], 0) + 0.0722 * toneMap(p[2], 0);
+      };
+      const double u = luma(a), v = luma(b);
+      mx += k * u; my += k * v; sxx += k * u * u; syy += k * v * v; sxy += k * u * v;
+    }
+  const double vx = sxx - mx * mx, vy = syy - my * my, cxy = sxy - mx * my;
+  const double c1 = 1e-4, c2 = 9e-4;
+  return (2 * mx * my + c1) * (2 * cxy + c2) / ((mx * mx + my * my + c1) * (vx + vy + c2));
+}
+
+TEST(Metrics, SsimMatchesFormulaAndFallsWithNoise) {
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<float> U(0.f, 1.f);
+  std::normal_distribution<float> N(0.f, 1.f);
+  Image ref = Image::make("beauty", 11, 11, 3);
+  for (float& v : ref.pixels) v = U(rng);
+  Image test = ref;
+  for (float& v : test.pixels) v = std::max(0.f, v + 0.1f * N(rng));
+  EXPECT_NEAR(compareImages(test, ref).ssim, ssimSingleWindow(test, ref), 1e-9);
+
+  Image big = Image::make("beauty", 48, 48, 3);
+  for (int y = 0; y < 48; ++y)
+    for (int x = 0; x < 48; ++x)
+      for (int c = 0; c < 3; ++c) big.at(x, y)[c] = 0.5f + 0.4f * std::sin(0.3f * x + 0.2f * y + c);
+  double previous = 1.0;
+  for (float sigma : {0.01f, 0.05f, 0.1f, 0.3f}) {
+    Image noisy = big;
+    std::mt19937 r2(2);
+    for (float& v : noisy.pixels) v = std::max(0.f, v + sigma * N(r2));
+    const ImageMetrics m = compareImages(noisy, big);
+    EXPECT_LT(m.ssim, previous) << sigma;
+    EXPECT_GT(m.ssim, -1.0);
+    EXPECT_GT(m.rmse, 0.0);
+    previous = m.ssim;
+  }
+  EXPECT_LT(previous, 0.8);
+}
+
+TEST(Metrics, OiioErrorsAgreeWithDirectSums) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> U(0.f, 4.f);
+  Image a = Image::make("beauty", 23, 17, 4), b = Image::make("beauty", 23, 17, 4);
+  for (float& v : a.pixels) v = U(rng);
+  for (float& v : b.pixels) v = U(rng);
+  double sq = 0, ab = 0, mx = 0, rel = 0;
+  int n = 0;
+  for (int i = 0; i < 23 * 17; ++i)
+    for (int c = 0; c < 3; ++c) {  // alpha (channel 3) is not a colour channel
+      const double d = a.pixels[i * 4 + c] - b.pixels[i * 4 + c];
+      sq += d * d; ab += std::abs(d); mx = std::max(mx, std::abs(d));
+      rel += d * d / (double(b.pixels[i * 4 + c]) * b.pixels[i * 4 + c] + 0.01);
+      ++n;
+    }
+  const ImageMetrics m = compareImages(a, b);
+  EXPECT_NEAR(m.rmse, std::sqrt(sq / n), 1e-6);
+  EXPECT_NEAR(m.meanAbs, ab / n, 1e-6);
+  EXPECT_NEAR(m.maxAbs, mx, 1e-6);
+  EXPECT_NEAR(m.relMse, rel / n, 1e-6 * rel / n);
+}
+
+TEST(Metrics, RejectsMismatchedImages) {
+  EXPECT_THROW(compareImages(constant(4, 4, 0.f), constant(4, 5, 0.f)), std::invalid_argument);
+  EXPECT_THROW(compareImages(constant(4, 4, 0.f, 3), constant(4, 4, 0.f, 4)), std::invalid_argument);
+  EXPECT_THROW(errorMap(Image{}, Image{}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace radiant::metrics
