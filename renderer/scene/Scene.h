@@ -129,8 +129,8 @@ struct Camera {
 struct SceneFeatures {
   int pointLights = 0, spotLights = 0, directionalLights = 0;
   int emissiveTriangles = 0;
-  int specularMaterials = 0;      // metallic with roughness below Material::kSpecularRoughness
-  int transmissiveMaterials = 0;  // KHR_materials_transmission > 0
+  int specularMaterials = 0;      // used materials with isSpecular(): smooth metal or transmissive
+  int transmissiveMaterials = 0;  // used materials with KHR_materials_transmission > 0
   int textures = 0;
   std::size_t triangles = 0;
   Bounds bounds;
