@@ -5,6 +5,7 @@
 #include <cmath>
 #include <map>
 
+#include "api/Validate.h"
 #include "renderer/frame/FramePlanner.h"
 #include "renderer/frame/FrameResources.h"
 #include "renderer/frame/FrameView.h"
@@ -61,10 +62,14 @@ void compare(FrameResources& resources, const Scene& scene, const FrameView& vie
     r.aov = c.aov;
     r.spp = c.spp;
     r.maxBounces = c.maxBounces;
-    if (auto ao = request.passes.find("ambient_occlusion"); ao != request.passes.end()) {
-      r.aoRadius = ao->second.value("radius", 1.f);
-      // Volumetric AO estimates thesis eq. 4.6; the other methods estimate the cosine-weighted step.
-      r.aoDefinition = ao->second.value("method", std::string("volumetric")) == "volumetric" ? "volumetric" : "cosine";
+    if (c.aov == "ao") {
+      // The ground truth of the AO the frame used: same radius, and the definition its method estimates
+      // (volumetric: thesis eq. 4.6; the others: the cosine-weighted step).
+      auto given = request.passes.find("ambient_occlusion");
+      const nlohmann::json ao = api::techniqueParams(
+          "ambient_occlusion", given == request.passes.end() ? nlohmann::json() : given->second);
+      r.aoRadius = ao.at("radius").get<float>();
+      r.aoDefinition = ao.at("method").get<std::string>() == "volumetric" ? "volumetric" : "cosine";
     }
     bool hit = false;
     const auto t0 = Clock::now();
@@ -185,7 +190,7 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
       Technique* t = plan.passes[i];
       stats.passes[i].name = t->info().name;
       auto p = request.passes.find(t->info().name);
-      params[i] = Params(p == request.passes.end() ? nlohmann::json::object() : p->second);
+      params[i] = Params(api::techniqueParams(t->info().name, p == request.passes.end() ? nlohmann::json() : p->second));
       t->prepare(scene, params[i], im.resources);
       gl::checkError(("prepare " + t->info().name).c_str());
     }

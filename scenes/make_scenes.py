@@ -237,11 +237,14 @@ def cornell(variant):
     b.node("left_wall", b.mesh("left_wall", quad([-0.5, 0, 0.5], [0, 0, -1], [0, 1, 0]), red))
     b.node("right_wall", b.mesh("right_wall", quad([0.5, 0, -0.5], [0, 0, 1], [0, 1, 0]), green))
     # The classic tall block: 0.3 x 0.6 x 0.3, turned 17 degrees, back left.
+    # "radiant_receiver" marks the objects that env_diffuse gives indirect diffuse light to (the
+    # environment is everything else); only diffuse objects are receivers.
+    receiver = {"radiant_receiver": True}
     b.node("tall_box", b.mesh("tall_box", unit_box(), box_white), translation=[-0.17, 0.3, -0.15],
-           rotation=y_rotation(17.0), scale=[0.3, 0.6, 0.3])
+           rotation=y_rotation(17.0), scale=[0.3, 0.6, 0.3], extras=receiver)
     radius = 0.17
     b.node("sphere", b.mesh("sphere", uv_sphere(radius), sphere_mat),
-           translation=[0.19, radius, 0.13])
+           translation=[0.19, radius, 0.13], extras=receiver if variant == "box" else None)
     # Point light 0.15 m below the ceiling: the floor below it gets E = I / d^2 = 4 / 0.85^2,
     # about 5.5 W/m^2, so the white (0.73) floor's radiance is ~ 0.73 * 5.5 / pi ~ 1.3. Any closer
     # and the ceiling's hot spot (E = I / 0.15^2 ~ 180 W/m^2 right above it) grows sharply,

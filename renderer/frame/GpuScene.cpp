@@ -116,9 +116,16 @@ GpuScene::GpuScene(const Scene& scene) {
 }
 
 void GpuScene::draw(const gl::Program& program, bool withTextures) const {
+  drawMeshes(program, withTextures, [](std::size_t) { return true; });
+}
+
+void GpuScene::drawMeshes(const gl::Program& program, bool withTextures,
+                          const std::function<bool(std::size_t meshIndex)>& select) const {
   materials.bindBase(GL_SHADER_STORAGE_BUFFER, kMaterialBinding);
   const GLint materialLoc = program.uniformLocation("u_material");
-  for (const GpuMesh& m : meshes) {
+  for (std::size_t i = 0; i < meshes.size(); ++i) {
+    if (!select(i)) continue;
+    const GpuMesh& m = meshes[i];
     if (materialLoc >= 0) glProgramUniform1i(program.id(), materialLoc, m.material);
     if (withTextures) {
       for (int s = 0; s < gpu::kSlotCount; ++s)

@@ -3,6 +3,7 @@
 // storage buffers, and the textures (sRGB views for colour). Built once per scene digest and reused
 // by every pass and every frame while the scene is unchanged.
 #include <array>
+#include <functional>
 #include <map>
 #include <vector>
 
@@ -36,6 +37,10 @@ public:
   // Binds the materials buffer and, per draw, the mesh's textures; issues one draw per mesh.
   // The program must declare `uniform int u_material;`.
   void draw(const gl::Program& program, bool withTextures) const;
+  // Same, for the meshes whose index `select` accepts; `select` runs just before each mesh's draw, so
+  // it may also set per-mesh uniforms (the specular pass draws per-object layers with it).
+  void drawMeshes(const gl::Program& program, bool withTextures,
+                  const std::function<bool(std::size_t meshIndex)>& select) const;
 };
 
 }  // namespace radiant

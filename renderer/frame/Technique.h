@@ -23,7 +23,7 @@ struct TechniqueInfo {
   std::vector<std::string> optionalInputs;  // resources it reads when present ("shadow_maps")
   std::vector<std::string> outputs;   // resources / AOVs it writes ("direct")
   bool addsToBeauty = false;  // accumulates its result into "beauty"
-  bool onByDefault = false;   // wanted whenever beauty is, unless the request names passes explicitly
+  bool onByDefault = false;   // wanted in every frame; requirements() then decides (e.g. AO: only with ambient light)
 };
 
 // Run or skip, and the reason if skipped. The planner records the reason in the frame stats.
@@ -34,7 +34,8 @@ struct Requirements {
   static Requirements skip(std::string why) { return {false, std::move(why)}; }
 };
 
-// A technique's parameters, already validated against its schema with defaults filled in (api/).
+// A technique's parameters, validated against its schema with every default filled in
+// (api::techniqueParams), whether or not the request named the technique.
 class Params {
 public:
   Params() : json_(nlohmann::json::object()) {}

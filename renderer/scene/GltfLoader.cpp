@@ -80,7 +80,7 @@ struct FsContext {
   fs::path root;     // canonical; empty = no external files
   fs::path baseDir;  // canonical directory URIs are relative to (names files in the digest)
   std::size_t budget = 0;
-  Sha256* digest = nullptr;
+  api::Sha256* digest = nullptr;
   std::string refused;  // why the last path was refused, for the error message
 };
 
@@ -1026,7 +1026,7 @@ Scene load(std::string_view bytes, const fs::path& baseDir, const fs::path& root
                              std::to_string(options.maxBytes));
   if (bytes.size() >= std::numeric_limits<unsigned int>::max())
     throw SceneError("", "the scene is too large");
-  Sha256 digest;
+  api::Sha256 digest;
   digest.update(bytes);
   const bool glb = bytes.size() >= 4 && bytes.substr(0, 4) == "glTF";
   const std::string_view jsonText = glb ? glbJson(bytes) : bytes;

@@ -31,7 +31,7 @@
 #include <string_view>
 
 #include "renderer/scene/Scene.h"
-#include "renderer/scene/Sha256.h"
+#include "api/Sha256.h"
 
 namespace radiant {
 

@@ -1,6 +1,8 @@
 #include "renderer/techniques/Registry.h"
 
+#include "renderer/techniques/ambient_occlusion/AmbientOcclusion.h"
 #include "renderer/techniques/direct/Direct.h"
+#include "renderer/techniques/env_diffuse/EnvDiffuse.h"
 #include "renderer/techniques/gbuffer/GBuffer.h"
 #include "renderer/techniques/reference/ReferencePass.h"
 #include "renderer/techniques/shadow_maps/ShadowMaps.h"
@@ -12,6 +14,8 @@ std::vector<std::unique_ptr<Technique>> createTechniques() {
   t.push_back(std::make_unique<GBufferPass>());
   t.push_back(std::make_unique<ShadowMapsPass>());
   t.push_back(std::make_unique<DirectPass>());
+  t.push_back(std::make_unique<EnvDiffusePass>());
+  t.push_back(std::make_unique<AmbientOcclusionPass>());
   t.push_back(std::make_unique<ReferencePass>());
   return t;
 }

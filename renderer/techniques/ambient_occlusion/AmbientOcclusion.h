@@ -31,15 +31,17 @@ constexpr int kPatternCells = 16;  // 4x4 interleaved-sampling pattern (thesis 4
 // std140 uniform block shared with shaders/ambient_occlusion/ao.frag (binding kSampleBinding).
 struct SampleBlock {
   glm::vec4 samples[kMaxSamples];     // method-specific kernel, see buildSampleBlock()
-  glm::vec4 rotations[kPatternCells];  // (cos a, sin a, jitter in (0,1), 0) per pattern cell
+  glm::vec4 rotations[kPatternCells];  // per pattern cell: (cos a, sin a, gtao slice offset, gtao step jitter)
 };
 static_assert(sizeof(SampleBlock) == (kMaxSamples + kPatternCells) * 16, "std140 layout of AoSamples");
 
-// n points on the unit disk with a Poisson-disk (blue-noise) distribution: Mitchell's best-candidate
-// dart throwing, uniform in area (each point stands for 1/n of the disk, as eq. 4.7 assumes).
+// n points on the unit disk with a Poisson-disk (blue-noise) distribution, uniform in area (each point
+// stands for 1/n of the disk, as eq. 4.7 assumes): Mitchell's best candidate on the torus [0,1)^2 mapped
+// by the area-preserving concentric map.
 // Deterministic (fixed seed), identical on every machine.
 std::vector<glm::vec2> poissonDisk(int n, std::uint32_t seed = 0x5eedu);
-// n points uniform in the unit ball, Poisson-disk distributed the same way (Crytek's sphere kernel).
+// n points uniform in the unit ball (Crytek's sphere kernel): Poisson-disk directions on the sphere,
+// stratified radii cbrt((k + 1/2) / n) shuffled against them.
 std::vector<glm::vec3> poissonBall(int n, std::uint32_t seed = 0x5eedu);
 
 // The kernel uploaded to the shader:
@@ -47,7 +49,8 @@ std::vector<glm::vec3> poissonBall(int n, std::uint32_t seed = 0x5eedu);
 //   containment: (X_i, Y_i, Z_i, 0) / R = omega_i r_i / R in the tangent frame (eq. 4.5): omega_i is
 //                cosine distributed (Malley: the Poisson-disk point lifted to the hemisphere) and
 //                r_i = mu^-1(xi_i), xi_i stratified in (0,1): step -> r = R, cubic -> r = R xi^(1/3).
-//   crytek:      points uniform in the unit ball (scaled by R in the shader).
+//   crytek:      points uniform in the unit ball (scaled by R in the shader), in antithetic pairs
+//                (p, -p) so that every plane through x halves the kernel.
 //   gtao:        unused (horizon marching), zeros.
 // rotations: cell j of the 4x4 pattern rotates the kernel by alpha_j = 2 pi (rank_j + u_j) / 16, rank
 // from a 4x4 Bayer matrix so that neighbouring pixels get distant angles, u_j random (fixed seed).
@@ -80,8 +83,6 @@ private:
   bool blur_ = true;
   int scale_ = 1;  // 1 = full resolution, 2 = half
   const ao::SampleBlock* block_ = nullptr;  // cached in FrameResources
-  bool blockDirty_ = true;
-  std::string uploadedKey_;
 };
 
 }  // namespace radiant

@@ -89,7 +89,7 @@ void ReferencePass::prepare(const Scene&, const Params& params, FrameResources& 
   request_.spp = params.get<int>("spp", 64);
   request_.maxBounces = params.get<int>("max_bounces", 8);
   request_.russianRoulette = params.get<bool>("russian_roulette", true);
-  request_.aoRadius = params.get<float>("ao_radius", 1.f);
+  request_.aoRadius = params.get<float>("ao_radius", 0.5f);
   request_.aoDefinition = params.get<std::string>("ao_definition", "cosine");
   res.texture("reference", GL_TEXTURE_2D, GL_RGBA32F, res.view().width, res.view().height);
 }

@@ -19,7 +19,7 @@ struct ReferenceRequest {
   int spp = 64;
   int maxBounces = 8;
   bool russianRoulette = true;
-  float aoRadius = 1.f;
+  float aoRadius = 0.5f;
   std::string aoDefinition = "cosine";
 };
 const Image& referenceImage(FrameResources& resources, const Scene& scene, const FrameView& view,

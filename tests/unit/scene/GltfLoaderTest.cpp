@@ -42,7 +42,7 @@ TEST(GltfLoader, DataUriWithU8Indices) {
   EXPECT_EQ(mi.indices, (std::vector<std::uint32_t>{0, 1, 2}));
   ASSERT_EQ(mi.positions.size(), 3u);
   expectVec(mi.positions[1], {1, 0, 0});
-  EXPECT_EQ(s.digest, "sha256:" + sha256Hex(text));
+  EXPECT_EQ(s.digest, "sha256:" + api::sha256Hex(text));
   EXPECT_EQ(s.features.triangles, 1u);
   expectVec(s.features.bounds.max, {1, 1, 0});
 }
@@ -58,7 +58,7 @@ TEST(GltfLoader, GlbWithU16Indices) {
   ASSERT_EQ(s.meshes.size(), 1u);
   EXPECT_EQ(s.meshes[0].indices, (std::vector<std::uint32_t>{0, 1, 2, 2, 1, 3}));
   expectVec(s.meshes[0].positions[3], {2, 2, 0});
-  EXPECT_EQ(s.digest, "sha256:" + sha256Hex(glb));
+  EXPECT_EQ(s.digest, "sha256:" + api::sha256Hex(glb));
 }
 
 TEST(GltfLoader, U32IndicesAndNonIndexedPrimitivesInOneMesh) {

@@ -1,0 +1,28 @@
+#include "api/Types.h"
+
+namespace radiant::api {
+
+void to_json(nlohmann::json& j, const PassStats& s) {
+  j = nlohmann::json{{"name", s.name}, {"gpu_ms", s.gpuMs}, {"cpu_ms", s.cpuMs}, {"counters", s.counters}};
+}
+
+void to_json(nlohmann::json& j, const FrameStats& s) {
+  nlohmann::json cache = nlohmann::json::array();
+  for (const auto& c : s.cache) cache.push_back({{"what", c.what}, {"hit", c.hit}});
+  nlohmann::json passes = nlohmann::json::array();
+  for (const auto& p : s.passes) passes.push_back(p);
+  j = nlohmann::json{{"passes", passes},
+                     {"skipped", s.skipped},
+                     {"cache", cache},
+                     {"scene_load_ms", s.sceneLoadMs},
+                     {"upload_ms", s.uploadMs},
+                     {"render_ms", s.renderMs},
+                     {"readback_ms", s.readbackMs},
+                     {"encode_ms", s.encodeMs},
+                     {"triangles", s.triangles},
+                     {"lights", s.lights},
+                     {"device", s.device},
+                     {"metrics", s.metrics}};
+}
+
+}  // namespace radiant::api

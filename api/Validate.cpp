@@ -1,0 +1,287 @@
+#include "api/Validate.h"
+
+#include <cmath>
+#include <regex>
+#include <sstream>
+
+#include "embedded/radiant_api_schema.h"
+
+namespace radiant::api {
+
+using nlohmann::json;
+
+namespace {
+
+std::string shown(const json& v) {
+  std::string s = v.dump();
+  return s.size() > 80 ? s.substr(0, 77) + "..." : s;
+}
+
+std::string at(const std::string& pointer) { return pointer.empty() ? "the request" : pointer; }
+
+[[noreturn]] void typeError(const std::string& pointer, const std::string& expected, const json& value) {
+  throw ApiError(400, "type-mismatch", "Wrong JSON type",
+                 at(pointer) + ": expected " + expected + ", got " + std::string(value.type_name()) + " " + shown(value),
+                 pointer);
+}
+
+[[noreturn]] void invalid(const std::string& pointer, const std::string& detail) {
+  throw ApiError(422, "invalid-value", "Invalid value", at(pointer) + ": " + detail, pointer);
+}
+
+std::string number(double v) {
+  std::ostringstream os;
+  os << v;
+  return os.str();
+}
+
+bool isIntegral(const json& v) {
+  if (v.is_number_integer()) return true;
+  if (!v.is_number_float()) return false;
+  double d = v.get<double>();
+  return std::isfinite(d) && std::floor(d) == d && std::fabs(d) <= 9007199254740992.0;
+}
+
+json checkType(const std::string& type, const json& v, const std::string& pointer) {
+  if (type == "object") {
+    if (!v.is_object()) typeError(pointer, "an object", v);
+  } else if (type == "array") {
+    if (!v.is_array()) typeError(pointer, "an array", v);
+  } else if (type == "string") {
+    if (!v.is_string()) typeError(pointer, "a string", v);
+  } else if (type == "boolean") {
+    if (!v.is_boolean()) typeError(pointer, "a boolean", v);
+  } else if (type == "number") {
+    if (!v.is_number()) typeError(pointer, "a number", v);
+  } else if (type == "integer") {
+    if (!isIntegral(v)) typeError(pointer, "an integer", v);
+    if (v.is_number_float()) {  // 5.0 is an integer in JSON Schema; store it as one
+      double d = v.get<double>();
+      return d < 0 ? json(static_cast<std::int64_t>(d)) : json(static_cast<std::uint64_t>(d));
+    }
+  } else {
+    throw std::logic_error("schema: unsupported type \"" + type + "\" at " + pointer);
+  }
+  return v;
+}
+
+}  // namespace
+
+std::string pointerAppend(const std::string& pointer, std::string_view token) {
+  std::string out = pointer + "/";
+  for (char c : token) {
+    if (c == '~') out += "~0";
+    else if (c == '/') out += "~1";
+    else out += c;
+  }
+  return out;
+}
+
+std::string pointerAppend(const std::string& pointer, std::size_t index) {
+  return pointer + "/" + std::to_string(index);
+}
+
+json validate(const json& schema, const json& input, const std::string& pointer) {
+  json value = input;
+  if (auto t = schema.find("type"); t != schema.end()) value = checkType(t->get<std::string>(), value, pointer);
+
+  if (auto e = schema.find("enum"); e != schema.end()) {
+    if (std::find(e->begin(), e->end(), value) == e->end())
+      invalid(pointer, shown(value) + " is not one of " + shown(*e));
+  }
+  if (value.is_number()) {
+    const double d = value.get<double>();
+    if (auto m = schema.find("minimum"); m != schema.end() && d < m->get<double>())
+      throw ApiError(422, "out-of-range", "Value out of range",
+                     at(pointer) + ": " + shown(value) + " is below the minimum " + number(m->get<double>()), pointer);
+    if (auto m = schema.find("maximum"); m != schema.end() && d > m->get<double>())
+      throw ApiError(422, "out-of-range", "Value out of range",
+                     at(pointer) + ": " + shown(value) + " is above the maximum " + number(m->get<double>()), pointer);
+  }
+  if (value.is_string()) {
+    if (auto p = schema.find("pattern"); p != schema.end()) {
+      // Patterns are few and small; compiling per call keeps this function stateless.
+      if (!std::regex_search(value.get<std::string>(), std::regex(p->get<std::string>(), std::regex::ECMAScript)))
+        invalid(pointer, shown(value) + " does not match " + p->get<std::string>());
+    }
+  }
+  if (value.is_array()) {
+    if (auto m = schema.find("minItems"); m != schema.end() && value.size() < m->get<std::size_t>())
+      invalid(pointer, "needs at least " + std::to_string(m->get<std::size_t>()) + " items, got " + std::to_string(value.size()));
+    if (auto m = schema.find("maxItems"); m != schema.end() && value.size() > m->get<std::size_t>())
+      invalid(pointer, "allows at most " + std::to_string(m->get<std::size_t>()) + " items, got " + std::to_string(value.size()));
+    if (auto items = schema.find("items"); items != schema.end())
+      for (std::size_t i = 0; i < value.size(); ++i) value[i] = validate(*items, value[i], pointerAppend(pointer, i));
+  }
+  if (value.is_object()) {
+    static const json kEmpty = json::object();
+    auto pit = schema.find("properties");
+    const json& props = pit != schema.end() ? *pit : kEmpty;
+    const bool closed = schema.contains("additionalProperties") && schema["additionalProperties"] == false;
+    for (auto it = value.begin(); it != value.end(); ++it) {
+      auto ps = props.find(it.key());
+      if (ps == props.end()) {
+        if (closed) {
+          std::string known;
+          for (auto k = props.begin(); k != props.end(); ++k) known += (known.empty() ? "" : ", ") + k.key();
+          throw ApiError(422, "unknown-field", "Unknown field",
+                         pointerAppend(pointer, it.key()) + ": unknown key \"" + it.key() + "\"" +
+                             (known.empty() ? " (this object takes no keys)" : " (known: " + known + ")"),
+                         pointerAppend(pointer, it.key()));
+        }
+        continue;
+      }
+      it.value() = validate(*ps, it.value(), pointerAppend(pointer, it.key()));
+    }
+    if (auto r = schema.find("required"); r != schema.end())
+      for (const auto& key : *r)
+        if (!value.contains(key.get<std::string>()))
+          throw ApiError(422, "missing-field", "Missing field",
+                         pointerAppend(pointer, key.get<std::string>()) + ": required key \"" +
+                             key.get<std::string>() + "\" is missing",
+                         pointerAppend(pointer, key.get<std::string>()));
+    if (auto m = schema.find("minProperties"); m != schema.end() && value.size() < m->get<std::size_t>()) {
+      std::string keys;
+      for (auto k = props.begin(); k != props.end(); ++k) keys += (keys.empty() ? "" : ", ") + k.key();
+      invalid(pointer, "needs at least " + std::to_string(m->get<std::size_t>()) + " of the keys " + keys);
+    }
+    if (auto m = schema.find("maxProperties"); m != schema.end() && value.size() > m->get<std::size_t>())
+      invalid(pointer, "allows at most " + std::to_string(m->get<std::size_t>()) + " key(s), got " + std::to_string(value.size()));
+    for (auto k = props.begin(); k != props.end(); ++k)
+      if (!value.contains(k.key()) && k->contains("default"))
+        value[k.key()] = validate(*k, (*k)["default"], pointerAppend(pointer, k.key()));
+  }
+  return value;
+}
+
+json parseJson(std::string_view text) {
+  try {
+    return json::parse(text.begin(), text.end());
+  } catch (const json::parse_error& e) {
+    throw ApiError(400, "malformed-json", "Malformed JSON",
+                   "the body is not valid JSON: syntax error at byte " + std::to_string(e.byte), "");
+  }
+}
+
+const json& renderRequestSchema() {
+  static const json schema = [] {
+    std::string_view text = embedded_schema::find("render_request.json");
+    if (text.empty()) throw std::logic_error("embedded render_request.json missing");
+    return json::parse(text);
+  }();
+  return schema;
+}
+
+json techniqueParams(std::string_view technique, const json& given) {
+  const json& passes = renderRequestSchema().at("properties").at("passes").at("properties");
+  auto it = passes.find(std::string(technique));
+  if (it == passes.end()) throw std::out_of_range("no schema for technique '" + std::string(technique) + "'");
+  return validate(*it, given.is_null() ? json::object() : given, pointerAppend("/passes", technique));
+}
+
+const std::vector<TechniqueSchema>& techniqueSchemas() {
+  static const std::vector<TechniqueSchema> all = [] {
+    std::vector<TechniqueSchema> out;
+    for (const auto& [name, s] : renderRequestSchema()["properties"]["passes"]["properties"].items()) {
+      TechniqueSchema t;
+      t.name = name;
+      t.description = s.value("description", "");
+      t.outputs = s.value("x-outputs", std::vector<std::string>{});
+      t.params = s.value("properties", json::object());
+      out.push_back(std::move(t));
+    }
+    return out;
+  }();
+  return all;
+}
+
+const TechniqueSchema* findTechnique(std::string_view name) {
+  for (const auto& t : techniqueSchemas())
+    if (t.name == name) return &t;
+  return nullptr;
+}
+
+json to_json_value(const TechniqueSchema& t) {
+  return json{{"name", t.name}, {"description", t.description}, {"outputs", t.outputs}, {"params", t.params}};
+}
+
+const char* toString(ImageFormat f) { return f == ImageFormat::Exr ? "exr" : "png"; }
+
+json normaliseRenderRequest(const json& body, const RequestLimits& limits) {
+  json v = validate(renderRequestSchema(), body, "");
+
+  auto limit = [](const std::string& pointer, long long value, long long max, const char* what) {
+    if (value > max)
+      throw ApiError(422, "limit-exceeded", "Server limit exceeded",
+                     pointer + ": " + std::to_string(value) + " is above this server's " + what + " limit " +
+                         std::to_string(max),
+                     pointer);
+  };
+  limit("/width", v["width"].get<long long>(), limits.maxWidth, "width");
+  limit("/height", v["height"].get<long long>(), limits.maxHeight, "height");
+  for (const auto& [pass, params] : v["passes"].items())
+    for (const char* key : {"spp", "samples"})
+      if (params.contains(key) && params[key].is_number())
+        limit(pointerAppend(pointerAppend("/passes", pass), key), params[key].get<long long>(), limits.maxSamples,
+              "samples");
+  if (v.contains("compare")) limit("/compare/spp", v["compare"]["spp"].get<long long>(), limits.maxSamples, "samples");
+
+  const json& outputs = v["outputs"];
+  for (std::size_t i = 0; i < outputs.size(); ++i)
+    if (outputs[i]["format"] == "png" && outputs[i]["aovs"].size() != 1)
+      throw ApiError(422, "invalid-value", "Invalid value",
+                     "/outputs/" + std::to_string(i) + "/aovs: a png output holds exactly one AOV, got " +
+                         std::to_string(outputs[i]["aovs"].size()),
+                     "/outputs/" + std::to_string(i) + "/aovs");
+  return v;
+}
+
+RenderRequest parseRenderRequest(const json& body, const RequestLimits& limits) {
+  const json v = normaliseRenderRequest(body, limits);
+  auto vec3 = [](const json& a) { return glm::vec3(a[0].get<float>(), a[1].get<float>(), a[2].get<float>()); };
+
+  RenderRequest r;
+  const json& scene = v["scene"];
+  if (scene.contains("digest")) r.scene = {SceneRef::Kind::Digest, scene["digest"]};
+  else if (scene.contains("builtin")) r.scene = {SceneRef::Kind::Builtin, scene["builtin"]};
+  else r.scene = {SceneRef::Kind::Inline, scene["inline_glb"]};
+  if (v.contains("camera")) {
+    const json& c = v["camera"];
+    CameraOverride cam;
+    cam.position = vec3(c["position"]);
+    cam.target = vec3(c["target"]);
+    cam.up = vec3(c["up"]);
+    cam.yfovDegrees = c["yfov_deg"].get<float>();
+    if (glm::length(cam.target - cam.position) == 0.f)
+      throw ApiError(422, "invalid-value", "Invalid value", "/camera/target: equals the camera position", "/camera/target");
+    if (glm::length(glm::cross(cam.target - cam.position, cam.up)) == 0.f)
+      throw ApiError(422, "invalid-value", "Invalid value", "/camera/up: parallel to the view direction", "/camera/up");
+    r.camera = cam;
+  }
+  r.width = v["width"];
+  r.height = v["height"];
+  for (const auto& [name, params] : v["passes"].items()) r.passes[name] = params;
+  r.outputs.clear();
+  for (const auto& o : v["outputs"]) {
+    OutputSpec spec;
+    spec.format = o["format"] == "exr" ? ImageFormat::Exr : ImageFormat::Png;
+    spec.aovs = o["aovs"].get<std::vector<std::string>>();
+    spec.halfFloat = o["half"];
+    r.outputs.push_back(std::move(spec));
+  }
+  r.exposure = v["exposure"].get<float>();
+  r.seed = v["seed"].get<std::uint64_t>();
+  r.ambient = vec3(v["ambient"]);
+  if (v.contains("compare")) {
+    const json& c = v["compare"];
+    r.compare = CompareSpec{c["against"], c["aov"], c["spp"], c["max_bounces"]};
+  }
+  r.async = v["async"];
+  return r;
+}
+
+RenderRequest parseRenderRequest(std::string_view text, const RequestLimits& limits) {
+  return parseRenderRequest(parseJson(text), limits);
+}
+
+}  // namespace radiant::api

@@ -1,0 +1,77 @@
+#pragma once
+// Validation of request JSON against the embedded schema (api/schema/, merged at build time), and
+// conversion to the typed RenderRequest.
+//
+// The schema language is a subset of JSON Schema: type (object, array, string, integer, number,
+// boolean), properties, additionalProperties (false only), required, minimum, maximum, enum, default,
+// description, items, minItems, maxItems, minProperties, maxProperties, pattern. Annotations ("title",
+// "$id", "x-outputs") are ignored. Every property with a default is filled in when absent.
+//
+// Error mapping (one rule, documented in docs/API.md): every error is an api::ApiError whose pointer
+// (RFC 6901) names the offending field.
+//   400 malformed-json   the body is not JSON (pointer "")
+//   400 type-mismatch    a value has the wrong JSON type ("width": "big")
+//   422 unknown-field    a key the schema does not define (unknown technique, misspelt parameter)
+//   422 missing-field    a required key is absent
+//   422 out-of-range     a number outside [minimum, maximum]
+//   422 invalid-value    a value not in its enum, not matching its pattern, or a wrong item/key count
+//   422 limit-exceeded   within the schema, but above a limit this server is configured with
+// i.e. 400 means "this is not the shape of a request", 422 means "a request, but not one we accept".
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "api/Types.h"
+
+namespace radiant::api {
+
+// Limits a server sets at or below the schema's own.
+struct RequestLimits {
+  int maxWidth = 4096;
+  int maxHeight = 4096;
+  int maxSamples = 65536;  // caps every "spp"/"samples" parameter and compare.spp
+};
+
+// The merged request schema (technique parameter schemas included under properties.passes).
+const nlohmann::json& renderRequestSchema();
+
+// One technique as declared in api/schema/techniques/<name>.json, params in schema form.
+struct TechniqueSchema {
+  std::string name, description;
+  std::vector<std::string> outputs;
+  nlohmann::json params;  // name -> {type, default, minimum?, maximum?, enum?, description}
+};
+const std::vector<TechniqueSchema>& techniqueSchemas();
+const TechniqueSchema* findTechnique(std::string_view name);
+nlohmann::json to_json_value(const TechniqueSchema& t);
+
+// Validates `value` against `schema` (the subset above) and returns it with defaults filled in.
+// `pointer` is where `value` sits in the document. Throws ApiError.
+nlohmann::json validate(const nlohmann::json& schema, const nlohmann::json& value, const std::string& pointer = "");
+
+// A technique's parameters: `given` (an object, or null for none) validated against the technique's
+// schema with every default filled in. This is what a technique receives, whether or not the request
+// named it, so the schema is the only place a default is written. Throws ApiError for bad values and
+// std::out_of_range for a technique the schema does not declare.
+nlohmann::json techniqueParams(std::string_view technique, const nlohmann::json& given = nullptr);
+
+// JSON text -> json. Throws ApiError 400 malformed-json, detail names the byte offset.
+nlohmann::json parseJson(std::string_view text);
+
+// Validates against the request schema, applies `limits`, and converts. Throws ApiError.
+RenderRequest parseRenderRequest(const nlohmann::json& body, const RequestLimits& limits = {});
+RenderRequest parseRenderRequest(std::string_view text, const RequestLimits& limits = {});
+
+// The validated request's JSON form with defaults filled (what parseRenderRequest converted).
+nlohmann::json normaliseRenderRequest(const nlohmann::json& body, const RequestLimits& limits = {});
+
+// RFC 6901: appends one reference token, escaping '~' and '/'.
+std::string pointerAppend(const std::string& pointer, std::string_view token);
+std::string pointerAppend(const std::string& pointer, std::size_t index);
+
+const char* toString(ImageFormat f);  // "exr" | "png"
+
+}  // namespace radiant::api

@@ -1,0 +1,28 @@
+#pragma once
+// One function per subcommand; main.cpp dispatches. Each returns an exit code or throws
+// UsageError / ServerError / UnreachableError (mapped to 2 / 3 / 4 by main).
+// Future subcommands (sweep, report, bench) go in commands/<name>.cpp and the table in main.cpp.
+#include <string>
+#include <vector>
+
+#include "client/HttpClient.h"
+
+namespace radiant::client {
+
+struct GlobalOptions {
+  std::string server;  // base URL
+  std::string token;   // bearer token ("" = none)
+};
+
+int cmdRender(const GlobalOptions& g, const std::vector<std::string>& args);
+int cmdInfo(const GlobalOptions& g, const std::vector<std::string>& args);
+int cmdScenes(const GlobalOptions& g, const std::vector<std::string>& args);
+
+// Helpers shared by commands.
+std::string readFile(const std::string& path);            // throws UsageError
+void writeFile(const std::string& path, const std::string& bytes);  // throws UsageError
+// Uploads `bytes` unless the server already has its digest; returns the digest.
+std::string ensureSceneUploaded(const HttpClient& http, const std::string& bytes, const std::string& fileName,
+                                bool verbose);
+
+}  // namespace radiant::client

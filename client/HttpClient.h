@@ -1,0 +1,58 @@
+#pragma once
+// A small blocking HTTP client for the radiant CLI: base URL, optional bearer token, and the
+// error model mapped to exceptions the CLI turns into exit codes.
+#include <map>
+#include <stdexcept>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace radiant::client {
+
+// Exit codes of every subcommand.
+enum ExitCode { kExitOk = 0, kExitUsage = 2, kExitServerError = 3, kExitUnreachable = 4 };
+
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+struct UnreachableError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+// The server answered with an error: `problem` is its application/problem+json body (or a
+// synthesised one when the body was something else).
+struct ServerError : std::runtime_error {
+  ServerError(int status, nlohmann::json problem);
+  int status;
+  nlohmann::json problem;
+};
+
+struct HttpResponse {
+  int status = 0;
+  std::string body;
+  std::multimap<std::string, std::string> headers;  // lower-case names
+  std::string header(const std::string& lowerName) const;
+  nlohmann::json json() const;  // throws ServerError when the body is not JSON
+};
+
+class HttpClient {
+public:
+  // baseUrl: "http://host:port" (no TLS: put a proxy in front). token: "" = no Authorization header.
+  explicit HttpClient(std::string baseUrl, std::string token = "", int timeoutSeconds = 600);
+  HttpResponse get(const std::string& path) const;
+  HttpResponse head(const std::string& path) const;
+  HttpResponse del(const std::string& path) const;
+  HttpResponse post(const std::string& path, const std::string& body, const std::string& contentType) const;
+  HttpResponse put(const std::string& path, const std::string& body, const std::string& contentType) const;
+  const std::string& baseUrl() const { return base_; }
+
+  // Throws ServerError unless 200 <= status < 300.
+  static const HttpResponse& expectOk(const HttpResponse& r);
+
+private:
+  HttpResponse send(const std::string& method, const std::string& path, const std::string* body,
+                    const std::string& contentType) const;
+  std::string base_, token_;
+  int timeout_;
+};
+
+}  // namespace radiant::client

@@ -1,0 +1,41 @@
+#include <fstream>
+#include <iostream>
+
+#include "api/Sha256.h"
+#include "client/Commands.h"
+
+namespace radiant::client {
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw UsageError("cannot read " + path);
+  return std::string((std::istreambuf_iterator<char>(in)), {});
+}
+
+void writeFile(const std::string& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  if (!out) throw UsageError("cannot write " + path);
+}
+
+std::string ensureSceneUploaded(const HttpClient& http, const std::string& bytes, const std::string& fileName,
+                                bool verbose) {
+  const std::string digest = api::sceneDigest(bytes);
+  const HttpResponse head = http.head("/v1/scenes/" + digest);
+  if (head.status == 200) {
+    if (verbose) std::cerr << "scene " << digest << " already on the server\n";
+    return digest;
+  }
+  if (head.status != 404) HttpClient::expectOk(head);
+  const bool glb = bytes.size() >= 4 && bytes.compare(0, 4, "glTF") == 0;
+  const HttpResponse r = http.put("/v1/scenes", bytes, glb ? "model/gltf-binary" : "model/gltf+json");
+  HttpClient::expectOk(r);
+  const std::string stored = r.json().value("digest", "");
+  if (stored != digest)
+    throw ServerError(r.status, {{"title", "Digest mismatch"}, {"status", r.status},
+                                 {"detail", "uploaded " + fileName + " as " + digest + " but the server stored " + stored}});
+  if (verbose) std::cerr << "uploaded " << fileName << " as " << digest << " (" << bytes.size() << " bytes)\n";
+  return digest;
+}
+
+}  // namespace radiant::client

@@ -1,0 +1,52 @@
+#pragma once
+// What the server needs from a renderer, as an interface, so the server core builds and is tested
+// without GL (tests inject a deterministic fake; radiantd injects the real Renderer, see main.cpp).
+//
+// Threading contract:
+//   createBackend() and every RenderBackend call run on the one render thread, which owns the GL
+//   context for the backend's lifetime. Nothing else in the server touches it.
+//   decodeScene, builtin*, encodeFrame are pure CPU and are called from HTTP / encoder threads.
+
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "api/Types.h"
+#include "renderer/Image.h"
+#include "renderer/Renderer.h"  // RenderOutput, TechniqueDescription, DeviceInfo (headers only: no GL)
+#include "renderer/scene/Scene.h"
+
+namespace radiant::server {
+
+class RenderBackend {
+public:
+  virtual ~RenderBackend() = default;
+  virtual DeviceInfo device() const = 0;
+  // Throws api::ApiError for request problems found only while rendering (the job fails with that
+  // status; the backend stays in use) and anything else for environment failures (the job fails
+  // with 500 and the server destroys and recreates the backend before the next job).
+  // `cancel` becomes true when the job is cancelled or times out; poll it between passes.
+  virtual RenderOutput render(const Scene& scene, const api::RenderRequest& request,
+                              const std::atomic<bool>* cancel) = 0;
+};
+
+struct BackendHooks {
+  // Runs on the render thread; throws when no context can be created (the server retries with
+  // backoff and /v1/ready says why).
+  std::function<std::unique_ptr<RenderBackend>()> createBackend;
+  // glTF JSON or GLB bytes -> Scene. Throws api::ApiError (422) for files it cannot load.
+  std::function<Scene(std::string_view bytes)> decodeScene;
+  std::function<std::vector<std::string>()> builtinSceneNames;
+  std::function<std::string(const std::string& name)> builtinSceneSource;  // glTF/GLB bytes
+  // One output file: EXR of every AOV in spec.aovs, or PNG of the single one with exposure applied.
+  // `outputIndex` is the spec's index in request.outputs (for error pointers; see selectAovs()).
+  std::function<std::string(const std::vector<Image>& aovs, const api::OutputSpec& spec, std::size_t outputIndex,
+                            float exposureEV)>
+      encodeFrame;
+  std::vector<TechniqueDescription> techniques;  // what the backend implements (may be empty: unknown)
+};
+
+}  // namespace radiant::server

@@ -1,0 +1,151 @@
+#include "server/Config.h"
+
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+#include <nlohmann/json.hpp>
+
+namespace radiant::server {
+
+std::string usage() {
+  return R"(usage: radiantd [options]
+  --host ADDR               bind address (default 127.0.0.1)
+  --port N                  TCP port, 0 = ephemeral (default 8080)
+  --cache-dir DIR           persist uploaded scenes here across restarts
+  --token-file FILE         require "Authorization: Bearer <contents of FILE>"
+  --config FILE             JSON file with any of these options (keys use '_': "max_queue")
+  --max-body-bytes N        largest request body (default 67108864)
+  --max-width N, --max-height N   largest image (default 4096, never above the schema's 4096)
+  --max-samples N           largest spp/samples of any pass and of compare (default 65536)
+  --max-queue N             jobs waiting behind the running one before 503 (default 16)
+  --request-timeout S       seconds from submission to encoded frames (default 300)
+  --frame-ttl S             seconds frames and finished jobs are kept (default 600)
+  --max-frame-bytes N       frame store size (default 536870912)
+  --max-scene-bytes N       scene store size, least recently used evicted (default 1073741824)
+  --scene-cache N           decoded scenes kept in memory (default 8)
+  --encoder-threads N       EXR/PNG encoder threads (default 2)
+  --http-threads N          HTTP worker threads (default max-queue + 8)
+  --device-index N          EGL device index
+  --device NAME             EGL device whose GL_RENDERER or GL_VENDOR contains NAME
+  --gl-debug                GL debug context, messages to stderr
+)";
+}
+
+namespace {
+
+std::string readToken(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::invalid_argument("--token-file: cannot read " + path);
+  std::string token((std::istreambuf_iterator<char>(in)), {});
+  while (!token.empty() && (token.back() == '\n' || token.back() == '\r' || token.back() == ' ')) token.pop_back();
+  if (token.empty()) throw std::invalid_argument("--token-file: " + path + " is empty");
+  return token;
+}
+
+long long toInt(const std::string& flag, const std::string& v, long long lo, long long hi) {
+  std::size_t used = 0;
+  long long n = 0;
+  try {
+    n = std::stoll(v, &used);
+  } catch (...) {
+    used = 0;
+  }
+  if (used != v.size() || v.empty()) throw std::invalid_argument(flag + ": expected an integer, got \"" + v + "\"");
+  if (n < lo || n > hi)
+    throw std::invalid_argument(flag + ": " + v + " is outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  return n;
+}
+
+double toDouble(const std::string& flag, const std::string& v) {
+  std::size_t used = 0;
+  double d = 0;
+  try {
+    d = std::stod(v, &used);
+  } catch (...) {
+    used = 0;
+  }
+  if (used != v.size() || !(d > 0)) throw std::invalid_argument(flag + ": expected a positive number, got \"" + v + "\"");
+  return d;
+}
+
+// Applies one option (flag name without dashes, '-' form) to the config.
+void apply(ServerConfig& c, const std::string& name, const std::string& v, std::string& tokenFile) {
+  const std::string flag = "--" + name;
+  if (name == "host") c.host = v;
+  else if (name == "port") c.port = static_cast<int>(toInt(flag, v, 0, 65535));
+  else if (name == "cache-dir") c.cacheDir = v;
+  else if (name == "token-file") tokenFile = v;
+  else if (name == "max-body-bytes") c.maxBodyBytes = static_cast<std::size_t>(toInt(flag, v, 1024, 1ll << 40));
+  else if (name == "max-width") c.limits.maxWidth = static_cast<int>(toInt(flag, v, 1, 4096));
+  else if (name == "max-height") c.limits.maxHeight = static_cast<int>(toInt(flag, v, 1, 4096));
+  else if (name == "max-samples") c.limits.maxSamples = static_cast<int>(toInt(flag, v, 1, 65536));
+  else if (name == "max-queue") c.maxQueue = static_cast<int>(toInt(flag, v, 1, 10000));
+  else if (name == "request-timeout") c.requestTimeoutS = toDouble(flag, v);
+  else if (name == "frame-ttl") c.frameTtlS = toDouble(flag, v);
+  else if (name == "max-frame-bytes") c.maxFrameBytes = static_cast<std::size_t>(toInt(flag, v, 1024, 1ll << 40));
+  else if (name == "max-scene-bytes") c.maxSceneBytes = static_cast<std::size_t>(toInt(flag, v, 1024, 1ll << 40));
+  else if (name == "scene-cache") c.sceneCacheEntries = static_cast<std::size_t>(toInt(flag, v, 1, 1000));
+  else if (name == "encoder-threads") c.encoderThreads = static_cast<int>(toInt(flag, v, 1, 64));
+  else if (name == "http-threads") c.httpThreads = static_cast<int>(toInt(flag, v, 1, 1024));
+  else if (name == "device-index") c.deviceIndex = static_cast<int>(toInt(flag, v, 0, 1024));
+  else if (name == "device") c.deviceName = v;
+  else if (name == "gl-debug") c.glDebug = v != "false" && v != "0";
+  else throw std::invalid_argument("unknown option " + flag);
+}
+
+}  // namespace
+
+std::optional<ServerConfig> parseCommandLine(const std::vector<std::string>& args) {
+  ServerConfig c;
+  std::string tokenFile;
+  // The config file first, so flags override it wherever they appear.
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    if (args[i] == "--config") {
+      if (i + 1 >= args.size()) throw std::invalid_argument("--config needs a file");
+      std::ifstream in(args[i + 1]);
+      if (!in) throw std::invalid_argument("--config: cannot read " + args[i + 1]);
+      nlohmann::json j;
+      try {
+        j = nlohmann::json::parse(in);
+      } catch (const std::exception& e) {
+        throw std::invalid_argument("--config: " + args[i + 1] + ": " + e.what());
+      }
+      if (!j.is_object()) throw std::invalid_argument("--config: " + args[i + 1] + " must hold a JSON object");
+      for (const auto& [k, v] : j.items()) {
+        std::string name = k;
+        for (char& ch : name)
+          if (ch == '_') ch = '-';
+        if (name == "token") throw std::invalid_argument("--config: put the token in a file and name it with token_file");
+        apply(c, name, v.is_string() ? v.get<std::string>() : v.dump(), tokenFile);
+      }
+    }
+  }
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a == "--help" || a == "-h") {
+      std::cout << usage();
+      return std::nullopt;
+    }
+    if (a.rfind("--", 0) != 0) throw std::invalid_argument("unexpected argument \"" + a + "\"");
+    std::string name = a.substr(2), value;
+    if (auto eq = name.find('='); eq != std::string::npos) {
+      value = name.substr(eq + 1);
+      name = name.substr(0, eq);
+    } else if (name == "gl-debug") {
+      value = "true";
+    } else {
+      if (i + 1 >= args.size()) throw std::invalid_argument(a + " needs a value");
+      value = args[++i];
+    }
+    if (name == "token") throw std::invalid_argument("--token is not accepted: use --token-file");
+    if (name == "config") continue;
+    apply(c, name, value, tokenFile);
+  }
+  if (!tokenFile.empty()) c.token = readToken(tokenFile);
+  return c;
+}
+
+}  // namespace radiant::server

@@ -1,0 +1,39 @@
+#pragma once
+// radiantd settings: command-line flags, optionally on top of a JSON config file (--config) whose
+// keys are the flag names with '_' for '-' ({"max_queue": 4, "cache_dir": "/var/cache/radiant"}).
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "api/Validate.h"
+
+namespace radiant::server {
+
+struct ServerConfig {
+  std::string host = "127.0.0.1";
+  int port = 8080;                     // 0 = ephemeral
+  std::string cacheDir;                // "" = scenes in memory only
+  std::string token;                   // bearer token ("" = no auth), read from token_file
+  std::size_t maxBodyBytes = 64u << 20;
+  api::RequestLimits limits;
+  int maxQueue = 16;                   // jobs waiting (the running one not counted)
+  double requestTimeoutS = 300;        // submit -> frames encoded; a timed-out job frees its slot
+  double frameTtlS = 600;              // frames and finished async jobs are kept this long
+  std::size_t maxFrameBytes = 512u << 20;
+  std::size_t maxSceneBytes = 1024u << 20;  // scene store (uploads), LRU evicted
+  std::size_t sceneCacheEntries = 8;   // decoded scenes kept in memory
+  int encoderThreads = 2;
+  int httpThreads = 0;                 // 0 = maxQueue + 8
+  std::optional<int> deviceIndex;      // EGL device index (radiantd only)
+  std::string deviceName;              // substring of GL_RENDERER/GL_VENDOR
+  bool glDebug = false;
+};
+
+// Parses argv (argv[0] skipped). Throws std::invalid_argument with a usage message on bad flags.
+// Reads --config and --token-file. Returns nullopt for --help (usage printed to stdout).
+std::optional<ServerConfig> parseCommandLine(const std::vector<std::string>& args);
+std::string usage();
+
+}  // namespace radiant::server

@@ -1,0 +1,601 @@
+#include "server/HttpServer.h"
+
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <list>
+#include <map>
+#include <mutex>
+#include <random>
+#include <set>
+
+#include <httplib.h>
+#include <nlohmann/json.hpp>
+
+#include "api/Sha256.h"
+#include "api/Validate.h"
+#include "server/FrameStore.h"
+#include "server/Metrics.h"
+#include "server/RenderService.h"
+#include "server/SceneStore.h"
+
+namespace radiant::server {
+
+using nlohmann::json;
+
+namespace {
+
+constexpr const char* kVersion = "0.1.0";
+
+// Per-request context for the log line; the logger runs on the handler's thread after the response.
+struct RequestContext {
+  std::string id;
+  Clock::time_point start;
+  double queueMs = -1, renderMs = -1, encodeMs = -1;
+  std::string renderId;
+  bool active = false;
+};
+thread_local RequestContext tRequest;
+
+std::string randomHex(int n) {
+  static std::mutex m;
+  static std::mt19937_64 rng{std::random_device{}()};
+  std::lock_guard lock(m);
+  std::string s;
+  static const char* kHex = "0123456789abcdef";
+  for (int i = 0; i < n; ++i) s += kHex[rng() & 15];
+  return s;
+}
+
+bool validRequestId(const std::string& s) {
+  if (s.empty() || s.size() > 64) return false;
+  for (char c : s)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.')) return false;
+  return true;
+}
+
+void beginRequest(const httplib::Request& req, httplib::Response& res) {
+  tRequest = RequestContext{};
+  tRequest.active = true;
+  tRequest.start = Clock::now();
+  const std::string given = req.get_header_value("X-Request-Id");
+  tRequest.id = validRequestId(given) ? given : "q-" + randomHex(16);
+  res.set_header("X-Request-Id", tRequest.id);
+}
+
+void sendJson(httplib::Response& res, int status, const json& body) {
+  res.status = status;
+  res.set_content(body.dump(2) + "\n", "application/json");
+}
+
+void sendProblem(httplib::Response& res, int status, const std::string& type, const std::string& title,
+                 const std::string& detail, const std::string& pointer = "", const std::string& renderId = "") {
+  json p{{"type", "https://radiant.dev/problems/" + type}, {"title", title}, {"status", status}, {"detail", detail}};
+  if (!pointer.empty()) p["pointer"] = pointer;
+  if (!tRequest.id.empty()) p["request_id"] = tRequest.id;
+  if (!renderId.empty()) p["render_id"] = renderId;
+  res.status = status;
+  res.set_content(p.dump(2) + "\n", "application/problem+json");
+}
+
+void sendProblem(httplib::Response& res, const api::ApiError& e, const std::string& renderId = "") {
+  sendProblem(res, e.status, e.type, e.title, e.detail(), e.pointer, renderId);
+}
+
+std::string mediaType(const httplib::Request& req) {
+  std::string ct = req.get_header_value("Content-Type");
+  if (auto semi = ct.find(';'); semi != std::string::npos) ct.resize(semi);
+  while (!ct.empty() && ct.back() == ' ') ct.pop_back();
+  for (char& c : ct) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ct;
+}
+
+std::string statusTitle(int status) {
+  switch (status) {
+    case 400: return "Bad request";
+    case 401: return "Unauthorized";
+    case 404: return "Not found";
+    case 405: return "Method not allowed";
+    case 413: return "Payload too large";
+    case 414: return "URI too long";
+    case 415: return "Unsupported media type";
+    case 503: return "Service unavailable";
+    default: return status >= 500 ? "Internal error" : "Error";
+  }
+}
+
+std::string base64Decode(const std::string& in, const std::string& pointer) {
+  static const std::string kAlphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve(in.size() * 3 / 4);
+  unsigned buffer = 0;
+  int bits = 0;
+  std::size_t i = 0;
+  for (; i < in.size(); ++i) {
+    const char c = in[i];
+    if (c == '=') break;
+    if (c == '\n' || c == '\r') continue;
+    const auto v = kAlphabet.find(c);
+    if (v == std::string::npos)
+      throw api::ApiError(422, "invalid-value", "Invalid value",
+                          pointer + ": not base64 (character " + std::to_string(i) + ")", pointer);
+    buffer = (buffer << 6) | static_cast<unsigned>(v);
+    bits += 6;
+    if (bits >= 8) {
+      bits -= 8;
+      out.push_back(static_cast<char>((buffer >> bits) & 0xff));
+    }
+  }
+  return out;
+}
+
+json deviceJson(const DeviceInfo& d) {
+  return json{{"vendor", d.vendor},         {"renderer", d.renderer}, {"version", d.version},
+              {"glsl_version", d.glslVersion}, {"platform", d.platform}, {"device_index", d.deviceIndex},
+              {"reason", d.reason},         {"software", d.software}};
+}
+
+// Decoded scenes by digest, least recently used dropped first.
+class DecodedScenes {
+public:
+  explicit DecodedScenes(std::size_t capacity) : capacity_(capacity) {}
+  std::shared_ptr<const Scene> get(const std::string& digest) {
+    std::lock_guard lock(mutex_);
+    auto it = index_.find(digest);
+    if (it == index_.end()) return nullptr;
+    lru_.splice(lru_.begin(), lru_, it->second);
+    return it->second->second;
+  }
+  void put(const std::string& digest, std::shared_ptr<const Scene> scene) {
+    std::lock_guard lock(mutex_);
+    if (index_.count(digest)) return;
+    lru_.emplace_front(digest, std::move(scene));
+    index_[digest] = lru_.begin();
+    while (lru_.size() > capacity_) {
+      index_.erase(lru_.back().first);
+      lru_.pop_back();
+    }
+  }
+
+private:
+  std::mutex mutex_;
+  std::size_t capacity_;
+  std::list<std::pair<std::string, std::shared_ptr<const Scene>>> lru_;
+  std::map<std::string, std::list<std::pair<std::string, std::shared_ptr<const Scene>>>::iterator> index_;
+};
+
+}  // namespace
+
+struct HttpServer::Impl {
+  ServerConfig config;
+  BackendHooks hooks;
+  Metrics metrics;
+  FrameStore frames;
+  SceneStore scenes;
+  DecodedScenes decoded;
+  RenderService service;
+  httplib::Server http;
+  std::atomic<bool> shuttingDown{false};
+
+  std::mutex builtinMutex;
+  std::map<std::string, std::string> builtinDigests;  // name -> digest, filled on first use
+
+  Impl(ServerConfig c, BackendHooks h)
+      : config(std::move(c)),
+        hooks(std::move(h)),
+        frames(config.maxFrameBytes, config.frameTtlS),
+        scenes(config.cacheDir, config.maxSceneBytes),
+        decoded(config.sceneCacheEntries),
+        service(config, hooks, frames, metrics) {
+    routes();
+  }
+
+  // ---- scenes ---------------------------------------------------------------------------------
+  std::vector<std::string> builtinNames() { return hooks.builtinSceneNames ? hooks.builtinSceneNames() : std::vector<std::string>{}; }
+
+  std::optional<std::string> builtinDigest(const std::string& name) {
+    {
+      std::lock_guard lock(builtinMutex);
+      if (auto it = builtinDigests.find(name); it != builtinDigests.end()) return it->second;
+    }
+    const auto names = builtinNames();
+    if (std::find(names.begin(), names.end(), name) == names.end()) return std::nullopt;
+    const std::string digest = api::sceneDigest(hooks.builtinSceneSource(name));
+    std::lock_guard lock(builtinMutex);
+    builtinDigests[name] = digest;
+    return digest;
+  }
+
+  std::optional<std::string> builtinByDigest(const std::string& digest) {
+    for (const auto& name : builtinNames())
+      if (builtinDigest(name) == digest) return name;
+    return std::nullopt;
+  }
+
+  std::shared_ptr<const Scene> decode(const std::string& digest, std::string_view bytes, const std::string& pointer) {
+    if (auto s = decoded.get(digest)) return s;
+    if (!hooks.decodeScene) throw std::logic_error("no scene decoder configured");
+    std::shared_ptr<Scene> scene;
+    try {
+      scene = std::make_shared<Scene>(hooks.decodeScene(bytes));
+    } catch (const api::ApiError& e) {
+      throw api::ApiError(e.status, e.type, e.title, e.detail(), e.pointer.empty() ? pointer : e.pointer);
+    } catch (const std::exception& e) {
+      throw api::ApiError(422, "invalid-scene", "Invalid scene", std::string("the scene cannot be loaded: ") + e.what(),
+                          pointer);
+    }
+    if (scene->digest.empty()) scene->digest = digest;
+    decoded.put(digest, scene);
+    return scene;
+  }
+
+  std::shared_ptr<const Scene> resolveScene(const api::SceneRef& ref) {
+    switch (ref.kind) {
+      case api::SceneRef::Kind::Builtin: {
+        auto digest = builtinDigest(ref.value);
+        if (!digest)
+          throw api::ApiError(404, "unknown-scene", "Unknown scene",
+                              "/scene/builtin: no built-in scene \"" + ref.value + "\" (GET /v1/scenes lists them)",
+                              "/scene/builtin");
+        if (auto s = decoded.get(*digest)) return s;
+        return decode(*digest, hooks.builtinSceneSource(ref.value), "/scene/builtin");
+      }
+      case api::SceneRef::Kind::Digest: {
+        if (auto s = decoded.get(ref.value)) return s;
+        if (auto bytes = scenes.get(ref.value)) return decode(ref.value, *bytes, "/scene/digest");
+        if (auto name = builtinByDigest(ref.value))
+          return decode(ref.value, hooks.builtinSceneSource(*name), "/scene/digest");
+        throw api::ApiError(404, "unknown-scene", "Unknown scene",
+                            "/scene/digest: no scene " + ref.value + " (upload it with PUT /v1/scenes)", "/scene/digest");
+      }
+      case api::SceneRef::Kind::Inline: {
+        std::string bytes = base64Decode(ref.value, "/scene/inline_glb");
+        const std::string digest = api::sceneDigest(bytes);
+        auto scene = decode(digest, bytes, "/scene/inline_glb");
+        scenes.put(digest, std::move(bytes));  // now addressable by digest too
+        return scene;
+      }
+    }
+    throw std::logic_error("unreachable");
+  }
+
+  // ---- helpers --------------------------------------------------------------------------------
+  void checkBodySize(const httplib::Request& req) {
+    if (req.body.size() > config.maxBodyBytes)
+      throw api::ApiError(413, "payload-too-large", "Payload too large",
+                          "the body is " + std::to_string(req.body.size()) + " bytes, the limit is " +
+                              std::to_string(config.maxBodyBytes));
+  }
+
+  template <class F>
+  httplib::Server::Handler wrap(F f) {
+    return [this, f](const httplib::Request& req, httplib::Response& res) {
+      try {
+        f(req, res);
+      } catch (const api::ApiError& e) {
+        sendProblem(res, e, tRequest.renderId);
+      } catch (const std::exception& e) {
+        sendProblem(res, 500, "internal-error", "Internal error", e.what(), "", tRequest.renderId);
+      }
+    };
+  }
+
+  json limitsJson() const {
+    return json{{"max_body_bytes", config.maxBodyBytes},
+                {"max_width", config.limits.maxWidth},
+                {"max_height", config.limits.maxHeight},
+                {"max_samples", config.limits.maxSamples},
+                {"max_queue", config.maxQueue},
+                {"request_timeout_s", config.requestTimeoutS},
+                {"frame_ttl_s", config.frameTtlS}};
+  }
+
+  json techniquesJson() const {
+    json out = json::array();
+    std::set<std::string> seen;
+    for (const auto& t : api::techniqueSchemas()) {
+      json j = api::to_json_value(t);
+      bool available = hooks.techniques.empty();
+      for (const auto& d : hooks.techniques) available = available || d.name == t.name;
+      j["available"] = available;
+      out.push_back(j);
+      seen.insert(t.name);
+    }
+    for (const auto& d : hooks.techniques)
+      if (!seen.count(d.name))  // implemented but without a schema file: usable with no parameters
+        out.push_back(json{{"name", d.name}, {"description", d.description}, {"outputs", d.outputs},
+                           {"params", json::object()}, {"available", true}});
+    return out;
+  }
+
+  // Timings from a describe() snapshot (taken under the service's lock).
+  void timingHeader(httplib::Response& res, const json& described) {
+    const json& t = described["timings"];
+    tRequest.queueMs = t.value("queue_ms", 0.0);
+    tRequest.renderMs = t.value("render_ms", 0.0);
+    tRequest.encodeMs = t.value("encode_ms", 0.0);
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "queue;dur=%.3f, render;dur=%.3f, encode;dur=%.3f", tRequest.queueMs,
+                  tRequest.renderMs, tRequest.encodeMs);
+    res.set_header("Server-Timing", buf);
+  }
+
+  // ---- routes ---------------------------------------------------------------------------------
+  void routes() {
+    const int threads = config.httpThreads > 0 ? config.httpThreads : std::min(256, config.maxQueue + 8);
+    http.new_task_queue = [threads] { return new httplib::ThreadPool(static_cast<size_t>(threads)); };
+    http.set_payload_max_length(config.maxBodyBytes);
+    http.set_read_timeout(30, 0);
+    http.set_write_timeout(30, 0);
+    http.set_keep_alive_timeout(2);  // idle keep-alive connections must not hold up a shutdown for long
+
+    http.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
+      beginRequest(req, res);
+      if (!config.token.empty() && req.path != "/v1/health") {
+        const std::string auth = req.get_header_value("Authorization");
+        const std::string expected = "Bearer " + config.token;
+        // Constant-time comparison: the time taken must not reveal how much of the token matched.
+        unsigned diff = auth.size() != expected.size();
+        for (std::size_t i = 0; i < expected.size(); ++i) diff |= i < auth.size() ? (auth[i] ^ expected[i]) : 1u;
+        if (diff != 0) {
+          res.set_header("WWW-Authenticate", "Bearer");
+          sendProblem(res, 401, "unauthorized", "Unauthorized", "a valid \"Authorization: Bearer <token>\" header is required");
+          return httplib::Server::HandlerResponse::Handled;
+        }
+      }
+      return httplib::Server::HandlerResponse::Unhandled;
+    });
+
+    // Errors httplib produces itself (no route, body over the limit, bad request line) become
+    // problem+json too. Handlers' own errors already have a body and are left alone.
+    http.set_error_handler(httplib::Server::HandlerWithResponse([this](const httplib::Request& req, httplib::Response& res) {
+      if (!tRequest.active) beginRequest(req, res);
+      if (!res.has_header("X-Request-Id")) res.set_header("X-Request-Id", tRequest.id);
+      if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;
+      std::string detail = statusTitle(res.status);
+      std::string type = "http-" + std::to_string(res.status);
+      if (res.status == 404) { type = "not-found"; detail = "no resource at " + req.method + " " + req.path; }
+      if (res.status == 413) { type = "payload-too-large"; detail = "the body exceeds the limit of " + std::to_string(config.maxBodyBytes) + " bytes"; }
+      sendProblem(res, res.status, type, statusTitle(res.status), detail);
+      return httplib::Server::HandlerResponse::Handled;
+    }));
+    http.set_exception_handler([](const httplib::Request&, httplib::Response& res, std::exception_ptr ep) {
+      std::string what = "unknown exception";
+      try {
+        if (ep) std::rethrow_exception(ep);
+      } catch (const std::exception& e) {
+        what = e.what();
+      } catch (...) {
+      }
+      sendProblem(res, 500, "internal-error", "Internal error", what);
+    });
+    // Count in the post-routing handler, which httplib runs before it writes the response: counting
+    // in the logger (after the write) let a client see its own request missing from /metrics.
+    http.set_post_routing_handler([this](const httplib::Request&, httplib::Response& res) {
+      metrics.countRequest(res.status);
+    });
+    http.set_logger([this](const httplib::Request& req, const httplib::Response& res) {
+      json line{{"ts_ms", std::chrono::duration_cast<std::chrono::milliseconds>(
+                              std::chrono::system_clock::now().time_since_epoch()).count()},
+                {"id", tRequest.id},
+                {"method", req.method},
+                {"path", req.path},
+                {"status", res.status},
+                {"duration_ms", tRequest.active ? std::chrono::duration<double, std::milli>(Clock::now() - tRequest.start).count() : 0.0}};
+      line["queue_ms"] = tRequest.queueMs >= 0 ? json(tRequest.queueMs) : json(nullptr);
+      line["render_ms"] = tRequest.renderMs >= 0 ? json(tRequest.renderMs) : json(nullptr);
+      line["encode_ms"] = tRequest.encodeMs >= 0 ? json(tRequest.encodeMs) : json(nullptr);
+      if (!tRequest.renderId.empty()) line["render_id"] = tRequest.renderId;
+      std::fprintf(stderr, "%s\n", line.dump().c_str());
+      tRequest = RequestContext{};
+    });
+
+    http.Get("/v1/health", wrap([](const httplib::Request&, httplib::Response& res) {
+      sendJson(res, 200, {{"status", "ok"}});
+    }));
+
+    http.Get("/v1/ready", wrap([this](const httplib::Request&, httplib::Response& res) {
+      if (shuttingDown) {
+        res.set_header("Retry-After", "5");
+        return sendProblem(res, 503, "shutting-down", "Shutting down", "the daemon is shutting down");
+      }
+      auto device = service.device();
+      if (!service.ready() || !device) {
+        res.set_header("Retry-After", "1");
+        return sendProblem(res, 503, "not-ready", "Not ready", service.notReadyReason());
+      }
+      sendJson(res, 200, {{"ready", true}, {"device", deviceJson(*device)}});
+    }));
+
+    http.Get("/v1/info", wrap([this](const httplib::Request&, httplib::Response& res) {
+      auto device = service.device();
+      sendJson(res, 200,
+               {{"name", "radiantd"},
+                {"version", kVersion},
+                {"api", "v1"},
+                {"ready", service.ready()},
+                {"device", device ? deviceJson(*device) : json(nullptr)},
+                {"limits", limitsJson()},
+                {"techniques", techniquesJson()},
+                {"request_schema", api::renderRequestSchema()}});
+    }));
+
+    http.Get("/metrics", wrap([this](const httplib::Request&, httplib::Response& res) {
+      std::map<std::string, std::pair<std::string, double>> gauges{
+          {"radiant_queue_depth", {"Jobs waiting for the render thread.", double(service.queueDepth())}},
+          {"radiant_jobs_active", {"Jobs rendering or encoding.", double(service.active())}},
+          {"radiant_ready", {"1 once the render thread has a GL context.", service.ready() ? 1.0 : 0.0}},
+          {"radiant_scene_store_bytes", {"Bytes of uploaded scenes stored.", double(scenes.totalBytes())}},
+          {"radiant_frame_store_bytes", {"Bytes of encoded frames stored.", double(frames.totalBytes())}}};
+      res.status = 200;
+      res.set_content(metrics.text(gauges), "text/plain; version=0.0.4; charset=utf-8");
+    }));
+
+    auto upload = wrap([this](const httplib::Request& req, httplib::Response& res) {
+      static const std::set<std::string> kTypes{"model/gltf-binary", "model/gltf+json", "application/octet-stream",
+                                                "application/json"};
+      const std::string type = mediaType(req);
+      if (!kTypes.count(type))
+        throw api::ApiError(415, "unsupported-media-type", "Unsupported media type",
+                            "scenes are uploaded as model/gltf-binary or model/gltf+json (also accepted: "
+                            "application/octet-stream, application/json), got \"" + type + "\"");
+      checkBodySize(req);
+      if (req.body.empty()) throw api::ApiError(400, "empty-body", "Empty body", "the body holds no scene");
+      const std::string digest = api::sceneDigest(req.body);
+      bool created = false;
+      if (!scenes.contains(digest)) {
+        decode(digest, req.body, "");  // reject what the loader cannot read before storing it
+        created = scenes.put(digest, req.body);
+      }
+      res.set_header("Location", "/v1/scenes/" + digest);
+      sendJson(res, created ? 201 : 200,
+               {{"digest", digest}, {"bytes", req.body.size()}, {"format", SceneStore::formatOf(req.body)},
+                {"created", created}});
+    });
+    http.Put("/v1/scenes", upload);
+    http.Post("/v1/scenes", upload);
+
+    http.Get("/v1/scenes", wrap([this](const httplib::Request&, httplib::Response& res) {
+      json builtins = json::array();
+      for (const auto& name : builtinNames()) builtins.push_back({{"name", name}, {"digest", *builtinDigest(name)}});
+      json uploaded = json::array();
+      for (const auto& s : scenes.list())
+        uploaded.push_back({{"digest", s.digest}, {"bytes", s.bytes}, {"format", s.format}});
+      sendJson(res, 200,
+               {{"builtins", builtins},
+                {"uploaded", uploaded},
+                {"store", {{"bytes", scenes.totalBytes()}, {"max_bytes", config.maxSceneBytes}}}});
+    }));
+
+    // GET and HEAD (httplib routes HEAD to GET handlers and sends no body).
+    http.Get(R"(/v1/scenes/([^/]+))", wrap([this](const httplib::Request& req, httplib::Response& res) {
+      const std::string ref = req.matches[1];
+      std::optional<std::string> bytes;
+      if (api::isSceneDigest(ref)) {
+        if (req.method == "HEAD" && scenes.contains(ref)) bytes = std::string();
+        else bytes = scenes.get(ref);
+        if (!bytes)
+          if (auto name = builtinByDigest(ref)) bytes = req.method == "HEAD" ? std::string() : hooks.builtinSceneSource(*name);
+      } else if (builtinDigest(ref)) {
+        bytes = req.method == "HEAD" ? std::string() : hooks.builtinSceneSource(ref);
+      }
+      if (!bytes) throw api::ApiError(404, "unknown-scene", "Unknown scene", "no scene " + ref);
+      res.status = 200;
+      if (req.method == "HEAD") return;
+      res.set_content(*bytes, SceneStore::formatOf(*bytes) == "glb" ? "model/gltf-binary" : "model/gltf+json");
+    }));
+
+    http.Post("/v1/renders", wrap([this](const httplib::Request& req, httplib::Response& res) {
+      if (mediaType(req) != "application/json")
+        throw api::ApiError(415, "unsupported-media-type", "Unsupported media type",
+                            "render requests are application/json, got \"" + mediaType(req) + "\"");
+      checkBodySize(req);
+      if (shuttingDown)
+        throw api::ApiError(503, "shutting-down", "Shutting down", "the daemon is shutting down and accepts no new renders");
+      api::RenderRequest request = api::parseRenderRequest(std::string_view(req.body), config.limits);
+      if (!hooks.techniques.empty())
+        for (const auto& [name, params] : request.passes) {
+          bool known = false;
+          for (const auto& t : hooks.techniques) known = known || t.name == name;
+          if (!known)
+            throw api::ApiError(422, "technique-unavailable", "Technique unavailable",
+                                "/passes/" + name + ": this daemon does not implement \"" + name + "\"",
+                                api::pointerAppend("/passes", name));
+        }
+      auto scene = resolveScene(request.scene);
+      std::shared_ptr<Job> job;
+      try {
+        job = service.submit(request, scene);
+      } catch (const api::ApiError& e) {
+        if (e.type == "queue-full") res.set_header("Retry-After", std::to_string(service.retryAfterSeconds()));
+        throw;
+      }
+      tRequest.renderId = job->id;
+      res.set_header("X-Render-Id", job->id);
+      if (request.async) {
+        res.set_header("Location", "/v1/renders/" + job->id);
+        json body = service.describe(*job);
+        body["url"] = "/v1/renders/" + job->id;
+        return sendJson(res, 202, body);
+      }
+      // Housekeeping fails the job at its deadline; the margin covers its 50 ms tick.
+      service.waitFor(job, job->deadline + std::chrono::seconds(2));
+      json body = service.describe(*job);
+      timingHeader(res, body);
+      if (body["state"] == "done") return sendJson(res, 200, body);
+      if (body.contains("error")) {
+        const json& e = body["error"];
+        std::string type = e["type"].get<std::string>().substr(std::string("https://radiant.dev/problems/").size());
+        return sendProblem(res, e["status"], type, e["title"], e["detail"], e.value("pointer", ""), job->id);
+      }
+      sendProblem(res, 504, "timeout", "Render timed out", "render " + job->id + " did not finish in time", "", job->id);
+    }));
+
+    http.Get(R"(/v1/renders/([A-Za-z0-9_-]+))", wrap([this](const httplib::Request& req, httplib::Response& res) {
+      auto job = service.find(req.matches[1]);
+      if (!job)
+        throw api::ApiError(404, "unknown-render", "Unknown render", "no render " + std::string(req.matches[1]) + " (finished renders expire after " + std::to_string(config.frameTtlS) + " s)");
+      tRequest.renderId = job->id;
+      json body = service.describe(*job);
+      if (body["progress"] == 1.0) timingHeader(res, body);
+      sendJson(res, 200, body);
+    }));
+
+    http.Delete(R"(/v1/renders/([A-Za-z0-9_-]+))", wrap([this](const httplib::Request& req, httplib::Response& res) {
+      const std::string id = req.matches[1];
+      tRequest.renderId = id;
+      switch (service.cancel(id)) {
+        case RenderService::CancelResult::NotFound:
+          throw api::ApiError(404, "unknown-render", "Unknown render", "no render " + id);
+        case RenderService::CancelResult::Removed:
+          return sendJson(res, 200, {{"id", id}, {"state", "canceled"}});
+        case RenderService::CancelResult::Requested:
+          return sendJson(res, 202, {{"id", id}, {"state", "running"}, {"cancel_requested", true}});
+        case RenderService::CancelResult::Forgotten:
+          return sendJson(res, 200, {{"id", id}, {"deleted", true}});
+      }
+    }));
+
+    http.Get(R"(/v1/frames/([A-Za-z0-9_-]+)/([A-Za-z0-9_.-]+))", wrap([this](const httplib::Request& req, httplib::Response& res) {
+      auto frame = frames.get(req.matches[1], req.matches[2]);
+      if (!frame)
+        throw api::ApiError(404, "unknown-frame", "Unknown frame",
+                            "no frame " + std::string(req.matches[1]) + "/" + std::string(req.matches[2]) +
+                                " (frames expire after " + std::to_string(config.frameTtlS) + " s)");
+      res.status = 200;
+      res.set_content(*frame->bytes, frame->contentType);
+    }));
+  }
+};
+
+HttpServer::HttpServer(ServerConfig config, BackendHooks hooks)
+    : impl_(std::make_unique<Impl>(std::move(config), std::move(hooks))) {}
+
+HttpServer::~HttpServer() {
+  impl_->http.stop();
+  impl_->service.stop();
+}
+
+int HttpServer::bind() {
+  int port = impl_->config.port;
+  if (port == 0) {
+    port = impl_->http.bind_to_any_port(impl_->config.host);
+    if (port < 0) throw std::runtime_error("HttpServer::bind(): cannot bind " + impl_->config.host + " to any port");
+  } else if (!impl_->http.bind_to_port(impl_->config.host, port)) {
+    throw std::runtime_error("HttpServer::bind(): cannot bind " + impl_->config.host + ":" + std::to_string(port));
+  }
+  return port;
+}
+
+bool HttpServer::run() { return impl_->http.listen_after_bind(); }
+
+void HttpServer::shutdown() {
+  impl_->shuttingDown = true;
+  impl_->service.drain();
+  impl_->http.stop();
+}
+
+RenderService& HttpServer::service() { return impl_->service; }
+const ServerConfig& HttpServer::config() const { return impl_->config; }
+
+}  // namespace radiant::server

@@ -1,0 +1,426 @@
+#include "server/RenderService.h"
+
+#include <cmath>
+#include <iostream>
+#include <random>
+
+namespace radiant::server {
+
+using nlohmann::json;
+
+namespace {
+
+double msBetween(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+std::string newRenderId() {
+  static std::mutex m;
+  static std::mt19937_64 rng{std::random_device{}()};
+  std::lock_guard lock(m);
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "r-%016llx", static_cast<unsigned long long>(rng()));
+  return buf;
+}
+
+}  // namespace
+
+const char* toString(JobState s) {
+  switch (s) {
+    case JobState::Queued: return "queued";
+    case JobState::Running: return "running";
+    case JobState::Encoding: return "encoding";
+    case JobState::Done: return "done";
+    case JobState::Failed: return "failed";
+    case JobState::Canceled: return "canceled";
+  }
+  return "unknown";
+}
+
+std::vector<Image> selectAovs(const std::vector<Image>& aovs, const api::OutputSpec& spec, std::size_t outputIndex) {
+  std::vector<Image> out;
+  for (std::size_t i = 0; i < spec.aovs.size(); ++i) {
+    const Image* found = nullptr;
+    for (const auto& img : aovs)
+      if (img.aov == spec.aovs[i]) found = &img;
+    if (!found) {
+      std::string have;
+      for (const auto& img : aovs) have += (have.empty() ? "" : ", ") + img.aov;
+      const std::string pointer = "/outputs/" + std::to_string(outputIndex) + "/aovs/" + std::to_string(i);
+      throw api::ApiError(422, "aov-not-produced", "AOV not produced",
+                          pointer + ": no pass that ran produced \"" + spec.aovs[i] + "\" (produced: " + have + ")",
+                          pointer);
+    }
+    out.push_back(*found);
+  }
+  return out;
+}
+
+RenderService::RenderService(const ServerConfig& config, const BackendHooks& hooks, FrameStore& frames,
+                             Metrics& metrics)
+    : config_(config), hooks_(hooks), frames_(frames), metrics_(metrics) {
+  renderThread_ = std::thread([this] { renderLoop(); });
+  for (int i = 0; i < std::max(1, config_.encoderThreads); ++i) encoders_.emplace_back([this] { encoderLoop(); });
+  housekeeping_ = std::thread([this] { housekeepingLoop(); });
+}
+
+RenderService::~RenderService() { stop(); }
+
+std::shared_ptr<Job> RenderService::submit(api::RenderRequest request, std::shared_ptr<const Scene> scene) {
+  auto job = std::make_shared<Job>();
+  job->id = newRenderId();
+  request.id = job->id;
+  job->request = std::move(request);
+  job->scene = std::move(scene);
+  std::lock_guard lock(mutex_);
+  if (draining_ || stopping_)
+    throw api::ApiError(503, "shutting-down", "Shutting down", "the daemon is shutting down and accepts no new renders");
+  if (queue_.size() >= static_cast<std::size_t>(config_.maxQueue)) {
+    metrics_.countRender("rejected");
+    throw api::ApiError(503, "queue-full", "Render queue full",
+                        "the render queue holds " + std::to_string(queue_.size()) + " jobs, its limit; retry later");
+  }
+  job->submitted = Clock::now();
+  job->deadline = job->submitted + std::chrono::duration_cast<Clock::duration>(
+                                       std::chrono::duration<double>(config_.requestTimeoutS));
+  queue_.push_back(job);
+  jobs_[job->id] = job;
+  changed_.notify_all();
+  return job;
+}
+
+std::shared_ptr<Job> RenderService::find(const std::string& id) {
+  std::lock_guard lock(mutex_);
+  auto it = jobs_.find(id);
+  return it == jobs_.end() ? nullptr : it->second;
+}
+
+bool RenderService::waitFor(const std::shared_ptr<Job>& job, Clock::time_point until) {
+  std::unique_lock lock(mutex_);
+  return changed_.wait_until(lock, until, [&] { return job->terminal(); });
+}
+
+json RenderService::describe(const Job& job) {
+  std::lock_guard lock(mutex_);
+  json j{{"id", job.id}, {"state", toString(job.state)}};
+  double progress = 0;
+  switch (job.state) {
+    case JobState::Queued: {
+      progress = 0;
+      std::size_t pos = 0;
+      for (; pos < queue_.size(); ++pos)
+        if (queue_[pos].get() == &job) break;
+      j["queue_position"] = pos;
+      break;
+    }
+    case JobState::Running: progress = 0.1; break;  // the renderer reports no finer progress yet
+    case JobState::Encoding: progress = 0.9; j["state"] = "running"; j["phase"] = "encoding"; break;
+    default: progress = 1; break;
+  }
+  if (job.state == JobState::Running) j["phase"] = "rendering";
+  j["progress"] = progress;
+  j["timings"] = {{"queue_ms", job.queueMs}, {"render_ms", job.renderMs}, {"encode_ms", job.encodeMs}};
+  if (job.state == JobState::Done) {
+    j["stats"] = job.stats;
+    json frames = json::array();
+    for (const auto& f : job.frames)
+      frames.push_back({{"name", f.name}, {"url", f.url}, {"format", f.format}, {"aovs", f.aovs}, {"bytes", f.bytes}});
+    j["frames"] = frames;
+  }
+  if (job.error) {
+    const Problem& p = *job.error;
+    j["error"] = {{"type", "https://radiant.dev/problems/" + p.type}, {"title", p.title}, {"status", p.status},
+                  {"detail", p.detail}};
+    if (!p.pointer.empty()) j["error"]["pointer"] = p.pointer;
+  }
+  return j;
+}
+
+RenderService::CancelResult RenderService::cancel(const std::string& id) {
+  std::unique_lock lock(mutex_);
+  auto it = jobs_.find(id);
+  if (it == jobs_.end()) return CancelResult::NotFound;
+  std::shared_ptr<Job> job = it->second;
+  switch (job->state) {
+    case JobState::Queued:
+      std::erase(queue_, job);
+      finishLocked(*job, JobState::Canceled, Problem{409, "canceled", "Render canceled", "canceled while queued", ""});
+      jobs_.erase(job->id);
+      return CancelResult::Removed;
+    case JobState::Running:
+    case JobState::Encoding:
+      job->cancel = true;
+      return CancelResult::Requested;
+    default:
+      jobs_.erase(it);
+      lock.unlock();
+      frames_.eraseRender(id);
+      return CancelResult::Forgotten;
+  }
+}
+
+bool RenderService::ready() {
+  std::lock_guard lock(mutex_);
+  return ready_;
+}
+std::optional<DeviceInfo> RenderService::device() {
+  std::lock_guard lock(mutex_);
+  return device_;
+}
+std::string RenderService::notReadyReason() {
+  std::lock_guard lock(mutex_);
+  return notReadyReason_;
+}
+int RenderService::retryAfterSeconds() {
+  std::lock_guard lock(mutex_);
+  return std::max(1, static_cast<int>(std::ceil(meanRenderSeconds_ * static_cast<double>(queue_.size() + 1))));
+}
+std::size_t RenderService::queueDepth() {
+  std::lock_guard lock(mutex_);
+  return queue_.size();
+}
+int RenderService::active() {
+  std::lock_guard lock(mutex_);
+  return running_ + encoding_;
+}
+
+void RenderService::finishLocked(Job& job, JobState state, std::optional<Problem> error) {
+  if (job.terminal()) return;
+  job.state = state;
+  job.finished = Clock::now();
+  job.error = std::move(error);
+  if (state == JobState::Done) metrics_.countRender("done");
+  else if (job.timedOut) metrics_.countRender("timeout");
+  else metrics_.countRender(state == JobState::Canceled ? "canceled" : "failed");
+  changed_.notify_all();
+}
+
+void RenderService::renderLoop() {
+  std::unique_ptr<RenderBackend> backend;
+  double backoff = 0.25;
+  for (;;) {
+    if (!backend) {
+      {
+        std::lock_guard lock(mutex_);
+        if (stopping_) break;
+      }
+      try {
+        backend = hooks_.createBackend();
+        DeviceInfo info = backend->device();
+        std::lock_guard lock(mutex_);
+        ready_ = true;
+        device_ = info;
+        notReadyReason_.clear();
+        backoff = 0.25;
+      } catch (const std::exception& e) {
+        backend.reset();
+        std::unique_lock lock(mutex_);
+        ready_ = false;
+        notReadyReason_ = std::string("creating the render backend failed: ") + e.what();
+        std::cerr << "{\"event\":\"backend_create_failed\",\"detail\":" << json(e.what()).dump() << "}\n";
+        changed_.wait_for(lock, std::chrono::duration<double>(backoff), [&] { return stopping_; });
+        backoff = std::min(backoff * 2, 30.0);
+        continue;
+      }
+    }
+
+    std::shared_ptr<Job> job;
+    {
+      std::unique_lock lock(mutex_);
+      changed_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
+      if (queue_.empty()) break;  // stopping and nothing left
+      job = queue_.front();
+      queue_.pop_front();
+      job->state = JobState::Running;
+      job->started = Clock::now();
+      job->queueMs = msBetween(job->submitted, job->started);
+      ++running_;
+      changed_.notify_all();
+    }
+    metrics_.observeQueue(job->queueMs / 1000);
+
+    std::optional<Problem> problem;
+    RenderOutput output;
+    bool recreate = false;
+    try {
+      output = backend->render(*job->scene, job->request, &job->cancel);
+    } catch (const api::ApiError& e) {
+      problem = Problem{e.status, e.type, e.title, e.detail(), e.pointer};
+    } catch (const std::exception& e) {
+      problem = Problem{500, "render-failed", "Render failed", std::string("render ") + job->id + ": " + e.what(), ""};
+      recreate = true;
+    } catch (...) {
+      problem = Problem{500, "render-failed", "Render failed", "render " + job->id + ": unknown exception", ""};
+      recreate = true;
+    }
+    const auto rendered = Clock::now();
+    const double renderS = std::chrono::duration<double>(rendered - job->started).count();
+    metrics_.observeRender(renderS);
+    if (!problem)
+      for (const auto& p : output.stats.passes) {
+        metrics_.observePass(p.name, "gpu", p.gpuMs / 1000);
+        metrics_.observePass(p.name, "cpu", p.cpuMs / 1000);
+      }
+    if (recreate) {
+      std::cerr << "{\"event\":\"backend_recreate\",\"render_id\":" << json(job->id).dump()
+                << ",\"detail\":" << json(problem->detail).dump() << "}\n";
+      backend.reset();  // destroyed here, on the thread that owns its context
+      std::lock_guard lock(mutex_);
+      ready_ = false;
+      notReadyReason_ = "recreating the render backend after: " + problem->detail;
+    }
+
+    std::lock_guard lock(mutex_);
+    --running_;
+    changed_.notify_all();  // drain() waits for running_ to reach 0
+    meanRenderSeconds_ = 0.8 * meanRenderSeconds_ + 0.2 * renderS;
+    job->rendered = rendered;
+    job->renderMs = renderS * 1000;
+    if (job->terminal()) continue;  // timed out meanwhile
+    if (problem) {
+      finishLocked(*job, JobState::Failed, problem);
+    } else if (job->cancel) {
+      finishLocked(*job, JobState::Canceled, Problem{409, "canceled", "Render canceled", "canceled while running", ""});
+    } else {
+      job->state = JobState::Encoding;
+      ++encoding_;
+      encodeQueue_.emplace_back(job, std::move(output));
+      encodeReady_.notify_one();
+      changed_.notify_all();
+    }
+  }
+  backend.reset();
+}
+
+void RenderService::encoderLoop() {
+  for (;;) {
+    std::pair<std::shared_ptr<Job>, RenderOutput> work;
+    {
+      std::unique_lock lock(mutex_);
+      encodeReady_.wait(lock, [&] { return stopping_ || !encodeQueue_.empty(); });
+      if (encodeQueue_.empty()) return;
+      work = std::move(encodeQueue_.front());
+      encodeQueue_.pop_front();
+    }
+    encode(work.first, std::move(work.second));
+  }
+}
+
+void RenderService::encode(const std::shared_ptr<Job>& job, RenderOutput output) {
+  const auto start = Clock::now();
+  std::optional<Problem> problem;
+  std::vector<FrameInfo> infos;
+  try {
+    const auto& outputs = job->request.outputs;
+    for (std::size_t i = 0; i < outputs.size(); ++i) {
+      if (job->cancel) break;
+      const api::OutputSpec& spec = outputs[i];
+      std::string bytes = hooks_.encodeFrame(output.aovs, spec, i, job->request.exposure);
+      FrameInfo f;
+      f.format = api::toString(spec.format);
+      f.name = std::to_string(i) + "." + f.format;
+      f.url = "/v1/frames/" + job->id + "/" + f.name;
+      f.aovs = spec.aovs;
+      f.bytes = bytes.size();
+      frames_.put(job->id, f.name, std::move(bytes), spec.format == api::ImageFormat::Exr ? "image/x-exr" : "image/png");
+      infos.push_back(std::move(f));
+    }
+  } catch (const api::ApiError& e) {
+    problem = Problem{e.status, e.type, e.title, e.detail(), e.pointer};
+  } catch (const std::exception& e) {
+    problem = Problem{500, "encode-failed", "Encoding failed", std::string("render ") + job->id + ": " + e.what(), ""};
+  }
+  const auto end = Clock::now();
+  metrics_.observeEncode(std::chrono::duration<double>(end - start).count());
+  std::lock_guard lock(mutex_);
+  --encoding_;
+  job->encodeMs = msBetween(start, end);
+  changed_.notify_all();
+  if (job->terminal()) {  // timed out while encoding
+    frames_.eraseRender(job->id);
+    return;
+  }
+  if (problem) {
+    frames_.eraseRender(job->id);
+    finishLocked(*job, JobState::Failed, problem);
+  } else if (job->cancel) {
+    frames_.eraseRender(job->id);
+    finishLocked(*job, JobState::Canceled, Problem{409, "canceled", "Render canceled", "canceled while encoding", ""});
+  } else {
+    job->stats = std::move(output.stats);
+    job->stats.encodeMs = job->encodeMs;
+    if (job->stats.renderMs == 0) job->stats.renderMs = job->renderMs;
+    job->frames = std::move(infos);
+    finishLocked(*job, JobState::Done, std::nullopt);
+  }
+}
+
+void RenderService::housekeepingLoop() {
+  std::unique_lock lock(mutex_);
+  while (!stopping_) {
+    changed_.wait_for(lock, std::chrono::milliseconds(50), [&] { return stopping_; });
+    const auto now = Clock::now();
+    for (auto it = queue_.begin(); it != queue_.end();) {
+      Job& job = **it;
+      if (now >= job.deadline) {
+        job.timedOut = true;
+        finishLocked(job, JobState::Failed,
+                     Problem{504, "timeout", "Render timed out",
+                             "render " + job.id + " waited in the queue past the request timeout of " +
+                                 std::to_string(config_.requestTimeoutS) + " s",
+                             ""});
+        it = queue_.erase(it);
+      } else {
+        ++it;
+      }
+    }
+    const auto ttl = std::chrono::duration<double>(config_.frameTtlS);
+    std::vector<std::string> expired;
+    for (auto& [id, job] : jobs_) {
+      if ((job->state == JobState::Running || job->state == JobState::Encoding) && now >= job->deadline &&
+          !job->terminal()) {
+        job->cancel = true;
+        job->timedOut = true;
+        finishLocked(*job, JobState::Failed,
+                     Problem{504, "timeout", "Render timed out",
+                             "render " + id + " ran past the request timeout of " +
+                                 std::to_string(config_.requestTimeoutS) + " s",
+                             ""});
+      }
+      if (job->terminal() && now - job->finished > ttl) expired.push_back(id);
+    }
+    for (const auto& id : expired) jobs_.erase(id);
+    lock.unlock();
+    for (const auto& id : expired) frames_.eraseRender(id);
+    frames_.purgeExpired();
+    lock.lock();
+  }
+}
+
+void RenderService::drain() {
+  std::unique_lock lock(mutex_);
+  draining_ = true;
+  changed_.wait(lock, [&] { return queue_.empty() && running_ == 0 && encoding_ == 0; });
+}
+
+void RenderService::stop() {
+  {
+    std::lock_guard lock(mutex_);
+    if (stopping_ && !renderThread_.joinable()) return;
+    stopping_ = true;
+    draining_ = true;
+    // Jobs still queued at a hard stop fail rather than hang their waiters.
+    for (auto& job : queue_)
+      finishLocked(*job, JobState::Failed, Problem{503, "shutting-down", "Shutting down", "the daemon stopped", ""});
+    queue_.clear();
+    changed_.notify_all();
+    encodeReady_.notify_all();
+  }
+  if (renderThread_.joinable()) renderThread_.join();
+  for (auto& t : encoders_)
+    if (t.joinable()) t.join();
+  encoders_.clear();
+  if (housekeeping_.joinable()) housekeeping_.join();
+}
+
+}  // namespace radiant::server

@@ -1,0 +1,59 @@
+#include "server/RendererBackend.h"
+
+#include "renderer/Renderer.h"
+#include "renderer/io/ImageIO.h"
+#include "renderer/scene/BuiltinScenes.h"
+#include "renderer/scene/GltfLoader.h"
+#include "server/RenderService.h"
+
+namespace radiant::server {
+
+namespace {
+
+class RendererBackend final : public RenderBackend {
+public:
+  explicit RendererBackend(const DeviceOptions& options) : renderer_(options) {}
+  DeviceInfo device() const override { return renderer_.device(); }
+  RenderOutput render(const Scene& scene, const api::RenderRequest& request,
+                      const std::atomic<bool>* cancel) override {
+    return renderer_.render(scene, request, cancel);
+  }
+
+private:
+  Renderer renderer_;
+};
+
+}  // namespace
+
+BackendHooks rendererHooks(const ServerConfig& config) {
+  DeviceOptions device;
+  device.index = config.deviceIndex;
+  device.nameContains = config.deviceName;
+  device.debug = config.glDebug;
+
+  BackendHooks h;
+  h.createBackend = [device] { return std::make_unique<RendererBackend>(device); };
+  const std::size_t maxBytes = config.maxBodyBytes;
+  h.decodeScene = [maxBytes](std::string_view bytes) {
+    LoadOptions options;  // empty asset root: uploads may not reference external files
+    options.maxBytes = std::max<std::size_t>(maxBytes, std::size_t(256) << 20);
+    try {
+      return loadSceneFromMemory(bytes, options);
+    } catch (const SceneError& e) {
+      throw api::ApiError(422, "invalid-scene", "Invalid scene",
+                          std::string("the glTF file is invalid") +
+                              (e.pointer.empty() ? "" : " at " + e.pointer) + ": " + e.what());
+    }
+  };
+  h.builtinSceneNames = [] { return builtinSceneNames(); };
+  h.builtinSceneSource = [](const std::string& name) { return std::string(builtinSceneSource(name)); };
+  h.encodeFrame = [](const std::vector<Image>& aovs, const api::OutputSpec& spec, std::size_t index, float exposure) {
+    std::vector<Image> chosen = selectAovs(aovs, spec, index);
+    return spec.format == api::ImageFormat::Exr ? io::encodeExr(chosen, spec.halfFloat)
+                                                : io::encodePng(chosen.front(), exposure);
+  };
+  h.techniques = Renderer::techniques();
+  return h;
+}
+
+}  // namespace radiant::server

@@ -1,0 +1,142 @@
+#include "server/SceneStore.h"
+
+#include <algorithm>
+#include <fstream>
+#include <iostream>
+#include <system_error>
+
+#include "api/Sha256.h"
+#include "api/Types.h"
+
+namespace radiant::server {
+
+namespace fs = std::filesystem;
+
+std::string SceneStore::formatOf(const std::string& bytes) {
+  return bytes.size() >= 4 && bytes.compare(0, 4, "glTF") == 0 ? "glb" : "gltf";
+}
+
+SceneStore::SceneStore(fs::path cacheDir, std::size_t maxBytes) : maxBytes_(maxBytes) {
+  if (cacheDir.empty()) return;
+  dir_ = cacheDir / "scenes";
+  fs::create_directories(dir_);
+  struct Found {
+    StoredSceneInfo info;
+    fs::file_time_type mtime;
+  };
+  std::vector<Found> found;
+  for (const auto& f : fs::directory_iterator(dir_)) {
+    if (!f.is_regular_file()) continue;
+    const std::string ext = f.path().extension().string();
+    const std::string digest = "sha256:" + f.path().stem().string();
+    if ((ext != ".glb" && ext != ".gltf") || !api::isSceneDigest(digest)) {
+      if (f.path().filename().string().rfind(".tmp-", 0) == 0) fs::remove(f.path());  // an interrupted write
+      continue;
+    }
+    found.push_back({{digest, static_cast<std::size_t>(f.file_size()), ext.substr(1)}, f.last_write_time()});
+  }
+  std::sort(found.begin(), found.end(), [](const Found& a, const Found& b) { return a.mtime > b.mtime; });
+  for (auto& f : found) {
+    lru_.push_back(Entry{f.info, nullptr});
+    index_[f.info.digest] = std::prev(lru_.end());
+    total_ += f.info.bytes;
+  }
+  evictLocked("");
+}
+
+fs::path SceneStore::fileFor(const Entry& e) const {
+  return dir_ / (e.info.digest.substr(7) + "." + e.info.format);
+}
+
+void SceneStore::touch(std::list<Entry>::iterator it) {
+  lru_.splice(lru_.begin(), lru_, it);
+  if (!dir_.empty()) {
+    std::error_code ec;  // best effort: the order survives a restart
+    fs::last_write_time(fileFor(*it), fs::file_time_type::clock::now(), ec);
+  }
+}
+
+void SceneStore::evictLocked(const std::string& keep) {
+  while (total_ > maxBytes_ && !lru_.empty()) {
+    auto victim = std::prev(lru_.end());
+    if (victim->info.digest == keep) {
+      if (lru_.size() == 1) break;
+      victim = std::prev(victim);
+    }
+    total_ -= victim->info.bytes;
+    if (!dir_.empty()) {
+      std::error_code ec;
+      fs::remove(fileFor(*victim), ec);
+    }
+    index_.erase(victim->info.digest);
+    lru_.erase(victim);
+  }
+}
+
+bool SceneStore::put(const std::string& digest, std::string bytes) {
+  if (bytes.size() > maxBytes_)
+    throw api::ApiError(413, "payload-too-large", "Payload too large",
+                        "the scene is " + std::to_string(bytes.size()) + " bytes, the scene store holds " +
+                            std::to_string(maxBytes_));
+  std::lock_guard lock(mutex_);
+  if (auto it = index_.find(digest); it != index_.end()) {
+    touch(it->second);
+    return false;
+  }
+  Entry e{{digest, bytes.size(), formatOf(bytes)}, nullptr};
+  if (!dir_.empty()) {
+    // Write then rename, so a crash never leaves a truncated file under a digest name.
+    const fs::path tmp = dir_ / (".tmp-" + digest.substr(7));
+    {
+      std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+      out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+      if (!out) throw std::runtime_error("SceneStore::put(): cannot write " + tmp.string());
+    }
+    fs::rename(tmp, fileFor(e));
+  } else {
+    e.bytes = std::make_shared<const std::string>(std::move(bytes));
+  }
+  lru_.push_front(std::move(e));
+  index_[digest] = lru_.begin();
+  total_ += lru_.front().info.bytes;
+  evictLocked(digest);
+  return true;
+}
+
+bool SceneStore::contains(const std::string& digest) {
+  std::lock_guard lock(mutex_);
+  auto it = index_.find(digest);
+  if (it == index_.end()) return false;
+  touch(it->second);
+  return true;
+}
+
+std::optional<std::string> SceneStore::get(const std::string& digest) {
+  std::lock_guard lock(mutex_);
+  auto it = index_.find(digest);
+  if (it == index_.end()) return std::nullopt;
+  touch(it->second);
+  if (it->second->bytes) return *it->second->bytes;
+  std::ifstream in(fileFor(*it->second), std::ios::binary);
+  if (!in) {  // removed behind our back: forget it
+    total_ -= it->second->info.bytes;
+    lru_.erase(it->second);
+    index_.erase(it);
+    return std::nullopt;
+  }
+  return std::string((std::istreambuf_iterator<char>(in)), {});
+}
+
+std::vector<StoredSceneInfo> SceneStore::list() {
+  std::lock_guard lock(mutex_);
+  std::vector<StoredSceneInfo> out;
+  for (const auto& e : lru_) out.push_back(e.info);
+  return out;
+}
+
+std::size_t SceneStore::totalBytes() {
+  std::lock_guard lock(mutex_);
+  return total_;
+}
+
+}  // namespace radiant::server

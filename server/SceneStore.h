@@ -1,0 +1,54 @@
+#pragma once
+// Content-addressed scene store: glTF/GLB bytes keyed by "sha256:<hex>" of exactly those bytes.
+// Bounded in bytes with least-recently-used eviction. With a cache directory the bytes live in
+// <dir>/scenes/<hex>.glb|.gltf (written atomically, mtime = last use) and survive restarts;
+// without one they live in memory. Thread-safe.
+
+#include <cstddef>
+#include <filesystem>
+#include <list>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace radiant::server {
+
+struct StoredSceneInfo {
+  std::string digest;
+  std::size_t bytes = 0;
+  std::string format;  // "glb" | "gltf"
+};
+
+class SceneStore {
+public:
+  SceneStore(std::filesystem::path cacheDir, std::size_t maxBytes);
+  // Stores `bytes` under its digest; returns false when it was already there (idempotent).
+  // Throws api::ApiError 413 when the scene alone exceeds the store.
+  bool put(const std::string& digest, std::string bytes);
+  bool contains(const std::string& digest);  // counts as a use
+  std::optional<std::string> get(const std::string& digest);
+  std::vector<StoredSceneInfo> list();  // most recently used first
+  std::size_t totalBytes();
+  static std::string formatOf(const std::string& bytes);  // "glb" when it starts with the GLB magic
+
+private:
+  struct Entry {
+    StoredSceneInfo info;
+    std::shared_ptr<const std::string> bytes;  // in memory (no cache dir)
+  };
+  std::filesystem::path fileFor(const Entry& e) const;
+  void touch(std::list<Entry>::iterator it);
+  void evictLocked(const std::string& keep);
+
+  std::filesystem::path dir_;  // "" = memory only
+  std::size_t maxBytes_;
+  std::mutex mutex_;
+  std::list<Entry> lru_;  // front = most recently used
+  std::map<std::string, std::list<Entry>::iterator> index_;
+  std::size_t total_ = 0;
+};
+
+}  // namespace radiant::server

@@ -1,0 +1,130 @@
+#pragma once
+// A deterministic render backend for testing the server without GL. Every pixel of "beauty" is
+// seed + 0.25, so a frame proves which request it belongs to; the encoder writes a one-line text
+// "frame" that the tests parse. A shared FakeControl lets a test hold renders (gate), make one
+// fail, or count backend creations.
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "api/Validate.h"
+#include "server/Backend.h"
+#include "server/RenderService.h"
+
+namespace radiant::test {
+
+struct FakeControl {
+  std::mutex m;
+  std::condition_variable cv;
+  bool gateOpen = true;
+  std::atomic<int> creates{0}, started{0}, finished{0};
+  std::atomic<bool> failNext{false}, apiErrorNext{false}, failCreate{false};
+  std::atomic<int> delayMs{0};
+
+  void close() { std::lock_guard l(m); gateOpen = false; }
+  void open() { { std::lock_guard l(m); gateOpen = true; } cv.notify_all(); }
+  // Waits until `n` renders have started (the render thread holds one).
+  bool waitStarted(int n, std::chrono::milliseconds timeout = std::chrono::seconds(10)) {
+    const auto end = std::chrono::steady_clock::now() + timeout;
+    while (started < n) {
+      if (std::chrono::steady_clock::now() > end) return false;
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    return true;
+  }
+};
+
+class FakeBackend final : public server::RenderBackend {
+public:
+  explicit FakeBackend(FakeControl& c) : c_(c) {}
+  DeviceInfo device() const override {
+    DeviceInfo d;
+    d.vendor = "Radiant tests";
+    d.renderer = "fake";
+    d.version = "4.5 (fake)";
+    d.platform = "none";
+    d.reason = "injected by the test";
+    d.software = true;
+    return d;
+  }
+  RenderOutput render(const Scene& scene, const api::RenderRequest& r, const std::atomic<bool>* cancel) override {
+    ++c_.started;
+    {
+      std::unique_lock l(c_.m);
+      while (!c_.gateOpen && !(cancel && *cancel)) c_.cv.wait_for(l, std::chrono::milliseconds(5));
+    }
+    for (int waited = 0; waited < c_.delayMs && !(cancel && *cancel); waited += 5)
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    if (c_.failNext.exchange(false)) throw std::runtime_error("glDrawElements: GL_OUT_OF_MEMORY (fake)");
+    if (c_.apiErrorNext.exchange(false))
+      throw api::ApiError(422, "unknown-receiver", "Unknown receiver", "no node named 'floor' (fake)", "/passes/direct");
+    RenderOutput out;
+    Image beauty = Image::make("beauty", r.width, r.height, 3);
+    for (float& v : beauty.pixels) v = static_cast<float>(r.seed) + 0.25f;
+    out.aovs.push_back(beauty);
+    Image depth = Image::make("depth", r.width, r.height, 1);
+    out.aovs.push_back(depth);
+    api::PassStats p;
+    p.name = "fake_pass";
+    p.gpuMs = 1.0;
+    p.cpuMs = 0.5;
+    p.counters["pixels"] = double(r.width) * r.height;
+    out.stats.passes.push_back(p);
+    out.stats.triangles = scene.features.triangles;
+    out.stats.device["renderer"] = "fake";
+    ++c_.finished;
+    return out;
+  }
+
+private:
+  FakeControl& c_;
+};
+
+inline const char* kTinyGltf = R"({"asset":{"version":"2.0"},"scenes":[{"nodes":[]}],"scene":0})";
+
+inline server::BackendHooks fakeHooks(FakeControl& c) {
+  server::BackendHooks h;
+  h.createBackend = [&c]() -> std::unique_ptr<server::RenderBackend> {
+    ++c.creates;
+    if (c.failCreate) throw std::runtime_error("eglInitialize failed: EGL_NOT_INITIALIZED (fake)");
+    return std::make_unique<FakeBackend>(c);
+  };
+  h.decodeScene = [](std::string_view bytes) {
+    Scene s;
+    const bool glb = bytes.size() >= 4 && bytes.substr(0, 4) == "glTF";
+    if (!glb) {
+      nlohmann::json j = nlohmann::json::parse(bytes, nullptr, false);
+      if (j.is_discarded() || !j.is_object() || !j.contains("asset"))
+        throw api::ApiError(422, "invalid-scene", "Invalid scene", "the glTF file is invalid at /asset: missing (fake)");
+    }
+    s.name = glb ? "glb" : "gltf";
+    s.features.triangles = bytes.size();  // lets a test see which bytes reached the renderer
+    return s;
+  };
+  h.builtinSceneNames = [] { return std::vector<std::string>{"tiny", "tiny2"}; };
+  h.builtinSceneSource = [](const std::string& name) {
+    if (name == "tiny") return std::string(kTinyGltf);
+    if (name == "tiny2") return std::string(R"({"asset":{"version":"2.0"},"extras":{"n":2}})");
+    throw std::out_of_range("no builtin " + name);
+  };
+  h.encodeFrame = [](const std::vector<Image>& aovs, const api::OutputSpec& spec, std::size_t index, float exposure) {
+    std::vector<Image> chosen = server::selectAovs(aovs, spec, index);
+    nlohmann::json j{{"format", api::toString(spec.format)}, {"width", chosen[0].width}, {"height", chosen[0].height},
+                     {"value", chosen[0].pixels.empty() ? 0.f : chosen[0].pixels[0]}, {"exposure", exposure}};
+    for (const auto& img : chosen) j["aovs"].push_back(img.aov);
+    return "FAKEFRAME " + j.dump();
+  };
+  h.techniques = {{"direct", "fake direct", {"direct"}},
+                  {"gbuffer", "fake gbuffer", {"albedo", "normal", "depth"}},
+                  {"shadow_maps", "fake shadow maps", {}}};
+  return h;
+}
+
+}  // namespace radiant::test

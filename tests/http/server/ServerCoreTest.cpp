@@ -1,0 +1,601 @@
+// The server core in-process, with the fake backend: routes, error model, queue, cancel, timeouts,
+// scene store, metrics, shutdown. Talks real HTTP on an ephemeral loopback port.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <future>
+#include <set>
+#include <thread>
+
+#include <httplib.h>
+#include <nlohmann/json.hpp>
+
+#include "FakeBackend.h"
+#include "api/Sha256.h"
+#include "server/Config.h"
+#include "server/HttpServer.h"
+#include "server/RenderService.h"
+
+using nlohmann::json;
+using radiant::server::HttpServer;
+using radiant::server::ServerConfig;
+using radiant::test::FakeControl;
+
+namespace {
+
+struct TestServer {
+  FakeControl control;
+  std::unique_ptr<HttpServer> server;
+  std::thread thread;
+  int port = 0;
+
+  explicit TestServer(ServerConfig config = {}) {
+    config.port = 0;
+    server = std::make_unique<HttpServer>(config, radiant::test::fakeHooks(control));
+    port = server->bind();
+    thread = std::thread([this] { server->run(); });
+  }
+  ~TestServer() { stop(); }
+  void stop() {
+    if (!server) return;
+    control.open();
+    server->shutdown();
+    thread.join();
+    server.reset();
+  }
+  httplib::Client client(int readTimeoutS = 20) const {
+    httplib::Client c("127.0.0.1", port);
+    c.set_read_timeout(readTimeoutS, 0);
+    return c;
+  }
+  void waitReady() {
+    auto c = client();
+    for (int i = 0; i < 500; ++i) {
+      auto r = c.Get("/v1/ready");
+      if (r && r->status == 200) return;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    FAIL() << "not ready";
+  }
+};
+
+json renderBody(std::uint64_t seed = 1, int w = 8, int h = 4) {
+  return json{{"scene", {{"builtin", "tiny"}}}, {"width", w}, {"height", h}, {"seed", seed}};
+}
+
+httplib::Result post(httplib::Client& c, const std::string& path, const json& body) {
+  return c.Post(path.c_str(), body.dump(), "application/json");
+}
+
+json body(const httplib::Result& r) { return json::parse(r->body); }
+
+// Every error response: problem+json with the given status, type slug and pointer.
+void expectProblem(const httplib::Result& r, int status, const std::string& type, const std::string& pointer) {
+  ASSERT_TRUE(r) << "no response";
+  EXPECT_EQ(r->status, status) << r->body;
+  EXPECT_EQ(r->get_header_value("Content-Type"), "application/problem+json") << r->body;
+  json p = json::parse(r->body, nullptr, false);
+  ASSERT_TRUE(p.is_object()) << r->body;
+  EXPECT_EQ(p["type"], "https://radiant.dev/problems/" + type) << r->body;
+  EXPECT_EQ(p["status"], status);
+  EXPECT_TRUE(p["title"].is_string());
+  EXPECT_TRUE(p["detail"].is_string());
+  EXPECT_TRUE(p["request_id"].is_string()) << r->body;
+  EXPECT_EQ(p["request_id"], r->get_header_value("X-Request-Id"));
+  if (pointer.empty()) EXPECT_FALSE(p.contains("pointer")) << r->body;
+  else EXPECT_EQ(p.value("pointer", "<none>"), pointer) << r->body;
+}
+
+// The fake encoder writes "FAKEFRAME {json}".
+json frameOf(const std::string& bytes) {
+  EXPECT_EQ(bytes.rfind("FAKEFRAME ", 0), 0u) << bytes;
+  return json::parse(bytes.substr(10));
+}
+
+void expectGoodRender(httplib::Client& c, std::uint64_t seed) {
+  auto r = post(c, "/v1/renders", renderBody(seed));
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  json b = body(r);
+  ASSERT_EQ(b["frames"].size(), 1u);
+  auto f = c.Get(b["frames"][0]["url"].get<std::string>().c_str());
+  ASSERT_TRUE(f);
+  ASSERT_EQ(f->status, 200);
+  EXPECT_DOUBLE_EQ(frameOf(f->body)["value"].get<double>(), double(seed) + 0.25);
+}
+
+std::filesystem::path tempDir(const std::string& name) {
+  auto dir = std::filesystem::temp_directory_path() / ("radiant-http-" + name + "-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+}  // namespace
+
+TEST(ServerCore, HealthReadyInfo) {
+  TestServer s;
+  auto c = s.client();
+  auto h = c.Get("/v1/health");
+  ASSERT_TRUE(h);
+  EXPECT_EQ(h->status, 200);
+  EXPECT_EQ(body(h)["status"], "ok");
+  s.waitReady();
+  auto ready = c.Get("/v1/ready");
+  EXPECT_EQ(body(ready)["device"]["renderer"], "fake");
+
+  auto info = c.Get("/v1/info");
+  ASSERT_EQ(info->status, 200);
+  json i = body(info);
+  EXPECT_EQ(i["name"], "radiantd");
+  EXPECT_EQ(i["limits"]["max_width"], 4096);
+  bool sawDirect = false, sawReference = false;
+  for (const auto& t : i["techniques"]) {
+    if (t["name"] == "direct") {
+      sawDirect = true;
+      EXPECT_EQ(t["available"], true);
+      EXPECT_EQ(t["params"]["pcf_radius"]["type"], "integer");
+      EXPECT_EQ(t["params"]["pcf_radius"]["default"], 1);
+      EXPECT_EQ(t["params"]["pcf_radius"]["maximum"], 4);
+    }
+    if (t["name"] == "reference") {
+      sawReference = true;
+      EXPECT_EQ(t["available"], false);  // the fake lists no reference technique
+    }
+  }
+  EXPECT_TRUE(sawDirect);
+  EXPECT_TRUE(sawReference);
+  EXPECT_TRUE(i["request_schema"]["properties"]["passes"]["properties"].contains("direct"));
+}
+
+TEST(ServerCore, EveryErrorClassNamesItsFieldAndTheNextRequestWorks) {
+  ServerConfig config;
+  config.limits.maxWidth = 512;
+  config.maxBodyBytes = 64 * 1024;
+  TestServer s(config);
+  s.waitReady();
+  auto c = s.client();
+
+  // 400: not JSON.
+  expectProblem(c.Post("/v1/renders", "{\"scene\": ", "application/json"), 400, "malformed-json", "");
+  expectGoodRender(c, 1);
+  // 400: wrong JSON type.
+  json b = renderBody();
+  b["width"] = "wide";
+  expectProblem(post(c, "/v1/renders", b), 400, "type-mismatch", "/width");
+  expectGoodRender(c, 2);
+  // 422: unknown key, deep.
+  b = renderBody();
+  b["passes"] = {{"direct", {{"pcf_radius", 1}, {"pcf_radios", 2}}}};
+  expectProblem(post(c, "/v1/renders", b), 422, "unknown-field", "/passes/direct/pcf_radios");
+  expectGoodRender(c, 3);
+  // 422: out of range.
+  b = renderBody();
+  b["passes"] = {{"shadow_maps", {{"shadow_map_size", 100000}}}};
+  expectProblem(post(c, "/v1/renders", b), 422, "out-of-range", "/passes/shadow_maps/shadow_map_size");
+  expectGoodRender(c, 4);
+  // 422: within the schema but above this server's limit.
+  b = renderBody(1, 1024, 8);
+  expectProblem(post(c, "/v1/renders", b), 422, "limit-exceeded", "/width");
+  // 422: a technique the schema knows but this backend does not implement.
+  b = renderBody();
+  b["passes"] = {{"reference", json::object()}};
+  expectProblem(post(c, "/v1/renders", b), 422, "technique-unavailable", "/passes/reference");
+  // 422: an AOV no pass produced (found while encoding).
+  b = renderBody();
+  b["outputs"] = {{{"format", "exr"}, {"aovs", {"beauty", "albedo"}}}};
+  expectProblem(post(c, "/v1/renders", b), 422, "aov-not-produced", "/outputs/0/aovs/1");
+  expectGoodRender(c, 5);
+  // 404: unknown scenes.
+  b = renderBody();
+  b["scene"] = {{"digest", "sha256:" + std::string(64, '0')}};
+  expectProblem(post(c, "/v1/renders", b), 404, "unknown-scene", "/scene/digest");
+  b["scene"] = {{"builtin", "nope"}};
+  expectProblem(post(c, "/v1/renders", b), 404, "unknown-scene", "/scene/builtin");
+  expectGoodRender(c, 6);
+  // 413: body over the limit (httplib's own check via Content-Length, and ours).
+  std::string big(100 * 1024, ' ');
+  expectProblem(c.Post("/v1/renders", big, "application/json"), 413, "payload-too-large", "");
+  expectProblem(c.Put("/v1/scenes", big, "model/gltf+json"), 413, "payload-too-large", "");
+  expectGoodRender(c, 7);
+  // 415: wrong content type.
+  expectProblem(c.Post("/v1/renders", renderBody().dump(), "text/plain"), 415, "unsupported-media-type", "");
+  expectProblem(c.Put("/v1/scenes", radiant::test::kTinyGltf, "image/png"), 415, "unsupported-media-type", "");
+  expectGoodRender(c, 8);
+  // 422: an invalid scene upload.
+  expectProblem(c.Put("/v1/scenes", "{\"no\":\"asset\"}", "model/gltf+json"), 422, "invalid-scene", "");
+  // 404: no such route, no such render, no such frame: still problem+json.
+  expectProblem(c.Get("/v1/nothing"), 404, "not-found", "");
+  expectProblem(c.Get("/v1/renders/r-doesnotexist"), 404, "unknown-render", "");
+  expectProblem(c.Get("/v1/frames/r-x/0.png"), 404, "unknown-frame", "");
+  // 422 raised by the renderer itself keeps its pointer.
+  s.control.apiErrorNext = true;
+  expectProblem(post(c, "/v1/renders", renderBody()), 422, "unknown-receiver", "/passes/direct");
+  expectGoodRender(c, 9);
+  EXPECT_EQ(s.control.creates, 1) << "a request error must not recreate the backend";
+  // 500: an environment failure; the problem carries the render id, the backend is recreated.
+  s.control.failNext = true;
+  auto failed = post(c, "/v1/renders", renderBody());
+  expectProblem(failed, 500, "render-failed", "");
+  EXPECT_TRUE(body(failed)["render_id"].is_string());
+  EXPECT_NE(body(failed)["detail"].get<std::string>().find("GL_OUT_OF_MEMORY"), std::string::npos);
+  expectGoodRender(c, 10);
+  EXPECT_EQ(s.control.creates, 2) << "the backend is recreated after an environment failure";
+}
+
+TEST(ServerCore, ClientRequestIdIsEchoed) {
+  TestServer s;
+  auto c = s.client();
+  auto r = c.Get("/v1/health", {{"X-Request-Id", "trace-123"}});
+  EXPECT_EQ(r->get_header_value("X-Request-Id"), "trace-123");
+  r = c.Get("/v1/health", {{"X-Request-Id", "bad id with spaces"}});
+  EXPECT_NE(r->get_header_value("X-Request-Id"), "bad id with spaces");
+  EXPECT_FALSE(r->get_header_value("X-Request-Id").empty());
+}
+
+TEST(ServerCore, FullQueueIs503WithRetryAfter) {
+  ServerConfig config;
+  config.maxQueue = 2;
+  TestServer s(config);
+  s.waitReady();
+  auto c = s.client();
+  s.control.close();
+  json a = renderBody(1);
+  a["async"] = true;
+  auto first = post(c, "/v1/renders", a);
+  ASSERT_EQ(first->status, 202) << first->body;
+  ASSERT_TRUE(s.control.waitStarted(1));  // running: not counted against the queue
+  EXPECT_EQ(post(c, "/v1/renders", a)->status, 202);
+  EXPECT_EQ(post(c, "/v1/renders", a)->status, 202);
+  auto full = post(c, "/v1/renders", a);
+  expectProblem(full, 503, "queue-full", "");
+  ASSERT_TRUE(full->has_header("Retry-After"));
+  EXPECT_GE(std::stoi(full->get_header_value("Retry-After")), 1);
+  auto metrics = c.Get("/metrics");
+  EXPECT_NE(metrics->body.find("radiant_queue_depth 2"), std::string::npos) << metrics->body;
+  s.control.open();
+  // Once the queue drains, a sync request goes through.
+  expectGoodRender(c, 77);
+}
+
+TEST(ServerCore, EightConcurrentClientsGetTheirOwnFrames) {
+  TestServer s;
+  s.waitReady();
+  s.control.delayMs = 20;
+  std::vector<std::future<std::string>> results;
+  for (int i = 0; i < 8; ++i)
+    results.push_back(std::async(std::launch::async, [&s, i]() -> std::string {
+      auto c = s.client();
+      json b = renderBody(100 + i, 16 + i, 8 + i);
+      b["outputs"] = {{{"format", "png"}}, {{"format", "exr"}, {"aovs", {"beauty", "depth"}}}};
+      auto r = post(c, "/v1/renders", b);
+      if (!r || r->status != 200) return "render failed: " + (r ? r->body : std::string("no response"));
+      json out = body(r);
+      if (out["frames"].size() != 2) return "expected 2 frames";
+      json png = frameOf(c.Get(out["frames"][0]["url"].get<std::string>().c_str())->body);
+      json exr = frameOf(c.Get(out["frames"][1]["url"].get<std::string>().c_str())->body);
+      if (png["value"] != 100 + i + 0.25 || png["width"] != 16 + i || png["height"] != 8 + i || png["format"] != "png")
+        return "wrong png frame " + png.dump();
+      if (exr["aovs"] != json::array({"beauty", "depth"}) || exr["format"] != "exr") return "wrong exr frame " + exr.dump();
+      return out["id"].get<std::string>();
+    }));
+  std::set<std::string> ids;
+  for (auto& f : results) {
+    std::string id = f.get();
+    EXPECT_EQ(id.rfind("r-", 0), 0u) << id;
+    ids.insert(id);
+  }
+  EXPECT_EQ(ids.size(), 8u);
+  EXPECT_EQ(s.control.finished, 8);
+}
+
+TEST(ServerCore, AsyncRenderPollsToDone) {
+  TestServer s;
+  s.waitReady();
+  auto c = s.client();
+  json b = renderBody(5);
+  b["async"] = true;
+  auto r = post(c, "/v1/renders", b);
+  ASSERT_EQ(r->status, 202);
+  const std::string location = r->get_header_value("Location");
+  EXPECT_EQ(location, "/v1/renders/" + body(r)["id"].get<std::string>());
+  json state;
+  for (int i = 0; i < 500; ++i) {
+    state = body(c.Get(location.c_str()));
+    if (state["state"] == "done") break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_EQ(state["state"], "done") << state.dump();
+  EXPECT_EQ(state["progress"], 1.0);
+  EXPECT_EQ(state["stats"]["passes"][0]["name"], "fake_pass");
+  EXPECT_EQ(state["stats"]["triangles"], std::string(radiant::test::kTinyGltf).size());
+  auto f = c.Get(state["frames"][0]["url"].get<std::string>().c_str());
+  EXPECT_EQ(frameOf(f->body)["value"], 5.25);
+  EXPECT_EQ(f->get_header_value("Content-Type"), "image/png");
+}
+
+TEST(ServerCore, CancelQueuedRemovesItAndCancelRunningStopsIt) {
+  TestServer s;
+  s.waitReady();
+  auto c = s.client();
+  s.control.close();
+  json b = renderBody(1);
+  b["async"] = true;
+  std::string running = body(post(c, "/v1/renders", b))["id"];
+  ASSERT_TRUE(s.control.waitStarted(1));
+  std::string queued = body(post(c, "/v1/renders", b))["id"];
+  json q = body(c.Get(("/v1/renders/" + queued).c_str()));
+  EXPECT_EQ(q["state"], "queued");
+  EXPECT_EQ(q["queue_position"], 0);
+
+  auto del = c.Delete(("/v1/renders/" + queued).c_str());
+  ASSERT_EQ(del->status, 200);
+  EXPECT_EQ(body(del)["state"], "canceled");
+  expectProblem(c.Get(("/v1/renders/" + queued).c_str()), 404, "unknown-render", "");
+
+  del = c.Delete(("/v1/renders/" + running).c_str());
+  ASSERT_EQ(del->status, 202);
+  EXPECT_EQ(body(del)["cancel_requested"], true);
+  json st;
+  for (int i = 0; i < 500; ++i) {
+    st = body(c.Get(("/v1/renders/" + running).c_str()));
+    if (st["state"] == "canceled") break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  EXPECT_EQ(st["state"], "canceled") << st.dump();
+  EXPECT_EQ(s.control.started, 1) << "the canceled queued job never reached the renderer";
+  s.control.open();
+  expectGoodRender(c, 3);
+}
+
+TEST(ServerCore, UploadIsIdempotentAndHeadAnswers) {
+  TestServer s;
+  s.waitReady();
+  auto c = s.client();
+  const std::string scene = R"({"asset":{"version":"2.0"},"extras":{"upload":1}})";
+  const std::string digest = radiant::api::sceneDigest(scene);
+
+  EXPECT_EQ(c.Head(("/v1/scenes/" + digest).c_str())->status, 404);
+  auto first = c.Put("/v1/scenes", scene, "model/gltf+json");
+  ASSERT_EQ(first->status, 201) << first->body;
+  EXPECT_EQ(body(first)["digest"], digest);
+  EXPECT_EQ(first->get_header_value("Location"), "/v1/scenes/" + digest);
+  auto again = c.Post("/v1/scenes", scene, "model/gltf+json");
+  ASSERT_EQ(again->status, 200);
+  EXPECT_EQ(body(again)["digest"], digest);
+  EXPECT_EQ(body(again)["created"], false);
+  EXPECT_EQ(c.Head(("/v1/scenes/" + digest).c_str())->status, 200);
+  EXPECT_EQ(c.Get(("/v1/scenes/" + digest).c_str())->body, scene);
+  EXPECT_EQ(c.Head("/v1/scenes/tiny")->status, 200);  // builtins by name
+  EXPECT_EQ(c.Head("/v1/scenes/nope")->status, 404);
+
+  json list = body(c.Get("/v1/scenes"));
+  ASSERT_EQ(list["uploaded"].size(), 1u);
+  EXPECT_EQ(list["uploaded"][0]["digest"], digest);
+  EXPECT_EQ(list["uploaded"][0]["format"], "gltf");
+  ASSERT_EQ(list["builtins"].size(), 2u);
+  EXPECT_EQ(list["builtins"][0]["name"], "tiny");
+  EXPECT_EQ(list["builtins"][0]["digest"], radiant::api::sceneDigest(radiant::test::kTinyGltf));
+
+  json b = renderBody(4);
+  b["scene"] = {{"digest", digest}};
+  auto r = post(c, "/v1/renders", b);
+  ASSERT_EQ(r->status, 200) << r->body;
+  EXPECT_EQ(body(r)["stats"]["triangles"], scene.size());
+  // A builtin is addressable by its digest too.
+  b["scene"] = {{"digest", radiant::api::sceneDigest(radiant::test::kTinyGltf)}};
+  EXPECT_EQ(post(c, "/v1/renders", b)->status, 200);
+}
+
+TEST(ServerCore, InlineGlbIsDecodedAndStored) {
+  TestServer s;
+  s.waitReady();
+  auto c = s.client();
+  const std::string glb = std::string("glTF\x02\x00\x00\x00", 8) + "0123456789";
+  static const char* kB64 = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string b64;
+  for (std::size_t i = 0; i < glb.size(); i += 3) {
+    unsigned n = (unsigned char)glb[i] << 16;
+    if (i + 1 < glb.size()) n |= (unsigned char)glb[i + 1] << 8;
+    if (i + 2 < glb.size()) n |= (unsigned char)glb[i + 2];
+    b64 += kB64[(n >> 18) & 63];
+    b64 += kB64[(n >> 12) & 63];
+    b64 += i + 1 < glb.size() ? kB64[(n >> 6) & 63] : '=';
+    b64 += i + 2 < glb.size() ? kB64[n & 63] : '=';
+  }
+  json b = renderBody(2);
+  b["scene"] = {{"inline_glb", b64}};
+  auto r = post(c, "/v1/renders", b);
+  ASSERT_EQ(r->status, 200) << r->body;
+  EXPECT_EQ(body(r)["stats"]["triangles"], glb.size());
+  EXPECT_EQ(c.Head(("/v1/scenes/" + radiant::api::sceneDigest(glb)).c_str())->status, 200);
+  b["scene"] = {{"inline_glb", "not*base64"}};
+  expectProblem(post(c, "/v1/renders", b), 422, "invalid-value", "/scene/inline_glb");
+}
+
+TEST(ServerCore, SceneStoreSurvivesRestart) {
+  const auto dir = tempDir("restart");
+  ServerConfig config;
+  config.cacheDir = dir.string();
+  const std::string scene = R"({"asset":{"version":"2.0"},"extras":{"persist":true}})";
+  const std::string digest = radiant::api::sceneDigest(scene);
+  {
+    TestServer s(config);
+    auto c = s.client();
+    ASSERT_EQ(c.Put("/v1/scenes", scene, "model/gltf+json")->status, 201);
+  }
+  {
+    TestServer s(config);
+    s.waitReady();
+    auto c = s.client();
+    EXPECT_EQ(c.Head(("/v1/scenes/" + digest).c_str())->status, 200);
+    EXPECT_EQ(c.Put("/v1/scenes", scene, "model/gltf+json")->status, 200) << "already stored";
+    json b = renderBody(6);
+    b["scene"] = {{"digest", digest}};
+    auto r = post(c, "/v1/renders", b);
+    ASSERT_EQ(r->status, 200) << r->body;
+    EXPECT_EQ(body(r)["stats"]["triangles"], scene.size());
+  }
+  std::filesystem::remove_all(dir);
+}
+
+TEST(ServerCore, SceneStoreEvictsLeastRecentlyUsed) {
+  const auto dir = tempDir("lru");
+  ServerConfig config;
+  config.cacheDir = dir.string();
+  config.maxSceneBytes = 2048;
+  TestServer s(config);
+  auto c = s.client();
+  auto sceneOf = [](int i) {
+    return R"({"asset":{"version":"2.0"},"extras":{"i":)" + std::to_string(i) + R"(,"pad":")" + std::string(700, 'x') + "\"}}";
+  };
+  ASSERT_EQ(c.Put("/v1/scenes", sceneOf(1), "model/gltf+json")->status, 201);
+  ASSERT_EQ(c.Put("/v1/scenes", sceneOf(2), "model/gltf+json")->status, 201);
+  EXPECT_EQ(c.Head(("/v1/scenes/" + radiant::api::sceneDigest(sceneOf(1))).c_str())->status, 200);  // 1 is now newer
+  ASSERT_EQ(c.Put("/v1/scenes", sceneOf(3), "model/gltf+json")->status, 201);
+  EXPECT_EQ(c.Head(("/v1/scenes/" + radiant::api::sceneDigest(sceneOf(2))).c_str())->status, 404) << "evicted";
+  EXPECT_EQ(c.Head(("/v1/scenes/" + radiant::api::sceneDigest(sceneOf(1))).c_str())->status, 200);
+  EXPECT_EQ(c.Head(("/v1/scenes/" + radiant::api::sceneDigest(sceneOf(3))).c_str())->status, 200);
+  int files = 0;
+  for (const auto& f : std::filesystem::directory_iterator(dir / "scenes")) files += f.is_regular_file();
+  EXPECT_EQ(files, 2);
+  s.stop();
+  std::filesystem::remove_all(dir);
+}
+
+TEST(ServerCore, TimeoutFreesTheQueueSlot) {
+  ServerConfig config;
+  config.maxQueue = 1;
+  config.requestTimeoutS = 0.5;
+  TestServer s(config);
+  s.waitReady();
+  auto c = s.client();
+  s.control.close();
+  json b = renderBody(1);
+  b["async"] = true;
+  std::string running = body(post(c, "/v1/renders", b))["id"];
+  ASSERT_TRUE(s.control.waitStarted(1));
+  std::string queued = body(post(c, "/v1/renders", b))["id"];
+  expectProblem(post(c, "/v1/renders", b), 503, "queue-full", "");
+  std::this_thread::sleep_for(std::chrono::milliseconds(800));
+  json q = body(c.Get(("/v1/renders/" + queued).c_str()));
+  EXPECT_EQ(q["state"], "failed");
+  EXPECT_EQ(q["error"]["status"], 504);
+  json r = body(c.Get(("/v1/renders/" + running).c_str()));
+  EXPECT_EQ(r["state"], "failed") << "the running job timed out too";
+  // The slot is free again: a new job is accepted although the first is still on the render thread.
+  auto next = post(c, "/v1/renders", b);
+  EXPECT_EQ(next->status, 202) << next->body;
+  // A synchronous request that times out answers 504. (Wait until `next` runs, so the queue is empty.)
+  ASSERT_TRUE(s.control.waitStarted(2));
+  b["async"] = false;
+  auto sync = post(c, "/v1/renders", b);
+  expectProblem(sync, 504, "timeout", "");
+  s.control.open();
+}
+
+TEST(ServerCore, MetricsCountRequestsPassesAndQueue) {
+  TestServer s;
+  s.waitReady();
+  auto c = s.client();
+  auto r = post(c, "/v1/renders", renderBody());
+  ASSERT_EQ(r->status, 200);
+  EXPECT_EQ(c.Get("/v1/nothing")->status, 404);
+  auto m = c.Get("/metrics");
+  ASSERT_EQ(m->status, 200);
+  EXPECT_EQ(m->get_header_value("Content-Type").rfind("text/plain", 0), 0u);
+  const std::string& t = m->body;
+  EXPECT_NE(t.find("radiant_http_requests_total{status=\"200\"}"), std::string::npos) << t;
+  EXPECT_NE(t.find("radiant_http_requests_total{status=\"404\"} 1"), std::string::npos) << t;
+  EXPECT_NE(t.find("radiant_pass_duration_seconds_bucket{pass=\"fake_pass\",clock=\"gpu\",le=\"0.001\"} 1"), std::string::npos) << t;
+  EXPECT_NE(t.find("radiant_pass_duration_seconds_count{pass=\"fake_pass\",clock=\"gpu\"} 1"), std::string::npos) << t;
+  EXPECT_NE(t.find("radiant_render_duration_seconds_count 1"), std::string::npos) << t;
+  EXPECT_NE(t.find("radiant_renders_total{result=\"done\"} 1"), std::string::npos) << t;
+  EXPECT_NE(t.find("radiant_queue_depth 0"), std::string::npos) << t;
+  EXPECT_NE(t.find("# TYPE radiant_render_seconds_total counter"), std::string::npos) << t;
+}
+
+TEST(ServerCore, BearerTokenGuardsEverythingButHealth) {
+  ServerConfig config;
+  config.token = "s3cret";
+  TestServer s(config);
+  auto c = s.client();
+  EXPECT_EQ(c.Get("/v1/health")->status, 200);
+  auto denied = c.Get("/v1/info");
+  expectProblem(denied, 401, "unauthorized", "");
+  EXPECT_EQ(denied->get_header_value("WWW-Authenticate"), "Bearer");
+  EXPECT_EQ(c.Get("/v1/info", {{"Authorization", "Bearer wrong!"}})->status, 401);
+  EXPECT_EQ(c.Get("/v1/info", {{"Authorization", "Bearer s3cret"}})->status, 200);
+}
+
+TEST(ServerCore, ShutdownFinishesInFlightAndRefusesNew) {
+  TestServer s;
+  s.waitReady();
+  s.control.close();
+  auto inflight = std::async(std::launch::async, [&s] {
+    auto c = s.client();
+    auto r = post(c, "/v1/renders", renderBody(9));
+    return r ? r->status : -1;
+  });
+  ASSERT_TRUE(s.control.waitStarted(1));
+  auto stopping = std::async(std::launch::async, [&s] { s.server->shutdown(); });
+  auto c = s.client();
+  for (int i = 0; i < 1000 && c.Get("/v1/ready")->status != 503; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  expectProblem(post(c, "/v1/renders", renderBody(10)), 503, "shutting-down", "");
+  EXPECT_EQ(c.Get("/v1/ready")->status, 503);
+  s.control.open();
+  EXPECT_EQ(inflight.get(), 200);
+  stopping.get();
+  s.thread.join();
+  s.server.reset();
+}
+
+TEST(ServerCore, BackendCreationFailureIsReportedAndRetried) {
+  // The fake cannot create a context at first; /v1/ready says why, and recovers once it can.
+  FakeControl control;
+  control.failCreate = true;
+  ServerConfig config;
+  config.port = 0;
+  HttpServer server(config, radiant::test::fakeHooks(control));
+  const int port = server.bind();
+  std::thread t([&] { server.run(); });
+  httplib::Client c("127.0.0.1", port);
+  while (control.creates < 1) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  auto r = c.Get("/v1/ready");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 503);
+  EXPECT_NE(json::parse(r->body)["detail"].get<std::string>().find("EGL_NOT_INITIALIZED"), std::string::npos) << r->body;
+  control.failCreate = false;
+  bool ready = false;
+  for (int i = 0; i < 300 && !ready; ++i) {
+    ready = c.Get("/v1/ready")->status == 200;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  EXPECT_TRUE(ready);
+  server.shutdown();
+  t.join();
+}
+
+TEST(ServerConfig, FlagsOverrideTheConfigFileAndTheTokenComesFromAFile) {
+  const auto dir = tempDir("config");
+  std::ofstream(dir / "c.json") << R"({"max_queue": 3, "max_width": 100, "cache_dir": "/tmp/x", "request_timeout": 5})";
+  std::ofstream(dir / "t") << "tok\n";
+  auto c = radiant::server::parseCommandLine(
+      {"--config", (dir / "c.json").string(), "--max-queue", "7", "--token-file", (dir / "t").string(), "--port=0"});
+  ASSERT_TRUE(c);
+  EXPECT_EQ(c->maxQueue, 7);
+  EXPECT_EQ(c->limits.maxWidth, 100);
+  EXPECT_EQ(c->cacheDir, "/tmp/x");
+  EXPECT_DOUBLE_EQ(c->requestTimeoutS, 5.0);
+  EXPECT_EQ(c->token, "tok");
+  EXPECT_EQ(c->port, 0);
+  EXPECT_EQ(c->host, "127.0.0.1");
+  EXPECT_THROW(radiant::server::parseCommandLine({"--token", "x"}), std::invalid_argument);
+  EXPECT_THROW(radiant::server::parseCommandLine({"--max-width", "5000"}), std::invalid_argument);
+  EXPECT_THROW(radiant::server::parseCommandLine({"--max-queue", "0"}), std::invalid_argument);
+  EXPECT_THROW(radiant::server::parseCommandLine({"--port", "http"}), std::invalid_argument);
+  std::filesystem::remove_all(dir);
+}
