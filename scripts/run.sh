@@ -23,5 +23,5 @@ done
 [ -n "$url" ] || { echo "radiantd did not start; see $log"; exit 1; }
 export RADIANT_SERVER=$url
 "$build"/client/radiant render --builtin "$scene" -o "out/$scene.png" --stats "out/$scene.stats.json"
-"$build"/client/radiant render --builtin "$scene" -o "out/$scene.exr" --aovs beauty,direct,albedo,normal,depth
+"$build"/client/radiant render --builtin "$scene" -o "out/$scene.exr" --aov beauty --aov direct --aov albedo --aov normal --aov depth
 echo "wrote out/$scene.png, out/$scene.exr and out/$scene.stats.json (daemon log: $log)"

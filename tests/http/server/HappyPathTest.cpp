@@ -1,0 +1,67 @@
+// Issue 3's happy path: a frame the daemon returns over HTTP is the frame the renderer library makes
+// for the same request. Both run the same code on the same device, so a float EXR must match to the
+// last bit of what the GPU computes; the bound allows llvmpipe's thread-count-dependent rasterisation
+// order (different processes) but nothing more: 1e-5 relative.
+#include <cmath>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "api/Validate.h"
+#include "renderer/Renderer.h"
+#include "renderer/io/ImageIO.h"
+#include "renderer/scene/BuiltinScenes.h"
+#include "tests/support/DaemonProcess.h"
+
+namespace radiant {
+namespace {
+
+using nlohmann::json;
+
+TEST(RealDaemon, FramesMatchTheRendererLibraryPixelForPixel) {
+  const auto dir = testing::scratch("happy");
+  testing::Daemon d(RADIANTD_PATH, {"--port", "0"}, {}, dir / "stderr.log");
+  ASSERT_GT(d.port(), 0) << d.firstLine();
+  ASSERT_TRUE(d.waitReady(std::chrono::seconds(120))) << testing::slurp(dir / "stderr.log");
+  auto c = d.client();
+
+  const json body{{"scene", {{"builtin", "cornell_box"}}},
+                  {"width", 64},
+                  {"height", 48},
+                  {"ambient", {0.2, 0.2, 0.25}},
+                  {"passes", {{"direct", {{"pcf_radius", 2}}}}},
+                  {"outputs", {{{"format", "exr"}, {"aovs", {"beauty", "direct"}}, {"half", false}}}}};
+  auto r = c.Post("/v1/renders", body.dump(), "application/json");
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  const json out = json::parse(r->body);
+  const std::string exr = c.Get(out["frames"][0]["url"].get<std::string>().c_str())->body;
+  io::writeFile((dir / "served.exr").string(), exr);
+  const Image served = io::readImage((dir / "served.exr").string());
+
+  // The same request through the library, parsed by the same validator.
+  const api::RenderRequest request = api::parseRenderRequest(body);
+  Renderer renderer;
+  const RenderOutput local = renderer.render(loadBuiltinScene("cornell_box"), request);
+  const Image& beauty = local.aovs.front();
+  ASSERT_EQ(beauty.aov, "beauty");
+  ASSERT_EQ(served.width, beauty.width);
+  ASSERT_EQ(served.height, beauty.height);
+  double maxRel = 0.0, sum = 0.0;
+  for (int y = 0; y < beauty.height; ++y)
+    for (int x = 0; x < beauty.width; ++x)
+      for (int ch = 0; ch < 3; ++ch) {
+        const float a = served.at(x, y)[ch], b = beauty.at(x, y)[ch];
+        maxRel = std::max(maxRel, static_cast<double>(std::abs(a - b) / std::max(std::abs(b), 1e-3f)));
+        sum += b;
+      }
+  EXPECT_LT(maxRel, 1e-5);
+  EXPECT_GT(sum, 0.0);  // not two black images
+  // The stats name the same passes in the same order.
+  ASSERT_EQ(out["stats"]["passes"].size(), local.stats.passes.size());
+  for (std::size_t i = 0; i < local.stats.passes.size(); ++i)
+    EXPECT_EQ(out["stats"]["passes"][i]["name"], local.stats.passes[i].name);
+}
+
+}  // namespace
+}  // namespace radiant
