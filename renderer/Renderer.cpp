@@ -55,6 +55,9 @@ void compare(FrameResources& resources, const Scene& scene, const FrameView& vie
                         "/compare/aov");
   nlohmann::json m = {{"against", c.against}, {"aov", c.aov}, {"rel_mse_epsilon", metrics::kRelMseEpsilon}};
   Image reference;
+  if (!target && c.against != "reference")
+    throw api::ApiError(422, "invalid-compare", "Nothing to compare against",
+                        "compare.against names an image (" + c.against + ") that was not supplied", "/compare/against");
   if (target) {
     reference = *target;
   } else {

@@ -29,8 +29,9 @@ public:
   // status; the backend stays in use) and anything else for environment failures (the job fails
   // with 500 and the server destroys and recreates the backend before the next job).
   // `cancel` becomes true when the job is cancelled or times out; poll it between passes.
+  // `compareTarget` is the decoded image a request's compare.against names (null for "reference").
   virtual RenderOutput render(const Scene& scene, const api::RenderRequest& request,
-                              const std::atomic<bool>* cancel) = 0;
+                              const std::atomic<bool>* cancel, const Image* compareTarget) = 0;
 };
 
 struct BackendHooks {
@@ -39,6 +40,8 @@ struct BackendHooks {
   std::function<std::unique_ptr<RenderBackend>()> createBackend;
   // glTF JSON or GLB bytes -> Scene. Throws api::ApiError (422) for files it cannot load.
   std::function<Scene(std::string_view bytes)> decodeScene;
+  // EXR/HDR/PNG bytes -> Image, for compare.against an uploaded image. Throws api::ApiError (422).
+  std::function<Image(std::string_view bytes)> decodeImage;
   std::function<std::vector<std::string>()> builtinSceneNames;
   std::function<std::string(const std::string& name)> builtinSceneSource;  // glTF/GLB bytes
   // One output file: EXR of every AOV in spec.aovs, or PNG of the single one with exposure applied.

@@ -17,7 +17,7 @@
 #include "server/FrameStore.h"
 #include "server/Metrics.h"
 #include "server/RenderService.h"
-#include "server/SceneStore.h"
+#include "server/ContentStore.h"
 
 namespace radiant::server {
 
@@ -171,7 +171,8 @@ struct HttpServer::Impl {
   BackendHooks hooks;
   Metrics metrics;
   FrameStore frames;
-  SceneStore scenes;
+  ContentStore scenes;
+  ContentStore images;  // comparison targets (compare.against = their digest)
   DecodedScenes decoded;
   RenderService service;
   httplib::Server http;
@@ -184,7 +185,8 @@ struct HttpServer::Impl {
       : config(std::move(c)),
         hooks(std::move(h)),
         frames(config.maxFrameBytes, config.frameTtlS),
-        scenes(config.cacheDir, config.maxSceneBytes),
+        scenes(config.cacheDir, config.maxSceneBytes, "scenes"),
+        images(config.cacheDir, config.maxSceneBytes, "images"),
         decoded(config.sceneCacheEntries),
         service(config, hooks, frames, metrics) {
     routes();
@@ -426,6 +428,7 @@ struct HttpServer::Impl {
           {"radiant_jobs_active", {"Jobs rendering or encoding.", double(service.active())}},
           {"radiant_ready", {"1 once the render thread has a GL context.", service.ready() ? 1.0 : 0.0}},
           {"radiant_scene_store_bytes", {"Bytes of uploaded scenes stored.", double(scenes.totalBytes())}},
+          {"radiant_image_store_bytes", {"Bytes of uploaded comparison images stored.", double(images.totalBytes())}},
           {"radiant_frame_store_bytes", {"Bytes of encoded frames stored.", double(frames.totalBytes())}}};
       res.status = 200;
       res.set_content(metrics.text(gauges), "text/plain; version=0.0.4; charset=utf-8");
@@ -449,7 +452,7 @@ struct HttpServer::Impl {
       }
       res.set_header("Location", "/v1/scenes/" + digest);
       sendJson(res, created ? 201 : 200,
-               {{"digest", digest}, {"bytes", req.body.size()}, {"format", SceneStore::formatOf(req.body)},
+               {{"digest", digest}, {"bytes", req.body.size()}, {"format", ContentStore::formatOf(req.body)},
                 {"created", created}});
     });
     http.Put("/v1/scenes", upload);
@@ -482,7 +485,44 @@ struct HttpServer::Impl {
       if (!bytes) throw api::ApiError(404, "unknown-scene", "Unknown scene", "no scene " + ref);
       res.status = 200;
       if (req.method == "HEAD") return;
-      res.set_content(*bytes, SceneStore::formatOf(*bytes) == "glb" ? "model/gltf-binary" : "model/gltf+json");
+      res.set_content(*bytes, ContentStore::formatOf(*bytes) == "glb" ? "model/gltf-binary" : "model/gltf+json");
+    }));
+
+    // Comparison images: content-addressed like scenes; a render's compare.against names one by digest.
+    auto uploadImage = wrap([this](const httplib::Request& req, httplib::Response& res) {
+      static const std::set<std::string> kTypes{"image/x-exr", "image/vnd.radiance", "image/png",
+                                                "application/octet-stream"};
+      const std::string type = mediaType(req);
+      if (!kTypes.count(type))
+        throw api::ApiError(415, "unsupported-media-type", "Unsupported media type",
+                            "comparison images are uploaded as image/x-exr, image/vnd.radiance or image/png (also "
+                            "accepted: application/octet-stream), got \"" + type + "\"");
+      checkBodySize(req);
+      if (req.body.empty()) throw api::ApiError(400, "empty-body", "Empty body", "the body holds no image");
+      const std::string digest = api::sceneDigest(req.body);
+      bool created = false;
+      if (!images.contains(digest)) {
+        if (!hooks.decodeImage) throw std::logic_error("no image decoder configured");
+        const Image decoded = hooks.decodeImage(req.body);  // refuse what cannot be read before storing it
+        created = images.put(digest, req.body);
+      }
+      res.set_header("Location", "/v1/images/" + digest);
+      sendJson(res, created ? 201 : 200,
+               {{"digest", digest}, {"bytes", req.body.size()}, {"format", ContentStore::formatOf(req.body)},
+                {"created", created}});
+    });
+    http.Put("/v1/images", uploadImage);
+    http.Post("/v1/images", uploadImage);
+    http.Get(R"(/v1/images/([^/]+))", wrap([this](const httplib::Request& req, httplib::Response& res) {
+      const std::string digest = req.matches[1];
+      std::optional<std::string> bytes;
+      if (api::isSceneDigest(digest)) bytes = req.method == "HEAD" ? (images.contains(digest) ? std::optional<std::string>("") : std::nullopt)
+                                                                   : images.get(digest);
+      if (!bytes) throw api::ApiError(404, "unknown-image", "Unknown image", "no image " + digest);
+      res.status = 200;
+      if (req.method == "HEAD") return;
+      static const std::map<std::string, std::string> kMime{{"exr", "image/x-exr"}, {"hdr", "image/vnd.radiance"}, {"png", "image/png"}};
+      res.set_content(*bytes, kMime.at(ContentStore::formatOf(*bytes)));
     }));
 
     http.Post("/v1/renders", wrap([this](const httplib::Request& req, httplib::Response& res) {
@@ -503,9 +543,23 @@ struct HttpServer::Impl {
                                 api::pointerAppend("/passes", name));
         }
       auto scene = resolveScene(request.scene);
+      std::shared_ptr<const Image> compareTarget;
+      if (request.compare && request.compare->against != "reference") {
+        const std::string& against = request.compare->against;
+        if (!api::isSceneDigest(against))
+          throw api::ApiError(422, "invalid-value", "Invalid value",
+                              "/compare/against: \"reference\" or the sha256:... digest of an image uploaded to /v1/images",
+                              "/compare/against");
+        auto bytes = images.get(against);
+        if (!bytes)
+          throw api::ApiError(404, "unknown-image", "Unknown image",
+                              "/compare/against: no image " + against + " (upload it to /v1/images first)",
+                              "/compare/against");
+        compareTarget = std::make_shared<const Image>(hooks.decodeImage(*bytes));
+      }
       std::shared_ptr<Job> job;
       try {
-        job = service.submit(request, scene);
+        job = service.submit(request, scene, compareTarget);
       } catch (const api::ApiError& e) {
         if (e.type == "queue-full") res.set_header("Retry-After", std::to_string(service.retryAfterSeconds()));
         throw;

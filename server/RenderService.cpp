@@ -1,5 +1,6 @@
 #include "server/RenderService.h"
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <random>
@@ -53,6 +54,13 @@ std::vector<Image> selectAovs(const std::vector<Image>& aovs, const api::OutputS
     }
     out.push_back(*found);
   }
+  // With a compare block, an EXR also carries the error map and the ground truth it was scored
+  // against, so the numbers in the stats can be inspected pixel by pixel.
+  if (spec.format == api::ImageFormat::Exr)
+    for (const char* extra : {"error", "reference"})
+      for (const auto& img : aovs)
+        if (img.aov == extra && std::none_of(out.begin(), out.end(), [&](const Image& o) { return o.aov == extra; }))
+          out.push_back(img);
   return out;
 }
 
@@ -66,12 +74,14 @@ RenderService::RenderService(const ServerConfig& config, const BackendHooks& hoo
 
 RenderService::~RenderService() { stop(); }
 
-std::shared_ptr<Job> RenderService::submit(api::RenderRequest request, std::shared_ptr<const Scene> scene) {
+std::shared_ptr<Job> RenderService::submit(api::RenderRequest request, std::shared_ptr<const Scene> scene,
+                                           std::shared_ptr<const Image> compareTarget) {
   auto job = std::make_shared<Job>();
   job->id = newRenderId();
   request.id = job->id;
   job->request = std::move(request);
   job->scene = std::move(scene);
+  job->compareTarget = std::move(compareTarget);
   std::lock_guard lock(mutex_);
   if (draining_ || stopping_)
     throw api::ApiError(503, "shutting-down", "Shutting down", "the daemon is shutting down and accepts no new renders");
@@ -243,7 +253,7 @@ void RenderService::renderLoop() {
     RenderOutput output;
     bool recreate = false;
     try {
-      output = backend->render(*job->scene, job->request, &job->cancel);
+      output = backend->render(*job->scene, job->request, &job->cancel, job->compareTarget.get());
     } catch (const api::ApiError& e) {
       problem = Problem{e.status, e.type, e.title, e.detail(), e.pointer};
     } catch (const std::exception& e) {

@@ -14,9 +14,9 @@ class RendererBackend final : public RenderBackend {
 public:
   explicit RendererBackend(const DeviceOptions& options) : renderer_(options) {}
   DeviceInfo device() const override { return renderer_.device(); }
-  RenderOutput render(const Scene& scene, const api::RenderRequest& request,
-                      const std::atomic<bool>* cancel) override {
-    return renderer_.render(scene, request, cancel);
+  RenderOutput render(const Scene& scene, const api::RenderRequest& request, const std::atomic<bool>* cancel,
+                      const Image* compareTarget) override {
+    return renderer_.render(scene, request, cancel, compareTarget);
   }
 
 private:
@@ -43,6 +43,13 @@ BackendHooks rendererHooks(const ServerConfig& config) {
       throw api::ApiError(422, "invalid-scene", "Invalid scene",
                           std::string("the glTF file is invalid") +
                               (e.pointer.empty() ? "" : " at " + e.pointer) + ": " + e.what());
+    }
+  };
+  h.decodeImage = [](std::string_view bytes) {
+    try {
+      return io::decodeImage(bytes);
+    } catch (const std::exception& e) {
+      throw api::ApiError(422, "invalid-image", "Invalid image", e.what());
     }
   };
   h.builtinSceneNames = [] { return builtinSceneNames(); };

@@ -95,17 +95,38 @@ void writeFile(const std::string& path, const std::string& bytes) {
   if (!f) throw std::runtime_error("io: short write to " + path);
 }
 
-Image readImage(const std::string& path, const std::string& aov) {
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) throw std::runtime_error("io: cannot read " + path + ": " + OIIO::geterror());
+namespace {
+
+Image readFrom(OIIO::ImageInput* in, const std::string& what, const std::string& aov) {
+  if (!in) throw std::runtime_error("io: cannot read " + what + ": " + OIIO::geterror());
   const OIIO::ImageSpec& spec = in->spec();
-  Image img = Image::make(aov, spec.width, spec.height, std::min(spec.nchannels, 3));
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0) throw std::runtime_error("io: " + what + " is empty");
+  Image img = Image::make(aov, spec.width, spec.height, spec.nchannels >= 3 ? 3 : 1);
   std::vector<float> all(static_cast<std::size_t>(spec.width) * spec.height * spec.nchannels);
   if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()))
-    throw std::runtime_error("io: read " + path + ": " + in->geterror());
+    throw std::runtime_error("io: read " + what + ": " + in->geterror());
   for (std::size_t p = 0; p < static_cast<std::size_t>(spec.width) * spec.height; ++p)
     for (int c = 0; c < img.channels; ++c) img.pixels[p * img.channels + c] = all[p * spec.nchannels + c];
   return img;
+}
+
+}  // namespace
+
+Image readImage(const std::string& path, const std::string& aov) {
+  auto in = OIIO::ImageInput::open(path);
+  return readFrom(in.get(), path, aov);
+}
+
+Image decodeImage(std::string_view bytes, const std::string& aov) {
+  auto starts = [&](std::string_view magic) { return bytes.substr(0, magic.size()) == magic; };
+  const char* name = starts(std::string_view("\x76\x2f\x31\x01", 4)) ? "image.exr"
+                     : starts("#?RADIANCE") || starts("#?RGBE") ? "image.hdr"
+                     : starts("\x89PNG")                        ? "image.png"
+                                                                 : nullptr;
+  if (!name) throw std::runtime_error("io: not an EXR, Radiance HDR or PNG image");
+  OIIO::Filesystem::IOMemReader reader(const_cast<char*>(bytes.data()), bytes.size());
+  auto in = OIIO::ImageInput::open(name, nullptr, &reader);
+  return readFrom(in.get(), std::string("the uploaded ") + (name + 6) + " image", aov);
 }
 
 }  // namespace radiant::io

@@ -3,6 +3,7 @@
 // render thread so the GPU keeps working while frames are written).
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "renderer/Image.h"
@@ -15,8 +16,11 @@ std::string encodeExr(const std::vector<Image>& aovs, bool halfFloat);
 // 8-bit sRGB PNG of one AOV: value * 2^exposure, clamped to [0,1] (never wrapped), sRGB transfer.
 std::string encodePng(const Image& image, float exposureEV);
 void writeFile(const std::string& path, const std::string& bytes);
-// Reads an EXR/HDR/PNG into float RGB(A) (for compare-against-upload and tests).
+// Reads an EXR/HDR/PNG into float RGB (its first three channels, or its one channel) for
+// compare-against-upload and tests. Throws std::runtime_error naming what failed.
 Image readImage(const std::string& path, const std::string& aov = "beauty");
+// The same from bytes in memory; the format comes from the magic bytes (EXR, Radiance HDR, PNG).
+Image decodeImage(std::string_view bytes, const std::string& aov = "beauty");
 
 // sRGB transfer of one linear value in [0,1] (IEC 61966-2-1).
 float linearToSrgb(float linear);

@@ -54,7 +54,8 @@ public:
     d.software = true;
     return d;
   }
-  RenderOutput render(const Scene& scene, const api::RenderRequest& r, const std::atomic<bool>* cancel) override {
+  RenderOutput render(const Scene& scene, const api::RenderRequest& r, const std::atomic<bool>* cancel,
+                      const Image* /*compareTarget*/) override {
     ++c_.started;
     {
       std::unique_lock l(c_.m);

@@ -3,6 +3,9 @@
 // last bit of what the GPU computes; the bound allows llvmpipe's thread-count-dependent rasterisation
 // order (different processes) but nothing more: 1e-5 relative.
 #include <cmath>
+#include <set>
+
+#include <OpenImageIO/imageio.h>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -61,6 +64,55 @@ TEST(RealDaemon, FramesMatchTheRendererLibraryPixelForPixel) {
   ASSERT_EQ(out["stats"]["passes"].size(), local.stats.passes.size());
   for (std::size_t i = 0; i < local.stats.passes.size(); ++i)
     EXPECT_EQ(out["stats"]["passes"][i]["name"], local.stats.passes[i].name);
+}
+
+TEST(RealDaemon, ComparesAgainstAnUploadedImage) {
+  const auto dir = testing::scratch("compare-upload");
+  testing::Daemon d(RADIANTD_PATH, {"--port", "0"}, {}, dir / "stderr.log");
+  ASSERT_GT(d.port(), 0) << d.firstLine();
+  ASSERT_TRUE(d.waitReady(std::chrono::seconds(120))) << testing::slurp(dir / "stderr.log");
+  auto c = d.client();
+
+  json body{{"scene", {{"builtin", "cornell_box"}}}, {"width", 32}, {"height", 32},
+            {"outputs", {{{"format", "exr"}, {"aovs", {"beauty"}}, {"half", false}}}}};
+  auto r = c.Post("/v1/renders", body.dump(), "application/json");
+  ASSERT_EQ(r->status, 200) << r->body;
+  const std::string exr = c.Get(json::parse(r->body)["frames"][0]["url"].get<std::string>().c_str())->body;
+
+  // Upload it as a comparison image: 201, then idempotent 200; HEAD finds it.
+  auto up = c.Put("/v1/images", exr, "image/x-exr");
+  ASSERT_EQ(up->status, 201) << up->body;
+  const std::string digest = json::parse(up->body)["digest"];
+  EXPECT_EQ(c.Put("/v1/images", exr, "image/x-exr")->status, 200);
+  EXPECT_EQ(c.Head(("/v1/images/" + digest).c_str())->status, 200);
+  // Bytes that are no image are refused and not stored.
+  auto bad = c.Put("/v1/images", "not an image", "application/octet-stream");
+  EXPECT_EQ(bad->status, 422);
+
+  // The same render compared against its own upload: zero error, and the EXR gains the layers.
+  body["compare"] = {{"against", digest}, {"aov", "beauty"}};
+  r = c.Post("/v1/renders", body.dump(), "application/json");
+  ASSERT_EQ(r->status, 200) << r->body;
+  const json out = json::parse(r->body);
+  const json& m = out["stats"]["metrics"];
+  EXPECT_EQ(m["against"], digest);
+  EXPECT_LT(m["rmse"].get<double>(), 1e-5);
+  EXPECT_GT(m["ssim"].get<double>(), 0.99999);
+  const std::string compared = c.Get(out["frames"][0]["url"].get<std::string>().c_str())->body;
+  io::writeFile((dir / "compared.exr").string(), compared);
+  auto in = OIIO::ImageInput::open((dir / "compared.exr").string());
+  ASSERT_TRUE(in);
+  std::set<std::string> channels(in->spec().channelnames.begin(), in->spec().channelnames.end());
+  EXPECT_TRUE(channels.count("error.Y")) << "EXR lacks the error-map layer";
+  EXPECT_TRUE(channels.count("reference.R"));
+
+  // An unknown image digest: 404 naming the field, and the daemon keeps serving.
+  body["compare"]["against"] = "sha256:" + std::string(64, 'a');
+  r = c.Post("/v1/renders", body.dump(), "application/json");
+  EXPECT_EQ(r->status, 404);
+  EXPECT_EQ(json::parse(r->body)["pointer"], "/compare/against");
+  body.erase("compare");
+  EXPECT_EQ(c.Post("/v1/renders", body.dump(), "application/json")->status, 200);
 }
 
 }  // namespace

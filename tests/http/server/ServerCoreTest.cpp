@@ -414,7 +414,7 @@ TEST(ServerCore, InlineGlbIsDecodedAndStored) {
   expectProblem(post(c, "/v1/renders", b), 422, "invalid-value", "/scene/inline_glb");
 }
 
-TEST(ServerCore, SceneStoreSurvivesRestart) {
+TEST(ServerCore, ContentStoreSurvivesRestart) {
   const auto dir = tempDir("restart");
   ServerConfig config;
   config.cacheDir = dir.string();
@@ -440,7 +440,7 @@ TEST(ServerCore, SceneStoreSurvivesRestart) {
   std::filesystem::remove_all(dir);
 }
 
-TEST(ServerCore, SceneStoreEvictsLeastRecentlyUsed) {
+TEST(ServerCore, ContentStoreEvictsLeastRecentlyUsed) {
   const auto dir = tempDir("lru");
   ServerConfig config;
   config.cacheDir = dir.string();

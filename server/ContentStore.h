@@ -1,7 +1,8 @@
 #pragma once
-// Content-addressed scene store: glTF/GLB bytes keyed by "sha256:<hex>" of exactly those bytes.
+// Content-addressed store: bytes keyed by "sha256:<hex>" of exactly those bytes. The daemon keeps
+// one for scenes (glTF/GLB) and one for comparison images (EXR/HDR/PNG).
 // Bounded in bytes with least-recently-used eviction. With a cache directory the bytes live in
-// <dir>/scenes/<hex>.glb|.gltf (written atomically, mtime = last use) and survive restarts;
+// <dir>/<kind>/<hex>.<format> (written atomically, mtime = last use) and survive restarts;
 // without one they live in memory. Thread-safe.
 
 #include <cstddef>
@@ -16,27 +17,29 @@
 
 namespace radiant::server {
 
-struct StoredSceneInfo {
+struct StoredBlobInfo {
   std::string digest;
   std::size_t bytes = 0;
-  std::string format;  // "glb" | "gltf"
+  std::string format;  // file extension from the magic bytes: glb | gltf | exr | hdr | png
 };
 
-class SceneStore {
+class ContentStore {
 public:
-  SceneStore(std::filesystem::path cacheDir, std::size_t maxBytes);
+  // kind: the subdirectory of cacheDir ("scenes", "images").
+  ContentStore(std::filesystem::path cacheDir, std::size_t maxBytes, const std::string& kind = "scenes");
   // Stores `bytes` under its digest; returns false when it was already there (idempotent).
   // Throws api::ApiError 413 when the scene alone exceeds the store.
   bool put(const std::string& digest, std::string bytes);
   bool contains(const std::string& digest);  // counts as a use
   std::optional<std::string> get(const std::string& digest);
-  std::vector<StoredSceneInfo> list();  // most recently used first
+  std::vector<StoredBlobInfo> list();  // most recently used first
   std::size_t totalBytes();
-  static std::string formatOf(const std::string& bytes);  // "glb" when it starts with the GLB magic
+  // From the magic bytes: glb, exr, hdr, png; anything else is taken for glTF JSON ("gltf").
+  static std::string formatOf(const std::string& bytes);
 
 private:
   struct Entry {
-    StoredSceneInfo info;
+    StoredBlobInfo info;
     std::shared_ptr<const std::string> bytes;  // in memory (no cache dir)
   };
   std::filesystem::path fileFor(const Entry& e) const;

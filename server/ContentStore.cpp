@@ -1,4 +1,4 @@
-#include "server/SceneStore.h"
+#include "server/ContentStore.h"
 
 #include <algorithm>
 #include <fstream>
@@ -12,16 +12,21 @@ namespace radiant::server {
 
 namespace fs = std::filesystem;
 
-std::string SceneStore::formatOf(const std::string& bytes) {
-  return bytes.size() >= 4 && bytes.compare(0, 4, "glTF") == 0 ? "glb" : "gltf";
+std::string ContentStore::formatOf(const std::string& bytes) {
+  auto starts = [&](std::string_view magic) { return bytes.size() >= magic.size() && bytes.compare(0, magic.size(), magic) == 0; };
+  if (starts("glTF")) return "glb";
+  if (starts(std::string_view("\x76\x2f\x31\x01", 4))) return "exr";
+  if (starts("#?RADIANCE") || starts("#?RGBE")) return "hdr";
+  if (starts("\x89PNG")) return "png";
+  return "gltf";
 }
 
-SceneStore::SceneStore(fs::path cacheDir, std::size_t maxBytes) : maxBytes_(maxBytes) {
+ContentStore::ContentStore(fs::path cacheDir, std::size_t maxBytes, const std::string& kind) : maxBytes_(maxBytes) {
   if (cacheDir.empty()) return;
-  dir_ = cacheDir / "scenes";
+  dir_ = cacheDir / kind;
   fs::create_directories(dir_);
   struct Found {
-    StoredSceneInfo info;
+    StoredBlobInfo info;
     fs::file_time_type mtime;
   };
   std::vector<Found> found;
@@ -29,7 +34,8 @@ SceneStore::SceneStore(fs::path cacheDir, std::size_t maxBytes) : maxBytes_(maxB
     if (!f.is_regular_file()) continue;
     const std::string ext = f.path().extension().string();
     const std::string digest = "sha256:" + f.path().stem().string();
-    if ((ext != ".glb" && ext != ".gltf") || !api::isSceneDigest(digest)) {
+    const bool known = ext == ".glb" || ext == ".gltf" || ext == ".exr" || ext == ".hdr" || ext == ".png";
+    if (!known || !api::isSceneDigest(digest)) {
       if (f.path().filename().string().rfind(".tmp-", 0) == 0) fs::remove(f.path());  // an interrupted write
       continue;
     }
@@ -44,11 +50,11 @@ SceneStore::SceneStore(fs::path cacheDir, std::size_t maxBytes) : maxBytes_(maxB
   evictLocked("");
 }
 
-fs::path SceneStore::fileFor(const Entry& e) const {
+fs::path ContentStore::fileFor(const Entry& e) const {
   return dir_ / (e.info.digest.substr(7) + "." + e.info.format);
 }
 
-void SceneStore::touch(std::list<Entry>::iterator it) {
+void ContentStore::touch(std::list<Entry>::iterator it) {
   lru_.splice(lru_.begin(), lru_, it);
   if (!dir_.empty()) {
     std::error_code ec;  // best effort: the order survives a restart
@@ -56,7 +62,7 @@ void SceneStore::touch(std::list<Entry>::iterator it) {
   }
 }
 
-void SceneStore::evictLocked(const std::string& keep) {
+void ContentStore::evictLocked(const std::string& keep) {
   while (total_ > maxBytes_ && !lru_.empty()) {
     auto victim = std::prev(lru_.end());
     if (victim->info.digest == keep) {
@@ -73,7 +79,7 @@ void SceneStore::evictLocked(const std::string& keep) {
   }
 }
 
-bool SceneStore::put(const std::string& digest, std::string bytes) {
+bool ContentStore::put(const std::string& digest, std::string bytes) {
   if (bytes.size() > maxBytes_)
     throw api::ApiError(413, "payload-too-large", "Payload too large",
                         "the scene is " + std::to_string(bytes.size()) + " bytes, the scene store holds " +
@@ -90,7 +96,7 @@ bool SceneStore::put(const std::string& digest, std::string bytes) {
     {
       std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
       out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-      if (!out) throw std::runtime_error("SceneStore::put(): cannot write " + tmp.string());
+      if (!out) throw std::runtime_error("ContentStore::put(): cannot write " + tmp.string());
     }
     fs::rename(tmp, fileFor(e));
   } else {
@@ -103,7 +109,7 @@ bool SceneStore::put(const std::string& digest, std::string bytes) {
   return true;
 }
 
-bool SceneStore::contains(const std::string& digest) {
+bool ContentStore::contains(const std::string& digest) {
   std::lock_guard lock(mutex_);
   auto it = index_.find(digest);
   if (it == index_.end()) return false;
@@ -111,7 +117,7 @@ bool SceneStore::contains(const std::string& digest) {
   return true;
 }
 
-std::optional<std::string> SceneStore::get(const std::string& digest) {
+std::optional<std::string> ContentStore::get(const std::string& digest) {
   std::lock_guard lock(mutex_);
   auto it = index_.find(digest);
   if (it == index_.end()) return std::nullopt;
@@ -127,14 +133,14 @@ std::optional<std::string> SceneStore::get(const std::string& digest) {
   return std::string((std::istreambuf_iterator<char>(in)), {});
 }
 
-std::vector<StoredSceneInfo> SceneStore::list() {
+std::vector<StoredBlobInfo> ContentStore::list() {
   std::lock_guard lock(mutex_);
-  std::vector<StoredSceneInfo> out;
+  std::vector<StoredBlobInfo> out;
   for (const auto& e : lru_) out.push_back(e.info);
   return out;
 }
 
-std::size_t SceneStore::totalBytes() {
+std::size_t ContentStore::totalBytes() {
   std::lock_guard lock(mutex_);
   return total_;
 }
