@@ -214,8 +214,13 @@ struct HttpServer::Impl {
     return std::nullopt;
   }
 
+  // Milliseconds this thread's last resolveScene() spent decoding (0 when the decoded scene was cached);
+  // it becomes the frame's stats.scene_load_ms.
+  static inline thread_local double tSceneLoadMs = 0;
+
   std::shared_ptr<const Scene> decode(const std::string& digest, std::string_view bytes, const std::string& pointer) {
     if (auto s = decoded.get(digest)) return s;
+    const auto start = Clock::now();
     if (!hooks.decodeScene) throw std::logic_error("no scene decoder configured");
     std::shared_ptr<Scene> scene;
     try {
@@ -227,11 +232,13 @@ struct HttpServer::Impl {
                           pointer);
     }
     if (scene->digest.empty()) scene->digest = digest;
+    tSceneLoadMs = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
     decoded.put(digest, scene);
     return scene;
   }
 
   std::shared_ptr<const Scene> resolveScene(const api::SceneRef& ref) {
+    tSceneLoadMs = 0;
     switch (ref.kind) {
       case api::SceneRef::Kind::Builtin: {
         auto digest = builtinDigest(ref.value);
@@ -559,7 +566,7 @@ struct HttpServer::Impl {
       }
       std::shared_ptr<Job> job;
       try {
-        job = service.submit(request, scene, compareTarget);
+        job = service.submit(request, scene, compareTarget, tSceneLoadMs);
       } catch (const api::ApiError& e) {
         if (e.type == "queue-full") res.set_header("Retry-After", std::to_string(service.retryAfterSeconds()));
         throw;

@@ -75,13 +75,14 @@ RenderService::RenderService(const ServerConfig& config, const BackendHooks& hoo
 RenderService::~RenderService() { stop(); }
 
 std::shared_ptr<Job> RenderService::submit(api::RenderRequest request, std::shared_ptr<const Scene> scene,
-                                           std::shared_ptr<const Image> compareTarget) {
+                                           std::shared_ptr<const Image> compareTarget, double sceneLoadMs) {
   auto job = std::make_shared<Job>();
   job->id = newRenderId();
   request.id = job->id;
   job->request = std::move(request);
   job->scene = std::move(scene);
   job->compareTarget = std::move(compareTarget);
+  job->sceneLoadMs = sceneLoadMs;
   std::lock_guard lock(mutex_);
   if (draining_ || stopping_)
     throw api::ApiError(503, "shutting-down", "Shutting down", "the daemon is shutting down and accepts no new renders");
@@ -358,6 +359,7 @@ void RenderService::encode(const std::shared_ptr<Job>& job, RenderOutput output)
     finishLocked(*job, JobState::Canceled, Problem{409, "canceled", "Render canceled", "canceled while encoding", ""});
   } else {
     job->stats = std::move(output.stats);
+    job->stats.sceneLoadMs = job->sceneLoadMs;
     job->stats.encodeMs = job->encodeMs;
     if (job->stats.renderMs == 0) job->stats.renderMs = job->renderMs;
     job->frames = std::move(infos);

@@ -50,6 +50,7 @@ struct Job {
   api::RenderRequest request;
   std::shared_ptr<const Scene> scene;
   std::shared_ptr<const Image> compareTarget;  // decoded compare.against image (null: the reference)
+  double sceneLoadMs = 0;                      // decoding the scene for this request (0: it was cached)
   std::atomic<bool> cancel{false};
   // Everything below is guarded by RenderService's mutex.
   JobState state = JobState::Queued;
@@ -75,7 +76,7 @@ public:
 
   // Queues a job. Throws ApiError 503 ("queue-full", with retryAfterSeconds()) or 503 "shutting-down".
   std::shared_ptr<Job> submit(api::RenderRequest request, std::shared_ptr<const Scene> scene,
-                              std::shared_ptr<const Image> compareTarget = nullptr);
+                              std::shared_ptr<const Image> compareTarget = nullptr, double sceneLoadMs = 0);
   std::shared_ptr<Job> find(const std::string& id);
   // Blocks until the job is terminal or `until`; returns whether it is terminal.
   bool waitFor(const std::shared_ptr<Job>& job, Clock::time_point until);

@@ -78,6 +78,8 @@ TEST(RealDaemon, ComparesAgainstAnUploadedImage) {
   auto r = c.Post("/v1/renders", body.dump(), "application/json");
   ASSERT_EQ(r->status, 200) << r->body;
   const std::string exr = c.Get(json::parse(r->body)["frames"][0]["url"].get<std::string>().c_str())->body;
+  // The first request of this daemon decoded the scene; later ones reuse the decoded scene.
+  EXPECT_GT(json::parse(r->body)["stats"]["scene_load_ms"].get<double>(), 0.0);
 
   // Upload it as a comparison image: 201, then idempotent 200; HEAD finds it.
   auto up = c.Put("/v1/images", exr, "image/x-exr");
@@ -96,6 +98,7 @@ TEST(RealDaemon, ComparesAgainstAnUploadedImage) {
   const json out = json::parse(r->body);
   const json& m = out["stats"]["metrics"];
   EXPECT_EQ(m["against"], digest);
+  EXPECT_EQ(out["stats"]["scene_load_ms"].get<double>(), 0.0);
   EXPECT_LT(m["rmse"].get<double>(), 1e-5);
   EXPECT_GT(m["ssim"].get<double>(), 0.99999);
   const std::string compared = c.Get(out["frames"][0]["url"].get<std::string>().c_str())->body;

@@ -255,7 +255,12 @@ TEST(ServerCore, FullQueueIs503WithRetryAfter) {
   auto metrics = c.Get("/metrics");
   EXPECT_NE(metrics->body.find("radiant_queue_depth 2"), std::string::npos) << metrics->body;
   s.control.open();
-  // Once the queue drains, a sync request goes through.
+  // Once the queue drains, a sync request goes through. (Wait for the drain: posting at once races
+  // the render thread, which may not have taken the queued jobs yet.)
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (c.Get("/metrics")->body.find("radiant_queue_depth 0\n") == std::string::npos &&
+         std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
   expectGoodRender(c, 77);
 }
 
