@@ -2,6 +2,8 @@
 
 #include <stdexcept>
 
+#include "renderer/frame/GpuScene.h"
+
 namespace radiant {
 
 void FrameResources::beginFrame(const GpuScene& gpu, const FrameView& view, std::vector<api::CacheEvent>* cacheLog) {
@@ -10,6 +12,8 @@ void FrameResources::beginFrame(const GpuScene& gpu, const FrameView& view, std:
   cacheLog_ = cacheLog;
   written_.clear();
 }
+
+const std::string& FrameResources::sceneKey() const { return gpu_->sceneKey; }
 
 gl::Texture& FrameResources::texture(const std::string& name, GLenum target, GLenum internalFormat, int width,
                                      int height, int depth, int levels) {

@@ -28,6 +28,8 @@ public:
   // Called by the Renderer at the start of each frame.
   void beginFrame(const GpuScene& gpu, const FrameView& view, std::vector<api::CacheEvent>* cacheLog);
   const GpuScene& gpuScene() const { return *gpu_; }
+  // The frame's scene identity for cache keys of derived data (GpuScene::sceneKey).
+  const std::string& sceneKey() const;
   const FrameView& view() const { return *view_; }
   gl::ShaderLibrary& shaders() { return shaders_; }
 

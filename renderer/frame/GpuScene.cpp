@@ -1,5 +1,6 @@
 #include "renderer/frame/GpuScene.h"
 
+#include <atomic>
 #include <cmath>
 #include <string>
 
@@ -26,7 +27,14 @@ gl::Buffer makeBuffer(const std::string& label, const std::vector<T>& data) {
 
 }  // namespace
 
-GpuScene::GpuScene(const Scene& scene) {
+namespace {
+std::string nextSceneKey(const Scene& scene) {
+  static std::atomic<std::uint64_t> generation{0};
+  return (scene.digest.empty() ? std::string("unnamed") : scene.digest) + "#" + std::to_string(++generation);
+}
+}  // namespace
+
+GpuScene::GpuScene(const Scene& scene) : sceneKey(nextSceneKey(scene)) {
   // Textures: colour textures are sampled through sRGB formats so the hardware linearises them.
   std::map<std::pair<int, bool>, int> textureIndex;
   auto gpuTexture = [&](const TextureRef& ref, bool srgb) -> int {

@@ -24,6 +24,10 @@ struct GpuMesh {
 class GpuScene {
 public:
   explicit GpuScene(const Scene& scene);
+  // Identity of what was uploaded, for keys of derived data: "<digest>#<upload generation>". The
+  // generation is unique per upload, so a key never outlives the scene it was built from (an address
+  // could be reused by the next scene).
+  const std::string sceneKey;
   std::vector<GpuMesh> meshes;
   std::vector<gl::Texture> textures;  // one per (scene texture, colour space) actually used
   gl::Buffer materials;               // gpu::Material[], binding kMaterialBinding

@@ -41,6 +41,18 @@ public:
     return *this;
   }
 
+  // An axis-aligned solid box of outward-facing quads (names "<name>+x", "<name>-y", ...).
+  SceneBuilder& box(glm::vec3 lo, glm::vec3 hi, int mat, const std::string& name = "box") {
+    const glm::vec3 c = 0.5f * (lo + hi), e = 0.5f * (hi - lo);
+    quad(c + glm::vec3(e.x, 0, 0), {0, e.y, 0}, {0, 0, e.z}, mat, name + "+x");
+    quad(c - glm::vec3(e.x, 0, 0), {0, 0, e.z}, {0, e.y, 0}, mat, name + "-x");
+    quad(c + glm::vec3(0, e.y, 0), {0, 0, e.z}, {e.x, 0, 0}, mat, name + "+y");
+    quad(c - glm::vec3(0, e.y, 0), {e.x, 0, 0}, {0, 0, e.z}, mat, name + "-y");
+    quad(c + glm::vec3(0, 0, e.z), {e.x, 0, 0}, {0, e.y, 0}, mat, name + "+z");
+    quad(c - glm::vec3(0, 0, e.z), {0, e.y, 0}, {e.x, 0, 0}, mat, name + "-z");
+    return *this;
+  }
+
   // A UV sphere with outward normals.
   SceneBuilder& sphere(glm::vec3 c, float r, int mat, int segments = 48, int rings = 24, const std::string& name = "sphere") {
     MeshInstance m;

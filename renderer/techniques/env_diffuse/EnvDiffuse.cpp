@@ -96,9 +96,7 @@ void EnvDiffusePass::prepare(const Scene& scene, const Params& params, FrameReso
   // copy it was uploaded to), the sky, the receiver and its reference point, the cube parameters, and
   // for extra bounces the form of the gathering that feeds them. Not the camera, not the method.
   const glm::vec3 sky = skyRadiance_;
-  const std::string sceneKey = (scene.digest.empty() ? "addr:" + std::to_string(reinterpret_cast<std::uintptr_t>(&scene))
-                                                     : scene.digest) +
-                               "|gpu:" + std::to_string(reinterpret_cast<std::uintptr_t>(&res.gpuScene()));
+  const std::string& sceneKey = res.sceneKey();
   receivers_.clear();
   for (const env_diffuse::Receiver& r : selected) {
     ReceiverState st;

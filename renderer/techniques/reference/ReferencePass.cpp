@@ -17,15 +17,12 @@ struct ReferenceScene {
   explicit ReferenceScene(const Scene& s) : scene(s), tracer(scene) {}
 };
 
-std::string sceneKey(const Scene& scene) {
-  return scene.digest.empty() ? "addr:" + std::to_string(reinterpret_cast<std::uintptr_t>(&scene)) : scene.digest;
-}
 
 }  // namespace
 
 const Image& referenceImage(FrameResources& res, const Scene& scene, const FrameView& view,
                             const ReferenceRequest& r, bool* cacheHit, std::uint64_t* rays) {
-  ReferenceScene& rs = res.cached<ReferenceScene>("reference_bvh", sceneKey(scene),
+  ReferenceScene& rs = res.cached<ReferenceScene>("reference_bvh", res.sceneKey(),
                                                   [&] { return std::make_unique<ReferenceScene>(scene); });
   reference::ReferenceOptions o;
   o.spp = r.spp;
@@ -43,7 +40,7 @@ const Image& referenceImage(FrameResources& res, const Scene& scene, const Frame
     o.aoRadius = r.aoRadius;
   }
   const glm::mat4& w = view.camera.world;
-  nlohmann::json key = {{"scene", sceneKey(scene)},
+  nlohmann::json key = {{"scene", res.sceneKey()},
                         {"camera", std::vector<float>(&w[0][0], &w[0][0] + 16)},
                         {"projection", static_cast<int>(view.camera.projection)},
                         {"yfov", view.camera.yfov}, {"mag", {view.camera.xmag, view.camera.ymag}},

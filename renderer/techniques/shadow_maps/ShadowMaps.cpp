@@ -95,8 +95,7 @@ void ShadowMapsPass::prepare(const Scene& scene, const Params& params, FrameReso
   res.buffer("shadow_info", infos_.size() * sizeof(gpu::ShadowInfo));
 
   // The maps depend on geometry, lights and size only.
-  const std::string digest = scene.digest + "|" + std::to_string(reinterpret_cast<std::uintptr_t>(&res.gpuScene())) +
-                             "|" + std::to_string(size_);
+  const std::string digest = res.sceneKey() + "|" + std::to_string(size_);
   bool built = false;
   res.cached<ShadowMapsCacheEntry>("shadow_maps", digest, [&] {
     built = true;

@@ -38,10 +38,14 @@
 #include "renderer/reference/PathTracer.h"
 #include "renderer/scene/BuiltinScenes.h"
 #include "renderer/techniques/ambient_occlusion/AmbientOcclusion.h"
+#include "tests/support/RenderTestSupport.h"
 #include "tests/support/SceneBuilder.h"
 
 namespace radiant {
 namespace {
+
+using testing::aov;
+using testing::renderer;
 
 using nlohmann::json;
 using testing::SceneBuilder;
@@ -171,27 +175,8 @@ TEST(AmbientOcclusionKernels, MatchTheirDistributions) {
 }
 
 // ---------------------------------------------------------------------------------------------------
-Renderer& renderer() {
-  static std::unique_ptr<Renderer> r = std::make_unique<Renderer>();
-  return *r;
-}
 
-const Image& aov(const RenderOutput& out, const std::string& name) {
-  for (const auto& a : out.aovs)
-    if (a.aov == name) return a;
-  throw std::runtime_error("missing aov " + name);
-}
 
-// An axis-aligned solid box of outward-facing quads.
-void box(SceneBuilder& b, glm::vec3 lo, glm::vec3 hi, int mat) {
-  const glm::vec3 c = 0.5f * (lo + hi), e = 0.5f * (hi - lo);
-  b.quad(c + glm::vec3(e.x, 0, 0), {0, e.y, 0}, {0, 0, e.z}, mat, "box+x");
-  b.quad(c - glm::vec3(e.x, 0, 0), {0, 0, e.z}, {0, e.y, 0}, mat, "box-x");
-  b.quad(c + glm::vec3(0, e.y, 0), {0, 0, e.z}, {e.x, 0, 0}, mat, "box+y");
-  b.quad(c - glm::vec3(0, e.y, 0), {e.x, 0, 0}, {0, 0, e.z}, mat, "box-y");
-  b.quad(c + glm::vec3(0, 0, e.z), {e.x, 0, 0}, {0, e.y, 0}, mat, "box+z");
-  b.quad(c - glm::vec3(0, 0, e.z), {0, e.y, 0}, {e.x, 0, 0}, mat, "box-z");
-}
 
 void floorQuad(SceneBuilder& b, float half, int mat) { b.quad({0, 0, 0}, {half, 0, 0}, {0, 0, -half}, mat, "floor"); }
 
@@ -317,8 +302,8 @@ void checkCreases(const CreaseCase& cc, bool cornerScene, double& worstBlock, in
   SceneBuilder b;
   const int white = b.material(lambertian());
   floorQuad(b, 4.f, white);
-  box(b, {-3.f, 0.f, -3.f}, {0.f, 1.f, 3.f}, white);                 // wall: face x = 0
-  if (cornerScene) box(b, {-3.f, 0.f, -3.f}, {3.f, 1.f, 0.f}, white);  // wall: face z = 0
+  b.box({-3.f, 0.f, -3.f}, {0.f, 1.f, 3.f}, white);                 // wall: face x = 0
+  if (cornerScene) b.box({-3.f, 0.f, -3.f}, {3.f, 1.f, 0.f}, white);  // wall: face z = 0
   b.topDownOrtho(5.f, half);
   const Scene scene = b.build(std::string("ao-crease-") + (cornerScene ? "corner" : "edge"));
   const AoFrame f = renderAo(scene, size, params(cc.method, 64, true, false, R));
@@ -373,7 +358,7 @@ TEST(AmbientOcclusion, EdgeInPerspectiveMatchesClosedForm) {
   SceneBuilder b;
   const int white = b.material(lambertian());
   floorQuad(b, 6.f, white);
-  box(b, {-4.f, 0.f, -4.f}, {0.f, 3.f, 4.f}, white);
+  b.box({-4.f, 0.f, -4.f}, {0.f, 3.f, 4.f}, white);
   perspective(b, {2.2f, 1.6f, 0.4f}, {0.f, 0.25f, 0.f}, 50.f, 0.01f);
   const Scene scene = b.build("ao-edge-perspective");
   struct Case { const char* method; std::function<double(double, double)> closed; double bound; };
@@ -457,7 +442,7 @@ Scene edgeScene() {
   SceneBuilder b;
   const int white = b.material(lambertian());
   floorQuad(b, 4.f, white);
-  box(b, {-3.f, 0.f, -3.f}, {0.f, 1.f, 3.f}, white);
+  b.box({-3.f, 0.f, -3.f}, {0.f, 1.f, 3.f}, white);
   b.topDownOrtho(5.f, 1.f);
   return b.build("ao-noise-edge");
 }
@@ -519,7 +504,7 @@ TEST(AmbientOcclusion, ExtremesStayFiniteAndInRange) {
     const int white = b.material(lambertian());
     floorQuad(b, 50.f, white);
     b.sphere({0, 0.5f, 0}, 0.5f, white, 24, 12);
-    box(b, {0.8f, 0.f, -0.5f}, {1.4f, 2.f, 0.f}, white);
+    b.box({0.8f, 0.f, -0.5f}, {1.4f, 2.f, 0.f}, white);
     perspective(b, {3.f, 0.05f, 3.f}, {0.f, 0.3f, 0.f}, 40.f, 0.01f);
     scenes.emplace_back("grazing+silhouettes", b.build("ao-ext-grazing"));
   }
@@ -528,8 +513,8 @@ TEST(AmbientOcclusion, ExtremesStayFiniteAndInRange) {
     SceneBuilder b;
     const int white = b.material(lambertian());
     floorQuad(b, 1e5f, white);
-    box(b, {-0.001f, 0.999f, 1.995f}, {0.001f, 1.001f, 1.997f}, white);
-    box(b, {-5.f, 0.f, -1e4f}, {5.f, 50.f, -9.9e3f}, white);
+    b.box({-0.001f, 0.999f, 1.995f}, {0.001f, 1.001f, 1.997f}, white);
+    b.box({-5.f, 0.f, -1e4f}, {5.f, 50.f, -9.9e3f}, white);
     perspective(b, {0.f, 1.f, 2.f}, {0.f, 0.9f, 0.f}, 60.f, 1e-3f);
     scenes.emplace_back("near 1e-3 far 1e5", b.build("ao-ext-depthrange"));
   }

@@ -17,39 +17,22 @@
 #include "renderer/Renderer.h"
 #include "renderer/reference/PathTracer.h"
 #include "renderer/scene/BuiltinScenes.h"
+#include "tests/support/RenderTestSupport.h"
 #include "tests/support/SceneBuilder.h"
 
 namespace radiant {
 namespace {
 
-Renderer& renderer() {
-  static std::unique_ptr<Renderer> r = std::make_unique<Renderer>();
-  return *r;
-}
+using testing::aov;
+using testing::renderer;
+using testing::allFinite;
+using testing::cacheEvent;
+using testing::pass;
 
-const Image& aov(const RenderOutput& out, const std::string& name) {
-  for (const auto& a : out.aovs)
-    if (a.aov == name) return a;
-  throw std::runtime_error("missing aov " + name);
-}
 
-const api::PassStats* pass(const RenderOutput& out, const std::string& name) {
-  for (const auto& p : out.stats.passes)
-    if (p.name == name) return &p;
-  return nullptr;
-}
 
-int cacheEvent(const RenderOutput& out, const std::string& what) {  // -1 absent, 0 miss, 1 hit
-  for (const auto& e : out.stats.cache)
-    if (e.what == what) return e.hit ? 1 : 0;
-  return -1;
-}
 
-bool allFinite(const RenderOutput& out) {
-  for (const auto& p : out.stats.passes)
-    if (p.counters.count("non_finite_pixels_zeroed")) return false;
-  return true;
-}
+
 
 api::RenderRequest request(int size, nlohmann::json params, std::vector<std::string> aovs = {"indirect_diffuse"}) {
   api::RenderRequest r;

@@ -10,21 +10,16 @@
 #include "renderer/metrics/Metrics.h"
 #include "renderer/reference/PathTracer.h"
 #include "renderer/scene/BuiltinScenes.h"
+#include "tests/support/RenderTestSupport.h"
 #include "tests/support/SceneBuilder.h"
 
 namespace radiant {
 namespace {
 
-Renderer& renderer() {
-  static std::unique_ptr<Renderer> r = std::make_unique<Renderer>();
-  return *r;
-}
+using testing::aov;
+using testing::renderer;
 
-const Image& aov(const RenderOutput& out, const std::string& name) {
-  for (const auto& a : out.aovs)
-    if (a.aov == name) return a;
-  throw std::runtime_error("missing aov " + name);
-}
+
 
 TEST(ReferenceAgreement, CalibrationPlaneMatchesRasterAndClosedForm) {
   // Point light of intensity pi at height 1 over a white Lambertian plane: radiance 1.0 at the foot.

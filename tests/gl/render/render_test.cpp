@@ -7,19 +7,19 @@
 
 #include "renderer/Renderer.h"
 #include "renderer/io/ImageIO.h"
+#include "tests/support/RenderTestSupport.h"
 #include "tests/support/SceneBuilder.h"
 
 namespace radiant {
 namespace {
 
+using testing::aov;
+using testing::renderer;
+
 using testing::SceneBuilder;
 using testing::lambertian;
 using testing::topDownPixelToWorld;
 
-Renderer& renderer() {
-  static std::unique_ptr<Renderer> r = std::make_unique<Renderer>();
-  return *r;
-}
 
 api::RenderRequest request(int size, std::vector<std::string> aovs = {"beauty", "direct"}) {
   api::RenderRequest req;
@@ -29,11 +29,6 @@ api::RenderRequest request(int size, std::vector<std::string> aovs = {"beauty", 
   return req;
 }
 
-const Image& aov(const RenderOutput& out, const std::string& name) {
-  for (const auto& a : out.aovs)
-    if (a.aov == name) return a;
-  throw std::runtime_error("missing aov " + name);
-}
 
 void expectAllFinite(const RenderOutput& out) {
   for (const auto& a : out.aovs)

@@ -261,7 +261,7 @@ TEST(Schema, EveryTechniqueFileIsMergedWithDocumentedParams) {
   const auto& techniques = radiant::api::techniqueSchemas();
   std::vector<std::string> names;
   for (const auto& t : techniques) names.push_back(t.name);
-  for (const char* expected : {"direct", "gbuffer", "reference", "shadow_maps", "tonemap"})
+  for (const char* expected : {"direct", "gbuffer", "reference", "shadow_maps", "ambient_occlusion", "env_diffuse", "specular"})
     EXPECT_NE(std::find(names.begin(), names.end(), expected), names.end()) << expected;
   for (const auto& t : techniques) {
     EXPECT_FALSE(t.description.empty()) << t.name;

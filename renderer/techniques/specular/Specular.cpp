@@ -1,0 +1,285 @@
+#include "renderer/techniques/specular/Specular.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <string>
+
+#include "renderer/frame/PassContext.h"
+#include "renderer/techniques/direct/DirectLighting.h"
+#include "renderer/techniques/shadow_maps/ShadowMaps.h"
+
+namespace radiant {
+namespace {
+
+struct SpecularMapsCacheEntry {};  // the maps live in FrameResources; the entry marks them valid
+
+// Branches of the reflection/refraction tree whose path weight drops below this are not traced: each
+// dropped branch changes the pixel by less than 1e-3 times the radiance it would have fetched, and
+// it keeps a glass object's 2^(max_depth+1) rays down to the few that matter.
+constexpr float kMinBranchWeight = 1e-3f;
+
+constexpr int kMapTextureUnitPeel = 13;
+constexpr float kEmptyDistance = 3.0e38f;  // shaders/specular/ldm.glsl
+
+}  // namespace
+
+const TechniqueInfo& SpecularPass::info() const {
+  static const TechniqueInfo i{
+      "specular",
+      "Multiple specular reflections and refractions traced in layered distance maps (thesis ch. 5)",
+      {"gbuffer_position", "normal", "albedo", "material", "emission"},
+      {"shadow_maps"},
+      {"specular"},
+      true,
+      true};
+  return i;
+}
+
+Requirements SpecularPass::requirements(const SceneFeatures& f, const api::RenderRequest&) const {
+  if (f.specularMaterials == 0 && f.transmissiveMaterials == 0)
+    return Requirements::skip("the scene has no specular or transmissive material");
+  return Requirements::ok();
+}
+
+void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
+  // Fallbacks are the schema defaults (api/schema/techniques/specular.json).
+  maxDepth_ = std::clamp(params.get<int>("max_depth", 4), 1, 8);
+  linearSteps_ = std::clamp(params.get<int>("linear_steps", 32), 1, 256);
+  secantSteps_ = std::clamp(params.get<int>("secant_steps", 4), 0, 32);
+  resolution_ = std::clamp(params.get<int>("cube_resolution", 256), 16, 2048);
+  layers_ = std::clamp(params.get<int>("layers", 3), 3, 6);
+  minmax_ = params.get<bool>("minmax", true);
+
+  const Bounds& sb = scene.features.bounds;
+  objects_.clear();
+  objectOfMesh_.assign(scene.meshes.size(), -1);
+  for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
+    const MeshInstance& m = scene.meshes[i];
+    if (!scene.material(m.material).isSpecular() || m.triangleCount() == 0) continue;
+    Object o;
+    o.mesh = i;
+    const glm::vec3 ref = referencePoint(m);
+    float extent = 0.f;
+    for (int c = 0; c < 8; ++c) {
+      const glm::vec3 corner((c & 1) ? sb.max.x : sb.min.x, (c & 2) ? sb.max.y : sb.min.y, (c & 4) ? sb.max.z : sb.min.z);
+      extent = std::max(extent, glm::length(corner - ref));
+    }
+    o.gpu.referenceRadius = glm::vec4(ref, std::max(m.bounds.radius(), 1e-6f));
+    o.gpu.extent = glm::vec4(extent * 1.01f + 1e-6f, 0.f, 0.f, 0.f);
+    objectOfMesh_[i] = static_cast<int>(objects_.size());
+    objects_.push_back(o);
+  }
+
+  const int w = res.view().width, h = res.view().height;
+  const int cubes = std::max<int>(1, static_cast<int>(objects_.size()) * layers_);
+  gl::Texture& material = res.texture("specular_ldm_material", GL_TEXTURE_CUBE_MAP_ARRAY, GL_RGBA16F, resolution_,
+                                      resolution_, 6 * cubes);
+  gl::Texture& geometry = res.texture("specular_ldm_geometry", GL_TEXTURE_CUBE_MAP_ARRAY, GL_RGBA32F, resolution_,
+                                      resolution_, 6 * cubes);
+  // Material and geometry: nearest texels (a texel is one surface point; blending normals, F0/ior or
+  // object indices across a silhouette is meaningless). The search reads a linearly filtered copy of
+  // the distance (empty texels hold a huge value, so blends with them stay "empty").
+  material.setFilter(GL_NEAREST, GL_NEAREST);
+  geometry.setFilter(GL_NEAREST, GL_NEAREST);
+  gl::Texture& distance = res.texture("specular_ldm_distance", GL_TEXTURE_CUBE_MAP_ARRAY, GL_R32F, resolution_,
+                                      resolution_, 6 * cubes);
+  distance.setFilter(GL_LINEAR, GL_LINEAR);
+  res.texture("specular_ldm_depth", GL_TEXTURE_2D, GL_DEPTH_COMPONENT32F, resolution_, resolution_);
+  gl::Texture& peel = res.texture("specular_ldm_peel", GL_TEXTURE_2D, GL_RGBA32F, resolution_, resolution_);
+  peel.setFilter(GL_NEAREST, GL_NEAREST);
+  res.framebuffer("specular_ldm");
+  res.buffer("specular_objects", std::max<std::size_t>(1, objects_.size()) * sizeof(GpuObject));
+  res.buffer("specular_minmax", static_cast<std::size_t>(cubes) * 2 * sizeof(std::uint32_t));
+
+  gl::Texture& specular = res.texture("specular", GL_TEXTURE_2D, GL_RGBA32F, w, h);
+  gl::Texture& depth = res.texture("specular_depth", GL_TEXTURE_2D, GL_DEPTH_COMPONENT32F, w, h);
+  gl::Framebuffer& fb = res.framebuffer("specular");
+  fb.attach(GL_COLOR_ATTACHMENT0, specular);
+  fb.attach(GL_DEPTH_ATTACHMENT, depth);
+  fb.setDrawBuffers({GL_COLOR_ATTACHMENT0});
+  fb.checkComplete("SpecularPass::prepare");
+  gl::Framebuffer& compose = res.framebuffer("specular_compose");
+  compose.attach(GL_COLOR_ATTACHMENT0, res.texture("beauty", GL_TEXTURE_2D, GL_RGBA32F, w, h));
+  compose.setDrawBuffers({GL_COLOR_ATTACHMENT0});
+  compose.checkComplete("SpecularPass::prepare");
+  declareDirectLightingResources(res);
+
+  // The maps depend on the geometry, materials and lights (the uploaded scene's key) and on the map
+  // shape. Not on the tracing knobs (steps, depth, minmax): a sweep over those reuses them.
+  const std::string digest = res.sceneKey() + "|res=" + std::to_string(resolution_) +
+                             "|layers=" + std::to_string(layers_) + "|objects=" + std::to_string(objects_.size());
+  bool built = false;
+  res.cached<SpecularMapsCacheEntry>("specular_maps", digest, [&] {
+    built = true;
+    return std::make_unique<SpecularMapsCacheEntry>();
+  });
+  mapsValid_ = !built;
+}
+
+void SpecularPass::execute(PassContext& ctx) {
+  FrameResources& res = ctx.resources;
+  const FrameView& view = ctx.view;
+  const int objectCount = static_cast<int>(objects_.size());
+  std::vector<GpuObject> gpuObjects;
+  for (const Object& o : objects_) gpuObjects.push_back(o.gpu);
+  if (gpuObjects.empty()) gpuObjects.push_back(GpuObject{});
+  gl::Buffer& objectBuffer = res.buffer("specular_objects");
+  objectBuffer.upload(gpuObjects.data(), gpuObjects.size() * sizeof(GpuObject));
+  gl::Buffer& minmax = res.buffer("specular_minmax");
+  gl::Texture& material = res.texture("specular_ldm_material");
+  gl::Texture& geometry = res.texture("specular_ldm_geometry");
+  gl::Texture& distance = res.texture("specular_ldm_distance");
+
+  ctx.stats.counters["objects"] = objectCount;
+  ctx.stats.counters["maps_rendered"] = 0;
+  if (!mapsValid_ && objectCount > 0) {
+    // Layered distance maps (thesis 5.1.1): per object and face, its front faces, its back faces, the
+    // environment (everything else, closest surface) and depth-peeled environment layers.
+    gl::Framebuffer& fb = res.framebuffer("specular_ldm");
+    gl::Texture& depth = res.texture("specular_ldm_depth");
+    gl::Texture& peel = res.texture("specular_ldm_peel");
+    fb.attach(GL_DEPTH_ATTACHMENT, depth);
+    const gl::Program& prog = ctx.shaders.program({"specular/map.vert", "specular/map.frag"});
+    prog.use();
+    bindDirectLighting(prog, res, ctx.gpu, static_cast<int>(ctx.scene.lights.size()), 1);
+    peel.bindUnit(kMapTextureUnitPeel);
+    glViewport(0, 0, resolution_, resolution_);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_GREATER);  // reversed-Z
+    glDepthMask(GL_TRUE);
+    glDisable(GL_CULL_FACE);  // front/back selection is done per fragment from the reference point
+    glDisable(GL_BLEND);
+    const float zero[4] = {0.f, 0.f, 0.f, 0.f};
+    const float empty[4] = {kEmptyDistance, 0.f, 0.f, 0.f};
+    const float depthClear = 0.f;
+    const float sceneRadius = std::max(ctx.scene.features.bounds.radius(), 1e-6f);
+    const GLint codeLoc = prog.uniformLocation("u_objectCode");
+    int draws = 0;
+    for (int k = 0; k < objectCount; ++k) {
+      const Object& o = objects_[k];
+      const glm::vec3 ref(o.gpu.referenceRadius);
+      const float znear = sceneRadius * 1e-5f;
+      prog.set("u_reference", &ref[0], 3);
+      for (int l = 0; l < layers_; ++l)
+        for (int f = 0; f < 6; ++f) {
+          const int layerFace = (k * layers_ + l) * 6 + f;
+          if (l >= 3) {
+            // Depth peeling reads the previous layer of this face; copy it out first, since sampling a
+            // texture that is also attached is a feedback loop.
+            glCopyImageSubData(geometry.id(), GL_TEXTURE_CUBE_MAP_ARRAY, 0, 0, 0, layerFace - 6, peel.id(),
+                               GL_TEXTURE_2D, 0, 0, 0, 0, resolution_, resolution_, 1);
+          }
+          fb.attach(GL_COLOR_ATTACHMENT0, material, 0, layerFace);
+          fb.attach(GL_COLOR_ATTACHMENT1, geometry, 0, layerFace);
+          fb.attach(GL_COLOR_ATTACHMENT2, distance, 0, layerFace);
+          fb.setDrawBuffers({GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2});
+          fb.checkComplete("SpecularPass::execute (maps)");
+          fb.bind();
+          glClearNamedFramebufferfv(fb.id(), GL_COLOR, 0, zero);
+          glClearNamedFramebufferfv(fb.id(), GL_COLOR, 1, zero);
+          glClearNamedFramebufferfv(fb.id(), GL_COLOR, 2, empty);
+          glClearNamedFramebufferfv(fb.id(), GL_DEPTH, 0, &depthClear);
+          const glm::mat4 vp = ShadowMapsPass::cubeFaceViewProj(ref, f, znear);
+          prog.setMat4("u_viewProj", &vp[0][0]);
+          prog.set("u_faceMode", l == 0 ? 0 : l == 1 ? 1 : 2);
+          prog.set("u_peel", l >= 3 ? 1 : 0);
+          ctx.gpu.drawMeshes(prog, true, [&](std::size_t mesh) {
+            const bool own = mesh == o.mesh;
+            if ((l < 2) != own) return false;
+            glProgramUniform1i(prog.id(), codeLoc, objectOfMesh_[mesh] + 1);
+            return true;
+          });
+          ++draws;
+        }
+    }
+    // Min-max distance per layer (thesis Fig. 5.3).
+    std::vector<std::uint32_t> init(static_cast<std::size_t>(objectCount) * layers_ * 2);
+    for (std::size_t i = 0; i < init.size(); i += 2) {
+      const float big = std::numeric_limits<float>::max();
+      std::memcpy(&init[i], &big, sizeof(float));
+      init[i + 1] = 0u;
+    }
+    minmax.upload(init.data(), init.size() * sizeof(std::uint32_t));
+    glMemoryBarrier(GL_ALL_BARRIER_BITS);
+    const gl::Program& reduce = ctx.shaders.program({"specular/minmax.comp"});
+    reduce.use();
+    geometry.bindImage(0, GL_READ_ONLY, 0, true, 0);
+    minmax.bindBase(GL_SHADER_STORAGE_BUFFER, 4);
+    reduce.set("u_size", resolution_);
+    for (int c = 0; c < objectCount * layers_; ++c) {
+      reduce.set("u_cube", c);
+      glDispatchCompute((resolution_ + 7) / 8, (resolution_ + 7) / 8, 6);
+    }
+    glMemoryBarrier(GL_ALL_BARRIER_BITS);
+    ctx.stats.counters["maps_rendered"] = draws;
+  }
+  ctx.stats.counters["cube_resolution"] = resolution_;
+  ctx.stats.counters["layers"] = layers_;
+
+  // Trace from the rasterised first hits of the specular objects.
+  gl::Framebuffer& fb = res.framebuffer("specular");
+  fb.bind();
+  glViewport(0, 0, view.width, view.height);
+  const float zero[4] = {0.f, 0.f, 0.f, 0.f};
+  const float depthClear = 0.f;
+  glClearNamedFramebufferfv(fb.id(), GL_COLOR, 0, zero);
+  glClearNamedFramebufferfv(fb.id(), GL_DEPTH, 0, &depthClear);
+  if (objectCount > 0) {
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_GREATER);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_BLEND);
+    const char* inputs[] = {"gbuffer_position", "normal", "albedo", "material", "emission"};
+    for (GLuint i = 0; i < std::size(inputs); ++i) res.texture(inputs[i]).bindUnit(i);
+    material.bindUnit(13);
+    geometry.bindUnit(14);
+    distance.bindUnit(15);
+    objectBuffer.bindBase(GL_SHADER_STORAGE_BUFFER, 3);
+    minmax.bindBase(GL_SHADER_STORAGE_BUFFER, 4);
+    const gl::Program& prog = ctx.shaders.program({"specular/map.vert", "specular/specular.frag"});
+    prog.use();
+    prog.setMat4("u_viewProj", &view.viewProj[0][0]);
+    prog.set("u_eye", &view.eye[0], 3);
+    const glm::vec3 forward = -glm::normalize(glm::vec3(view.camera.world[2]));
+    prog.set("u_viewForward", &forward[0], 3);
+    prog.set("u_orthographic", view.camera.projection == ProjectionType::Orthographic ? 1 : 0);
+    prog.set("u_background", &view.ambient[0], 3);
+    prog.set("u_maxDepth", maxDepth_);
+    prog.set("u_minWeight", kMinBranchWeight);
+    prog.set("u_layers", layers_);
+    prog.set("u_linearSteps", linearSteps_);
+    prog.set("u_secantSteps", secantSteps_);
+    prog.set("u_minmax", minmax_ ? 1 : 0);
+    prog.set("u_cubeResolution", static_cast<float>(resolution_));
+    const GLint objectLoc = prog.uniformLocation("u_object");
+    ctx.gpu.drawMeshes(prog, false, [&](std::size_t mesh) {
+      if (objectOfMesh_[mesh] < 0) return false;
+      glProgramUniform1i(prog.id(), objectLoc, objectOfMesh_[mesh]);
+      return true;
+    });
+  }
+  res.markWritten("specular");
+
+  // beauty += specular.
+  gl::Framebuffer& compose = res.framebuffer("specular_compose");
+  compose.bind();
+  glDisable(GL_DEPTH_TEST);
+  glEnable(GL_BLEND);
+  glBlendEquation(GL_FUNC_ADD);
+  glBlendFunc(GL_ONE, GL_ONE);
+  res.texture("specular").bindUnit(0);
+  const gl::Program& composeProg = ctx.shaders.program({"common/fullscreen.vert", "specular/compose.frag"});
+  composeProg.use();
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glDisable(GL_BLEND);
+  res.markWritten("beauty");
+  ctx.stats.counters["max_depth"] = maxDepth_;
+  ctx.stats.counters["linear_steps"] = linearSteps_;
+  ctx.stats.counters["secant_steps"] = secantSteps_;
+}
+
+}  // namespace radiant

@@ -1,0 +1,48 @@
+#pragma once
+// Multiple specular reflections and refractions with layered distance maps (thesis ch. 5).
+//
+// prepare(): finds the specular objects (meshes whose material is Material::isSpecular()), declares
+// their layered distance maps (cube-map arrays of material, geometry and filtered distance, `layers`
+// cubes per object; layout in shaders/specular/ldm.glsl) and looks the maps up
+// in the derived-data cache (scene digest, GPU scene, cube_resolution, layers).
+// execute(): on a cache miss renders every layer of every face of every object and reduces each layer
+// to its min-max distances; then rasterises the specular objects, traces their reflected/refracted
+// rays in the maps (shaders/specular/specular.frag) into the `specular` AOV, and adds it to beauty.
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "renderer/frame/Technique.h"
+
+namespace radiant {
+
+class SpecularPass final : public Technique {
+public:
+  const TechniqueInfo& info() const override;
+  Requirements requirements(const SceneFeatures&, const api::RenderRequest&) const override;
+  void prepare(const Scene&, const Params&, FrameResources&) override;
+  void execute(PassContext&) override;
+
+  // One specular object's map data (std430 in shaders/specular/ldm.glsl, binding 3).
+  struct GpuObject {
+    glm::vec4 referenceRadius;  // xyz reference point, w bounding radius
+    glm::vec4 extent;           // x distance from the reference point to the farthest scene-bounds corner
+  };
+  static_assert(sizeof(GpuObject) == 32, "std430 SpecularObject must be 32 bytes");
+
+  // The reference point of an object (thesis 5.1: the centre of its cube maps): its bounds' centre.
+  static glm::vec3 referencePoint(const MeshInstance& mesh) { return mesh.bounds.center(); }
+
+private:
+  struct Object {
+    std::size_t mesh;
+    GpuObject gpu;
+  };
+  std::vector<Object> objects_;
+  std::vector<int> objectOfMesh_;  // specular object index per mesh, -1 for diffuse meshes
+  int maxDepth_ = 4, linearSteps_ = 32, secantSteps_ = 4, resolution_ = 256, layers_ = 3;
+  bool minmax_ = true;
+  bool mapsValid_ = false;
+};
+
+}  // namespace radiant

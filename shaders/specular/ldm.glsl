@@ -1,0 +1,220 @@
+// Layered distance maps (thesis ch. 5): layout of the maps and ray tracing in them (5.1.2, Algorithm 3).
+// C++ side: renderer/techniques/specular/Specular.cpp. Included by specular.frag (tracing) and map.frag
+// (texel classification).
+//
+// Every specular object k has u_layers cube maps (index k * u_layers + l of the cube arrays):
+//   l = 0 its own front faces as seen from its reference point, l = 1 its back faces, l = 2 the
+//   environment (every other mesh, closest surface), l >= 3 depth-peeled environment layers.
+// Two cube maps per layer as thesis 5.2 describes, plus a filtered copy of the distance:
+//   t_ldmMaterial: rgb = reflected radiance (diffuse), F0 (mirror) or transmission tint (refractor);
+//                  a = signed index of refraction: < 0 mirror, 0 diffuse, > 0 refractor.
+//   t_ldmGeometry: xy = octahedral-encoded surface normal (as modelled: outward), z = distance from
+//                  the reference point (0 = empty texel, no surface), w = specular object index + 1
+//                  of the surface (0 for diffuse): a ray leaving a mirror or refractor continues in the
+//                  maps of the object it hit.
+//   t_ldmDistance:   the distance again (R32F), sampled with linear filtering for the search: the
+//                  secant steps then converge on a piecewise-linear surface instead of the staircase
+//                  of nearest texels. Empty texels hold kEmptyDistance, so a blend with an empty
+//                  neighbour stays huge and reads as "no surface" (the material and geometry maps are
+//                  read with nearest texels: filtering normals or object indices is meaningless).
+#ifndef RADIANT_SPECULAR_LDM
+#define RADIANT_SPECULAR_LDM
+
+// Reflection/refraction data of a specular surface in the thesis' representation (5.2). Mixtures are
+// reduced to one of the two ideal cases: a refractor (any transmission) keeps its ior and its
+// transmission tint; a metal-like mirror keeps F0 = mix(F0(ior), baseColor, metallic) (glTF's
+// metal/dielectric mix at normal incidence).
+vec4 specularTexel(vec3 baseColor, float metallic, float transmission, float ior) {
+  if (transmission > 0.0) return vec4(baseColor * transmission, max(ior, 1.0));
+  float r = (ior - 1.0) / (ior + 1.0);
+  return vec4(mix(vec3(r * r), baseColor, metallic), -1.0);
+}
+
+// Octahedral normal encoding (Cigolle et al. 2014): unit vector <-> [-1,1]^2.
+vec2 octEncode(vec3 n) {
+  n /= abs(n.x) + abs(n.y) + abs(n.z);
+  vec2 p = n.xy;
+  if (n.z < 0.0) p = (1.0 - abs(n.yx)) * vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);
+  return p;
+}
+vec3 octDecode(vec2 p) {
+  vec3 n = vec3(p, 1.0 - abs(p.x) - abs(p.y));
+  if (n.z < 0.0) n.xy = (1.0 - abs(n.yx)) * vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);
+  return normalize(n);
+}
+
+const float kEmptyDistance = 3.0e38;
+
+#ifdef LDM_TRACING
+layout(binding = 13) uniform samplerCubeArray t_ldmMaterial;
+layout(binding = 14) uniform samplerCubeArray t_ldmGeometry;
+layout(binding = 15) uniform samplerCubeArray t_ldmDistance;  // linear filtering, see below
+
+struct SpecularObject {
+  vec4 referenceRadius;  // xyz reference point (world), w bounding radius of the object
+  vec4 extent;           // x distance from the reference point to the farthest scene-bounds corner
+};
+layout(std430, binding = 3) readonly buffer SpecularObjects { SpecularObject objects[]; };
+// Per cube (object * layers + layer): floatBitsToUint of the minimum and maximum stored distance
+// (min = FLT_MAX, max = 0 for an empty layer). Written by minmax.comp when the maps are built.
+layout(std430, binding = 4) readonly buffer LayerMinMax { uint layerMinMax[]; };
+
+uniform int u_layers;
+uniform int u_linearSteps;
+uniform int u_secantSteps;
+uniform int u_minmax;
+uniform float u_cubeResolution;
+
+// One probe of a layer: signed mismatch f = |l| - |l'| (> 0 overshooting: the ray point lies behind
+// the stored surface) and whether the texel holds a surface at all.
+struct Probe { float d; float len; float stored; bool valid; };
+
+Probe probe(float cube, vec3 x, vec3 R, float d) {
+  vec3 l = x + R * d;
+  float len = length(l);
+  // On the reference point itself the direction is undefined: look along the ray instead.
+  vec3 dir = len > 1e-30 ? l : R;
+  float stored = texture(t_ldmDistance, vec4(dir, cube)).r;
+  // Within half a texel of a surface's edge against empty texels the filtered value blends with the
+  // empty marker: fall back to the nearest texel there, so edges keep nearest-texel accuracy instead
+  // of eroding by half a texel.
+  // (Any non-zero bilinear weight on an empty texel lifts the blend above 1e30.)
+  if (stored >= 1e30) stored = texture(t_ldmGeometry, vec4(dir, cube)).z;
+  Probe p;
+  p.d = d;
+  p.len = len;
+  p.valid = stored > 0.0 && stored < 1e30;
+  p.stored = p.valid ? stored : 0.0;
+  return p;
+}
+// Empty texels count as a surface infinitely far away: the ray is always in front of them.
+bool overshoots(Probe p) { return p.valid && p.len >= p.stored; }
+
+// Ray parameter at which |x + R d| = r (far root when far, else near root); false when the line misses
+// the sphere of radius r around the reference point.
+bool sphereRoots(vec3 x, vec3 R, float r, out float dNear, out float dFar) {
+  float b = dot(x, R);
+  float c = dot(x, x) - r * r;
+  float disc = b * b - c;
+  if (disc < 0.0) return false;
+  float s = sqrt(disc);
+  dNear = -b - s;
+  dFar = -b + s;
+  return true;
+}
+
+// Linear search + secant refinement in one layer (thesis 5.1.2). x is the ray origin relative to the
+// reference point, R the unit direction. Returns the ray parameter of the first crossing in this layer.
+bool traceLayer(int object, int layer, vec3 x, vec3 R, out float dHit) {
+  float cube = float(object * u_layers + layer);
+  float rMin = 0.0;
+  float rMax = objects[object].extent.x;
+  if (u_minmax != 0) {
+    int i = 2 * (object * u_layers + layer);
+    rMin = uintBitsToFloat(layerMinMax[i]);
+    rMax = uintBitsToFloat(layerMinMax[i + 1]);
+    if (rMax <= 0.0) return false;  // empty layer: no texel holds a surface
+    rMin *= 0.999;
+    rMax *= 1.001;
+  }
+  // Min-max acceleration (thesis Fig. 5.3): crossings can only happen inside the shell
+  // rMin <= |l| <= rMax, so the ray is clipped to it. Beyond the far intersection with the max sphere
+  // every probe overshoots; inside the min sphere every probe undershoots.
+  float n0, f0;
+  if (!sphereRoots(x, R, rMax, n0, f0) || f0 <= 0.0) return false;
+  float dStart = max(n0, 0.0);
+  float dEnd = f0;
+  float n1, f1;
+  if (rMin > 0.0 && dot(x, x) < rMin * rMin && sphereRoots(x, R, rMin, n1, f1)) dStart = max(dStart, f1);
+  if (dStart >= dEnd) return false;
+
+  // Uniform steps in t along the segment s -> e between the projections of the clipped ray ends A and
+  // B onto the unit sphere (thesis Fig. 5.2). The ray point in the direction of r'(t) = s (1 - t) + e t
+  // is A + (B - A) u with u = |A| t / (|A| t + |B| (1 - t)) (project r' back onto the ray). For
+  // B -> infinity along R this is the thesis formula d(t) = |x|/|R| * t / (1 - t); the clipped form is
+  // finite at t = 1. |A|, |B| are floored so a ray starting on the reference point (|x| = 0, where the
+  // thesis formula gives d = 0 for every t) still marches.
+  vec3 A = x + R * dStart;
+  vec3 B = x + R * dEnd;
+  float floorLen = 1e-7 * max(rMax, 1e-30);
+  float a = max(length(A), floorLen);
+  float b = max(length(B), floorLen);
+  vec3 s = length(A) > floorLen ? normalize(A) : R;
+  vec3 e = length(B) > floorLen ? normalize(B) : R;
+  // Step count proportional to the texels the segment s-e spans (one texel ~ 2/res at a face centre),
+  // capped by linear_steps. A ray parallel to its reference direction (s = e) needs a single step.
+  int steps = clamp(int(ceil(length(e - s) * 0.5 * u_cubeResolution)), 1, u_linearSteps);
+
+  Probe prev = probe(cube, x, R, dStart);
+
+  for (int i = 1; i <= steps; ++i) {
+    float t = float(i) / float(steps);
+    float u = a * t / (a * t + b * (1.0 - t));
+    Probe cur = probe(cube, x, R, mix(dStart, dEnd, u));
+    bool crossIn = !overshoots(prev) && overshoots(cur);               // undershoot -> overshoot
+    bool crossOut = prev.valid && cur.valid && overshoots(prev) && !overshoots(cur);  // hit from behind
+    if (crossIn || crossOut) {
+      // Refine the bracket [lo, hi] (lo on prev's side). Secant / false position on the ratio
+      // g(d) = |l| / |l'| (thesis eq. 2.3, read as: d_new = d_l + (d_p - d_l) (1 - g_l) / (g_p - g_l),
+      // where the PDF's "|l'|/|l'|" is the ratio of the ray point's distance to the stored one). While
+      // an end lies in an empty texel there is no surface to interpolate: bisect instead.
+      Probe lo = prev, hi = cur;
+      Probe m = cur;
+      bool fromEmpty = !prev.valid;
+      for (int k = 0; k < u_secantSteps; ++k) {
+        float dn;
+        if (lo.valid && hi.valid) {
+          float gl = lo.len / lo.stored, gp = hi.len / hi.stored;
+          float den = gp - gl;
+          float w = abs(den) > 1e-12 ? (1.0 - gl) / den : 0.5;
+          dn = mix(lo.d, hi.d, clamp(w, 0.0, 1.0));
+        } else {
+          dn = 0.5 * (lo.d + hi.d);
+        }
+        m = probe(cube, x, R, dn);
+        if (overshoots(m) == overshoots(lo)) lo = m; else hi = m;
+      }
+      // Accept only a crossing of one continuous surface (thesis 5.1.2: the safe search must bracket
+      // "a continuous surface"). Where the bracket straddles a depth discontinuity of the layer (the
+      // silhouette of a nearer surface) the ray passes behind that surface as seen from the reference
+      // point. Linear filtering bridges the discontinuity with a one-texel ramp (a "rubber sheet") on
+      // which the secant converges like on any surface, so the test uses the nearest texel at the
+      // converged point: on a real surface the ray is within a texel's step of it; at a discontinuity
+      // it is in front of the far side or behind the near side by the jump. A texel spans 2/res of the
+      // distance at a face centre and its step grows as the surface turns edge-on to the reference
+      // point (2/res tan(inclination)). Tolerance between two surface texels: 16 texels (inclinations up
+      // to atan 8 ~ 83 deg) plus what the bracket itself still spans (few secant steps leave it wide).
+      // A bracket that began in an empty texel is the edge of a surface against nothing (no sheet to
+      // fear): the ray must come within one texel of the filtered surface there.
+      Probe at = m.valid ? m : hi;
+      float nearestStored = texture(t_ldmGeometry, vec4(at.len > 1e-30 ? x + R * at.d : R, cube)).z;
+      float check = nearestStored > 0.0 && !fromEmpty ? nearestStored : at.stored;
+      float tol = fromEmpty ? 2.0 * at.stored / u_cubeResolution
+                            : 32.0 * at.stored / u_cubeResolution + abs(hi.len - lo.len);
+      if (at.valid && abs(at.len - check) <= tol) {
+        dHit = at.d;
+        return true;
+      }
+    }
+    prev = cur;
+  }
+  return false;
+}
+
+// Algorithm 3's "for each layer ... find the closest intersection".
+bool traceLayers(int object, vec3 originWorld, vec3 R, out float dHit, out int hitLayer) {
+  vec3 x = originWorld - objects[object].referenceRadius.xyz;
+  dHit = 3.4e38;
+  hitLayer = -1;
+  for (int l = 0; l < u_layers; ++l) {
+    float d;
+    if (traceLayer(object, l, x, R, d) && d < dHit) {
+      dHit = d;
+      hitLayer = l;
+    }
+  }
+  return hitLayer >= 0;
+}
+#endif  // LDM_TRACING
+
+#endif

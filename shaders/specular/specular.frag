@@ -1,0 +1,150 @@
+// The specular pass proper: rasterises each specular object (the first hit, thesis ch. 5: "the first
+// point is identified by rasterization"), keeps the fragment the G-buffer sees, and traces the
+// reflected and refracted rays through the layered distance maps, iterating Algorithm 3 with an
+// explicit, bounded stack instead of recursion:
+//   RayTrace(x, R) = radiance of the closest diffuse hit, or 0 when max_depth is reached, or
+//                    F RayTrace(x, Rl) + (1 - F) T RayTrace(x, Rf) at a mirror or refractor.
+// Writes the radiance arriving through the traced paths, already weighted by Fresnel and colour:
+// the `specular` AOV, which compose.frag adds to beauty.
+#define LDM_TRACING
+#include "common/scene.glsl"
+#include "specular/ldm.glsl"
+
+#ifndef MAX_STACK
+#define MAX_STACK 10  // max_depth (<= 8) pending siblings + the current ray, see below
+#endif
+
+in vec3 v_position;
+
+layout(binding = 0) uniform sampler2D t_position;
+layout(binding = 1) uniform sampler2D t_normal;
+layout(binding = 2) uniform sampler2D t_albedo;
+layout(binding = 3) uniform sampler2D t_material;
+layout(binding = 4) uniform sampler2D t_emission;
+
+uniform int u_object;  // index of the specular object being drawn
+uniform vec3 u_eye;
+uniform vec3 u_viewForward;
+uniform int u_orthographic;
+uniform vec3 u_background;  // radiance where a ray leaves the scene (the sky), as `direct` uses
+uniform int u_maxDepth;
+uniform float u_minWeight;  // branches whose path weight falls below this are dropped
+
+layout(location = 0) out vec4 o_specular;
+
+// Exact unpolarised Fresnel reflectance, eta = n_t / n_i, cosI >= 0; 1 under total internal
+// reflection (renderer/reference/Brdf.h fresnelDielectric, the same equations).
+float fresnelDielectric(float cosI, float eta) {
+  cosI = clamp(cosI, 0.0, 1.0);
+  float sin2T = (1.0 - cosI * cosI) / (eta * eta);
+  if (sin2T >= 1.0) return 1.0;
+  float cosT = sqrt(max(0.0, 1.0 - sin2T));
+  float rs = (cosI - eta * cosT) / (cosI + eta * cosT);
+  float rp = (eta * cosI - cosT) / (eta * cosI + cosT);
+  return 0.5 * (rs * rs + rp * rp);
+}
+
+vec3 schlick(vec3 f0, float cosTheta) {
+  float m = clamp(1.0 - cosTheta, 0.0, 1.0);
+  float m2 = m * m;
+  return f0 + (1.0 - f0) * (m2 * m2 * m);
+}
+
+struct Ray {
+  vec3 origin;
+  vec3 dir;
+  vec3 weight;
+  int depth;   // specular interactions on the path so far (the one that spawned this ray included)
+  int object;  // whose layered distance map the ray is traced in: the object it leaves
+};
+
+Ray stack[MAX_STACK];
+int sp = 0;
+
+void push(vec3 origin, vec3 dir, vec3 weight, int depth, int object) {
+  if (max(weight.r, max(weight.g, weight.b)) < u_minWeight || sp >= MAX_STACK) return;
+  stack[sp] = Ray(origin, dir, weight, depth, object);
+  ++sp;
+}
+
+// The two children of an ideal specular interaction at p. R: incoming unit direction; n: the
+// surface normal as modelled (either side); texel: specularTexel(); the rays leave in `object`'s map.
+void scatter(vec3 p, vec3 R, vec3 n, vec4 texel, vec3 weight, int depth, int object, bool entering) {
+  // Unit vectors throughout: the G-buffer normal is stored at half precision, and the search's shell
+  // clipping (ldm.glsl) assumes |R| = 1.
+  n = normalize(n);
+  vec3 nn = dot(n, R) > 0.0 ? -n : n;  // faces the incoming ray
+  float cosI = clamp(-dot(R, nn), 0.0, 1.0);
+  // Self-intersection offset: the maps are sampled at nearest texels, so the surface at the origin is
+  // known only to about half a texel; step off it by that (scaled by the object's size).
+  float eps = objects[object].referenceRadius.w * (1e-3 + 0.5 / u_cubeResolution);
+  vec3 rl = normalize(reflect(R, nn));
+  if (texel.a < 0.0) {
+    // Mirror: Schlick with F0 = the stored colour (glTF conductor Fresnel, as the reference).
+    push(p + nn * eps, rl, weight * schlick(texel.rgb, cosI), depth, object);
+    return;
+  }
+  float ior = texel.a;
+  float eta = entering ? ior : 1.0 / ior;  // n_t / n_i
+  float F = fresnelDielectric(cosI, eta);
+  push(p + nn * eps, rl, weight * F, depth, object);
+  if (F < 1.0) {
+    vec3 rf = refract(R, nn, 1.0 / eta);  // GLSL's eta is n_i / n_t
+    if (dot(rf, rf) > 0.0)
+      // Radiance crossing an interface scales by 1 / eta^2 (Veach 1997, 5.2), as in the reference.
+      push(p - nn * eps, normalize(rf), weight * (1.0 - F) * texel.rgb / (eta * eta), depth, object);
+  }
+}
+
+void main() {
+  ivec2 px = ivec2(gl_FragCoord.xy);
+  vec4 P = texelFetch(t_position, px, 0);
+  float viewDepth = dot(v_position - u_eye, u_viewForward);
+  // Only the fragment the G-buffer kept (same surface within rasterisation noise) is shaded.
+  if (P.w <= 0.0 || abs(P.w - viewDepth) > 1e-3 * max(viewDepth, 1e-6) + 1e-6) discard;
+
+  vec3 p = P.xyz;
+  vec3 n = texelFetch(t_normal, px, 0).xyz;
+  vec4 mat = texelFetch(t_material, px, 0);  // metallic, roughness, occlusion, transmission
+  vec3 albedo = texelFetch(t_albedo, px, 0).rgb;
+  float ior = texelFetch(t_emission, px, 0).a;
+  vec3 R = u_orthographic != 0 ? u_viewForward : normalize(p - u_eye);
+
+  sp = 0;
+  // The G-buffer normal faces the viewer; whether the ray enters or leaves the object is the face's
+  // orientation (a camera inside a glass object sees its back faces).
+  scatter(p, R, n, specularTexel(albedo, mat.x, mat.w, ior), vec3(1.0), 1, u_object, gl_FrontFacing);
+
+  vec3 L = vec3(0.0);
+  int traced = 0;
+  // Each pop pushes at most two children and the walk is depth-first, so at most one pending sibling
+  // per depth level waits on the stack: MAX_STACK >= max_depth + 1 bounds it, and the loop ends after
+  // at most 2^(max_depth + 1) - 2 rays.
+  while (sp > 0) {
+    --sp;
+    Ray r = stack[sp];
+    ++traced;
+    float d;
+    int layer;
+    if (!traceLayers(r.object, r.origin, r.dir, d, layer)) {
+      L += r.weight * u_background;  // no surface in any layer: the ray leaves the scene
+      continue;
+    }
+    vec3 hit = r.origin + r.dir * d;
+    vec3 dir = hit - objects[r.object].referenceRadius.xyz;
+    if (dot(dir, dir) < 1e-30) dir = r.dir;
+    float cube = float(r.object * u_layers + layer);
+    vec4 texel = texture(t_ldmMaterial, vec4(dir, cube));
+    vec4 geo = texture(t_ldmGeometry, vec4(dir, cube));
+    int code = int(geo.w + 0.5);
+    if (texel.a == 0.0 || code == 0) {
+      L += r.weight * texel.rgb;  // diffuse: its reflected radiance
+      continue;
+    }
+    if (r.depth >= u_maxDepth) continue;  // Algorithm 3: max ray depth reached -> zero
+    vec3 hn = octDecode(geo.xy);
+    // Entering a refractor when arriving against its outward normal.
+    scatter(hit, r.dir, hn, texel, r.weight, r.depth + 1, code - 1, dot(hn, r.dir) < 0.0);
+  }
+  o_specular = vec4(L, float(traced));
+}
