@@ -66,6 +66,7 @@ struct RenderRequest {
   float exposure = 0.f;  // EV; PNG = sRGB(clamp(L * 2^exposure))
   std::uint64_t seed = 0;
   glm::vec3 ambient{0.f};  // uniform sky radiance L^a (W/sr/m^2), used by ambient passes
+  std::string environment;  // digest of an uploaded equirect map ("" none); replaces ambient
   std::optional<CompareSpec> compare;
   bool async = false;
 };

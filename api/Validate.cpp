@@ -272,6 +272,10 @@ RenderRequest parseRenderRequest(const json& body, const RequestLimits& limits) 
   r.exposure = v["exposure"].get<float>();
   r.seed = v["seed"].get<std::uint64_t>();
   r.ambient = vec3(v["ambient"]);
+  r.environment = v["environment"].get<std::string>();
+  if (!r.environment.empty() && r.ambient != glm::vec3(0.f))
+    throw ApiError(422, "invalid-value", "Invalid value",
+                   "/environment: give the sky either as ambient or as an environment map, not both", "/environment");
   if (v.contains("compare")) {
     const json& c = v["compare"];
     r.compare = CompareSpec{c["against"], c["aov"], c["spp"], c["max_bounces"]};

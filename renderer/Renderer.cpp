@@ -163,7 +163,7 @@ std::vector<TechniqueDescription> Renderer::techniques() {
 }
 
 RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& request, const std::atomic<bool>* cancel,
-                              const Image* compareTarget) {
+                              const FrameInputs& inputs) {
   Impl& im = *impl_;
   im.device->makeCurrent();
   RenderOutput out;
@@ -176,7 +176,10 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
 
   try {
     const auto frameStart = Clock::now();
-    const FrameView view = makeFrameView(scene, request);
+    if (!request.environment.empty() && !inputs.environment)
+      throw api::ApiError(422, "invalid-value", "Environment not supplied",
+                          "the environment image " + request.environment + " was not supplied", "/environment");
+    const FrameView view = makeFrameView(scene, request, inputs.environment);
     const GpuScene& gpu = im.gpuScene(scene, stats);
 
     std::vector<Technique*> all;
@@ -242,7 +245,7 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     }
     stats.readbackMs = msSince(readStart);
     im.profiler.resolve();
-    if (request.compare) compare(im.resources, scene, view, request, compareTarget, out);
+    if (request.compare) compare(im.resources, scene, view, request, inputs.compareTarget, out);
     stats.renderMs = msSince(frameStart);
     if (nonFinite) stats.passes.back().counters["non_finite_pixels_zeroed"] = static_cast<double>(nonFinite);
     return out;

@@ -18,6 +18,12 @@ struct RenderOutput {
   api::FrameStats stats;
 };
 
+// Images a request refers to by digest, resolved by the caller (the server's image store).
+struct FrameInputs {
+  const Image* compareTarget = nullptr;  // compare.against when it names an image
+  const Image* environment = nullptr;    // request.environment
+};
+
 struct TechniqueDescription {
   std::string name, description;
   std::vector<std::string> outputs;  // AOVs it produces
@@ -33,9 +39,10 @@ public:
   // either the renderer stays usable. `cancel` is polled between passes.
   // With request.compare, stats.metrics holds the error of the compared AOV and the AOVs gain
   // "error" (per-pixel error map) and "reference". The ground truth is the reference path tracer, or
-  // `compareTarget` when the request compares against an uploaded image (the server resolves it).
+  // inputs.compareTarget when the request compares against an uploaded image (the server resolves
+  // it). A request naming an image that `inputs` does not supply is refused (422).
   RenderOutput render(const Scene& scene, const api::RenderRequest& request,
-                      const std::atomic<bool>* cancel = nullptr, const Image* compareTarget = nullptr);
+                      const std::atomic<bool>* cancel = nullptr, const FrameInputs& inputs = {});
   static std::vector<TechniqueDescription> techniques();
 
 private:

@@ -29,9 +29,9 @@ public:
   // status; the backend stays in use) and anything else for environment failures (the job fails
   // with 500 and the server destroys and recreates the backend before the next job).
   // `cancel` becomes true when the job is cancelled or times out; poll it between passes.
-  // `compareTarget` is the decoded image a request's compare.against names (null for "reference").
+  // `inputs` holds the decoded images the request names by digest (compare.against, environment).
   virtual RenderOutput render(const Scene& scene, const api::RenderRequest& request,
-                              const std::atomic<bool>* cancel, const Image* compareTarget) = 0;
+                              const std::atomic<bool>* cancel, const FrameInputs& inputs) = 0;
 };
 
 struct BackendHooks {

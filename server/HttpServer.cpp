@@ -268,6 +268,20 @@ struct HttpServer::Impl {
     throw std::logic_error("unreachable");
   }
 
+  // An image a request names by digest (compare.against, environment), decoded. 404 at `pointer`
+  // when the store does not hold it.
+  std::shared_ptr<const Image> resolveImage(const std::string& digest, const std::string& pointer) {
+    if (!api::isSceneDigest(digest))
+      throw api::ApiError(422, "invalid-value", "Invalid value",
+                          pointer + ": the sha256:... digest of an image uploaded to /v1/images", pointer);
+    auto bytes = images.get(digest);
+    if (!bytes)
+      throw api::ApiError(404, "unknown-image", "Unknown image",
+                          pointer + ": no image " + digest + " (upload it to /v1/images first)", pointer);
+    if (!hooks.decodeImage) throw std::logic_error("no image decoder configured");
+    return std::make_shared<const Image>(hooks.decodeImage(*bytes));
+  }
+
   // ---- helpers --------------------------------------------------------------------------------
   void checkBodySize(const httplib::Request& req) {
     if (req.body.size() > config.maxBodyBytes)
@@ -550,23 +564,13 @@ struct HttpServer::Impl {
                                 api::pointerAppend("/passes", name));
         }
       auto scene = resolveScene(request.scene);
-      std::shared_ptr<const Image> compareTarget;
-      if (request.compare && request.compare->against != "reference") {
-        const std::string& against = request.compare->against;
-        if (!api::isSceneDigest(against))
-          throw api::ApiError(422, "invalid-value", "Invalid value",
-                              "/compare/against: \"reference\" or the sha256:... digest of an image uploaded to /v1/images",
-                              "/compare/against");
-        auto bytes = images.get(against);
-        if (!bytes)
-          throw api::ApiError(404, "unknown-image", "Unknown image",
-                              "/compare/against: no image " + against + " (upload it to /v1/images first)",
-                              "/compare/against");
-        compareTarget = std::make_shared<const Image>(hooks.decodeImage(*bytes));
-      }
+      std::shared_ptr<const Image> compareTarget, environment;
+      if (request.compare && request.compare->against != "reference")
+        compareTarget = resolveImage(request.compare->against, "/compare/against");
+      if (!request.environment.empty()) environment = resolveImage(request.environment, "/environment");
       std::shared_ptr<Job> job;
       try {
-        job = service.submit(request, scene, compareTarget, tSceneLoadMs);
+        job = service.submit(request, scene, compareTarget, environment, tSceneLoadMs);
       } catch (const api::ApiError& e) {
         if (e.type == "queue-full") res.set_header("Retry-After", std::to_string(service.retryAfterSeconds()));
         throw;

@@ -75,13 +75,15 @@ RenderService::RenderService(const ServerConfig& config, const BackendHooks& hoo
 RenderService::~RenderService() { stop(); }
 
 std::shared_ptr<Job> RenderService::submit(api::RenderRequest request, std::shared_ptr<const Scene> scene,
-                                           std::shared_ptr<const Image> compareTarget, double sceneLoadMs) {
+                                           std::shared_ptr<const Image> compareTarget,
+                                           std::shared_ptr<const Image> environment, double sceneLoadMs) {
   auto job = std::make_shared<Job>();
   job->id = newRenderId();
   request.id = job->id;
   job->request = std::move(request);
   job->scene = std::move(scene);
   job->compareTarget = std::move(compareTarget);
+  job->environment = std::move(environment);
   job->sceneLoadMs = sceneLoadMs;
   std::lock_guard lock(mutex_);
   if (draining_ || stopping_)
@@ -254,7 +256,8 @@ void RenderService::renderLoop() {
     RenderOutput output;
     bool recreate = false;
     try {
-      output = backend->render(*job->scene, job->request, &job->cancel, job->compareTarget.get());
+      output = backend->render(*job->scene, job->request, &job->cancel,
+                               FrameInputs{job->compareTarget.get(), job->environment.get()});
     } catch (const api::ApiError& e) {
       problem = Problem{e.status, e.type, e.title, e.detail(), e.pointer};
     } catch (const std::exception& e) {

@@ -49,7 +49,9 @@ struct Job {
   std::string id;
   api::RenderRequest request;
   std::shared_ptr<const Scene> scene;
-  std::shared_ptr<const Image> compareTarget;  // decoded compare.against image (null: the reference)
+  // The decoded images the request names by digest (null when it names none).
+  std::shared_ptr<const Image> compareTarget;  // compare.against
+  std::shared_ptr<const Image> environment;    // environment
   double sceneLoadMs = 0;                      // decoding the scene for this request (0: it was cached)
   std::atomic<bool> cancel{false};
   // Everything below is guarded by RenderService's mutex.
@@ -76,7 +78,8 @@ public:
 
   // Queues a job. Throws ApiError 503 ("queue-full", with retryAfterSeconds()) or 503 "shutting-down".
   std::shared_ptr<Job> submit(api::RenderRequest request, std::shared_ptr<const Scene> scene,
-                              std::shared_ptr<const Image> compareTarget = nullptr, double sceneLoadMs = 0);
+                              std::shared_ptr<const Image> compareTarget = nullptr,
+                              std::shared_ptr<const Image> environment = nullptr, double sceneLoadMs = 0);
   std::shared_ptr<Job> find(const std::string& id);
   // Blocks until the job is terminal or `until`; returns whether it is terminal.
   bool waitFor(const std::shared_ptr<Job>& job, Clock::time_point until);

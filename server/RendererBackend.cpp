@@ -15,8 +15,8 @@ public:
   explicit RendererBackend(const DeviceOptions& options) : renderer_(options) {}
   DeviceInfo device() const override { return renderer_.device(); }
   RenderOutput render(const Scene& scene, const api::RenderRequest& request, const std::atomic<bool>* cancel,
-                      const Image* compareTarget) override {
-    return renderer_.render(scene, request, cancel, compareTarget);
+                      const FrameInputs& inputs) override {
+    return renderer_.render(scene, request, cancel, inputs);
   }
 
 private:

@@ -1,5 +1,7 @@
 #include "renderer/frame/FrameView.h"
 
+#include "renderer/scene/Environment.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -27,13 +29,18 @@ glm::mat4 reversedZOrthographic(float xmag, float ymag, float znear, float zfar)
   return p;
 }
 
-FrameView makeFrameView(const Scene& scene, const api::RenderRequest& request) {
+FrameView makeFrameView(const Scene& scene, const api::RenderRequest& request, const Image* environment) {
   FrameView v;
   v.width = request.width;
   v.height = request.height;
   v.exposure = request.exposure;
   v.seed = request.seed;
   v.ambient = request.ambient;
+  if (environment) {
+    v.environment = environment;
+    v.environmentKey = request.environment;
+    v.ambient = environmentAverage(*environment);
+  }
   const float aspect = static_cast<float>(request.width) / static_cast<float>(request.height);
   Camera cam = scene.camera;
   if (request.camera) {

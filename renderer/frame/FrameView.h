@@ -8,6 +8,7 @@
 #include <glm/glm.hpp>
 
 #include "api/Types.h"
+#include "renderer/Image.h"
 #include "renderer/scene/Scene.h"
 
 namespace radiant {
@@ -19,7 +20,9 @@ struct FrameView {
   glm::vec3 eye{0.f};
   float exposure = 0.f;
   std::uint64_t seed = 0;
-  glm::vec3 ambient{0.f};
+  glm::vec3 ambient{0.f};              // uniform sky radiance: request.ambient, or the map's average
+  const Image* environment = nullptr;  // equirect radiance map (renderer/scene/Environment.h), or null
+  std::string environmentKey;          // its digest, for cache keys
 };
 
 // Reversed-Z, infinite far plane (see above).
@@ -27,6 +30,7 @@ glm::mat4 reversedZPerspective(float yfov, float aspect, float znear);
 // Reversed-Z orthographic: depth 1 at znear, 0 at zfar.
 glm::mat4 reversedZOrthographic(float xmag, float ymag, float znear, float zfar);
 // The request's camera override if any, else the scene's camera, with the image's aspect.
-FrameView makeFrameView(const Scene& scene, const api::RenderRequest& request);
+// `environment` is the decoded request.environment (null when none).
+FrameView makeFrameView(const Scene& scene, const api::RenderRequest& request, const Image* environment = nullptr);
 
 }  // namespace radiant

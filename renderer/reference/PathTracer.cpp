@@ -1,4 +1,5 @@
 #include "renderer/reference/PathTracer.h"
+#include "renderer/scene/Environment.h"
 
 #include <algorithm>
 #include <array>
@@ -184,12 +185,7 @@ private:
     const float* p = map_->at(x, y);
     return map_->channels >= 3 ? glm::vec3(p[0], p[1], p[2]) : glm::vec3(p[0]);
   }
-  void texelOf(const glm::vec3& dir, int& x, int& y) const {
-    const float u = 0.5f + std::atan2(dir.x, -dir.z) / (2.f * kPi);
-    const float v = std::acos(std::clamp(dir.y, -1.f, 1.f)) / kPi;
-    x = std::clamp(static_cast<int>(u * map_->width), 0, map_->width - 1);
-    y = std::clamp(static_cast<int>(v * map_->height), 0, map_->height - 1);
-  }
+  void texelOf(const glm::vec3& dir, int& x, int& y) const { equirectTexel(*map_, dir, x, y); }
   // Largest i in [0, n) with cdf[i] <= value and cdf[i + 1] > cdf[i] when possible.
   static int findInterval(const float* cdf, int n, float value) {
     const float* it = std::upper_bound(cdf, cdf + n + 1, value);

@@ -228,13 +228,14 @@ const TechniqueInfo& AmbientOcclusionPass::info() const {
 }
 
 Requirements AmbientOcclusionPass::requirements(const SceneFeatures&, const api::RenderRequest& request) const {
-  const bool ambient = request.ambient.x > 0.f || request.ambient.y > 0.f || request.ambient.z > 0.f;
+  const bool ambient = request.ambient.x > 0.f || request.ambient.y > 0.f || request.ambient.z > 0.f ||
+                       !request.environment.empty();  // an environment map's average is the ambient
   bool aovWanted = request.compare && request.compare->aov == "ao";
   for (const auto& o : request.outputs)
     aovWanted = aovWanted || std::find(o.aovs.begin(), o.aovs.end(), "ao") != o.aovs.end();
   const bool named = request.passes.count(info().name) != 0;
   if (ambient || aovWanted || named) return Requirements::ok();
-  return Requirements::skip("no ambient lighting and the ao AOV was not requested");
+  return Requirements::skip("no ambient lighting (ambient or environment) and the ao AOV was not requested");
 }
 
 void AmbientOcclusionPass::prepare(const Scene&, const Params& params, FrameResources& res) {

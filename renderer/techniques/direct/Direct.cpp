@@ -1,9 +1,15 @@
 #include "renderer/techniques/direct/Direct.h"
 
+#include <algorithm>
+#include <vector>
+
 #include "renderer/frame/PassContext.h"
 #include "renderer/techniques/direct/DirectLighting.h"
 
 namespace radiant {
+namespace {
+struct EnvironmentMapEntry {};  // marks the environment_map texture as holding the keyed map
+}  // namespace
 
 const TechniqueInfo& DirectPass::info() const {
   static const TechniqueInfo i{"direct",
@@ -31,6 +37,24 @@ void DirectPass::prepare(const Scene&, const Params& params, FrameResources& res
   fb.setDrawBuffers({GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1});
   fb.checkComplete("DirectPass::prepare");
   declareDirectLightingResources(res);
+  // The environment map, uploaded once per map (a marker entry keyed by its digest); a 1x1 placeholder
+  // keeps the sampler complete when there is none.
+  const FrameView& view = res.view();
+  environmentUpload_ = nullptr;
+  if (view.environment) {
+    const Image& env = *view.environment;
+    gl::Texture& t = res.texture("environment_map", GL_TEXTURE_2D, GL_RGBA32F, env.width, env.height);
+    t.setFilter(GL_NEAREST, GL_NEAREST);
+    bool built = false;
+    res.cached<EnvironmentMapEntry>("environment_map", view.environmentKey + "|" + std::to_string(env.width) + "x" +
+                                                           std::to_string(env.height), [&] {
+      built = true;
+      return std::make_unique<EnvironmentMapEntry>();
+    });
+    if (built) environmentUpload_ = &env;
+  } else if (!res.hasTexture("environment_map")) {
+    res.texture("environment_map", GL_TEXTURE_2D, GL_RGBA32F, 1, 1);
+  }
 }
 
 void DirectPass::execute(PassContext& ctx) {
@@ -48,6 +72,18 @@ void DirectPass::execute(PassContext& ctx) {
   const gl::Program& prog = ctx.shaders.program({"common/fullscreen.vert", "direct/direct.frag"});
   prog.use();
   bindDirectLighting(prog, res, ctx.gpu, static_cast<int>(ctx.scene.lights.size()), pcfRadius_);
+  gl::Texture& environment = res.texture("environment_map");
+  if (environmentUpload_) {
+    const Image& env = *environmentUpload_;
+    std::vector<float> rgba(static_cast<std::size_t>(env.width) * env.height * 4, 0.f);
+    for (std::size_t p = 0; p < static_cast<std::size_t>(env.width) * env.height; ++p)
+      for (int c = 0; c < 3; ++c) rgba[p * 4 + c] = env.pixels[p * env.channels + std::min(c, env.channels - 1)];
+    // Rows in image order (row 0 = up): texel row v * height is image row v * height.
+    environment.upload(0, 0, 0, 0, env.width, env.height, 1, GL_RGBA, GL_FLOAT, rgba.data());
+  }
+  environment.bindUnit(8);
+  prog.set("u_hasEnvironment", view.environment ? 1 : 0);
+  prog.setMat4("u_invViewProj", &view.invViewProj[0][0]);
   prog.set("u_eye", &view.eye[0], 3);
   const glm::vec3 forward = -glm::normalize(glm::vec3(view.camera.world[2]));
   prog.set("u_viewForward", &forward[0], 3);

@@ -1,4 +1,5 @@
 #pragma once
+#include "renderer/Image.h"
 #include "renderer/frame/Technique.h"
 
 namespace radiant {
@@ -14,6 +15,7 @@ public:
   void execute(PassContext&) override;
 private:
   int pcfRadius_ = 1;
+  const Image* environmentUpload_ = nullptr;  // the map to upload in execute() (null: texture current)
 };
 
 }  // namespace radiant

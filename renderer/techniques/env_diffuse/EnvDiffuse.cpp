@@ -54,7 +54,7 @@ const TechniqueInfo& EnvDiffusePass::info() const {
 
 Requirements EnvDiffusePass::requirements(const SceneFeatures& f, const api::RenderRequest& request) const {
   if (f.triangles == 0) return Requirements::skip("the scene has no triangles");
-  if (f.lightCount() == 0 && !f.hasEmissive() && request.ambient == glm::vec3(0.f))
+  if (f.lightCount() == 0 && !f.hasEmissive() && request.ambient == glm::vec3(0.f) && request.environment.empty())
     return Requirements::skip("nothing lights the environment: no lights, no emissive surfaces, no ambient");
   return Requirements::ok();
 }

@@ -30,6 +30,7 @@ const Image& referenceImage(FrameResources& res, const Scene& scene, const Frame
   o.russianRoulette = r.russianRoulette;
   o.seed = view.seed;
   o.skyRadiance = view.ambient;
+  o.environment = view.environment;  // when set, it replaces skyRadiance
   if (r.aov == "direct") {
     o.minPathBounce = 0, o.maxPathBounce = 1;  // what the raster `direct` AOV holds: emission, sky, direct
   } else if (r.aov == "indirect" || r.aov == "indirect_diffuse") {
@@ -47,7 +48,8 @@ const Image& referenceImage(FrameResources& res, const Scene& scene, const Frame
                         {"size", {view.width, view.height}}, {"spp", o.spp}, {"max_bounces", o.maxBounces},
                         {"rr", o.russianRoulette}, {"seed", o.seed}, {"bounces", {o.minPathBounce, o.maxPathBounce}},
                         {"mode", static_cast<int>(o.mode)}, {"ao_radius", o.aoRadius},
-                        {"sky", {o.skyRadiance.x, o.skyRadiance.y, o.skyRadiance.z}}};
+                        {"sky", {o.skyRadiance.x, o.skyRadiance.y, o.skyRadiance.z}},
+                        {"environment", view.environmentKey}};
   bool built = false;
   Image& img = res.cached<Image>("reference:" + r.aov, key.dump(), [&] {
     built = true;

@@ -585,7 +585,7 @@ TEST(AmbientOcclusion, PlannerSkipsWithoutAmbientOrAov) {
   RenderOutput out = renderer().render(scene, req);
   EXPECT_FALSE(ran(out));
   ASSERT_EQ(out.stats.skipped.count("ambient_occlusion"), 1u);
-  EXPECT_EQ(out.stats.skipped.at("ambient_occlusion"), "no ambient lighting and the ao AOV was not requested");
+  EXPECT_EQ(out.stats.skipped.at("ambient_occlusion"), "no ambient lighting (ambient or environment) and the ao AOV was not requested");
 
   req.ambient = glm::vec3(1.f);
   out = renderer().render(scene, req);

@@ -97,7 +97,7 @@ TEST(ReferenceAgreement, IdenticalImagesGiveZeroError) {
   req.width = req.height = 32;
   RenderOutput first = renderer().render(scene, req);
   req.compare = api::CompareSpec{"sha256:self", "beauty", 1, 1};
-  RenderOutput out = renderer().render(scene, req, nullptr, &aov(first, "beauty"));
+  RenderOutput out = renderer().render(scene, req, nullptr, FrameInputs{&aov(first, "beauty"), nullptr});
   EXPECT_EQ(out.stats.metrics["rmse"].get<double>(), 0.0);
   EXPECT_EQ(out.stats.metrics["ssim"].get<double>(), 1.0);
   EXPECT_TRUE(out.stats.metrics["psnr"].is_null());

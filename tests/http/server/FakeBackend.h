@@ -55,7 +55,7 @@ public:
     return d;
   }
   RenderOutput render(const Scene& scene, const api::RenderRequest& r, const std::atomic<bool>* cancel,
-                      const Image* /*compareTarget*/) override {
+                      const FrameInputs& /*inputs*/) override {
     ++c_.started;
     {
       std::unique_lock l(c_.m);

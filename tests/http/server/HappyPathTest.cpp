@@ -116,6 +116,21 @@ TEST(RealDaemon, ComparesAgainstAnUploadedImage) {
   EXPECT_EQ(json::parse(r->body)["pointer"], "/compare/against");
   body.erase("compare");
   EXPECT_EQ(c.Post("/v1/renders", body.dump(), "application/json")->status, 200);
+
+  // The same upload serves as an environment map; an unknown one is 404 at /environment, and the
+  // sky given twice (ambient and environment) is 422 there.
+  body["environment"] = digest;
+  r = c.Post("/v1/renders", body.dump(), "application/json");
+  EXPECT_EQ(r->status, 200) << r->body;
+  body["environment"] = "sha256:" + std::string(64, 'b');
+  r = c.Post("/v1/renders", body.dump(), "application/json");
+  EXPECT_EQ(r->status, 404);
+  EXPECT_EQ(json::parse(r->body)["pointer"], "/environment");
+  body["environment"] = digest;
+  body["ambient"] = {1, 1, 1};
+  r = c.Post("/v1/renders", body.dump(), "application/json");
+  EXPECT_EQ(r->status, 422);
+  EXPECT_EQ(json::parse(r->body)["pointer"], "/environment");
 }
 
 }  // namespace
