@@ -1,7 +1,7 @@
 #pragma once
 // One function per subcommand; main.cpp dispatches. Each returns an exit code or throws
 // UsageError / ServerError / UnreachableError (mapped to 2 / 3 / 4 by main).
-// Future subcommands (sweep, report, bench) go in commands/<name>.cpp and the table in main.cpp.
+// sweep, report and bench live in commands/Sweep.cpp on top of client/sweep/ and client/report/.
 #include <string>
 #include <vector>
 
@@ -17,6 +17,9 @@ struct GlobalOptions {
 int cmdRender(const GlobalOptions& g, const std::vector<std::string>& args);
 int cmdInfo(const GlobalOptions& g, const std::vector<std::string>& args);
 int cmdScenes(const GlobalOptions& g, const std::vector<std::string>& args);
+int cmdSweep(const GlobalOptions& g, const std::vector<std::string>& args);
+int cmdReport(const GlobalOptions& g, const std::vector<std::string>& args);
+int cmdBench(const GlobalOptions& g, const std::vector<std::string>& args);
 
 // Helpers shared by commands.
 std::string readFile(const std::string& path);            // throws UsageError

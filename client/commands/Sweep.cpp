@@ -1,0 +1,451 @@
+// radiant sweep / report / bench.
+#include <signal.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <future>
+#include <iostream>
+#include <sstream>
+
+#include "client/Commands.h"
+#include "client/report/Report.h"
+#include "client/sweep/Sweep.h"
+
+namespace radiant::client {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+std::atomic<bool> gStop{false};
+
+// First SIGINT/SIGTERM: finish the renders in flight, record nothing partial, exit. Second: exit at
+// once (every record is already a whole line, so the file stays consistent).
+void onSignal(int) {
+  if (gStop.exchange(true)) ::_exit(130);
+}
+
+void installStopHandler() {
+  struct sigaction sa{};
+  sa.sa_handler = onSignal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+
+std::string commandLine(const std::string& name, const std::vector<std::string>& args) {
+  std::string c = "radiant " + name;
+  for (const auto& a : args) c += " " + (a.find_first_of(" '\"") == std::string::npos ? a : "'" + a + "'");
+  return c;
+}
+
+std::vector<std::string> splitCommas(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream in(s);
+  std::string part;
+  while (std::getline(in, part, ','))
+    if (!part.empty()) out.push_back(part);
+  return out;
+}
+
+int intArg(const std::string& flag, const std::string& v, int lo, int hi) {
+  try {
+    std::size_t used = 0;
+    const int n = std::stoi(v, &used);
+    if (used == v.size() && n >= lo && n <= hi) return n;
+  } catch (const std::exception&) {
+  }
+  throw UsageError(flag + " expects an integer in " + std::to_string(lo) + ".." + std::to_string(hi) + ", got \"" + v + "\"");
+}
+
+fs::path csvPathFor(const fs::path& results) {
+  fs::path csv = results;
+  csv.replace_extension(".csv");
+  return csv;
+}
+
+// Runs points into `resultsPath`, writes the CSV view; returns the exit code.
+int runPoints(const std::vector<sweep::Point>& points, const fs::path& resultsPath, sweep::RunOptions o) {
+  sweep::ResultsFile results(resultsPath);
+  installStopHandler();
+  o.stop = &gStop;
+  const sweep::RunSummary s = sweep::run(points, results, o);
+  const auto all = results.all();
+  sweep::writeCsv(all, csvPathFor(resultsPath));
+  std::cerr << "sweep: " << s.done << " done, " << s.failed << " failed, " << s.skipped << " skipped (already done), "
+            << s.remaining << " not run; results in " << resultsPath.string() << " and "
+            << csvPathFor(resultsPath).string() << "\n";
+  for (const auto& [url, n] : s.perServer) std::cerr << "  " << url << ": " << n << " points\n";
+  for (const auto& [url, why] : s.lost) {
+    if (url == "(client)") {
+      std::cerr << "sweep: error: stopped: " << why << "\n";
+      return 1;
+    }
+    std::cerr << "sweep: error: lost server " << url << ": " << why << "\n";
+  }
+  if (s.interrupted) {
+    std::cerr << "sweep: interrupted; run the same command again to resume\n";
+    return 130;
+  }
+  if (s.remaining > 0) {
+    std::cerr << "sweep: error: " << s.remaining
+              << " point(s) not run because no server is left; run the same command again to resume\n";
+    return kExitUnreachable;
+  }
+  return s.failed > 0 ? kExitServerError : kExitOk;
+}
+
+const char* kSweepUsage =
+    "usage: radiant sweep SPEC.json [-o RESULTS.jsonl] [--server URL ...] [--inflight N] [--retry-failed]\n"
+    "                     [--dry-run] [--quiet]\n"
+    "  Runs every point of the spec (docs/SWEEPS.md) and appends one JSON line per point to RESULTS.jsonl\n"
+    "  (default: SPEC's name with .jsonl), plus a CSV view next to it. Points already in the file are skipped.\n"
+    "  --server may be repeated (or comma-separated): the points are shared between the servers.\n"
+    "  --inflight N: requests in flight per server (default 1, so latency is not queueing).\n";
+
+const char* kReportUsage =
+    "usage: radiant report RESULTS.jsonl [MORE.jsonl ...] -o DIR [--metric rmse|rel_mse|mean_abs|max_abs|psnr|ssim]\n"
+    "                      [--title TEXT]\n"
+    "  Writes DIR/report.html (self-contained, plots inline) and DIR/report.md (plots in DIR/plots/).\n";
+
+const char* kBenchUsage =
+    "usage: radiant bench [-o DIR] [--quick] [--server URL ...] [--inflight N] [--no-report]\n"
+    "       radiant bench --service [-o DIR] [--requests N] [--size PX] [--scene NAME] [--throughput N]\n"
+    "  The standard suite: every built-in scene x every implemented technique at its presets x two\n"
+    "  resolutions, with error against the reference. Writes DIR/bench.spec.json, DIR/results.jsonl (+.csv),\n"
+    "  DIR/report.html and DIR/report.md (default DIR: bench-out). Re-running resumes.\n"
+    "  --service: the service's overhead (end-to-end latency against the renderer's frame time) and the\n"
+    "  throughput of back-to-back small requests; writes DIR/service.json and prints a Markdown table.\n";
+
+}  // namespace
+
+int cmdSweep(const GlobalOptions& g, const std::vector<std::string>& args) {
+  std::string specFile, out;
+  sweep::RunOptions o;
+  bool dryRun = false;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    auto need = [&]() -> const std::string& {
+      if (i + 1 >= args.size()) throw UsageError(a + " needs a value\n" + kSweepUsage);
+      return args[++i];
+    };
+    if (a == "-o" || a == "--output") out = need();
+    else if (a == "--server") for (const auto& s : splitCommas(need())) o.servers.push_back(s);
+    else if (a == "--inflight") o.inflight = intArg(a, need(), 1, 64);
+    else if (a == "--retry-failed") o.retryFailed = true;
+    else if (a == "--dry-run") dryRun = true;
+    else if (a == "--quiet" || a == "-q") o.quiet = true;
+    else if (a == "--help" || a == "-h") {
+      std::cout << kSweepUsage;
+      return kExitOk;
+    } else if (!a.empty() && a[0] == '-') throw UsageError("sweep: unknown option " + a + "\n" + kSweepUsage);
+    else if (specFile.empty()) specFile = a;
+    else throw UsageError(std::string("sweep: more than one spec given\n") + kSweepUsage);
+  }
+  if (specFile.empty()) throw UsageError(std::string("sweep: no spec given\n") + kSweepUsage);
+  std::vector<sweep::Point> points;
+  for (const auto& spec : sweep::parseSpecFile(specFile))
+    for (auto& p : sweep::expand(spec)) points.push_back(std::move(p));
+  if (dryRun) {
+    for (const auto& p : points)
+      std::cout << p.id << "  " << p.sweep << "  " << sweep::paramLabel(p.params) << "\n";
+    std::cout << points.size() << " points\n";
+    return kExitOk;
+  }
+  if (out.empty()) out = fs::path(specFile).stem().string() + ".jsonl";
+  if (o.servers.empty()) o.servers.push_back(g.server);
+  o.token = g.token;
+  o.command = commandLine("sweep", args);
+  return runPoints(points, out, o);
+}
+
+int cmdReport(const GlobalOptions&, const std::vector<std::string>& args) {
+  std::vector<std::string> inputs;
+  std::string out;
+  report::Options o;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    auto need = [&]() -> const std::string& {
+      if (i + 1 >= args.size()) throw UsageError(a + " needs a value\n" + kReportUsage);
+      return args[++i];
+    };
+    if (a == "-o" || a == "--output") out = need();
+    else if (a == "--metric") o.metric = need();
+    else if (a == "--title") o.title = need();
+    else if (a == "--help" || a == "-h") {
+      std::cout << kReportUsage;
+      return kExitOk;
+    } else if (!a.empty() && a[0] == '-') throw UsageError("report: unknown option " + a + "\n" + kReportUsage);
+    else inputs.push_back(a);
+  }
+  if (inputs.empty() || out.empty()) throw UsageError(std::string("report: give RESULTS.jsonl and -o DIR\n") + kReportUsage);
+  static const std::set<std::string> metrics{"rmse", "rel_mse", "mean_abs", "max_abs", "psnr", "ssim"};
+  if (!metrics.count(o.metric)) throw UsageError("report: --metric must be one of rmse, rel_mse, mean_abs, max_abs, psnr, ssim");
+  std::vector<json> records;
+  for (const auto& in : inputs)
+    for (auto& r : sweep::readRecords(in)) records.push_back(std::move(r));
+  if (records.empty()) throw UsageError("report: no records in " + inputs.front());
+  o.command = commandLine("report", args);
+  o.source = inputs.front();
+  for (std::size_t i = 1; i < inputs.size(); ++i) o.source += ", " + inputs[i];
+  const report::Summary s = report::write(records, out, o);
+  std::cout << "wrote " << s.html.string() << " and " << s.markdown.string() << " (" << s.records << " points, "
+            << s.errors << " failed, " << s.plots << " plots)\n";
+  return kExitOk;
+}
+
+namespace {
+
+// Presets per technique: axes over its parameters. Parameters this server's schema lacks, and values
+// outside its range or enum, are dropped, so the suite follows the techniques as they change.
+struct Preset {
+  json axes;      // dotted path -> values
+  json compare;   // compare block
+  json extra;     // extra request fields
+};
+
+Preset presetFor(const std::string& t, bool quick) {
+  const std::string p = "passes." + t + ".";
+  if (t == "direct")
+    return {{{p + "pcf_radius", quick ? json{0, 2} : json{0, 1, 2}}}, {{"max_bounces", 1}}, json::object()};
+  if (t == "ambient_occlusion")
+    return {{{p + "method", {"volumetric", "containment", "crytek", "gtao"}}, {p + "samples", quick ? json{8} : json{4, 16}}},
+            {{"aov", "ao"}},
+            {{"ambient", {1, 1, 1}}}};
+  if (t == "env_diffuse")
+    return {{{p + "form_factor", {"polygon", "point", "classic"}},
+             {p + "downsample", quick ? json{2} : json{2, 4}},
+             {p + "cube_resolution", quick ? json{32} : json{64}}},
+            {{"max_bounces", 2}},
+            json::object()};
+  if (t == "specular")
+    return {{{p + "linear_steps", quick ? json{8} : json{8, 32}}, {p + "cube_resolution", quick ? json{64} : json{128}}},
+            {{"max_bounces", 5}},
+            json::object()};
+  return {json::object(), json::object(), json::object()};
+}
+
+json fitToSchema(const json& axes, const json& params, const std::string& technique) {
+  json out = json::object();
+  const std::string prefix = "passes." + technique + ".";
+  for (const auto& [path, values] : axes.items()) {
+    const std::string name = path.substr(prefix.size());
+    if (!params.contains(name)) continue;
+    const json& s = params[name];
+    json kept = json::array();
+    for (const auto& v : values) {
+      if (s.contains("enum") && std::find(s["enum"].begin(), s["enum"].end(), v) == s["enum"].end()) continue;
+      const json lo = s.contains("minimum") ? s["minimum"] : s.value("min", json());
+      const json hi = s.contains("maximum") ? s["maximum"] : s.value("max", json());
+      if (v.is_number() && lo.is_number() && v.get<double>() < lo.get<double>()) continue;
+      if (v.is_number() && hi.is_number() && v.get<double>() > hi.get<double>()) continue;
+      kept.push_back(v);
+    }
+    if (!kept.empty()) out[path] = kept;
+  }
+  // Techniques without presets: every value of their method-like enum parameter.
+  if (out.empty()) {
+    for (const auto& [name, s] : params.items())
+      if (s.value("type", "") == "string" && s.contains("enum") && (name == "method" || out.empty()))
+        out = json{{prefix + name, s["enum"]}};
+  }
+  return out;
+}
+
+int serviceBench(const GlobalOptions& g, const fs::path& dir, int requests, int size, const std::string& scene,
+                 int throughputN) {
+  HttpClient http(g.server, g.token);
+  const json info = HttpClient::expectOk(http.get("/v1/info")).json();
+  using Clock = std::chrono::steady_clock;
+  struct Sample {
+    double latency, render, queue, encode, server;
+  };
+  auto once = [&](const HttpClient& c, const json& req) {
+    const auto t0 = Clock::now();
+    const HttpResponse r = c.post("/v1/renders", req.dump(), "application/json");
+    HttpClient::expectOk(r);
+    const json res = r.json();
+    for (const auto& f : res["frames"]) HttpClient::expectOk(c.get(f["url"].get<std::string>()));
+    const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    const json& t = res["timings"];
+    Sample s{ms, res["stats"].value("render_ms", 0.0), t.value("queue_ms", 0.0), t.value("encode_ms", 0.0),
+             t.value("queue_ms", 0.0) + t.value("render_ms", 0.0) + t.value("encode_ms", 0.0)};
+    c.del("/v1/renders/" + res.value("id", ""));
+    return s;
+  };
+  const json req{{"scene", {{"builtin", scene}}}, {"width", size}, {"height", size},
+                 {"outputs", {{{"format", "png"}, {"aovs", {"beauty"}}}}}};
+  for (int i = 0; i < 3; ++i) once(http, req);  // scene cached, shaders compiled
+  std::vector<Sample> samples;
+  for (int i = 0; i < requests; ++i) samples.push_back(once(http, req));
+  auto median = [](std::vector<double> v) { return sweep::summarize(std::move(v))["median"].get<double>(); };
+  auto col = [&](double Sample::*m) {
+    std::vector<double> v;
+    for (const auto& s : samples) v.push_back(s.*m);
+    return v;
+  };
+  std::vector<double> overhead, overheadNoEncode, transport;
+  for (const auto& s : samples) {
+    overhead.push_back(100.0 * (s.latency - s.render) / s.render);
+    overheadNoEncode.push_back(100.0 * (s.latency - s.encode - s.render) / s.render);
+    transport.push_back(s.latency - s.server);
+  }
+  const double mLat = median(col(&Sample::latency)), mRender = median(col(&Sample::render)),
+               mQueue = median(col(&Sample::queue)), mEncode = median(col(&Sample::encode)),
+               mServer = median(col(&Sample::server)), mOver = median(overhead),
+               mOverNoEncode = median(overheadNoEncode), mTransport = median(transport);
+  // Throughput: back-to-back small requests, 1 and 4 in flight.
+  const json small{{"scene", {{"builtin", scene}}}, {"width", 32}, {"height", 32},
+                   {"outputs", {{{"format", "png"}, {"aovs", {"beauty"}}}}}};
+  json tput = json::array();
+  for (int inflight : {1, 4}) {
+    std::atomic<int> next{0};
+    std::vector<double> renders;
+    std::mutex m;
+    const auto t0 = Clock::now();
+    std::vector<std::future<void>> workers;
+    for (int w = 0; w < inflight; ++w)
+      workers.push_back(std::async(std::launch::async, [&] {
+        HttpClient c(g.server, g.token);
+        while (next++ < throughputN) {
+          const Sample s = once(c, small);
+          std::lock_guard lock(m);
+          renders.push_back(s.render);
+        }
+      }));
+    for (auto& w : workers) w.get();
+    const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
+    tput.push_back({{"in_flight", inflight}, {"requests", throughputN}, {"seconds", wall},
+                    {"requests_per_s", throughputN / wall}, {"render_ms_median", median(renders)},
+                    {"render_bound_per_s", 1000.0 / median(renders)}});
+  }
+  const std::time_t now = std::time(nullptr);
+  char date[32];
+  std::strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
+  json result{{"date", date},
+              {"server", g.server},
+              {"device", info.value("device", json())},
+              {"overhead", {{"scene", scene}, {"size", size}, {"format", "png"}, {"requests", requests},
+                            {"latency_ms_median", mLat}, {"frame_ms_median", mRender}, {"queue_ms_median", mQueue},
+                            {"encode_ms_median", mEncode}, {"server_ms_median", mServer},
+                            {"overhead_pct_median", mOver}, {"overhead_without_encode_pct_median", mOverNoEncode},
+                            {"http_json_download_ms_median", mTransport}, {"overhead_pct_of_medians", 100.0 * (mLat - mRender) / mRender},
+                            {"target_pct", 15}, {"within_target", mOver <= 15.0}}},
+              {"throughput", tput}};
+  fs::create_directories(dir);
+  writeFile((dir / "service.json").string(), result.dump(2) + "\n");
+  std::cout << "Service overhead, " << scene << " " << size << "x" << size << " PNG, median over " << requests
+            << " sequential requests (" << date << ", " << info["device"].value("renderer", "?") << "):\n\n"
+            << "| end-to-end ms | renderer frame ms | queue ms | PNG encode ms | HTTP + JSON + download ms | overhead | "
+               "overhead without encode | target |\n"
+            << "|---|---|---|---|---|---|---|---|\n"
+            << "| " << report::formatNumber(mLat) << " | " << report::formatNumber(mRender) << " | "
+            << report::formatNumber(mQueue) << " | " << report::formatNumber(mEncode) << " | "
+            << report::formatNumber(mTransport) << " | " << report::formatNumber(mOver) << " % | "
+            << report::formatNumber(mOverNoEncode) << " % | <= 15 % " << (mOver <= 15.0 ? "(met)" : "(missed)")
+            << " |\n\n(overheads: median over requests of (end-to-end - frame) / frame)\n\n"
+            << "Throughput, " << throughputN << " back-to-back 32x32 PNG requests:\n\n"
+            << "| in flight | requests/s | renderer frame ms (median) | bound by render time, requests/s |\n|---|---|---|---|\n";
+  for (const auto& t : tput)
+    std::cout << "| " << t["in_flight"] << " | " << report::formatNumber(t["requests_per_s"]) << " | "
+              << report::formatNumber(t["render_ms_median"]) << " | " << report::formatNumber(t["render_bound_per_s"])
+              << " |\n";
+  std::cout << "\nwrote " << (dir / "service.json").string() << "\n";
+  return kExitOk;
+}
+
+}  // namespace
+
+int cmdBench(const GlobalOptions& g, const std::vector<std::string>& args) {
+  fs::path dir = "bench-out";
+  bool quick = false, service = false, makeReport = true;
+  int requests = 20, size = 256, throughputN = 40;
+  std::string scene = "cornell_box";
+  sweep::RunOptions o;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    auto need = [&]() -> const std::string& {
+      if (i + 1 >= args.size()) throw UsageError(a + " needs a value\n" + kBenchUsage);
+      return args[++i];
+    };
+    if (a == "-o" || a == "--output") dir = need();
+    else if (a == "--quick") quick = true;
+    else if (a == "--service") service = true;
+    else if (a == "--no-report") makeReport = false;
+    else if (a == "--server") for (const auto& s : splitCommas(need())) o.servers.push_back(s);
+    else if (a == "--inflight") o.inflight = intArg(a, need(), 1, 64);
+    else if (a == "--requests") requests = intArg(a, need(), 1, 10000);
+    else if (a == "--size") size = intArg(a, need(), 1, 4096);
+    else if (a == "--scene") scene = need();
+    else if (a == "--throughput") throughputN = intArg(a, need(), 1, 100000);
+    else if (a == "--quiet" || a == "-q") o.quiet = true;
+    else if (a == "--help" || a == "-h") {
+      std::cout << kBenchUsage;
+      return kExitOk;
+    } else throw UsageError("bench: unknown argument " + a + "\n" + kBenchUsage);
+  }
+  if (service) return serviceBench(g, dir, requests, size, scene, throughputN);
+  if (o.servers.empty()) o.servers.push_back(g.server);
+  // The suite follows what the (first) server implements and ships.
+  HttpClient http(o.servers.front(), g.token);
+  const json info = HttpClient::expectOk(http.get("/v1/info")).json();
+  const json scenes = HttpClient::expectOk(http.get("/v1/scenes")).json();
+  json sceneNames = json::array();
+  for (const auto& b : scenes.value("builtins", json::array())) {
+    const std::string name = b.value("name", "");
+    if (!quick || name == "cornell_box" || name == "ao_creases" || name == "cornell_mirror") sceneNames.push_back(name);
+  }
+  static const std::set<std::string> support{"gbuffer", "shadow_maps", "tonemap", "reference"};
+  const std::vector<int> sizes = quick ? std::vector<int>{32, 64} : std::vector<int>{128, 256};
+  json sweeps = json::array();
+  for (const auto& t : info.value("techniques", json::array())) {
+    const std::string name = t.value("name", "");
+    if (support.count(name) || !t.value("available", true)) continue;
+    const Preset preset = presetFor(name, quick);
+    json axes{{"scene.builtin", sceneNames}};
+    const json fitted = fitToSchema(preset.axes, t.value("params", json::object()), name);
+    for (const auto& [path, values] : fitted.items())
+      axes[path] = values;
+    json base{{"scene", {{"builtin", sceneNames.empty() ? "cornell_box" : sceneNames[0]}}},
+              {"passes", {{name, json::object()}}},
+              {"outputs", {{{"format", "png"}, {"aovs", {"beauty"}}}}}};
+    for (const auto& [k, v] : preset.extra.items()) base[k] = v;
+    json compare = preset.compare;
+    compare["spp"] = quick ? 16 : 64;
+    sweeps.push_back({{"name", "bench-" + name},
+                      {"technique", name},
+                      {"base", base},
+                      {"axes", axes},
+                      {"zip", {{{"width", sizes}, {"height", sizes}}}},
+                      {"repeats", quick ? 2 : 3},
+                      {"warmup", 1},
+                      {"compare", compare}});
+  }
+  if (sweeps.empty()) throw UsageError("bench: the server implements no technique to measure");
+  fs::create_directories(dir);
+  const fs::path specFile = dir / "bench.spec.json";
+  writeFile(specFile.string(), json{{"sweeps", sweeps}}.dump(2) + "\n");
+  std::vector<sweep::Point> points;
+  for (const auto& spec : sweep::parseSpecFile(specFile))
+    for (auto& p : sweep::expand(spec)) points.push_back(std::move(p));
+  o.token = g.token;
+  o.command = commandLine("bench", args);
+  const fs::path results = dir / "results.jsonl";
+  const int code = runPoints(points, results, o);
+  if (code == 130 || !makeReport) return code;
+  report::Options ro;
+  ro.title = std::string("Radiant benchmark") + (quick ? " (quick)" : "");
+  ro.source = results.string();
+  ro.command = o.command;
+  const report::Summary s = report::write(sweep::readRecords(results), dir, ro);
+  std::cout << "wrote " << s.html.string() << " and " << s.markdown.string() << " (" << s.records << " points, "
+            << s.errors << " failed, " << s.plots << " plots)\n";
+  return code;
+}
+
+}  // namespace radiant::client
