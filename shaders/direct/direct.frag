@@ -1,6 +1,7 @@
 // Direct lighting from punctual lights with shadow maps, plus emission, from the G-buffer.
 // Writes the `direct` AOV and initialises `beauty` with the same value (later passes add to beauty).
 #include "common/direct_lighting.glsl"
+#include "common/environment.glsl"
 
 in vec2 v_uv;
 
@@ -15,6 +16,9 @@ uniform vec3 u_eye;
 uniform vec3 u_viewForward;
 uniform int u_orthographic;
 uniform vec3 u_background;  // radiance seen where no surface is (the uniform sky)
+uniform int u_hasEnvironment;  // 1: the background is the environment map instead
+uniform mat4 u_invViewProj;
+layout(binding = 8) uniform sampler2D t_environment;
 
 layout(location = 0) out vec4 o_direct;
 layout(location = 1) out vec4 o_beauty;
@@ -23,7 +27,15 @@ void main() {
   ivec2 px = ivec2(gl_FragCoord.xy);
   vec4 P = texelFetch(t_position, px, 0);
   if (P.w <= 0.0) {
-    o_direct = vec4(u_background, 1.0);
+    vec3 sky = u_background;
+    if (u_hasEnvironment != 0) {
+      // The camera ray through the pixel centre: unproject a point on the near plane (reversed-Z:
+      // depth 1); orthographic cameras look along their forward axis.
+      vec4 nearPoint = u_invViewProj * vec4(v_uv * 2.0 - 1.0, 1.0, 1.0);
+      vec3 dir = u_orthographic != 0 ? u_viewForward : normalize(nearPoint.xyz / nearPoint.w - u_eye);
+      sky = environmentRadiance(t_environment, dir);
+    }
+    o_direct = vec4(sky, 1.0);
     o_beauty = o_direct;
     return;
   }
