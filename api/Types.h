@@ -46,6 +46,7 @@ struct OutputSpec {
   ImageFormat format = ImageFormat::Png;
   std::vector<std::string> aovs{"beauty"};  // EXR: all listed become channel groups; PNG: exactly one
   bool halfFloat = true;                    // EXR pixel type
+  int pngCompression = 1;                   // PNG zlib level 0..9
 };
 
 struct CompareSpec {

@@ -267,6 +267,7 @@ RenderRequest parseRenderRequest(const json& body, const RequestLimits& limits) 
     spec.format = o["format"] == "exr" ? ImageFormat::Exr : ImageFormat::Png;
     spec.aovs = o["aovs"].get<std::vector<std::string>>();
     spec.halfFloat = o["half"];
+    spec.pngCompression = o["png_compression"];
     r.outputs.push_back(std::move(spec));
   }
   r.exposure = v["exposure"].get<float>();

@@ -57,7 +57,7 @@ BackendHooks rendererHooks(const ServerConfig& config) {
   h.encodeFrame = [](const std::vector<Image>& aovs, const api::OutputSpec& spec, std::size_t index, float exposure) {
     std::vector<Image> chosen = selectAovs(aovs, spec, index);
     return spec.format == api::ImageFormat::Exr ? io::encodeExr(chosen, spec.halfFloat)
-                                                : io::encodePng(chosen.front(), exposure);
+                                                : io::encodePng(chosen.front(), exposure, spec.pngCompression);
   };
   h.techniques = Renderer::techniques();
   return h;

@@ -116,6 +116,7 @@ const char* kReportUsage =
 const char* kBenchUsage =
     "usage: radiant bench [-o DIR] [--quick] [--server URL ...] [--inflight N] [--no-report]\n"
     "       radiant bench --service [-o DIR] [--requests N] [--size PX] [--scene NAME] [--throughput N]\n"
+    "                               [--png-compression 0-9]\n"
     "  The standard suite: every built-in scene x every implemented technique at its presets x two\n"
     "  resolutions, with error against the reference. Writes DIR/bench.spec.json, DIR/results.jsonl (+.csv),\n"
     "  DIR/report.html and DIR/report.md (default DIR: bench-out). Re-running resumes.\n"
@@ -258,7 +259,7 @@ json fitToSchema(const json& axes, const json& params, const std::string& techni
 }
 
 int serviceBench(const GlobalOptions& g, const fs::path& dir, int requests, int size, const std::string& scene,
-                 int throughputN) {
+                 int throughputN, int pngCompression) {
   HttpClient http(g.server, g.token);
   const json info = HttpClient::expectOk(http.get("/v1/info")).json();
   using Clock = std::chrono::steady_clock;
@@ -279,7 +280,7 @@ int serviceBench(const GlobalOptions& g, const fs::path& dir, int requests, int 
     return s;
   };
   const json req{{"scene", {{"builtin", scene}}}, {"width", size}, {"height", size},
-                 {"outputs", {{{"format", "png"}, {"aovs", {"beauty"}}}}}};
+                 {"outputs", {{{"format", "png"}, {"aovs", {"beauty"}}, {"png_compression", pngCompression}}}}};
   for (int i = 0; i < 3; ++i) once(http, req);  // scene cached, shaders compiled
   std::vector<Sample> samples;
   for (int i = 0; i < requests; ++i) samples.push_back(once(http, req));
@@ -364,7 +365,7 @@ int serviceBench(const GlobalOptions& g, const fs::path& dir, int requests, int 
 int cmdBench(const GlobalOptions& g, const std::vector<std::string>& args) {
   fs::path dir = "bench-out";
   bool quick = false, service = false, makeReport = true;
-  int requests = 20, size = 256, throughputN = 40;
+  int requests = 20, size = 256, throughputN = 40, pngCompression = 1;
   std::string scene = "cornell_box";
   sweep::RunOptions o;
   for (std::size_t i = 0; i < args.size(); ++i) {
@@ -383,13 +384,14 @@ int cmdBench(const GlobalOptions& g, const std::vector<std::string>& args) {
     else if (a == "--size") size = intArg(a, need(), 1, 4096);
     else if (a == "--scene") scene = need();
     else if (a == "--throughput") throughputN = intArg(a, need(), 1, 100000);
+    else if (a == "--png-compression") pngCompression = intArg(a, need(), 0, 9);
     else if (a == "--quiet" || a == "-q") o.quiet = true;
     else if (a == "--help" || a == "-h") {
       std::cout << kBenchUsage;
       return kExitOk;
     } else throw UsageError("bench: unknown argument " + a + "\n" + kBenchUsage);
   }
-  if (service) return serviceBench(g, dir, requests, size, scene, throughputN);
+  if (service) return serviceBench(g, dir, requests, size, scene, throughputN, pngCompression);
   if (o.servers.empty()) o.servers.push_back(g.server);
   // The suite follows what the (first) server implements and ships.
   HttpClient http(o.servers.front(), g.token);

@@ -1,8 +1,10 @@
 #include "renderer/io/ImageIO.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <stdexcept>
 
 #include <OpenImageIO/filesystem.h>
@@ -73,21 +75,42 @@ std::string encodeExr(const std::vector<Image>& aovs, bool halfFloat) {
   return writeToMemory("frame.exr", spec, OIIO::TypeDesc::FLOAT, data.data());
 }
 
-std::string encodePng(const Image& image, float exposureEV) {
+std::string encodePng(const Image& image, float exposureEV, int zlibLevel) {
   const int outChannels = image.channels == 1 ? 1 : 3;
   OIIO::ImageSpec spec(image.width, image.height, outChannels, OIIO::TypeDesc::UINT8);
   const float scale = std::exp2(exposureEV);
+  // 8-bit sRGB without a pow per channel. Threshold k is the linear value at which sRGB(v) * 255
+  // crosses k + 0.5, so the rounded code of v is the number of thresholds at or below it. A table over
+  // 65536 cells of [0, 1] holds the code at each cell's lower edge; codes are at least 3e-4 apart in
+  // linear units (the transfer's steepest part), wider than a cell, so one comparison with the next
+  // threshold finishes the exact rounding. Values below 0 or above 1 saturate (never wrap).
+  struct SrgbTable {
+    std::array<float, 256> threshold{};
+    std::vector<unsigned char> lowerCode = std::vector<unsigned char>(65536);
+    SrgbTable() {
+      for (int k = 0; k < 255; ++k) threshold[k] = srgbToLinear((k + 0.5f) / 255.f);
+      threshold[255] = std::numeric_limits<float>::infinity();
+      int code = 0;
+      for (int i = 0; i < 65536; ++i) {
+        while (code < 255 && threshold[code] <= i / 65535.f) ++code;
+        lowerCode[i] = static_cast<unsigned char>(code);
+      }
+    }
+    unsigned char operator()(float v) const {
+      if (!(v > 0.f)) return 0;  // also NaN
+      if (v >= 1.f) return 255;
+      unsigned code = lowerCode[static_cast<std::size_t>(v * 65535.f)];
+      code += v >= threshold[code];
+      return static_cast<unsigned char>(code);
+    }
+  };
+  static const SrgbTable toSrgb8;
   std::vector<unsigned char> data(static_cast<std::size_t>(image.width) * image.height * outChannels);
   for (std::size_t p = 0; p < static_cast<std::size_t>(image.width) * image.height; ++p)
-    for (int c = 0; c < outChannels; ++c) {
-      float v = image.pixels[p * image.channels + c] * scale;
-      if (!std::isfinite(v)) v = 0.f;
-      // Clamp before quantising: out-of-range values saturate, never wrap.
-      data[p * outChannels + c] = static_cast<unsigned char>(std::lround(linearToSrgb(v) * 255.f));
-    }
-  // zlib level 1: about 3x faster than the default level 6 for a few per cent larger files, which
-  // is the right trade for a render service (the encode dominated the service overhead).
-  spec.attribute("png:compressionLevel", 1);
+    for (int c = 0; c < outChannels; ++c) data[p * outChannels + c] = toSrgb8(image.pixels[p * image.channels + c] * scale);
+  // zlib level 1 by default: about 3x faster than zlib's default 6 for a few per cent larger files,
+  // the right trade for a render service (the encode dominated the service overhead).
+  spec.attribute("png:compressionLevel", std::clamp(zlibLevel, 0, 9));
   return writeToMemory("frame.png", spec, OIIO::TypeDesc::UINT8, data.data());
 }
 

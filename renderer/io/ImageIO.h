@@ -14,7 +14,8 @@ namespace radiant::io {
 // beauty as the unprefixed default layer (R, G, B) so viewers show it first. halfFloat selects HALF.
 std::string encodeExr(const std::vector<Image>& aovs, bool halfFloat);
 // 8-bit sRGB PNG of one AOV: value * 2^exposure, clamped to [0,1] (never wrapped), sRGB transfer.
-std::string encodePng(const Image& image, float exposureEV);
+// zlibLevel 0 (stored) .. 9; 1 is the service's default (see docs/PERFORMANCE.md).
+std::string encodePng(const Image& image, float exposureEV, int zlibLevel = 1);
 void writeFile(const std::string& path, const std::string& bytes);
 // Reads an EXR/HDR/PNG into float RGB (its first three channels, or its one channel) for
 // compare-against-upload and tests. Throws std::runtime_error naming what failed.

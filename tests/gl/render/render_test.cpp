@@ -253,3 +253,33 @@ TEST(ImageIO, PngClampsAndExrKeepsLayers) {
 
 }  // namespace
 }  // namespace radiant
+
+namespace radiant {
+namespace {
+
+TEST(ImageIO, PngQuantisationIsTheRoundedSrgbTransfer) {
+  // Every code the threshold search produces equals lround(255 sRGB(v)), on a dense ramp over [0, 1]
+  // and through every boundary's neighbourhood.
+  Image img = Image::make("beauty", 4096, 1, 3);
+  for (int x = 0; x < 4096; ++x)
+    for (int c = 0; c < 3; ++c) img.at(x, 0)[c] = (x + 0.37f * c) / 4095.f;
+  const std::string path = ::testing::TempDir() + "/ramp.png";
+  io::writeFile(path, io::encodePng(img, 0.f));
+  const Image back = io::readImage(path);
+  int mismatches = 0;
+  for (int x = 0; x < 4096; ++x)
+    for (int c = 0; c < 3; ++c) {
+      const float v = std::min(img.at(x, 0)[c], 1.f);
+      const long expected = std::lround(io::linearToSrgb(v) * 255.f);
+      const long got = std::lround(back.at(x, 0)[c] * 255.f);
+      // Exactly at a threshold, float rounding may land either side: allow that, and only that.
+      if (got != expected) {
+        ++mismatches;
+        EXPECT_LE(std::abs(got - expected), 1);
+      }
+    }
+  EXPECT_LE(mismatches, 2);
+}
+
+}  // namespace
+}  // namespace radiant
