@@ -184,7 +184,7 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
 
     std::vector<Technique*> all;
     for (auto& t : im.techniques) all.push_back(t.get());
-    FramePlan plan = planFrame(all, scene.features, request);
+    FramePlan plan = planFrame(all, scene, request);
     stats.skipped = plan.skipped;
 
     im.resources.beginFrame(gpu, view, &stats.cache);

@@ -7,7 +7,7 @@ namespace radiant {
 
 bool isFrameAov(const std::string& aov) { return aov == "beauty"; }
 
-FramePlan planFrame(const std::vector<Technique*>& techniques, const SceneFeatures& features,
+FramePlan planFrame(const std::vector<Technique*>& techniques, const Scene& scene,
                     const api::RenderRequest& request) {
   std::map<std::string, Technique*> byName;
   std::map<std::string, Technique*> producerOf;
@@ -49,7 +49,7 @@ FramePlan planFrame(const std::vector<Technique*>& techniques, const SceneFeatur
   std::map<Technique*, Requirements> req;
   auto requirement = [&](Technique* t) -> const Requirements& {
     auto it = req.find(t);
-    if (it == req.end()) it = req.emplace(t, t->requirements(features, request)).first;
+    if (it == req.end()) it = req.emplace(t, t->requirements(scene, request)).first;
     return it->second;
   };
   std::set<Technique*> keep;

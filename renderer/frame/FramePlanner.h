@@ -23,7 +23,7 @@ bool isFrameAov(const std::string& aov);
 
 // `techniques` is in the canonical execution order (renderer/techniques/Registry.cpp).
 // Throws api::ApiError (422) for a requested pass or AOV that no technique knows.
-FramePlan planFrame(const std::vector<Technique*>& techniques, const SceneFeatures& features,
+FramePlan planFrame(const std::vector<Technique*>& techniques, const Scene& scene,
                     const api::RenderRequest& request);
 
 }  // namespace radiant

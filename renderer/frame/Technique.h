@@ -61,8 +61,10 @@ class Technique {
 public:
   virtual ~Technique() = default;
   virtual const TechniqueInfo& info() const = 0;
-  // Run or skip for this scene and request. Called by the FramePlanner only.
-  virtual Requirements requirements(const SceneFeatures& features, const api::RenderRequest& request) const = 0;
+  // Run or skip for this scene and request (scene.features summarises what it contains; the whole
+  // scene is there for rules that need more, such as which nodes receive indirect light). Called by
+  // the FramePlanner only.
+  virtual Requirements requirements(const Scene& scene, const api::RenderRequest& request) const = 0;
   // Allocate or reuse resources; build or fetch cached derived data. No drawing here.
   virtual void prepare(const Scene& scene, const Params& params, FrameResources& resources) = 0;
   // The only place GL is issued. Must not allocate GL objects.

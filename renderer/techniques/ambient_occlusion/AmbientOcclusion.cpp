@@ -227,7 +227,7 @@ const TechniqueInfo& AmbientOcclusionPass::info() const {
   return i;
 }
 
-Requirements AmbientOcclusionPass::requirements(const SceneFeatures&, const api::RenderRequest& request) const {
+Requirements AmbientOcclusionPass::requirements(const Scene&, const api::RenderRequest& request) const {
   const bool ambient = request.ambient.x > 0.f || request.ambient.y > 0.f || request.ambient.z > 0.f ||
                        !request.environment.empty();  // an environment map's average is the ambient
   bool aovWanted = request.compare && request.compare->aov == "ao";

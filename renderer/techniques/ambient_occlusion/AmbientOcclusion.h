@@ -70,7 +70,7 @@ Falloff parseFalloff(const std::string& s);
 class AmbientOcclusionPass final : public Technique {
 public:
   const TechniqueInfo& info() const override;
-  Requirements requirements(const SceneFeatures&, const api::RenderRequest&) const override;
+  Requirements requirements(const Scene&, const api::RenderRequest&) const override;
   void prepare(const Scene&, const Params&, FrameResources&) override;
   void execute(PassContext&) override;
 

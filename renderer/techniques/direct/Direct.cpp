@@ -22,7 +22,7 @@ const TechniqueInfo& DirectPass::info() const {
   return i;
 }
 
-Requirements DirectPass::requirements(const SceneFeatures&, const api::RenderRequest&) const {
+Requirements DirectPass::requirements(const Scene&, const api::RenderRequest&) const {
   // Always runs: even without lights or emitters it writes the sky behind the geometry and
   // initialises beauty. Lights and emission are handled per pixel in the shader.
   return Requirements::ok();

@@ -10,7 +10,7 @@ namespace radiant {
 class DirectPass final : public Technique {
 public:
   const TechniqueInfo& info() const override;
-  Requirements requirements(const SceneFeatures&, const api::RenderRequest&) const override;
+  Requirements requirements(const Scene&, const api::RenderRequest&) const override;
   void prepare(const Scene&, const Params&, FrameResources&) override;
   void execute(PassContext&) override;
 private:

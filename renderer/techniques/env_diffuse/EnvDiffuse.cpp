@@ -52,10 +52,19 @@ const TechniqueInfo& EnvDiffusePass::info() const {
   return i;
 }
 
-Requirements EnvDiffusePass::requirements(const SceneFeatures& f, const api::RenderRequest& request) const {
+Requirements EnvDiffusePass::requirements(const Scene& scene, const api::RenderRequest& request) const {
+  const SceneFeatures& f = scene.features;
   if (f.triangles == 0) return Requirements::skip("the scene has no triangles");
   if (f.lightCount() == 0 && !f.hasEmissive() && request.ambient == glm::vec3(0.f) && request.environment.empty())
     return Requirements::skip("nothing lights the environment: no lights, no emissive surfaces, no ambient");
+  // Receivers named in the request are checked in prepare() (an unknown name is a 422 there); by the
+  // default rule a scene may have none, and then there is nothing to do.
+  auto given = request.passes.find("env_diffuse");
+  const bool named = given != request.passes.end() && given->second.is_object() &&
+                     !given->second.value("receivers", std::string()).empty();
+  if (!named && env_diffuse::selectReceivers(scene, "", "").empty())
+    return Requirements::skip("no receivers: no node has extras.radiant_receiver and no object is compact and "
+                              "small enough; name them with passes.env_diffuse.receivers");
   return Requirements::ok();
 }
 

@@ -19,7 +19,7 @@ public:
   enum Method : int { kPolygon = 0, kPoint = 1, kClassic = 2 };  // matches ENV_METHOD_* in gather.glsl
 
   const TechniqueInfo& info() const override;
-  Requirements requirements(const SceneFeatures&, const api::RenderRequest&) const override;
+  Requirements requirements(const Scene&, const api::RenderRequest&) const override;
   void prepare(const Scene&, const Params&, FrameResources&) override;
   void execute(PassContext&) override;
 

@@ -23,7 +23,8 @@ const TechniqueInfo& GBufferPass::info() const {
   return i;
 }
 
-Requirements GBufferPass::requirements(const SceneFeatures& f, const api::RenderRequest&) const {
+Requirements GBufferPass::requirements(const Scene& scene, const api::RenderRequest&) const {
+  const SceneFeatures& f = scene.features;
   return f.triangles > 0 ? Requirements::ok() : Requirements::skip("the scene has no triangles");
 }
 

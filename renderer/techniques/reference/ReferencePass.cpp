@@ -79,7 +79,8 @@ const TechniqueInfo& ReferencePass::info() const {
   return i;
 }
 
-Requirements ReferencePass::requirements(const SceneFeatures& f, const api::RenderRequest&) const {
+Requirements ReferencePass::requirements(const Scene& scene, const api::RenderRequest&) const {
+  const SceneFeatures& f = scene.features;
   return f.triangles > 0 ? Requirements::ok() : Requirements::skip("the scene has no triangles");
 }
 

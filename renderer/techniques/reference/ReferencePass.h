@@ -29,7 +29,7 @@ const Image& referenceImage(FrameResources& resources, const Scene& scene, const
 class ReferencePass final : public Technique {
 public:
   const TechniqueInfo& info() const override;
-  Requirements requirements(const SceneFeatures&, const api::RenderRequest&) const override;
+  Requirements requirements(const Scene&, const api::RenderRequest&) const override;
   void prepare(const Scene&, const Params&, FrameResources&) override;
   void execute(PassContext&) override;
 private:

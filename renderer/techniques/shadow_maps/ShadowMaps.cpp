@@ -30,7 +30,8 @@ const TechniqueInfo& ShadowMapsPass::info() const {
   return i;
 }
 
-Requirements ShadowMapsPass::requirements(const SceneFeatures& f, const api::RenderRequest&) const {
+Requirements ShadowMapsPass::requirements(const Scene& scene, const api::RenderRequest&) const {
+  const SceneFeatures& f = scene.features;
   if (f.lightCount() == 0) return Requirements::skip("the scene has no punctual lights");
   if (f.triangles == 0) return Requirements::skip("the scene has no triangles to cast shadows");
   return Requirements::ok();

@@ -38,7 +38,8 @@ const TechniqueInfo& SpecularPass::info() const {
   return i;
 }
 
-Requirements SpecularPass::requirements(const SceneFeatures& f, const api::RenderRequest&) const {
+Requirements SpecularPass::requirements(const Scene& scene, const api::RenderRequest&) const {
+  const SceneFeatures& f = scene.features;
   if (f.specularMaterials == 0 && f.transmissiveMaterials == 0)
     return Requirements::skip("the scene has no specular or transmissive material");
   return Requirements::ok();

@@ -19,7 +19,7 @@ namespace radiant {
 class SpecularPass final : public Technique {
 public:
   const TechniqueInfo& info() const override;
-  Requirements requirements(const SceneFeatures&, const api::RenderRequest&) const override;
+  Requirements requirements(const Scene&, const api::RenderRequest&) const override;
   void prepare(const Scene&, const Params&, FrameResources&) override;
   void execute(PassContext&) override;
 

@@ -409,6 +409,22 @@ TEST(EnvDiffuse, SecondBounceAddsTheWallsReflectionInClosedForm) {
   }
 }
 
+TEST(EnvDiffuse, PlannerSkipsASceneWithNoReceivers) {
+  // A lit floor alone: flat, so not compact, and no extras flag. The planner skips the pass with the
+  // reason instead of running it for nothing; naming a receiver makes it run.
+  testing::SceneBuilder b;
+  const int grey = b.material(testing::lambertian(glm::vec3(0.5f)));
+  b.quad({0, 0, 0}, {5, 0, 0}, {0, 0, -5}, grey, "floor");
+  b.pointLight({0, 2, 0}, 5.f);
+  Scene scene = b.build("env-no-receivers");
+  RenderOutput out = renderer().render(scene, request(16, nlohmann::json::object(), {"beauty"}));
+  ASSERT_TRUE(out.stats.skipped.count("env_diffuse"));
+  EXPECT_EQ(out.stats.skipped.at("env_diffuse").rfind("no receivers", 0), 0u) << out.stats.skipped.at("env_diffuse");
+  EXPECT_EQ(pass(out, "env_diffuse"), nullptr);
+  RenderOutput named = renderer().render(scene, request(16, {{"receivers", "floor"}}, {"beauty"}));
+  EXPECT_NE(pass(named, "env_diffuse"), nullptr);
+}
+
 TEST(EnvDiffuse, SkyIsLeftToAmbientOcclusionByDefault) {
   // The same open-sky scene without include_sky: the only surface the sphere sees is a black floor,
   // so indirect_diffuse must be exactly 0; the sky's light is direct light from the environment, which
