@@ -17,6 +17,7 @@
 #include "renderer/Renderer.h"
 #include "renderer/reference/PathTracer.h"
 #include "renderer/scene/BuiltinScenes.h"
+#include "tests/gl/env_diffuse/EnvDiffuseTestSupport.h"
 
 namespace {
 using namespace radiant;
@@ -27,7 +28,7 @@ struct Fixture {
   Renderer renderer;
   Scene scene = loadBuiltinScene("cornell_box");
   Image reference;
-  std::vector<int> mask;  // 1 sphere, 2 tall box, 0 other or silhouette
+  testing::Masks masks;
 
   Fixture() {
     reference::PathTracer pt(scene);
@@ -38,52 +39,9 @@ struct Fixture {
     Camera cam = scene.camera;
     cam.aspectRatio = 1.f;
     reference = pt.render(cam, kSize, kSize, o);
-    // Receiver mask from the rasteriser: the receivers made emissive, read back from the G-buffer.
-    Scene s = scene;
-    s.digest += "|mask";
-    for (MeshInstance& m : s.meshes) {
-      if (m.name != "sphere" && m.name != "tall_box") continue;
-      Material mat = s.material(m.material);
-      mat.emissiveFactor = m.name == "sphere" ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
-      s.materials.push_back(mat);
-      m.material = static_cast<int>(s.materials.size()) - 1;
-    }
-    api::RenderRequest r;
-    r.width = r.height = kSize;
-    r.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"emission"}, false}};
-    RenderOutput out = renderer.render(s, r);
-    const Image& e = out.aovs.back();
-    std::vector<int> id(kSize * kSize);
-    for (int y = 0; y < kSize; ++y)
-      for (int x = 0; x < kSize; ++x) id[y * kSize + x] = e.at(x, y)[0] > 0.5f ? 1 : e.at(x, y)[1] > 0.5f ? 2 : 0;
-    mask = id;
-    for (int y = 0; y < kSize; ++y)
-      for (int x = 0; x < kSize; ++x)
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) {
-            const int X = std::clamp(x + dx, 0, kSize - 1), Y = std::clamp(y + dy, 0, kSize - 1);
-            if (id[Y * kSize + X] != id[y * kSize + x]) mask[y * kSize + x] = 0;
-          }
+    masks = testing::receiverMasks(renderer, scene, kSize);
   }
-
-  double relRmse(const Image& t, int which) const {
-    double num = 0, den = 0;
-    for (int y = 1; y + 1 < kSize; ++y)
-      for (int x = 1; x + 1 < kSize; ++x) {
-        bool inside = true;
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) inside = inside && mask[(y + dy) * kSize + x + dx] == which;
-        if (!inside) continue;
-        for (int c = 0; c < 3; ++c) {
-          double a = 0, b = 0;
-          for (int dy = -1; dy <= 1; ++dy)
-            for (int dx = -1; dx <= 1; ++dx) a += t.at(x + dx, y + dy)[c], b += reference.at(x + dx, y + dy)[c];
-          num += (a - b) * (a - b);
-          den += b * b;
-        }
-      }
-    return std::sqrt(num / den);
-  }
+  double relRmse(const Image& t, int which) const { return testing::relRmse3(t, reference, masks, which); }
 };
 
 Fixture& fixture() {

@@ -17,6 +17,7 @@
 #include "renderer/Renderer.h"
 #include "renderer/reference/PathTracer.h"
 #include "renderer/scene/BuiltinScenes.h"
+#include "tests/gl/env_diffuse/EnvDiffuseTestSupport.h"
 #include "tests/support/RenderTestSupport.h"
 #include "tests/support/SceneBuilder.h"
 
@@ -28,6 +29,9 @@ using testing::renderer;
 using testing::allFinite;
 using testing::cacheEvent;
 using testing::pass;
+using testing::Masks;
+using testing::receiverMasks;
+using testing::relRmse3;
 
 
 
@@ -155,43 +159,6 @@ Scene cornellWithSphereAt(glm::vec3 sphereCentre, const std::string& tag) {
   return s;
 }
 
-// Which receiver each pixel shows: the same scene with the receivers made emissive (red sphere, green
-// box), read back from the G-buffer's emission AOV, so the mask comes from the very rasteriser.
-struct Masks {
-  std::vector<int> id;  // 0 none, 1 sphere, 2 tall box; pixels at a silhouette (any 4-neighbour differs) -1
-};
-Masks receiverMasks(const Scene& scene, int size) {
-  Scene s = scene;
-  s.digest += "|mask";
-  for (MeshInstance& m : s.meshes) {
-    if (m.name != "sphere" && m.name != "tall_box") continue;
-    Material mat = s.material(m.material);
-    mat.emissiveFactor = m.name == "sphere" ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
-    s.materials.push_back(mat);
-    m.material = static_cast<int>(s.materials.size()) - 1;
-  }
-  api::RenderRequest r;
-  r.width = r.height = size;
-  r.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"emission"}, false}};
-  RenderOutput out = renderer().render(s, r);
-  const Image& e = aov(out, "emission");
-  Masks m;
-  m.id.assign(size * size, 0);
-  for (int y = 0; y < size; ++y)
-    for (int x = 0; x < size; ++x) m.id[y * size + x] = e.at(x, y)[0] > 0.5f ? 1 : e.at(x, y)[1] > 0.5f ? 2 : 0;
-  std::vector<int> eroded = m.id;
-  for (int y = 0; y < size; ++y)
-    for (int x = 0; x < size; ++x) {
-      const int v = m.id[y * size + x];
-      for (auto [dx, dy] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
-        const int X = std::clamp(x + dx, 0, size - 1), Y = std::clamp(y + dy, 0, size - 1);
-        if (m.id[Y * size + X] != v) eroded[y * size + x] = -1;
-      }
-    }
-  m.id = eroded;
-  return m;
-}
-
 // Relative RMS error sqrt(sum (t - r)^2 / sum r^2) over the pixels of receiver `id` (RGB).
 double relRmse(const Image& test, const Image& ref, const Masks& m, int id) {
   double num = 0, den = 0;
@@ -216,28 +183,6 @@ double meanRatio(const Image& test, const Image& ref, const Masks& m, int id) {
   return b > 0 ? a / b : 0.0;
 }
 
-// Relative RMS error after a 3 x 3 box filter, over the pixels whose whole 3 x 3 neighbourhood shows
-// receiver `id`: the filter divides the reference's Monte Carlo noise by 3 while keeping the methods'
-// errors, which are smooth (bias from the box-filtered environment) or a few pixels wide (spikes).
-double relRmse3(const Image& test, const Image& ref, const Masks& m, int id) {
-  double num = 0, den = 0;
-  const int w = test.width;
-  for (int y = 1; y + 1 < test.height; ++y)
-    for (int x = 1; x + 1 < w; ++x) {
-      bool inside = true;
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) inside = inside && m.id[(y + dy) * w + x + dx] == id;
-      if (!inside) continue;
-      for (int c = 0; c < 3; ++c) {
-        double t = 0, r = 0;
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) t += test.at(x + dx, y + dy)[c], r += ref.at(x + dx, y + dy)[c];
-        num += (t - r) * (t - r);
-        den += r * r;
-      }
-    }
-  return den > 0 ? std::sqrt(num / den) : 0.0;
-}
 
 TEST(EnvDiffuseAccuracy, CornellReceiversAgainstOneBounceReference) {
   // The built-in Cornell box, receivers sphere and tall box (extras flags), the sphere either in the
@@ -251,7 +196,7 @@ TEST(EnvDiffuseAccuracy, CornellReceiversAgainstOneBounceReference) {
   for (auto [centre, tag] : {std::pair{glm::vec3(0.1f, 0.17f, 0.22f), std::string("centred")},
                             std::pair{glm::vec3(0.33f, 0.17f, 0.13f), std::string("near_wall")}}) {
     Scene scene = cornellWithSphereAt(centre, tag);
-    Masks masks = receiverMasks(scene, size);
+    Masks masks = receiverMasks(renderer(), scene, size);
     reference::PathTracer pt(scene);
     reference::ReferenceOptions o;
     o.spp = 384;
