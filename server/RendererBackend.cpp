@@ -1,5 +1,8 @@
 #include "server/RendererBackend.h"
 
+#include <cmath>
+#include <string>
+
 #include "renderer/Renderer.h"
 #include "renderer/io/ImageIO.h"
 #include "renderer/scene/BuiltinScenes.h"
@@ -46,11 +49,25 @@ BackendHooks rendererHooks(const ServerConfig& config) {
     }
   };
   h.decodeImage = [](std::string_view bytes) {
+    Image image;
     try {
-      return io::decodeImage(bytes);
+      image = io::decodeImage(bytes);
     } catch (const std::exception& e) {
       throw api::ApiError(422, "invalid-image", "Invalid image", e.what());
     }
+    // Radiance is finite and non-negative: a NaN would poison the reference's importance-sampling
+    // distribution and every metric, so such an image is refused, naming the first bad pixel.
+    for (int y = 0; y < image.height; ++y)
+      for (int x = 0; x < image.width; ++x)
+        for (int c = 0; c < image.channels; ++c) {
+          const float v = image.at(x, y)[c];
+          if (!std::isfinite(v) || v < 0.f)
+            throw api::ApiError(422, "invalid-image", "Invalid image",
+                                "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ") channel " +
+                                    std::to_string(c) + " is " + std::to_string(v) +
+                                    ": radiance must be finite and non-negative");
+        }
+    return image;
   };
   h.builtinSceneNames = [] { return builtinSceneNames(); };
   h.builtinSceneSource = [](const std::string& name) { return std::string(builtinSceneSource(name)); };

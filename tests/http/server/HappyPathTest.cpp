@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "api/Sha256.h"
 #include "api/Validate.h"
 #include "renderer/Renderer.h"
 #include "renderer/io/ImageIO.h"
@@ -90,6 +91,14 @@ TEST(RealDaemon, ComparesAgainstAnUploadedImage) {
   // Bytes that are no image are refused and not stored.
   auto bad = c.Put("/v1/images", "not an image", "application/octet-stream");
   EXPECT_EQ(bad->status, 422);
+  // An image with a NaN pixel is refused too, naming the pixel, and nothing is stored.
+  Image nan = Image::make("beauty", 4, 4, 3);
+  nan.at(2, 1)[0] = std::nanf("");
+  const std::string nanExr = io::encodeExr({nan}, false);
+  bad = c.Put("/v1/images", nanExr, "image/x-exr");
+  EXPECT_EQ(bad->status, 422);
+  EXPECT_NE(json::parse(bad->body)["detail"].get<std::string>().find("pixel (2, 1)"), std::string::npos) << bad->body;
+  EXPECT_EQ(c.Head(("/v1/images/" + api::sceneDigest(nanExr)).c_str())->status, 404);
 
   // The same render compared against its own upload: zero error, and the EXR gains the layers.
   body["compare"] = {{"against", digest}, {"aov", "beauty"}};
