@@ -111,6 +111,9 @@ std::string encodePng(const Image& image, float exposureEV, int zlibLevel) {
   // zlib level 1 by default: about 3x faster than zlib's default 6 for a few per cent larger files,
   // the right trade for a render service (the encode dominated the service overhead).
   spec.attribute("png:compressionLevel", std::clamp(zlibLevel, 0, 9));
+  // Stored (level 0): libpng's per-row filter search only prepares data for a compressor that does
+  // not run; PNG_FILTER_NONE (8) makes the same bytes ~5x faster (0.5 ms instead of 3 at 256x256).
+  if (zlibLevel <= 0) spec.attribute("png:filter", 8);
   return writeToMemory("frame.png", spec, OIIO::TypeDesc::UINT8, data.data());
 }
 
