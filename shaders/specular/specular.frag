@@ -9,6 +9,7 @@
 #define LDM_TRACING
 #include "common/scene.glsl"
 #include "specular/ldm.glsl"
+#include "common/environment.glsl"
 
 #ifndef MAX_STACK
 #define MAX_STACK 10  // max_depth (<= 8) pending siblings + the current ray, see below
@@ -27,6 +28,8 @@ uniform vec3 u_eye;
 uniform vec3 u_viewForward;
 uniform int u_orthographic;
 uniform vec3 u_background;  // radiance where a ray leaves the scene (the sky), as `direct` uses
+uniform int u_hasEnvironment;  // 1: a ray leaving the scene sees the environment map instead
+layout(binding = 8) uniform sampler2D t_environment;
 uniform int u_maxDepth;
 uniform float u_minWeight;  // branches whose path weight falls below this are dropped
 
@@ -127,7 +130,8 @@ void main() {
     float d;
     int layer;
     if (!traceLayers(r.object, r.origin, r.dir, d, layer)) {
-      L += r.weight * u_background;  // no surface in any layer: the ray leaves the scene
+      // No surface in any layer: the ray leaves the scene and sees the sky in its direction.
+      L += r.weight * (u_hasEnvironment != 0 ? environmentRadiance(t_environment, r.dir) : u_background);
       continue;
     }
     vec3 hit = r.origin + r.dir * d;

@@ -249,6 +249,10 @@ void SpecularPass::execute(PassContext& ctx) {
     prog.set("u_viewForward", &forward[0], 3);
     prog.set("u_orthographic", view.camera.projection == ProjectionType::Orthographic ? 1 : 0);
     prog.set("u_background", &view.ambient[0], 3);
+    // The direct pass uploaded the environment map (it declares the texture in every frame).
+    const bool environment = view.environment && res.hasTexture("environment_map");
+    if (environment) res.texture("environment_map").bindUnit(8);
+    prog.set("u_hasEnvironment", environment ? 1 : 0);
     prog.set("u_maxDepth", maxDepth_);
     prog.set("u_minWeight", kMinBranchWeight);
     prog.set("u_layers", layers_);

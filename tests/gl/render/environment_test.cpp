@@ -109,5 +109,29 @@ TEST(Environment, ReferenceLightsByTheMapAndAmbientPassesByItsAverage) {
     }
 }
 
+TEST(Environment, MirrorsReflectTheMapNotItsAverage) {
+  // A perfect white mirror floor (metallic 1, roughness 0: Schlick F = 1 at any angle) seen straight
+  // down reflects the zenith: the red upper hemisphere, (1, 0, 0), not the average (0.5, 0, 1).
+  testing::SceneBuilder b;
+  Material mirror;
+  mirror.metallicFactor = 1.f;
+  mirror.roughnessFactor = 0.f;
+  int m = b.material(mirror);
+  b.quad({0, 0, 0}, {50, 0, 0}, {0, 0, -50}, m, "mirror").topDownOrtho(5.f, 1.f);
+  Scene scene = b.build("env-mirror");
+  const Image env = twoHemispheres();
+  api::RenderRequest req;
+  req.width = req.height = 8;
+  req.environment = "sha256:" + std::string(64, 'c');
+  req.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"specular"}, false}};
+  RenderOutput out = renderer().render(scene, req, nullptr, FrameInputs{nullptr, &env});
+  const Image& spec = aov(out, "specular");
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x) {
+      EXPECT_NEAR(spec.at(x, y)[0], 1.f, 1e-3f);
+      EXPECT_NEAR(spec.at(x, y)[2], 0.f, 1e-3f);
+    }
+}
+
 }  // namespace
 }  // namespace radiant
