@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "tests/support/Expect.h"
 #include "renderer/gl/Gl.h"
 #include "renderer/gl/ShaderLibrary.h"
 #include "renderer/platform/EglDevice.h"
@@ -18,7 +19,7 @@
 namespace radiant::gl {
 namespace {
 
-class GlTest : public testing::Test {
+class GlTest : public ::testing::Test {
 protected:
   void SetUp() override { device_ = EglDevice::create(); }
   void TearDown() override {
@@ -34,16 +35,6 @@ std::string objectLabel(GLenum identifier, GLuint id) {
   return std::string(buf, static_cast<std::size_t>(n));
 }
 
-template <class F>
-std::string glErrorOf(F&& f) {
-  try {
-    f();
-  } catch (const GlError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected GlError";
-  return {};
-}
 
 TEST_F(GlTest, CheckErrorNamesTheCallAndDrains) {
   EXPECT_NO_THROW(checkError("idle"));
@@ -51,7 +42,7 @@ TEST_F(GlTest, CheckErrorNamesTheCallAndDrains) {
   // (GL 4.5 core section 2.3.1); either way the first one is reported and nothing is left over.
   glEnable(0xFFFF);                                  // GL_INVALID_ENUM
   glBindBufferBase(GL_UNIFORM_BUFFER, 1u << 30, 0);  // GL_INVALID_VALUE
-  const std::string message = glErrorOf([] { checkError("CheckErrorTest"); });
+  const std::string message = testing::thrownMessage<GlError>([] { checkError("CheckErrorTest"); });
   EXPECT_EQ(message.rfind("CheckErrorTest: GL_INVALID_ENUM", 0), 0u) << message;
   EXPECT_NO_THROW(checkError("after drain"));
   EXPECT_STREQ(errorName(GL_OUT_OF_MEMORY), "GL_OUT_OF_MEMORY");
@@ -193,14 +184,14 @@ TEST_F(GlTest, CubeMapFacesAreAddressedByZ) {
 TEST_F(GlTest, TextureDownloadRefusesTooSmallBuffer) {
   Texture texture("small", GL_TEXTURE_2D, GL_RGBA32F, 4, 4);
   std::vector<float> out(4);
-  const std::string message = glErrorOf(
+  const std::string message = testing::thrownMessage<GlError>(
       [&] { texture.download(0, GL_RGBA, GL_FLOAT, out.data(), out.size() * sizeof(float)); });
   EXPECT_NE(message.find("Texture::download: GL_INVALID_OPERATION"), std::string::npos) << message;
 }
 
 TEST_F(GlTest, IncompleteFramebufferThrowsNamingTheStatus) {
   Framebuffer empty("empty");
-  const std::string missing = glErrorOf([&] { empty.checkComplete("EmptyTest"); });
+  const std::string missing = testing::thrownMessage<GlError>([&] { empty.checkComplete("EmptyTest"); });
   EXPECT_EQ(missing,
             "EmptyTest: framebuffer incomplete: GL_FRAMEBUFFER_INCOMPLETE_MISSING_ATTACHMENT");
 
@@ -208,7 +199,7 @@ TEST_F(GlTest, IncompleteFramebufferThrowsNamingTheStatus) {
   Texture colour("colour", GL_TEXTURE_2D, GL_RGBA8, 4, 4);
   Framebuffer wrong("wrong");
   wrong.attach(GL_DEPTH_ATTACHMENT, colour);
-  const std::string attachment = glErrorOf([&] { wrong.checkComplete("WrongTest"); });
+  const std::string attachment = testing::thrownMessage<GlError>([&] { wrong.checkComplete("WrongTest"); });
   EXPECT_NE(attachment.find("GL_FRAMEBUFFER_INCOMPLETE_ATTACHMENT"), std::string::npos)
       << attachment;
 

@@ -5,13 +5,14 @@
 #include <memory>
 #include <string>
 
+#include "tests/support/Expect.h"
 #include "renderer/gl/ShaderLibrary.h"
 #include "renderer/platform/EglDevice.h"
 
 namespace radiant::gl {
 namespace {
 
-class ShaderLibraryTest : public testing::Test {
+class ShaderLibraryTest : public ::testing::Test {
 protected:
   void SetUp() override { device_ = EglDevice::create(); }
   std::unique_ptr<EglDevice> device_;
@@ -27,16 +28,6 @@ int lineOf(std::string_view name, std::string_view needle) {
   return line;
 }
 
-template <class F>
-std::string glErrorOf(F&& f) {
-  try {
-    f();
-  } catch (const GlError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected GlError";
-  return {};
-}
 
 TEST(ShaderLibraryPreprocess, VersionFirstThenDefinesThenExpandedIncludes) {
   const std::string text =
@@ -71,14 +62,14 @@ TEST(ShaderLibraryPreprocess, VersionFirstThenDefinesThenExpandedIncludes) {
 
 TEST(ShaderLibraryPreprocess, RejectsCyclesMissingFilesAndBadDefines) {
   const std::string cycle =
-      glErrorOf([] { ShaderLibrary::preprocess("tests/include_cycle_a.glsl", {}); });
+      testing::thrownMessage<GlError>([] { ShaderLibrary::preprocess("tests/include_cycle_a.glsl", {}); });
   EXPECT_NE(cycle.find("#include cycle: tests/include_cycle_a.glsl -> tests/include_cycle_b.glsl "
                        "-> tests/include_cycle_a.glsl"),
             std::string::npos)
       << cycle;
   EXPECT_EQ(cycle.rfind("shaders/tests/include_cycle_b.glsl:2: ", 0), 0u) << cycle;
 
-  const std::string missing = glErrorOf([] { ShaderLibrary::source("tests/nope.frag"); });
+  const std::string missing = testing::thrownMessage<GlError>([] { ShaderLibrary::source("tests/nope.frag"); });
   EXPECT_NE(missing.find("\"tests/nope.frag\""), std::string::npos) << missing;
 
   EXPECT_THROW(ShaderLibrary::preprocess("tests/fill.comp", {{"1BAD", "1"}}), GlError);
@@ -87,7 +78,7 @@ TEST(ShaderLibraryPreprocess, RejectsCyclesMissingFilesAndBadDefines) {
 
 TEST_F(ShaderLibraryTest, CompileErrorNamesFileAndLine) {
   ShaderLibrary library;
-  const std::string message = glErrorOf([&] { library.program({"tests/broken.frag"}); });
+  const std::string message = testing::thrownMessage<GlError>([&] { library.program({"tests/broken.frag"}); });
   const int line = lineOf("tests/broken.frag", "color.g = UNDECLARED");
   EXPECT_NE(message.find("shaders/tests/broken.frag:" + std::to_string(line) + ":"),
             std::string::npos)
@@ -100,7 +91,7 @@ TEST_F(ShaderLibraryTest, CompileErrorNamesFileAndLine) {
 
 TEST_F(ShaderLibraryTest, CompileErrorInsideIncludeNamesTheIncludedFile) {
   ShaderLibrary library;
-  const std::string message = glErrorOf([&] {
+  const std::string message = testing::thrownMessage<GlError>([&] {
     library.program({"tests/triangle.vert", "tests/broken_include.frag"});
   });
   const int line = lineOf("tests/include_broken.glsl", "return UNDECLARED_IN_INCLUDE");
@@ -118,7 +109,7 @@ TEST_F(ShaderLibraryTest, CompileErrorInsideIncludeNamesTheIncludedFile) {
 
 TEST_F(ShaderLibraryTest, LinkErrorNamesTheFiles) {
   ShaderLibrary library;
-  const std::string message = glErrorOf([&] {
+  const std::string message = testing::thrownMessage<GlError>([&] {
     library.program({"tests/triangle.vert", "tests/link_mismatch.frag"});
   });
   EXPECT_NE(message.find("linking shaders/tests/triangle.vert + shaders/tests/link_mismatch.frag"),

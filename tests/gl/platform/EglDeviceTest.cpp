@@ -7,6 +7,7 @@
 #include <string>
 #include <thread>
 
+#include "tests/support/Expect.h"
 #include "renderer/platform/EglDevice.h"
 
 namespace radiant {
@@ -39,17 +40,6 @@ DeviceOptions withDebug() {
   return o;
 }
 
-// Runs `f`, expecting EglError, and returns its message.
-template <class F>
-std::string eglErrorOf(F&& f) {
-  try {
-    f();
-  } catch (const EglError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected EglError";
-  return {};
-}
 
 TEST(EglDevice, DefaultContextIsOpenGL45Core) {
   auto device = EglDevice::create();
@@ -94,7 +84,7 @@ TEST(EglDevice, ChoosesByRendererSubstringCaseInsensitively) {
 }
 
 TEST(EglDevice, BogusNameThrowsNamingTheRequest) {
-  const std::string message = eglErrorOf([] { EglDevice::create(byName("no-such-gpu-7f3a")); });
+  const std::string message = testing::thrownMessage<EglError>([] { EglDevice::create(byName("no-such-gpu-7f3a")); });
   EXPECT_EQ(message.rfind("EglDevice::create(): ", 0), 0u) << message;
   EXPECT_NE(message.find("\"no-such-gpu-7f3a\""), std::string::npos) << message;
   // It lists what it saw, so the operator can pick a better substring.
@@ -111,7 +101,7 @@ TEST(EglDevice, ChoosesByIndex) {
 
 TEST(EglDevice, BadIndexThrows) {
   for (int index : {999, -1}) {
-    const std::string message = eglErrorOf([&] { EglDevice::create(byIndex(index)); });
+    const std::string message = testing::thrownMessage<EglError>([&] { EglDevice::create(byIndex(index)); });
     EXPECT_EQ(message.rfind("EglDevice::create(): device index " + std::to_string(index), 0), 0u)
         << message;
     EXPECT_NE(message.find("out of range"), std::string::npos) << message;
@@ -154,9 +144,9 @@ TEST(EglDevice, OtherThreadSeesContextNotCurrentAndCannotStealIt) {
   auto device = EglDevice::create();
   std::string healthMessage, makeCurrentMessage;
   std::thread([&] {
-    healthMessage = eglErrorOf([&] { device->checkHealthy(); });
+    healthMessage = testing::thrownMessage<EglError>([&] { device->checkHealthy(); });
     // The context is current on the main thread; EGL refuses to bind it twice (EGL 1.5 3.7.3).
-    makeCurrentMessage = eglErrorOf([&] { device->makeCurrent(); });
+    makeCurrentMessage = testing::thrownMessage<EglError>([&] { device->makeCurrent(); });
   }).join();
   EXPECT_NE(healthMessage.find("not current"), std::string::npos) << healthMessage;
   EXPECT_EQ(makeCurrentMessage, "EglDevice::makeCurrent(): eglMakeCurrent failed: EGL_BAD_ACCESS");
@@ -168,9 +158,9 @@ TEST(EglDevice, DebugContextLogsErrorsToStderr) {
   GLint flags = 0;
   glGetIntegerv(GL_CONTEXT_FLAGS, &flags);
   EXPECT_TRUE(flags & GL_CONTEXT_FLAG_DEBUG_BIT);
-  testing::internal::CaptureStderr();
+  ::testing::internal::CaptureStderr();
   glEnable(0xFFFF);  // GL_INVALID_ENUM, reported synchronously through the debug callback
-  const std::string log = testing::internal::GetCapturedStderr();
+  const std::string log = ::testing::internal::GetCapturedStderr();
   EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_INVALID_ENUM));
   EXPECT_NE(log.find("[gl high api error"), std::string::npos) << log;
 }

@@ -304,12 +304,7 @@ TEST(PathTracer, DielectricSlabTransmittanceMatchesFresnelSeries) {
   // reflections carries (1 - R)^2 R^(2j):  T = (1 - R)^2 / (1 - R^2) = (1 - R) / (1 + R).
   // The renderer is unpolarised, so R is the unpolarised (Rs + Rp) / 2 of each interface.
   // The n^2 radiance change on entering cancels on leaving.
-  Material glass;
-  glass.baseColorFactor = glm::vec4(1.f);
-  glass.metallicFactor = 0.f;
-  glass.roughnessFactor = 0.f;
-  glass.transmissionFactor = 1.f;
-  glass.ior = 1.5f;
+  const Material glass = testing::smoothGlass(1.5f);
   Scene s;
   s.meshes.push_back(testing::box({-50, 0, -50}, {50, 0.2f, 50}, addMaterial(s, glass)));
   s.meshes.push_back(testing::square({0, -1, 0}, {0, 1, 0}, 1000.f, addMaterial(s, testing::emitter(glm::vec3(1.f)))));
@@ -328,12 +323,7 @@ TEST(PathTracer, TotalInternalReflectionAtTheCriticalAngle) {
   // Camera inside glass (n = 1.5) looking up at the flat top face, an emitter of radiance 1 just above.
   // With one scattering event only, the camera sees the emitter through the interface:
   // L = n^2 (1 - R(theta)) below the critical angle asin(1/1.5) = 41.81 deg, and 0 above it (TIR).
-  Material glass;
-  glass.baseColorFactor = glm::vec4(1.f);
-  glass.metallicFactor = 0.f;
-  glass.roughnessFactor = 0.f;
-  glass.transmissionFactor = 1.f;
-  glass.ior = 1.5f;
+  const Material glass = testing::smoothGlass(1.5f);
   Scene s;
   s.meshes.push_back(testing::box({-50, -50, -50}, {50, 0, 50}, addMaterial(s, glass)));
   s.meshes.push_back(testing::square({0, 0.001f, 0}, {0, -1, 0}, 1000.f, addMaterial(s, testing::emitter(glm::vec3(1.f)))));

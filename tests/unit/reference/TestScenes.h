@@ -37,6 +37,17 @@ inline Material emitter(glm::vec3 radiance, bool doubleSided = false) {
   return m;
 }
 
+// A smooth, clear dielectric (KHR_materials_transmission 1, roughness 0) of index `ior`.
+inline Material smoothGlass(float ior) {
+  Material m;
+  m.baseColorFactor = glm::vec4(1.f);
+  m.metallicFactor = 0.f;
+  m.roughnessFactor = 0.f;
+  m.transmissionFactor = 1.f;
+  m.ior = ior;
+  return m;
+}
+
 inline int addMaterial(Scene& s, const Material& m) {
   s.materials.push_back(m);
   return static_cast<int>(s.materials.size()) - 1;
