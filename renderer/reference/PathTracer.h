@@ -3,7 +3,8 @@
 // GPU technique is scored with, so it favours being right over being fast.
 //
 // Light transport (Radiance mode):
-// - BSDF: the glTF 2.0 metallic-roughness BRDF (+ transmission), see Brdf.h.
+// - BSDF: the glTF 2.0 metallic-roughness BRDF (+ transmission), see renderer/raytracing/Bsdf.h; the
+//   BVH, material decoding and light sampling are the shared core of renderer/raytracing/.
 // - Next-event estimation to every punctual light (KHR_lights_punctual, glTF units as-is), to one
 //   emissive triangle chosen in proportion to its power (area sampling), and to the environment.
 //   Emissive triangles and the environment are combined with BSDF sampling by multiple importance
@@ -63,6 +64,8 @@
 #include "renderer/Image.h"
 #include "renderer/scene/Scene.h"
 
+namespace radiant::rt { class RayScene; }
+
 namespace radiant::reference {
 
 struct ReferenceOptions {
@@ -83,6 +86,8 @@ public:
   // Builds the Embree BVH (one triangle geometry per MeshInstance) and the emissive-triangle light
   // distribution. `scene` must outlive the PathTracer.
   explicit PathTracer(const Scene& scene);
+  // Uses a BVH built elsewhere (shared with the photon tracer); `rays` must outlive the PathTracer.
+  explicit PathTracer(const rt::RayScene& rays);
   ~PathTracer();
   PathTracer(const PathTracer&) = delete;
   PathTracer& operator=(const PathTracer&) = delete;

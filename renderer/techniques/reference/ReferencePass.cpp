@@ -6,24 +6,13 @@
 #include <nlohmann/json.hpp>
 
 #include "renderer/frame/PassContext.h"
+#include "renderer/frame/RayScenes.h"
 
 namespace radiant {
-namespace {
-
-// The BVH owns a copy of the scene: a cache entry must not dangle when the caller's Scene goes away.
-struct ReferenceScene {
-  Scene scene;
-  reference::PathTracer tracer;
-  explicit ReferenceScene(const Scene& s) : scene(s), tracer(scene) {}
-};
-
-
-}  // namespace
 
 const Image& referenceImage(FrameResources& res, const Scene& scene, const FrameView& view,
                             const ReferenceRequest& r, bool* cacheHit, std::uint64_t* rays) {
-  ReferenceScene& rs = res.cached<ReferenceScene>("reference_bvh", res.sceneKey(),
-                                                  [&] { return std::make_unique<ReferenceScene>(scene); });
+  const reference::PathTracer tracer(sharedRayScene(res, scene));
   reference::ReferenceOptions o;
   o.spp = r.spp;
   o.maxBounces = r.maxBounces;
@@ -53,7 +42,7 @@ const Image& referenceImage(FrameResources& res, const Scene& scene, const Frame
   bool built = false;
   Image& img = res.cached<Image>("reference:" + r.aov, key.dump(), [&] {
     built = true;
-    auto image = std::make_unique<Image>(rs.tracer.render(view.camera, view.width, view.height, o));
+    auto image = std::make_unique<Image>(tracer.render(view.camera, view.width, view.height, o));
     image->aov = "reference";
     if (o.mode != reference::ReferenceOptions::Mode::Radiance) {
       // AO is scalar: keep one channel, like the raster `ao` AOV.
@@ -64,7 +53,7 @@ const Image& referenceImage(FrameResources& res, const Scene& scene, const Frame
     return image;
   });
   if (cacheHit) *cacheHit = !built;
-  if (rays) *rays = built ? rs.tracer.raysTraced() : 0;
+  if (rays) *rays = built ? tracer.raysTraced() : 0;
   return img;
 }
 

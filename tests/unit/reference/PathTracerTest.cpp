@@ -12,6 +12,8 @@
 namespace radiant::reference {
 namespace {
 
+using namespace radiant::rt;  // the BSDF and its constants
+
 using testing::addMaterial;
 using testing::lambert;
 using testing::meanPixel;

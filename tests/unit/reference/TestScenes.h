@@ -8,7 +8,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "renderer/Image.h"
-#include "renderer/reference/Brdf.h"
+#include "renderer/raytracing/Bsdf.h"
 #include "renderer/scene/Scene.h"
 
 namespace radiant::testing {
@@ -73,7 +73,7 @@ inline MeshInstance quad(glm::vec3 corner, glm::vec3 u, glm::vec3 v, int materia
 // Square of half-size `half` centred at c, perpendicular to axis n (front = n).
 inline MeshInstance square(glm::vec3 c, glm::vec3 n, float half, int material) {
   n = glm::normalize(n);
-  const reference::ShadingFrame f = reference::ShadingFrame::fromNormal(n);
+  const rt::ShadingFrame f = rt::ShadingFrame::fromNormal(n);
   glm::vec3 u = f.t * (2.f * half), v = f.b * (2.f * half);
   if (glm::dot(glm::cross(u, v), n) < 0.f) std::swap(u, v);
   return quad(c - 0.5f * u - 0.5f * v, u, v, material);
@@ -108,7 +108,7 @@ inline MeshInstance sphere(glm::vec3 c, float r, int stacks, int slices, int mat
   m.name = "sphere";
   m.material = material;
   auto point = [&](int i, int j) {
-    const float theta = reference::kPi * i / stacks, phi = 2.f * reference::kPi * j / slices;
+    const float theta = rt::kPi * i / stacks, phi = 2.f * rt::kPi * j / slices;
     return c + r * glm::vec3(std::sin(theta) * std::cos(phi), std::cos(theta), -std::sin(theta) * std::sin(phi));
   };
   auto tri = [&](glm::vec3 a, glm::vec3 b, glm::vec3 d) {
@@ -157,7 +157,7 @@ inline glm::dvec3 meanPixel(const Image& img) {
 
 // Directional albedo E(wo) = \int f(wo, wi) cos(theta_i) dwi of a BSDF over the upper hemisphere, by
 // midpoint quadrature in (theta, phi) -- independent of all the sampling code.
-inline glm::dvec3 directionalAlbedo(const reference::GltfBsdf& bsdf, float cosThetaO, int nTheta = 600,
+inline glm::dvec3 directionalAlbedo(const rt::GltfBsdf& bsdf, float cosThetaO, int nTheta = 600,
                                     int nPhi = 720) {
   const glm::vec3 wo(std::sqrt(std::max(0.f, 1.f - cosThetaO * cosThetaO)), 0.f, cosThetaO);
   glm::dvec3 sum(0.0);

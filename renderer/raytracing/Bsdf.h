@@ -1,5 +1,6 @@
 #pragma once
-// The glTF 2.0 metallic-roughness BSDF used by the CPU reference renderer, with its sampling routines.
+// The glTF 2.0 metallic-roughness BSDF of the CPU ray-tracing core, with its sampling routines. The
+// reference path tracer (radiance) and the photon tracer (importance) share it.
 //
 // Everything here works in a local shading frame where +z is the shading normal and wo (the direction
 // towards the viewer) lies in the upper hemisphere (wo.z > 0). Directions point away from the surface.
@@ -31,7 +32,7 @@
 
 #include <glm/glm.hpp>
 
-namespace radiant::reference {
+namespace radiant::rt {
 
 inline constexpr float kPi = 3.14159265358979323846f;
 inline constexpr float kInvPi = 1.f / kPi;
@@ -220,6 +221,17 @@ inline bool refract(const glm::vec3& wo, const glm::vec3& n, float eta, glm::vec
 // ---------------------------------------------------------------------------------------------------
 // The glTF material BSDF.
 
+// What a path carries (pbrt-v4 TransportMode, Mitsuba's BSDFContext). The BSDF is not symmetric under
+// refraction: radiance is compressed by (n_i / n_t)^2 = 1 / eta^2 when it enters a denser medium
+// (Veach 1997, eq. 5.14), importance (photons, light tracing) is not.
+enum class TransportMode { Radiance, Importance };
+
+// Which lobe produced a sample. Light-path classes (LD+E, LS+DE, LG+DE) are built from these.
+enum LobeFlags : unsigned {
+  kLobeReflection = 1u, kLobeTransmission = 2u,
+  kLobeDiffuse = 4u, kLobeGlossy = 8u, kLobeSpecular = 16u,  // specular = Dirac delta
+};
+
 struct GltfBsdf {
   glm::vec3 baseColor{1.f};
   float metallic = 1.f;
@@ -229,6 +241,10 @@ struct GltfBsdf {
   // Relative index across the interface as seen from wo's side: n_(far side) / n_(wo side).
   // ior when wo is outside a transmissive solid, 1 / ior inside. Only transmission uses it.
   float eta = 1.5f;
+  TransportMode mode = TransportMode::Radiance;
+
+  // 1 / eta^2 on refraction for radiance, 1 for importance.
+  float refractionScale() const { return mode == TransportMode::Radiance ? 1.f / (eta * eta) : 1.f; }
 
   bool isDelta() const { return roughness <= 0.f; }
   float alpha() const { return alphaFromRoughness(roughness); }
@@ -280,7 +296,7 @@ struct GltfBsdf {
     }
     if (t <= 0.f || isDelta()) return glm::vec3(0.f);
     // Walter et al. 2007, eq. 21, with the generalised half vector h = normalise(eta wi + wo) (eq. 16)
-    // and the height-correlated G2; divided by eta^2 because we transport radiance (Veach 1997, 5.2).
+    // and the height-correlated G2; divided by eta^2 when transporting radiance (Veach 1997, 5.2).
     const float a = alpha();
     glm::vec3 h = eta * wi + wo;
     if (glm::dot(h, h) == 0.f) return glm::vec3(0.f);
@@ -291,7 +307,7 @@ struct GltfBsdf {
     const float fe = fresnelDielectric(woh, eta);
     const float denom = sqr(wih + woh / eta) * std::abs(wi.z) * wo.z;
     const float ft = (1.f - fe) * ggxD(h.z, a) * smithG2HeightCorrelated(wo.z, wi.z, a) *
-                     std::abs(wih * woh) / denom / (eta * eta);
+                     std::abs(wih * woh) / denom * refractionScale();
     return (1.f - m) * t * ft * baseColor;
   }
 
@@ -328,6 +344,7 @@ struct GltfBsdf {
     glm::vec3 weight{0.f};  // f |wi.z| / pdf (for deltas: the lobe's reflectance / selection probability)
     float pdf = 0.f;        // solid-angle pdf of the non-delta mixture; 0 for a delta sample
     bool delta = false;
+    unsigned flags = 0;     // LobeFlags of the lobe that produced wi
   };
   // uLobe picks the lobe, uFresnel picks reflection or refraction in the dielectric lobe, u the direction.
   bool sample(const glm::vec3& wo, float uLobe, float uFresnel, glm::vec2 u, Sample& s) const {
@@ -342,14 +359,17 @@ struct GltfBsdf {
         s.weight = fr / p.reflect;
         s.pdf = 0.f;
         s.delta = true;
+        s.flags = kLobeReflection | kLobeSpecular;
         return true;
       }
       const glm::vec3 h = sampleGgxVndf(wo, alpha(), u);
       s.wi = reflect(wo, h);
       if (s.wi.z <= 0.f) return false;
+      s.flags = kLobeReflection | kLobeGlossy;
     } else if (uLobe < p.reflect + p.diffuse) {
       s.wi = sampleCosineHemisphere(u);
       if (s.wi.z <= 0.f) return false;
+      s.flags = kLobeReflection | kLobeDiffuse;
     } else {
       const glm::vec3 h = isDelta() ? glm::vec3(0.f, 0.f, 1.f) : sampleGgxVndf(wo, alpha(), u);
       const float woh = glm::dot(wo, h);
@@ -359,18 +379,21 @@ struct GltfBsdf {
       glm::vec3 wi;
       if (!reflected && !refract(wo, h, eta, wi)) reflected = true;  // fe == 1 already covers TIR
       if (reflected) wi = reflect(wo, h);
+      const unsigned side = reflected ? kLobeReflection : kLobeTransmission;
       if (isDelta()) {
         s.wi = wi;
         s.delta = true;
         s.pdf = 0.f;
-        // Lobe value (1-m) t F (reflection) or (1-m) t (1-F) base / eta^2 (refraction), over its
-        // selection probability p.dielectric * F or p.dielectric * (1 - F).
+        s.flags = side | kLobeSpecular;
+        // Lobe value (1-m) t F (reflection) or (1-m) t (1-F) base / eta^2 (refraction, radiance only),
+        // over its selection probability p.dielectric * F or p.dielectric * (1 - F).
         s.weight = reflected ? glm::vec3((1.f - m) * t / p.dielectric)
-                             : (1.f - m) * t * baseColor / (eta * eta * p.dielectric);
+                             : (1.f - m) * t * baseColor * refractionScale() / p.dielectric;
         return true;
       }
       if (reflected ? wi.z <= 0.f : wi.z >= 0.f) return false;
       s.wi = wi;
+      s.flags = side | kLobeGlossy;
     }
     s.delta = false;
     s.pdf = pdf(wo, s.wi);
@@ -380,4 +403,4 @@ struct GltfBsdf {
   }
 };
 
-}  // namespace radiant::reference
+}  // namespace radiant::rt

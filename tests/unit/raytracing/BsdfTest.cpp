@@ -7,10 +7,10 @@
 #include <random>
 #include <vector>
 
-#include "renderer/reference/Brdf.h"
+#include "renderer/raytracing/Bsdf.h"
 #include "tests/unit/reference/TestScenes.h"
 
-namespace radiant::reference {
+namespace radiant::rt {
 namespace {
 
 using PdfFn = std::function<double(const glm::vec3&)>;
@@ -271,4 +271,4 @@ TEST(Brdf, NeverNaN) {
 }
 
 }  // namespace
-}  // namespace radiant::reference
+}  // namespace radiant::rt

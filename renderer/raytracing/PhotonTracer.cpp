@@ -1,0 +1,114 @@
+#include "renderer/raytracing/PhotonTracer.h"
+
+#include <algorithm>
+#include <atomic>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+namespace radiant::rt {
+namespace {
+
+constexpr std::uint64_t kBlock = 1024;  // photons per work item; records are concatenated in block order
+// A path that keeps bouncing off albedo-1 surfaces is ended by Russian roulette with at least this
+// probability per bounce (survivors are re-weighted, so the estimate stays unbiased).
+constexpr float kMaxSurvival = 0.95f;
+
+bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+void tracePhoton(const RayScene& rays, const SceneLights& lights, const PhotonOptions& o, std::uint64_t index,
+                 std::vector<PhotonRecord>& out, RayCounter& counter) {
+  Sampler sampler(index, 0, o.seed ^ 0x70686F746F6E73ull);  // "photons": not the camera's sequences
+  Emission e;
+  if (!lights.sampleLe(sampler, e)) return;
+  glm::vec3 flux = e.flux;
+  Ray ray = e.ray;
+  const int lastBounce = o.maxBounces - 1;
+  for (int bounce = 0; bounce <= lastBounce; ++bounce) {
+    SurfaceHit hit;
+    if (!rays.intersect(ray, hit, sampler, counter)) return;
+    if (bounce == 0 && e.windowRange > 0.f) flux *= rangeWindow(hit.distance, e.windowRange);
+    if (!(maxComponent(flux) > 0.f) || !finite(flux)) return;
+    const glm::vec3 wo = -ray.dir;  // towards where the photon came from
+    const Shading sh = rays.shade(hit, wo, TransportMode::Importance);
+    const glm::vec3 woL = sh.frame.toLocal(wo);
+    if (sh.bsdf.hasNonDeltaLobe(woL)) {
+      PhotonRecord r;
+      r.position = hit.p;
+      r.mesh = hit.mesh;
+      r.normal = sh.ngFacing;
+      r.photon = static_cast<std::uint32_t>(index);
+      r.wi = wo;
+      r.bounce = static_cast<std::uint32_t>(bounce);
+      r.flux = flux;
+      r.light = static_cast<std::uint32_t>(e.light);
+      out.push_back(r);
+    }
+    if (bounce == lastBounce) return;
+    const float uLobe = sampler.next(), uFresnel = sampler.next();
+    const glm::vec2 uDir = sampler.next2();
+    GltfBsdf::Sample s;
+    if (!sh.bsdf.sample(woL, uLobe, uFresnel, uDir, s) || s.delta) return;
+    const glm::vec3 wi = sh.frame.toWorld(s.wi);
+    const float gi = glm::dot(wi, sh.ngFacing);
+    if (s.wi.z > 0.f ? gi <= 0.f : gi >= 0.f) return;  // leaked through the geometric surface
+    // Adjoint BSDF with shading normals (Veach 1997, eq. 5.21): |wo.ns| |wi.ng| / (|wo.ng| |wi.ns|).
+    const float den = std::abs(glm::dot(wo, sh.ngFacing)) * std::abs(s.wi.z);
+    const float num = std::abs(woL.z) * std::abs(gi);
+    if (!(den > 0.f)) return;
+    glm::vec3 weight = s.weight * (num / den);
+    if (o.russianRoulette) {
+      const float q = std::min(kMaxSurvival, maxComponent(weight));
+      if (!(q > 0.f) || sampler.next() >= q) return;
+      weight /= q;
+    }
+    flux *= weight;
+    ray = Ray{RayScene::offsetOrigin(hit.p, hit.ng, hit.offsetScale, wi), wi, 0.f, kInf};
+  }
+}
+
+}  // namespace
+
+std::size_t PhotonSet::recordsOfFirst(std::uint64_t n) const {
+  if (n >= emitted) return records.size();
+  return static_cast<std::size_t>(
+      std::lower_bound(records.begin(), records.end(), n,
+                       [](const PhotonRecord& r, std::uint64_t v) { return r.photon < v; }) -
+      records.begin());
+}
+
+void tracePhotons(const RayScene& rays, const SceneLights& lights, const PhotonOptions& options,
+                  std::uint64_t count, PhotonSet& set) {
+  if (count <= set.emitted) return;
+  const std::uint64_t begin = set.emitted;
+  const std::uint64_t blocks = (count - begin + kBlock - 1) / kBlock;
+  std::vector<std::vector<PhotonRecord>> perBlock(blocks);
+  std::atomic<std::uint64_t> rayCount{0};
+  auto run = [&] {
+    tbb::parallel_for(tbb::blocked_range<std::uint64_t>(0, blocks, 1), [&](const tbb::blocked_range<std::uint64_t>& r) {
+      RayCounter counter;
+      for (std::uint64_t b = r.begin(); b != r.end(); ++b) {
+        const std::uint64_t lo = begin + b * kBlock, hi = std::min(count, lo + kBlock);
+        auto& out = perBlock[b];
+        out.reserve((hi - lo) * 2);
+        for (std::uint64_t i = lo; i < hi; ++i) tracePhoton(rays, lights, options, i, out, counter);
+      }
+      rayCount += counter.rays;
+    });
+  };
+  if (options.threads > 0) {
+    tbb::task_arena arena(options.threads);
+    arena.execute(run);
+  } else {
+    run();
+  }
+  std::size_t total = set.records.size();
+  for (const auto& v : perBlock) total += v.size();
+  set.records.reserve(total);
+  for (auto& v : perBlock) set.records.insert(set.records.end(), v.begin(), v.end());
+  set.emitted = count;
+  set.rays += rayCount.load();
+}
+
+}  // namespace radiant::rt

@@ -1,0 +1,59 @@
+#pragma once
+// Photon tracing (Stürzlinger & Bastos 1997, §2.1): particles leave every emitter in proportion to its
+// power, scatter by the glTF BSDF in importance mode with unbiased Russian roulette, and leave a record
+// at every hit on a surface that has a non-delta lobe. The records are derived data: they depend on the
+// scene, its lights and environment, the seed and the bounce limit, never on the camera.
+//
+// Power (eq. 1): photon j carries phi_j = Phi_total / m * rho_j. A record stores Phi_total * rho_j (the
+// flux of one emission sample, `flux`); a consumer divides by the number of photons m it uses. So a set
+// of m photons grows to m + m' by tracing photons m .. m + m' - 1 and appending: the old records are
+// "rescaled" by using 1 / (m + m') instead of 1 / m, and the result is exactly a fresh run of m + m'
+// photons with the same seed (photon i's random numbers depend only on (i, seed)).
+//
+// A delta (mirror, smooth glass) scattering ends a photon: what it would carry is LS+D light, caustics,
+// which this tracer does not own.
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "renderer/raytracing/Lights.h"
+#include "renderer/raytracing/RayScene.h"
+
+namespace radiant::rt {
+
+struct PhotonRecord {
+  glm::vec3 position{0.f};
+  std::int32_t mesh = -1;       // MeshInstance index of the surface hit (the paper's surface id)
+  glm::vec3 normal{0.f};        // unit geometric normal on the side the photon arrived from
+  std::uint32_t photon = 0;     // index of the emitted photon; records are sorted by it
+  glm::vec3 wi{0.f};            // unit direction towards where the photon came from
+  std::uint32_t bounce = 0;     // scattering events before this hit (0 = straight from the emitter)
+  glm::vec3 flux{0.f};          // Phi_total * rho_j (W); divide by the photons used
+  std::uint32_t light = 0;      // index into SceneLights::emitters()
+};
+static_assert(sizeof(PhotonRecord) == 64, "PhotonRecord is 64 bytes");
+
+struct PhotonOptions {
+  // Most scattering events a path may have counting the surface the photon lands on as seen by the
+  // camera, like the reference's max_bounces: records hold bounce <= maxBounces - 1.
+  int maxBounces = 8;
+  bool russianRoulette = true;
+  std::uint64_t seed = 0;
+  int threads = 0;  // 0 = TBB default
+};
+
+struct PhotonSet {
+  std::vector<PhotonRecord> records;  // sorted by photon index
+  std::uint64_t emitted = 0;          // photons 0 .. emitted - 1 are traced
+  std::uint64_t rays = 0;             // rays traced in total
+  // Records of the first n photons (a prefix of `records`).
+  std::size_t recordsOfFirst(std::uint64_t n) const;
+};
+
+// Traces photons set.emitted .. count - 1 and appends their records (nothing when count <= emitted).
+// Deterministic for a seed and independent of the thread count.
+void tracePhotons(const RayScene& rays, const SceneLights& lights, const PhotonOptions& options,
+                  std::uint64_t count, PhotonSet& set);
+
+}  // namespace radiant::rt

@@ -1,0 +1,227 @@
+// The photon tracer and the emitters of the ray-tracing core against numbers that energy conservation
+// fixes: emitted power per light type, the integrating sphere bounce by bounce, refinement (m + m'
+// photons equal a fresh run), determinism across thread counts, albedo 1, and scale invariance.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+
+#include "renderer/raytracing/PhotonTracer.h"
+#include "tests/unit/reference/TestScenes.h"
+
+namespace radiant::rt {
+namespace {
+
+using testing::addMaterial;
+using testing::lambert;
+
+GltfBsdf bsdfOf(const Material& m) {
+  GltfBsdf b;
+  b.baseColor = glm::vec3(m.baseColorFactor);
+  b.metallic = m.metallicFactor;
+  b.roughness = m.roughnessFactor;
+  b.transmission = m.transmissionFactor;
+  b.ior = m.ior;
+  return b;
+}
+
+// Sum of the flux of the records with a given bounce count, per emitted photon.
+glm::dvec3 fluxOfBounce(const PhotonSet& set, std::uint32_t bounce) {
+  glm::dvec3 s(0.0);
+  for (const PhotonRecord& r : set.records)
+    if (r.bounce == bounce) s += glm::dvec3(r.flux);
+  return s / double(set.emitted);
+}
+
+Scene integratingSphere(float radius, float albedo, float intensity) {
+  Scene s;
+  const int mat = addMaterial(s, lambert(glm::vec3(albedo)));
+  s.meshes.push_back(testing::sphere(glm::vec3(0.f), radius, 48, 96, mat));
+  Light l;
+  l.type = LightType::Point;
+  l.intensity = intensity;
+  l.position = glm::vec3(0.f);
+  s.lights.push_back(l);
+  s.features = computeFeatures(s);
+  return s;
+}
+
+TEST(Lights, EmittedPowerMatchesEachLightsClosedForm) {
+  // Each scene has one emitter, so the mean flux of its emissions is its power (sampleLe's flux is
+  // Le cos / (pdf_pos pdf_dir p_select)). The closed forms: point 4 pi I, spot
+  // 2 pi I (1 - cos_i + (cos_i - cos_o) / 3), emissive triangle pi A L, directional E pi r^2.
+  Scene s;
+  const int mat = addMaterial(s, lambert(glm::vec3(0.5f)));
+  s.meshes.push_back(testing::square(glm::vec3(0.f), glm::vec3(0, 1, 0), 1.f, mat));  // bounds for the disk
+  struct Case { LightType type; float inner, outer; };
+  for (Case c : {Case{LightType::Point, 0.f, 0.f}, Case{LightType::Spot, 0.3f, 0.9f},
+                 Case{LightType::Spot, 0.f, 1.5f}, Case{LightType::Directional, 0.f, 0.f}}) {
+    Scene t = s;
+    Light l;
+    l.type = c.type;
+    l.intensity = 3.f;
+    l.color = glm::vec3(1.f, 0.5f, 0.25f);
+    l.innerConeAngle = c.inner;
+    l.outerConeAngle = c.outer;
+    l.position = glm::vec3(0, 2, 0);
+    l.direction = glm::vec3(0, -1, 0);
+    t.lights.push_back(l);
+    t.features = computeFeatures(t);
+    const RayScene rays(t);
+    const SceneLights lights(rays, nullptr, glm::vec3(0.f));
+    double expected;
+    const double I = 3.0;
+    if (c.type == LightType::Point) expected = 4 * M_PI * I;
+    else if (c.type == LightType::Spot)
+      expected = 2 * M_PI * I * ((1 - std::cos(c.inner)) + (std::cos(c.inner) - std::cos(c.outer)) / 3);
+    else expected = I * M_PI * std::pow(0.5 * std::sqrt(8.0), 2);  // bounds of a 2 x 0 x 2 square: r = sqrt(2)
+    ASSERT_NEAR(lights.emitters().at(0).power.r, expected, 1e-4 * expected);
+    glm::dvec3 mean(0.0);
+    const int n = 200000;
+    for (int i = 0; i < n; ++i) {
+      Sampler sampler(i, 0, 7);
+      Emission e;
+      ASSERT_TRUE(lights.sampleLe(sampler, e) || c.type == LightType::Spot);
+      mean += glm::dvec3(e.flux) / double(n);
+    }
+    EXPECT_NEAR(mean.r, expected, 0.01 * expected) << "light type " << int(c.type);
+    EXPECT_NEAR(mean.g / mean.r, 0.5, 1e-5);
+  }
+  // Emissive triangle (single-sided square, two triangles): pi A L.
+  Scene e;
+  Material em = testing::emitter(glm::vec3(2.f, 1.f, 1.f));
+  const int emat = addMaterial(e, em);
+  e.meshes.push_back(testing::square(glm::vec3(0.f), glm::vec3(0, -1, 0), 0.5f, emat));
+  e.features = computeFeatures(e);
+  const RayScene rays(e);
+  const SceneLights lights(rays, nullptr, glm::vec3(0.f));
+  glm::dvec3 mean(0.0);
+  const int n = 100000;
+  for (int i = 0; i < n; ++i) {
+    Sampler sampler(i, 0, 3);
+    Emission em1;
+    ASSERT_TRUE(lights.sampleLe(sampler, em1));
+    ASSERT_LT(em1.ray.dir.y, 0.f);  // leaves the front face only
+    mean += glm::dvec3(em1.flux) / double(n);
+  }
+  EXPECT_NEAR(mean.r, M_PI * 1.0 * 2.0, 1e-3 * M_PI * 2.0);  // uniform emitter: every sample is exact
+}
+
+TEST(PhotonTracer, IntegratingSphereBounceByBounce) {
+  // A point light of power Phi at the centre of a closed sphere: every photon lands, so bounce 0
+  // carries exactly Phi, and every reflected photon lands again, so bounce k + 1 carries bounce k
+  // times the albedo at the incidence it arrives with. Inside a sphere a diffusely reflected photon
+  // arrives at the same angle it left with, cosine-distributed, so E_(k+1) / E_k is the cosine-weighted
+  // mean a_bar of the directional albedo a(mu) for k >= 1, and E_1 / E_0 = a(1) (normal incidence).
+  // For a Lambertian of albedo rho these are rho and the Phi rho^k / (4 pi R^2) per unit area;
+  // glTF's dielectric is not Lambertian, so a(mu) comes from quadrature (independent of the sampler).
+  const float rho = 0.5f, I = 2.f;
+  const double Phi = 4 * M_PI * I;
+  const GltfBsdf b = bsdfOf(lambert(glm::vec3(rho)));
+  const double a1 = testing::directionalAlbedo(b, 1.f).x;
+  double aBar = 0.0;
+  const int nMu = 64;
+  for (int i = 0; i < nMu; ++i) {
+    const double mu = (i + 0.5) / nMu;
+    aBar += 2 * mu * testing::directionalAlbedo(b, float(mu), 200, 240).x / nMu;
+  }
+  for (float radius : {1.f, 1e-3f, 1e4f}) {
+    const Scene s = integratingSphere(radius, rho, I);
+    const RayScene rays(s);
+    const SceneLights lights(rays, nullptr, glm::vec3(0.f));
+    PhotonOptions o;
+    o.maxBounces = 40;
+    PhotonSet set;
+    tracePhotons(rays, lights, o, 200000, set);
+    EXPECT_NEAR(fluxOfBounce(set, 0).x, Phi, 1e-5 * Phi) << "R = " << radius;
+    double expected = Phi * a1;
+    for (std::uint32_t k = 1; k <= 4; ++k) {
+      // Russian roulette keeps the mean; 2% covers its noise at 2e5 photons (about 0.5% at k = 4).
+      EXPECT_NEAR(fluxOfBounce(set, k).x, expected, 0.02 * expected) << "R = " << radius << ", bounce " << k;
+      expected *= aBar;
+    }
+    glm::dvec3 indirect(0.0);
+    for (std::uint32_t k = 1; k < 40; ++k) indirect += fluxOfBounce(set, k);
+    const double closed = Phi * a1 / (1 - aBar);  // Phi rho / (1 - rho) for a Lambertian
+    EXPECT_NEAR(indirect.x, closed, 0.02 * closed) << "R = " << radius;
+    for (const PhotonRecord& r : set.records) {
+      ASSERT_TRUE(std::isfinite(r.flux.x) && std::isfinite(r.position.x));
+      ASSERT_NEAR(glm::length(r.position), radius, 0.01f * radius);
+    }
+  }
+}
+
+TEST(PhotonTracer, RefinementEqualsAFreshRunAndIsThreadIndependent) {
+  const Scene s = integratingSphere(1.f, 0.7f, 1.f);
+  const RayScene rays(s);
+  const SceneLights lights(rays, nullptr, glm::vec3(0.f));
+  PhotonOptions o;
+  o.seed = 11;
+  PhotonSet grown;
+  o.threads = 1;
+  tracePhotons(rays, lights, o, 30000, grown);
+  const std::size_t firstRecords = grown.records.size();
+  const glm::dvec3 e1First = fluxOfBounce(grown, 1);
+  o.threads = 2;
+  tracePhotons(rays, lights, o, 60000, grown);  // m = 30000, m' = 30000
+  PhotonSet fresh;
+  tracePhotons(rays, lights, o, 60000, fresh);
+  ASSERT_EQ(grown.records.size(), fresh.records.size());
+  EXPECT_EQ(0, std::memcmp(grown.records.data(), fresh.records.data(), fresh.records.size() * sizeof(PhotonRecord)));
+  EXPECT_EQ(grown.recordsOfFirst(30000), firstRecords);
+  // Eq. 1 rescales: the merged estimate uses 1 / (m + m'). Without rescaling (1 / m) it doubles.
+  const glm::dvec3 e1 = fluxOfBounce(grown, 1);
+  EXPECT_NEAR(e1.x, e1First.x, 0.02 * e1First.x);
+  EXPECT_NEAR(e1.x * 60000.0 / 30000.0 / e1First.x, 2.0, 0.04);
+}
+
+TEST(PhotonTracer, AlbedoOneTerminatesAndConservesEnergy) {
+  // Albedo 1 (f0 = 0 dielectric: a(mu) just below 1): Russian roulette survival is capped at 0.95, so
+  // paths end after about 20 bounces on average, and each bounce still carries about Phi.
+  const Scene s = integratingSphere(1.f, 1.f, 1.f);
+  const RayScene rays(s);
+  const SceneLights lights(rays, nullptr, glm::vec3(0.f));
+  PhotonOptions o;
+  o.maxBounces = 1000;
+  PhotonSet set;
+  tracePhotons(rays, lights, o, 20000, set);
+  const double recordsPerPhoton = double(set.records.size()) / set.emitted;
+  EXPECT_GT(recordsPerPhoton, 10.0);
+  EXPECT_LT(recordsPerPhoton, 25.0);  // 1 / (1 - 0.95) = 20 hits expected
+  const double Phi = 4 * M_PI;
+  const GltfBsdf b = bsdfOf(lambert(glm::vec3(1.f)));
+  const double a1 = testing::directionalAlbedo(b, 1.f).x;
+  EXPECT_NEAR(fluxOfBounce(set, 1).x, Phi * a1, 0.03 * Phi);
+  for (const PhotonRecord& r : set.records) ASSERT_TRUE(std::isfinite(r.flux.x + r.flux.y + r.flux.z));
+}
+
+TEST(PhotonTracer, DegenerateGeometryAndLightsInsideGeometryStayFinite) {
+  Scene s;
+  const int mat = addMaterial(s, lambert(glm::vec3(0.8f)));
+  const int em = addMaterial(s, testing::emitter(glm::vec3(5.f), true));
+  s.meshes.push_back(testing::box(glm::vec3(-1.f), glm::vec3(1.f), mat));
+  MeshInstance degenerate;  // a zero-area emissive triangle and a zero-area receiving triangle
+  degenerate.material = em;
+  degenerate.positions = {glm::vec3(0.f), glm::vec3(0.f), glm::vec3(0.f), glm::vec3(0.1f), glm::vec3(0.2f), glm::vec3(0.3f)};
+  degenerate.indices = {0, 1, 2, 3, 4, 5};
+  testing::finishMesh(degenerate);
+  s.meshes.push_back(degenerate);
+  Light l;  // a point light inside the (closed) box and one inside a wall's plane
+  l.position = glm::vec3(0.2f, 0.1f, -0.3f);
+  s.lights.push_back(l);
+  l.position = glm::vec3(1.f, 0.f, 0.f);
+  s.lights.push_back(l);
+  s.features = computeFeatures(s);
+  const RayScene rays(s);
+  const SceneLights lights(rays, nullptr, glm::vec3(0.f));
+  PhotonSet set;
+  tracePhotons(rays, lights, PhotonOptions{}, 20000, set);
+  EXPECT_GT(set.records.size(), 20000u);
+  for (const PhotonRecord& r : set.records) {
+    ASSERT_TRUE(std::isfinite(r.flux.x + r.flux.y + r.flux.z + r.position.x + r.normal.x + r.wi.x));
+    ASSERT_NEAR(glm::length(r.wi), 1.f, 1e-4f);
+  }
+}
+
+}  // namespace
+}  // namespace radiant::rt
