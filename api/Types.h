@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <map>
+#include <set>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -63,6 +64,8 @@ struct RenderRequest {
   int width = 256, height = 256;
   // Technique name -> its parameters, complete with defaults filled in from the schema.
   std::map<std::string, nlohmann::json> passes;
+  // Techniques the request turned off ("passes": {"specular": false}); the planner skips them.
+  std::set<std::string> disabledPasses;
   std::vector<OutputSpec> outputs{OutputSpec{}};
   float exposure = 0.f;  // EV; PNG = sRGB(clamp(L * 2^exposure))
   std::uint64_t seed = 0;

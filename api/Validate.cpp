@@ -208,7 +208,27 @@ json to_json_value(const TechniqueSchema& t) {
 const char* toString(ImageFormat f) { return f == ImageFormat::Exr ? "exr" : "png"; }
 
 json normaliseRenderRequest(const json& body, const RequestLimits& limits) {
-  json v = validate(renderRequestSchema(), body, "");
+  // "passes": {"name": false} turns an on-by-default pass off, {"name": true} turns one on with its
+  // defaults. The schema describes parameter objects, so booleans of known techniques are taken out
+  // before validation and put back after it (an unknown name still fails validation below).
+  json input = body;
+  std::vector<std::string> disabled;
+  if (input.is_object() && input.contains("passes") && input["passes"].is_object()) {
+    json& passes = input["passes"];
+    for (auto it = passes.begin(); it != passes.end();) {
+      if (it->is_boolean() && findTechnique(it.key())) {
+        if (!it->get<bool>()) {
+          disabled.push_back(it.key());
+          it = passes.erase(it);
+          continue;
+        }
+        *it = json::object();
+      }
+      ++it;
+    }
+  }
+  json v = validate(renderRequestSchema(), input, "");
+  for (const std::string& name : disabled) v["passes"][name] = false;
 
   auto limit = [](const std::string& pointer, long long value, long long max, const char* what) {
     if (value > max)
@@ -221,7 +241,7 @@ json normaliseRenderRequest(const json& body, const RequestLimits& limits) {
   limit("/height", v["height"].get<long long>(), limits.maxHeight, "height");
   for (const auto& [pass, params] : v["passes"].items())
     for (const char* key : {"spp", "samples"})
-      if (params.contains(key) && params[key].is_number())
+      if (params.is_object() && params.contains(key) && params[key].is_number())
         limit(pointerAppend(pointerAppend("/passes", pass), key), params[key].get<long long>(), limits.maxSamples,
               "samples");
   if (v.contains("compare")) limit("/compare/spp", v["compare"]["spp"].get<long long>(), limits.maxSamples, "samples");
@@ -260,7 +280,10 @@ RenderRequest parseRenderRequest(const json& body, const RequestLimits& limits) 
   }
   r.width = v["width"];
   r.height = v["height"];
-  for (const auto& [name, params] : v["passes"].items()) r.passes[name] = params;
+  for (const auto& [name, params] : v["passes"].items()) {
+    if (params.is_boolean()) r.disabledPasses.insert(name);  // only false survives normalisation
+    else r.passes[name] = params;
+  }
   r.outputs.clear();
   for (const auto& o : v["outputs"]) {
     OutputSpec spec;

@@ -12,6 +12,9 @@ Scenes
                   the ceiling, a camera looking in through the open front.
   cornell_mirror  the same, with a perfect mirror sphere (metallic 1, roughness 0).
   cornell_glass   the same, with a smooth glass sphere (KHR_materials_transmission 1, ior 1.5).
+  cornell_glossy  the paper's "Glosbox" (Stürzlinger & Bastos 1997): the same box whose larger (tall)
+                  block is a glossy metal (metallic 1, roughness 0.3), for photon splatting on glossy
+                  surfaces.
   ao_creases      objects on a floor and against two walls, with creases, contact points and a
                   90 degree groove, for ambient-occlusion work; one point light.
 """
@@ -220,7 +223,10 @@ def cornell(variant):
     white = b.material("white", WHITE, double_sided=True)
     red = b.material("red", RED, double_sided=True)
     green = b.material("green", GREEN, double_sided=True)
-    box_white = b.material("tall_box", WHITE)
+    if variant == "glossy":
+        box_white = b.material("glossy_metal", [0.85, 0.85, 0.85, 1.0], metallic=1.0, roughness=0.3)
+    else:
+        box_white = b.material("tall_box", WHITE)
     if variant == "mirror":
         sphere_mat = b.material("mirror", [0.95, 0.95, 0.95, 1.0], metallic=1.0, roughness=0.0)
     elif variant == "glass":
@@ -241,7 +247,7 @@ def cornell(variant):
     # environment is everything else); only diffuse objects are receivers.
     receiver = {"radiant_receiver": True}
     b.node("tall_box", b.mesh("tall_box", unit_box(), box_white), translation=[-0.17, 0.3, -0.15],
-           rotation=y_rotation(17.0), scale=[0.3, 0.6, 0.3], extras=receiver)
+           rotation=y_rotation(17.0), scale=[0.3, 0.6, 0.3], extras=receiver if variant != "glossy" else None)
     radius = 0.17
     b.node("sphere", b.mesh("sphere", uv_sphere(radius), sphere_mat),
            translation=[0.19, radius, 0.13], extras=receiver if variant == "box" else None)
@@ -292,7 +298,7 @@ def ao_creases():
 def main():
     out = sys.argv[1] if len(sys.argv) > 1 else os.path.dirname(os.path.abspath(__file__))
     scenes = {"cornell_box": cornell("box"), "cornell_mirror": cornell("mirror"),
-              "cornell_glass": cornell("glass"), "ao_creases": ao_creases()}
+              "cornell_glass": cornell("glass"), "cornell_glossy": cornell("glossy"), "ao_creases": ao_creases()}
     for name, text in scenes.items():
         path = os.path.join(out, name + ".gltf")
         with open(path, "w", encoding="ascii", newline="\n") as f:

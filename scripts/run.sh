@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The main job: builds Radiant, starts radiantd on a loopback port, renders the built-in Cornell box
-# through the radiant client into out/ (EXR with AOVs, tone-mapped PNG, stats JSON), then stops it.
+# through the radiant client with full GI into out/ (EXR with AOVs, tone-mapped PNG, stats JSON with the
+# error against the reference path tracer), then stops it.
 # Usage: scripts/run.sh [builtin-scene-name]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -22,6 +23,8 @@ for _ in $(seq 1 200); do
 done
 [ -n "$url" ] || { echo "radiantd did not start; see $log"; exit 1; }
 export RADIANT_SERVER=$url
-"$build"/client/radiant render --builtin "$scene" -o "out/$scene.png" --stats "out/$scene.stats.json"
-"$build"/client/radiant render --builtin "$scene" -o "out/$scene.exr" --aov beauty --aov direct --aov albedo --aov normal --aov depth
+# Full GI (direct + photon_gi, + specular where the scene needs it), scored against the reference path
+# tracer at 256 samples per pixel: the error goes into the stats (stats.metrics).
+"$build"/client/radiant render --builtin "$scene" -o "out/$scene.png" --stats "out/$scene.stats.json" --compare 256
+"$build"/client/radiant render --builtin "$scene" -o "out/$scene.exr" --aov beauty --aov direct --aov indirect --aov albedo --aov normal --aov depth
 echo "wrote out/$scene.png, out/$scene.exr and out/$scene.stats.json (daemon log: $log)"

@@ -17,7 +17,10 @@ namespace {
 const char* kUsage =
     "usage: radiant render (SCENE.gltf|SCENE.glb|--builtin NAME) -o OUT.exr|OUT.png\n"
     "         [--set pass.param=value ...] [--pass NAME ...] [--aov NAME ...] [--size WxH]\n"
-    "         [--exposure EV] [--seed N] [--float] [--stats stats.json] [--async] [--quiet]\n";
+    "         [--exposure EV] [--seed N] [--float] [--stats stats.json] [--async] [--quiet]\n"
+    "         [--no-pass NAME ...] [--compare SPP]\n"
+    "  --no-pass NAME   turn an on-by-default pass off (photon_gi, specular, ...)\n"
+    "  --compare SPP    score beauty against the reference path tracer at SPP samples (stats.metrics)\n";
 
 std::string extensionOf(const std::string& path) {
   auto dot = path.rfind('.');
@@ -68,8 +71,8 @@ nlohmann::json typedValue(const nlohmann::json& info, const std::string& pass, c
 int cmdRender(const GlobalOptions& g, const std::vector<std::string>& args) {
   std::string sceneFile, builtin, out, statsFile;
   std::vector<std::pair<std::string, std::string>> sets;  // "pass.param", value
-  std::vector<std::string> passes, aovs;
-  int width = 0, height = 0;
+  std::vector<std::string> passes, aovs, disabled;
+  int width = 0, height = 0, compareSpp = 0;
   std::optional<double> exposure;
   std::optional<unsigned long long> seed;
   bool async = false, quiet = false, fullFloat = false;
@@ -90,6 +93,15 @@ int cmdRender(const GlobalOptions& g, const std::vector<std::string>& args) {
         throw UsageError("--set expects pass.param=value, got \"" + kv + "\"");
       sets.emplace_back(kv.substr(0, eq), kv.substr(eq + 1));
     } else if (a == "--pass") passes.push_back(need(i));
+    else if (a == "--no-pass") disabled.push_back(need(i));
+    else if (a == "--compare") {
+      try {
+        compareSpp = std::stoi(need(i));
+      } catch (const std::exception&) {
+        compareSpp = 0;
+      }
+      if (compareSpp <= 0) throw UsageError("--compare expects a positive sample count");
+    }
     else if (a == "--aov") aovs.push_back(need(i));
     else if (a == "--size") {
       const std::string& s = need(i);
@@ -127,10 +139,11 @@ int cmdRender(const GlobalOptions& g, const std::vector<std::string>& args) {
 
   HttpClient http(g.server, g.token);
   nlohmann::json request;
-  if (!sets.empty() || !passes.empty()) {
+  if (!sets.empty() || !passes.empty() || !disabled.empty()) {
     const nlohmann::json info = HttpClient::expectOk(http.get("/v1/info")).json();
     nlohmann::json p = nlohmann::json::object();
     for (const auto& name : passes) p[name] = nlohmann::json::object();
+    for (const auto& name : disabled) p[name] = false;
     for (const auto& [key, value] : sets) {
       const std::string pass = key.substr(0, key.find('.')), param = key.substr(key.find('.') + 1);
       p[pass][param] = typedValue(info, pass, param, value);
@@ -145,6 +158,7 @@ int cmdRender(const GlobalOptions& g, const std::vector<std::string>& args) {
   }
   if (exposure) request["exposure"] = *exposure;
   if (seed) request["seed"] = *seed;
+  if (compareSpp > 0) request["compare"] = {{"against", "reference"}, {"aov", "beauty"}, {"spp", compareSpp}};
   nlohmann::json output{{"format", format}, {"aovs", aovs.empty() ? std::vector<std::string>{"beauty"} : aovs}};
   if (format == "exr") output["half"] = !fullFloat;
   request["outputs"] = nlohmann::json::array({output});
@@ -190,6 +204,11 @@ int cmdRender(const GlobalOptions& g, const std::vector<std::string>& args) {
     const double wallMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     std::cout << "wrote " << out << " (" << frame.body.size() << " bytes, render " << result["id"].get<std::string>()
               << ", " << static_cast<int>(wallMs) << " ms)\n";
+    const nlohmann::json& m = result["stats"].value("metrics", nlohmann::json());
+    if (m.is_object() && m.contains("rmse"))
+      std::cout << "error against the reference path tracer at " << m.value("spp", 0) << " spp: RMSE "
+                << m["rmse"].get<double>() << ", relMSE " << m.value("rel_mse", 0.0) << ", SSIM " << m.value("ssim", 0.0)
+                << "\n";
   }
   return kExitOk;
 }

@@ -49,7 +49,11 @@ FramePlan planFrame(const std::vector<Technique*>& techniques, const Scene& scen
   std::map<Technique*, Requirements> req;
   auto requirement = [&](Technique* t) -> const Requirements& {
     auto it = req.find(t);
-    if (it == req.end()) it = req.emplace(t, t->requirements(scene, request)).first;
+    if (it == req.end())
+      it = req.emplace(t, request.disabledPasses.count(t->info().name)
+                              ? Requirements::skip("turned off by the request (passes." + t->info().name + " = false)")
+                              : t->requirements(scene, request))
+               .first;
     return it->second;
   };
   std::set<Technique*> keep;

@@ -4,6 +4,7 @@
 #include "renderer/techniques/direct/Direct.h"
 #include "renderer/techniques/env_diffuse/EnvDiffuse.h"
 #include "renderer/techniques/gbuffer/GBuffer.h"
+#include "renderer/techniques/photon_gi/PhotonGi.h"
 #include "renderer/techniques/reference/ReferencePass.h"
 #include "renderer/techniques/shadow_maps/ShadowMaps.h"
 #include "renderer/techniques/specular/Specular.h"
@@ -16,6 +17,7 @@ std::vector<std::unique_ptr<Technique>> createTechniques() {
   t.push_back(std::make_unique<ShadowMapsPass>());
   t.push_back(std::make_unique<DirectPass>());
   t.push_back(std::make_unique<EnvDiffusePass>());
+  t.push_back(std::make_unique<PhotonGiPass>());
   t.push_back(std::make_unique<SpecularPass>());
   t.push_back(std::make_unique<AmbientOcclusionPass>());
   t.push_back(std::make_unique<ReferencePass>());

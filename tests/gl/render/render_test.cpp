@@ -180,7 +180,7 @@ TEST(RenderCore, StatsTimeEveryPassAndSkipWithReasons) {
     EXPECT_GT(p.gpuMs, 0.0) << p.name;
     EXPECT_GE(p.cpuMs, 0.0) << p.name;
   }
-  EXPECT_EQ(names, (std::vector<std::string>{"gbuffer", "shadow_maps", "direct"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"gbuffer", "shadow_maps", "direct", "photon_gi"}));
   EXPECT_EQ(out.stats.triangles, 4u);
   EXPECT_EQ(out.stats.lights, 1);
   EXPECT_FALSE(out.stats.device.at("renderer").empty());

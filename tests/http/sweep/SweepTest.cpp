@@ -199,7 +199,7 @@ json slowSpec(int points) {
            {{"scene", {{"builtin", "cornell_box"}}},
             {"width", 64},
             {"height", 64},
-            {"passes", {{"reference", {{"spp", 24}, {"max_bounces", 4}}}}}}},
+            {"passes", {{"reference", {{"spp", 24}, {"max_bounces", 4}}}, {"photon_gi", false}}}}},
           {"axes", {{"seed", seeds}}},
           {"repeats", 2},
           {"warmup", 0}};

@@ -278,3 +278,26 @@ TEST(Schema, EveryTechniqueFileIsMergedWithDocumentedParams) {
   for (const char* aov : {"beauty", "direct", "albedo", "depth", "normal"})
     EXPECT_NE(std::find(aovEnum.begin(), aovEnum.end(), aov), aovEnum.end()) << aov;
 }
+
+TEST(Validate, PassesTrueAndFalseTurnTechniquesOnAndOff) {
+  json body = minimal();
+  body["passes"] = {{"photon_gi", false}, {"specular", true}, {"direct", {{"pcf_radius", 2}}}};
+  const auto r = parseRenderRequest(body);
+  EXPECT_EQ(r.disabledPasses, (std::set<std::string>{"photon_gi"}));
+  EXPECT_EQ(r.passes.count("photon_gi"), 0u);
+  ASSERT_EQ(r.passes.count("specular"), 1u);
+  EXPECT_TRUE(r.passes.at("specular").is_object());
+  EXPECT_EQ(r.passes.at("direct")["pcf_radius"], 2);
+  // The normalised form keeps the false (a sweep record or the stats show what was asked).
+  EXPECT_EQ(radiant::api::normaliseRenderRequest(body)["passes"]["photon_gi"], false);
+  // An unknown technique is still named, whatever its value.
+  json bad = minimal();
+  bad["passes"] = {{"photon_splat", false}};
+  const ApiError e = errorOf(bad);
+  EXPECT_EQ(e.status, 422);
+  EXPECT_EQ(e.pointer, "/passes/photon_splat");
+  // A number is not a switch.
+  json num = minimal();
+  num["passes"] = {{"photon_gi", 0}};
+  EXPECT_EQ(errorOf(num).pointer, "/passes/photon_gi");
+}

@@ -10,7 +10,7 @@ namespace {
 
 TEST(BuiltinScenes, NamesAreTheShippedScenes) {
   EXPECT_EQ(builtinSceneNames(),
-            (std::vector<std::string>{"ao_creases", "cornell_box", "cornell_glass", "cornell_mirror"}));
+            (std::vector<std::string>{"ao_creases", "cornell_box", "cornell_glass", "cornell_glossy", "cornell_mirror"}));
 }
 
 TEST(BuiltinScenes, UnknownNameIsASceneError) {
@@ -93,6 +93,17 @@ TEST(BuiltinScenes, MirrorAndGlassVariants) {
       EXPECT_FLOAT_EQ(m.ior, 1.5f);
       EXPECT_FLOAT_EQ(m.roughnessFactor, 0.f);
     }
+}
+
+TEST(BuiltinScenes, GlossyBoxIsTheGlosbox) {
+  // Stürzlinger & Bastos's Glosbox: the larger block glossy, not a mirror (the specular pass's
+  // threshold is roughness 0.2), so photon_gi owns its indirect light.
+  const Scene s = loadBuiltinScene("cornell_glossy");
+  EXPECT_EQ(s.features.specularMaterials, 0);
+  int glossy = 0;
+  for (const auto& m : s.materials)
+    if (m.metallicFactor == 1.f && m.roughnessFactor > Material::kSpecularRoughness && m.roughnessFactor < 0.5f) ++glossy;
+  EXPECT_EQ(glossy, 1);
 }
 
 TEST(BuiltinScenes, AoCreasesCameraLooksAtTheCorner) {

@@ -1,0 +1,200 @@
+#include "renderer/techniques/photon_gi/PhotonGi.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include <nlohmann/json.hpp>
+
+#include "renderer/frame/PassContext.h"
+#include "renderer/frame/RayScenes.h"
+#include "renderer/raytracing/PhotonTracer.h"
+
+namespace radiant {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+// Coverage points per kernel disk (pi h^2) for the edge renormalisation: stratified, so the kernel mass
+// they estimate is within about 1% at this density.
+constexpr double kCoveragePerKernel = 64.0;
+constexpr std::size_t kMaxCoveragePerSurface = 1u << 18;
+
+struct PhotonCache {
+  rt::PhotonSet set;
+};
+struct SplatCache {
+  photon_gi::SplatGrid grid;
+  std::size_t photonSplats = 0, coveragePoints = 0;
+  float hMin = 0.f, hMax = 0.f;
+};
+
+[[noreturn]] void badParam(const std::string& key, const std::string& detail) {
+  throw api::ApiError(422, "invalid-value", "Invalid photon_gi parameter", detail, "/passes/photon_gi/" + key);
+}
+
+}  // namespace
+
+float PhotonGiPass::kernelRadius(float C, double area, double n, bool ppm, double photons, double ppmBasePhotons,
+                                 double ppmAlpha) {
+  if (!(n > 0.0) || !(area > 0.0)) return 0.f;
+  double h2 = double(C) * C * area / n;  // eq. 3
+  if (ppm && photons > 0.0 && ppmBasePhotons > 0.0) h2 *= std::pow(photons / ppmBasePhotons, ppmAlpha);
+  return static_cast<float>(std::sqrt(h2));
+}
+
+const TechniqueInfo& PhotonGiPass::info() const {
+  static const TechniqueInfo i{"photon_gi",
+                               "Photon tracing (Embree) and view-dependent photon splatting (Stürzlinger & Bastos "
+                               "1997): indirect light on every diffuse and glossy surface",
+                               {"gbuffer_position", "normal", "albedo", "material", "emission", "geometric_normal"},
+                               {"direct"},  // runs after direct, which initialises beauty
+                               {"indirect"},
+                               true,
+                               true};
+  return i;
+}
+
+Requirements PhotonGiPass::requirements(const Scene& scene, const api::RenderRequest& request) const {
+  const SceneFeatures& f = scene.features;
+  if (f.triangles == 0) return Requirements::skip("the scene has no triangles");
+  if (f.lightCount() == 0 && !f.hasEmissive() && request.ambient == glm::vec3(0.f) && request.environment.empty())
+    return Requirements::skip("nothing emits light: no lights, no emissive surfaces, no ambient or environment");
+  // Every light path is counted once: env_diffuse also supplies indirect diffuse light (LD+DE) on its
+  // receivers. When a request asks for env_diffuse and not for photon_gi, env_diffuse owns that light.
+  const bool envDiffuseAsked = request.passes.count("env_diffuse") != 0;
+  const bool photonsAsked = request.passes.count("photon_gi") != 0;
+  if (envDiffuseAsked && photonsAsked)
+    throw api::ApiError(422, "conflicting-passes", "Conflicting passes",
+                        "photon_gi and env_diffuse both supply indirect diffuse light (LD+DE); ask for one of them",
+                        "/passes/env_diffuse");
+  if (envDiffuseAsked) return Requirements::skip("env_diffuse owns indirect diffuse light (LD+DE) in this request");
+  return Requirements::ok();
+}
+
+void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
+  Settings s;
+  s.photons = static_cast<std::uint64_t>(params.get<std::int64_t>("photons", 250000));
+  s.C = params.get<float>("C", 20.f);
+  s.ppm = params.get<std::string>("h_schedule", "paper") == "ppm";
+  s.ppmAlpha = params.get<double>("ppm_alpha", 2.0 / 3.0);
+  s.ppmBase = params.get<double>("ppm_base_photons", 250000.0);
+  s.maxBounces = params.get<int>("max_bounces", 8);
+  if (!(s.C > 0.f) || !std::isfinite(s.C)) badParam("C", "C must be a positive number");
+  settings_ = s;
+  splat_.method = params.get<std::string>("method", "splat") == "gather" ? photon_gi::Method::Gather
+                                                                       : photon_gi::Method::Splat;
+  splat_.kernel = params.get<std::string>("kernel", "biweight") == "epanechnikov" ? photon_gi::Kernel::Epanechnikov
+                                                                                  : photon_gi::Kernel::Biweight;
+  splat_.renormalize = params.get<bool>("renormalize", true);
+  splat_.minGlossyRoughness = params.get<float>("min_glossy_roughness", 0.2f);
+
+  const FrameView& view = res.view();
+  // --- Photon records: derived data of the scene, its lights and environment, never of the camera.
+  const rt::RayScene& rays = sharedRayScene(res, scene);
+  const nlohmann::json photonKey = {{"scene", res.sceneKey()},
+                                    {"ambient", {view.ambient.x, view.ambient.y, view.ambient.z}},
+                                    {"environment", view.environmentKey},
+                                    {"seed", view.seed},
+                                    {"max_bounces", s.maxBounces}};
+  PhotonCache& cache = res.cached<PhotonCache>("photon_gi_photons", photonKey.dump(),
+                                               [] { return std::make_unique<PhotonCache>(); });
+  const rt::SceneLights lights(rays, view.environment, view.ambient);
+  traced_ = 0;
+  traceMs_ = 0.0;
+  if (cache.set.emitted < s.photons) {
+    const auto t0 = Clock::now();
+    rt::PhotonOptions o;
+    o.maxBounces = s.maxBounces;
+    o.seed = view.seed;
+    traced_ = s.photons - cache.set.emitted;
+    rt::tracePhotons(rays, lights, o, s.photons, cache.set);
+    traceMs_ = msSince(t0);
+  }
+  records_ = cache.set.recordsOfFirst(s.photons);
+
+  // --- The splats: which records, their kernel radius per surface (eq. 3), coverage points.
+  const nlohmann::json splatKey = {{"photons", photonKey}, {"count", s.photons}, {"C", s.C},
+                                   {"ppm", s.ppm}, {"alpha", s.ppmAlpha}, {"base", s.ppmBase},
+                                   {"renormalize", splat_.renormalize}};
+  upload_ = false;
+  buildMs_ = 0.0;
+  SplatCache& splats = res.cached<SplatCache>("photon_gi_splats", splatKey.dump(), [&] {
+    upload_ = true;
+    const auto t0 = Clock::now();
+    auto c = std::make_unique<SplatCache>();
+    // Splatted: photons with at least one earlier reflection (the paper's optimised mode: direct light
+    // from punctual lights and the sky is the raster passes'), and direct light from emissive
+    // triangles, which no raster pass computes.
+    auto splatted = [&](const rt::PhotonRecord& r) {
+      return r.bounce >= 1 || lights.emitters()[r.light].kind == rt::SceneLights::Kind::Triangle;
+    };
+    std::vector<double> count(scene.meshes.size(), 0.0), area(scene.meshes.size(), 0.0);
+    for (std::size_t i = 0; i < records_; ++i)
+      if (splatted(cache.set.records[i])) count[cache.set.records[i].mesh] += 1.0;
+    std::vector<float> h(scene.meshes.size(), 0.f);
+    for (std::size_t m = 0; m < scene.meshes.size(); ++m) {
+      area[m] = photon_gi::meshArea(scene.meshes[m]);
+      h[m] = kernelRadius(s.C, area[m], count[m], s.ppm, double(s.photons), s.ppmBase, s.ppmAlpha);
+      if (h[m] > 0.f) {
+        c->hMin = c->hMin == 0.f ? h[m] : std::min(c->hMin, h[m]);
+        c->hMax = std::max(c->hMax, h[m]);
+      }
+    }
+    std::vector<photon_gi::GpuSplat> out;
+    out.reserve(records_);
+    const float invPhotons = 1.f / static_cast<float>(s.photons);
+    for (std::size_t i = 0; i < records_; ++i) {
+      const rt::PhotonRecord& r = cache.set.records[i];
+      if (!splatted(r) || !(h[r.mesh] > 0.f)) continue;
+      out.push_back(photon_gi::photonSplat(r.position, h[r.mesh], r.normal, r.wi, r.flux * invPhotons));
+    }
+    c->photonSplats = out.size();
+    if (splat_.renormalize)
+      for (std::size_t m = 0; m < scene.meshes.size(); ++m) {
+        if (!(h[m] > 0.f)) continue;
+        const double kernels = area[m] / (rt::kPi * double(h[m]) * h[m]);
+        photon_gi::appendCoveragePoints(
+            scene.meshes[m],
+            std::clamp<std::size_t>(static_cast<std::size_t>(std::ceil(kCoveragePerKernel * kernels)), 16,
+                                    kMaxCoveragePerSurface),
+            h[m], out);
+      }
+    c->coveragePoints = out.size() - c->photonSplats;
+    c->grid = photon_gi::buildSplatGrid(std::move(out));
+    buildMs_ = msSince(t0);
+    return c;
+  });
+  grid_ = &splats.grid;
+  photonSplats_ = splats.photonSplats;
+  coveragePoints_ = splats.coveragePoints;
+  hMin_ = splats.hMin;
+  hMax_ = splats.hMax;
+  if (!res.hasBuffer("photon_gi_splats")) upload_ = true;  // resources were dropped after a failure
+  photon_gi::declareSplatResources(res, *grid_);
+}
+
+void PhotonGiPass::execute(PassContext& ctx) {
+  photon_gi::splatAndResolve(ctx.resources, ctx.shaders, ctx.view, splat_, *grid_, upload_, true);
+  auto& c = ctx.stats.counters;
+  c["photons"] = static_cast<double>(settings_.photons);
+  c["photons_traced"] = static_cast<double>(traced_);
+  c["photons_cached"] = traced_ == 0 ? 1.0 : 0.0;
+  c["trace_ms"] = traceMs_;
+  c["splat_build_ms"] = buildMs_;
+  c["records"] = static_cast<double>(records_);
+  c["photon_splats"] = static_cast<double>(photonSplats_);
+  c["coverage_points"] = static_cast<double>(coveragePoints_);
+  c["bytes_per_photon"] =
+      settings_.photons ? double(records_ * sizeof(rt::PhotonRecord)) / double(settings_.photons) : 0.0;
+  c["splat_bytes"] = static_cast<double>(grid_->splats.size() * sizeof(photon_gi::GpuSplat));
+  c["splats_uploaded"] = upload_ ? 1.0 : 0.0;
+  c["h_min"] = hMin_;
+  c["h_max"] = hMax_;
+  c["C"] = settings_.C;
+  c["gather"] = splat_.method == photon_gi::Method::Gather ? 1.0 : 0.0;
+  upload_ = false;
+}
+
+}  // namespace radiant

@@ -1,0 +1,53 @@
+#pragma once
+// Photon GI: photon tracing on the CPU (renderer/raytracing/PhotonTracer.h) and view-dependent
+// splatting on the GPU (Stürzlinger & Bastos 1997, optimised mode §2.2.1): the indirect light of every
+// visible diffuse and glossy surface, written to the `indirect` AOV and added to beauty. Direct light
+// from punctual lights stays with the raster `direct` pass (shadow maps); photons that reached their
+// surface straight from a punctual light or the sky are not splatted. Direct light from emissive
+// triangles, which no raster pass computes, is splatted (its photons have bounce 0).
+//
+// Derived data, each cached by exactly its inputs (stats.cache):
+//   photon_gi_photons  records, by scene, lights, environment, seed and max_bounces (not the camera,
+//                      not the photon count: more photons extend the set, fewer use a prefix);
+//   photon_gi_splats   the GPU array of splats (photons with their kernel radius, plus the coverage
+//                      points of the edge renormalisation), by the photon set, count, C, schedule.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "renderer/frame/Technique.h"
+#include "renderer/techniques/photon_gi/Splatting.h"
+
+namespace radiant {
+
+class PhotonGiPass final : public Technique {
+public:
+  const TechniqueInfo& info() const override;
+  Requirements requirements(const Scene&, const api::RenderRequest&) const override;
+  void prepare(const Scene&, const Params&, FrameResources&) override;
+  void execute(PassContext&) override;
+
+  // The kernel radius of eq. 3, h = C sqrt(A / n), for a surface of area A holding n splatted photons,
+  // and its progressive variant (h^2 scaled by (N / N0)^alpha for N photons in total, Knaus & Zwicker
+  // 2011: the radius shrinks more slowly than the paper's, so the photons per kernel grow as N^alpha).
+  static float kernelRadius(float C, double area, double n, bool ppm, double photons, double ppmBasePhotons,
+                            double ppmAlpha);
+
+private:
+  struct Settings {
+    std::uint64_t photons = 0;
+    float C = 20.f;
+    bool ppm = false;
+    double ppmAlpha = 2.0 / 3.0, ppmBase = 250000;
+    int maxBounces = 8;
+  } settings_;
+  photon_gi::SplatSettings splat_;
+  const photon_gi::SplatGrid* grid_ = nullptr;  // in the cache, valid for this frame
+  bool upload_ = false;                          // the grid changed: upload it in execute()
+  std::size_t records_ = 0, photonSplats_ = 0, coveragePoints_ = 0;
+  std::uint64_t traced_ = 0;  // photons traced by this frame (0 when the set was cached)
+  double traceMs_ = 0.0, buildMs_ = 0.0;
+  float hMin_ = 0.f, hMax_ = 0.f;
+};
+
+}  // namespace radiant

@@ -1,0 +1,200 @@
+#include "renderer/techniques/photon_gi/Splatting.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/gtc/type_ptr.hpp>
+
+#include "renderer/raytracing/Bsdf.h"
+
+namespace radiant::photon_gi {
+namespace {
+
+constexpr GLuint kSplatBinding = 5, kCellBinding = 6;
+constexpr int kMaxCellsPerAxis = 128;
+// The surface test (shaders/photon_gi/photon.glsl): a pixel's surface must lie within this fraction of
+// h of the photon's plane (a curved surface deviates from its tangent plane by r^2 / 2R) and its
+// geometric normal within acos(0.7) = 45.6 degrees of the photon's (creases between walls are 90).
+constexpr float kPlaneTolerance = 0.25f;
+constexpr float kNormalCosine = 0.7f;
+// Renormalised pixels divide by the kernel mass on their surface, at least this much (a right-angled
+// corner has 1/4; thin features much less, where dividing would only amplify noise).
+constexpr float kMinKernelMass = 0.2f;
+
+std::size_t capacity(std::size_t bytes) {
+  std::size_t c = 4096;
+  while (c < bytes) c *= 2;
+  return c;
+}
+
+}  // namespace
+
+double meshArea(const MeshInstance& m) {
+  double a = 0.0;
+  for (std::size_t t = 0; t + 2 < m.indices.size(); t += 3) {
+    const glm::vec3 &v0 = m.positions[m.indices[t]], &v1 = m.positions[m.indices[t + 1]],
+                    &v2 = m.positions[m.indices[t + 2]];
+    a += 0.5 * glm::length(glm::cross(v1 - v0, v2 - v0));
+  }
+  return a;
+}
+
+void appendCoveragePoints(const MeshInstance& m, std::size_t n, float h, std::vector<GpuSplat>& out) {
+  std::vector<double> cdf{0.0};
+  for (std::size_t t = 0; t + 2 < m.indices.size(); t += 3) {
+    const glm::vec3 &v0 = m.positions[m.indices[t]], &v1 = m.positions[m.indices[t + 1]],
+                    &v2 = m.positions[m.indices[t + 2]];
+    cdf.push_back(cdf.back() + 0.5 * glm::length(glm::cross(v1 - v0, v2 - v0)));
+  }
+  if (n == 0 || !(cdf.back() > 0.0)) return;
+  const float weight = static_cast<float>(cdf.back() / double(n));
+  constexpr double g1 = 0.7548776662466927, g2 = 0.5698402909980532;  // R2: 1/phi2, 1/phi2^2
+  for (std::size_t i = 0; i < n; ++i) {
+    const double target = (i + 0.5) / double(n) * cdf.back();
+    const std::size_t t = std::min<std::size_t>(
+        static_cast<std::size_t>(std::upper_bound(cdf.begin(), cdf.end(), target) - cdf.begin()) - 1, cdf.size() - 2);
+    if (!(cdf[t + 1] > cdf[t])) continue;
+    const glm::vec2 u(static_cast<float>(std::fmod(0.5 + g1 * i, 1.0)), static_cast<float>(std::fmod(0.5 + g2 * i, 1.0)));
+    const glm::vec2 b = rt::sampleUniformTriangle(u);
+    const glm::vec3 &v0 = m.positions[m.indices[3 * t]], &v1 = m.positions[m.indices[3 * t + 1]],
+                    &v2 = m.positions[m.indices[3 * t + 2]];
+    const glm::vec3 p = b.x * v0 + b.y * v1 + (1.f - b.x - b.y) * v2;
+    const glm::vec3 ng = glm::normalize(glm::cross(v1 - v0, v2 - v0));
+    out.push_back({glm::vec4(p, h), glm::vec4(ng, 0.f), glm::vec4(0.f), glm::vec4(0.f, 0.f, 0.f, weight)});
+  }
+}
+
+SplatGrid buildSplatGrid(std::vector<GpuSplat> splats) {
+  SplatGrid g;
+  Bounds b;
+  float hMax = 0.f;
+  for (const GpuSplat& s : splats) {
+    b.extend(glm::vec3(s.positionRadius));
+    hMax = std::max(hMax, s.positionRadius.w);
+  }
+  if (splats.empty()) {
+    g.cellStart = {0, 0};
+    return g;
+  }
+  const glm::vec3 extent = b.extent();
+  const float longest = std::max({extent.x, extent.y, extent.z});
+  g.cellSize = std::max({hMax, longest / kMaxCellsPerAxis, 1e-30f});
+  g.origin = b.min;
+  g.dims = glm::clamp(glm::ivec3(glm::floor(extent / g.cellSize)) + 1, glm::ivec3(1), glm::ivec3(kMaxCellsPerAxis));
+  const std::size_t cells = static_cast<std::size_t>(g.dims.x) * g.dims.y * g.dims.z;
+  auto cellOf = [&](const GpuSplat& s) {
+    const glm::ivec3 c = glm::clamp(glm::ivec3(glm::floor((glm::vec3(s.positionRadius) - g.origin) / g.cellSize)),
+                                    glm::ivec3(0), g.dims - 1);
+    return (static_cast<std::size_t>(c.z) * g.dims.y + c.y) * g.dims.x + c.x;
+  };
+  // Counting sort by cell: O(N), stable (photon order is kept within a cell).
+  g.cellStart.assign(cells + 1, 0);
+  for (const GpuSplat& s : splats) ++g.cellStart[cellOf(s) + 1];
+  for (std::size_t c = 0; c < cells; ++c) g.cellStart[c + 1] += g.cellStart[c];
+  std::vector<std::uint32_t> next(g.cellStart.begin(), g.cellStart.end() - 1);
+  g.splats.resize(splats.size());
+  for (const GpuSplat& s : splats) g.splats[next[cellOf(s)]++] = s;
+  return g;
+}
+
+void declareSplatResources(FrameResources& res, const SplatGrid& grid) {
+  const std::size_t splatBytes = std::max<std::size_t>(grid.splats.size(), 1) * sizeof(GpuSplat);
+  if (!res.hasBuffer("photon_gi_splats") || res.buffer("photon_gi_splats").size() < splatBytes)
+    res.buffer("photon_gi_splats", capacity(splatBytes));
+  const std::size_t cellBytes = grid.cellStart.size() * sizeof(std::uint32_t);
+  if (!res.hasBuffer("photon_gi_cells") || res.buffer("photon_gi_cells").size() < cellBytes)
+    res.buffer("photon_gi_cells", capacity(cellBytes));
+  const int w = res.view().width, h = res.view().height;
+  gl::Texture& accum = res.texture("photon_gi_accum", GL_TEXTURE_2D, GL_RGBA32F, w, h);
+  accum.setFilter(GL_NEAREST, GL_NEAREST);
+  gl::Framebuffer& splatFb = res.framebuffer("photon_gi_splat");
+  splatFb.attach(GL_COLOR_ATTACHMENT0, accum);
+  splatFb.setDrawBuffers({GL_COLOR_ATTACHMENT0});
+  splatFb.checkComplete("photon_gi::declareSplatResources");
+  gl::Texture& indirect = res.texture("indirect", GL_TEXTURE_2D, GL_RGBA32F, w, h);
+  indirect.setFilter(GL_NEAREST, GL_NEAREST);
+  gl::Framebuffer& resolveFb = res.framebuffer("photon_gi_resolve");
+  resolveFb.attach(GL_COLOR_ATTACHMENT0, indirect);
+  resolveFb.attach(GL_COLOR_ATTACHMENT1, res.texture("beauty", GL_TEXTURE_2D, GL_RGBA32F, w, h));
+  resolveFb.setDrawBuffers({GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1});
+  resolveFb.checkComplete("photon_gi::declareSplatResources");
+}
+
+void splatAndResolve(FrameResources& res, gl::ShaderLibrary& shaders, const FrameView& view,
+                     const SplatSettings& settings, const SplatGrid& grid, bool upload, bool addToBeauty) {
+  gl::Buffer& splats = res.buffer("photon_gi_splats");
+  gl::Buffer& cells = res.buffer("photon_gi_cells");
+  if (upload) {
+    if (!grid.splats.empty()) splats.upload(grid.splats.data(), grid.splats.size() * sizeof(GpuSplat));
+    cells.upload(grid.cellStart.data(), grid.cellStart.size() * sizeof(std::uint32_t));
+  }
+  const char* inputs[] = {"gbuffer_position", "normal", "albedo", "material", "emission"};
+  for (GLuint i = 0; i < std::size(inputs); ++i) res.texture(inputs[i]).bindUnit(i);
+  res.texture("geometric_normal").bindUnit(6);
+  splats.bindBase(GL_SHADER_STORAGE_BUFFER, kSplatBinding);
+  cells.bindBase(GL_SHADER_STORAGE_BUFFER, kCellBinding);
+  const glm::vec3 forward = -glm::normalize(glm::vec3(view.camera.world[2]));
+  auto common = [&](const gl::Program& p) {
+    p.use();
+    p.set("u_eye", glm::value_ptr(view.eye), 3);
+    p.set("u_viewForward", glm::value_ptr(forward), 3);
+    p.set("u_orthographic", view.camera.projection == ProjectionType::Orthographic ? 1 : 0);
+    p.set("u_kernel", static_cast<int>(settings.kernel));
+    p.set("u_planeTolerance", kPlaneTolerance);
+    p.set("u_normalCosine", kNormalCosine);
+    p.set("u_minGlossyRoughness", settings.minGlossyRoughness);
+  };
+  gl::Texture& accum = res.texture("photon_gi_accum");
+  const float zero[4] = {0.f, 0.f, 0.f, 0.f};
+  const GLsizei count = static_cast<GLsizei>(grid.splats.size());
+  if (settings.method == Method::Splat) {
+    gl::Framebuffer& fb = res.framebuffer("photon_gi_splat");
+    fb.bind();
+    glViewport(0, 0, view.width, view.height);
+    glClearNamedFramebufferfv(fb.id(), GL_COLOR, 0, zero);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_CULL_FACE);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+    const gl::Program& prog = shaders.program({"photon_gi/splat.vert", "photon_gi/splat.frag"});
+    common(prog);
+    prog.setMat4("u_viewProj", glm::value_ptr(view.viewProj));
+    if (count > 0) glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, count);
+    glDisable(GL_BLEND);
+  } else {
+    const gl::Program& prog = shaders.program({"photon_gi/gather.comp"});
+    common(prog);
+    prog.set("u_gridOrigin", glm::value_ptr(grid.origin), 3);
+    prog.set("u_cellSize", grid.cellSize);
+    const int dims[3] = {grid.dims.x, grid.dims.y, grid.dims.z};
+    glUniform3iv(glGetUniformLocation(prog.id(), "u_gridDims"), 1, dims);
+    const int size[2] = {view.width, view.height};
+    glUniform2iv(glGetUniformLocation(prog.id(), "u_size"), 1, size);
+    accum.bindImage(0, GL_WRITE_ONLY);
+    glDispatchCompute((view.width + 7) / 8, (view.height + 7) / 8, 1);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
+  }
+
+  gl::Framebuffer& resolveFb = res.framebuffer("photon_gi_resolve");
+  resolveFb.bind();
+  glViewport(0, 0, view.width, view.height);
+  glClearNamedFramebufferfv(resolveFb.id(), GL_COLOR, 0, zero);
+  if (addToBeauty) {
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+  } else {
+    glColorMaski(1, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+  }
+  accum.bindUnit(0);
+  const gl::Program& resolve = shaders.program({"common/fullscreen.vert", "photon_gi/resolve.frag"});
+  resolve.use();
+  resolve.set("u_renormalize", settings.renormalize ? 1 : 0);
+  resolve.set("u_minKernelMass", kMinKernelMass);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glDisable(GL_BLEND);
+  glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  res.markWritten("indirect");
+  if (addToBeauty) res.markWritten("beauty");
+}
+
+}  // namespace radiant::photon_gi

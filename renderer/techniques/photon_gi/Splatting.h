@@ -1,0 +1,67 @@
+#pragma once
+// The GPU half of photon GI, separate from where the photons come from so that tests can feed it
+// photons of their own: a splat array (photons with their kernel radius, and the coverage points of
+// the edge renormalisation), sorted into a uniform grid, turned into the `indirect` AOV either by
+// splatting (Stürzlinger & Bastos §2.2: one quad per photon, additive blending) or by a per-pixel
+// gather over the grid (the baseline of the issue: same photons, same kernel, same surface test,
+// so the two differ only by float rounding).
+#include <cstddef>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "renderer/frame/FrameResources.h"
+#include "renderer/frame/FrameView.h"
+#include "renderer/gl/ShaderLibrary.h"
+#include "renderer/scene/Scene.h"
+
+namespace radiant::photon_gi {
+
+// std430 mirror of GpuPhoton in shaders/photon_gi/photon.glsl.
+struct GpuSplat {
+  glm::vec4 positionRadius;  // xyz world position, w kernel radius h
+  glm::vec4 normal;          // xyz unit normal on the side the photon arrived from
+  glm::vec4 wi;              // xyz unit direction towards where the photon came from
+  glm::vec4 power;           // rgb phi = flux / photons used; a > 0: coverage point of weight A / n
+};
+static_assert(sizeof(GpuSplat) == 64, "std430 GpuSplat must be 4 vec4");
+
+inline GpuSplat photonSplat(const glm::vec3& p, float h, const glm::vec3& n, const glm::vec3& wi, const glm::vec3& phi) {
+  return {glm::vec4(p, h), glm::vec4(n, 0.f), glm::vec4(wi, 0.f), glm::vec4(phi, 0.f)};
+}
+
+// Appends n coverage points spread uniformly by area over `mesh` (stratified in the area CDF, R2
+// low-discrepancy inside each triangle), each of weight area / n and kernel radius h.
+void appendCoveragePoints(const MeshInstance& mesh, std::size_t n, float h, std::vector<GpuSplat>& out);
+double meshArea(const MeshInstance& mesh);
+
+enum class Method { Splat, Gather };
+enum class Kernel { Biweight = 0, Epanechnikov = 1 };
+
+struct SplatSettings {
+  Method method = Method::Splat;
+  Kernel kernel = Kernel::Biweight;
+  bool renormalize = true;
+  float minGlossyRoughness = 0.2f;
+};
+
+// The splats sorted by grid cell, and the grid (cell c holds splats cellStart[c] .. cellStart[c+1]-1).
+struct SplatGrid {
+  std::vector<GpuSplat> splats;
+  std::vector<std::uint32_t> cellStart;
+  glm::vec3 origin{0.f};
+  float cellSize = 1.f;
+  glm::ivec3 dims{1};
+};
+// Cells are at least the largest kernel radius (a gather visits the 27 cells around a pixel), and at
+// most 128 per axis.
+SplatGrid buildSplatGrid(std::vector<GpuSplat> splats);
+
+// Declares the splat buffers (capacity in powers of two), the accumulation target and `indirect`.
+void declareSplatResources(FrameResources& res, const SplatGrid& grid);
+// Uploads `grid` when `upload` (else the buffers hold it already), accumulates into the target and
+// resolves into `indirect`, adding it to `beauty` when addToBeauty. Reads the G-buffer resources.
+void splatAndResolve(FrameResources& res, gl::ShaderLibrary& shaders, const FrameView& view,
+                     const SplatSettings& settings, const SplatGrid& grid, bool upload, bool addToBeauty);
+
+}  // namespace radiant::photon_gi

@@ -1,0 +1,37 @@
+// The gather baseline: per pixel, the sum over the photons (and coverage points) of the 27 grid cells
+// around its surface point, with the same kernel and surface test as the splats (photon.glsl). Cells
+// are at least the largest kernel radius, so no photon whose kernel reaches the pixel is missed.
+#include "photon_gi/photon.glsl"
+#include "photon_gi/surface.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(std430, binding = 6) readonly buffer Cells { uint cellStart[]; };
+layout(rgba32f, binding = 0) uniform writeonly image2D i_accum;
+
+uniform vec3 u_gridOrigin;
+uniform float u_cellSize;
+uniform ivec3 u_gridDims;
+uniform ivec2 u_size;
+
+void main() {
+  ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+  if (px.x >= u_size.x || px.y >= u_size.y) return;
+  SplatSurface s;
+  vec4 acc = vec4(0.0);
+  if (loadSurface(px, s)) {
+    ivec3 c = ivec3(floor((s.x - u_gridOrigin) / u_cellSize));
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          ivec3 q = c + ivec3(dx, dy, dz);
+          if (any(lessThan(q, ivec3(0))) || any(greaterThanEqual(q, u_gridDims))) continue;
+          int cell = (q.z * u_gridDims.y + q.y) * u_gridDims.x + q.x;
+          for (uint i = cellStart[cell]; i < cellStart[cell + 1]; ++i) {
+            GpuPhoton p = photons[i];
+            if (p.power.a > 0.0) acc.a += coverageContribution(p, s);
+            else acc.rgb += photonContribution(p, s);
+          }
+        }
+  }
+  imageStore(i_accum, px, acc);
+}

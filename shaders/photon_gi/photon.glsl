@@ -1,0 +1,87 @@
+// Photon splatting (Stürzlinger & Bastos 1997, §2.2, optimised mode §2.2.1), shared by the splat
+// fragment shader and the per-pixel gather baseline so both compute exactly the same estimate:
+//   L_o(x, wo) = sum_j phi_j f_r(x, wi_j, wo) k((x - x_j) / h_j) / h_j^2            (eq. 2 with 1/h^2)
+// with a kernel k of unit integral over the unit disk, evaluated in photon j's tangent plane. A photon
+// contributes only to pixels whose G-buffer surface lies in its plane and faces the same way (the
+// paper's per-surface stencil, here a surface test), so splats do not bleed across creases or onto
+// other objects. The BRDF is the glTF one of the pixel's material (per pixel, not per splat: a
+// textured surface then keeps its texture detail).
+#ifndef RADIANT_PHOTON_GI_PHOTON
+#define RADIANT_PHOTON_GI_PHOTON
+#include "common/brdf.glsl"
+
+// std430 mirror of photon_gi::GpuSplat (renderer/techniques/photon_gi/Splatting.h).
+struct GpuPhoton {
+  vec4 positionRadius;  // xyz world position, w kernel radius h
+  vec4 normal;          // xyz unit normal on the side the photon arrived from
+  vec4 wi;              // xyz unit direction towards where it came from
+  vec4 power;           // rgb phi_j = flux / photons used; a > 0: a coverage point of weight A / n
+};
+
+layout(std430, binding = 5) readonly buffer Photons { GpuPhoton photons[]; };
+
+const int KERNEL_BIWEIGHT = 0;      // Silverman's K2 = 3/pi (1 - r^2)^2
+const int KERNEL_EPANECHNIKOV = 1;  // 2/pi (1 - r^2)
+
+uniform int u_kernel;
+uniform float u_planeTolerance;  // |distance to the photon's plane| < tolerance * h
+uniform float u_normalCosine;    // minimum cosine between the pixel's and the photon's normals
+uniform float u_minGlossyRoughness;  // below it only the diffuse lobe is splatted (see TECHNIQUES.md)
+
+float kernel2d(float r2) {
+  if (r2 >= 1.0) return 0.0;
+  float s = 1.0 - r2;
+  return u_kernel == KERNEL_EPANECHNIKOV ? 2.0 * INV_PI * s : 3.0 * INV_PI * s * s;
+}
+
+struct SplatSurface {
+  vec3 x;      // world position
+  vec3 n;      // shading normal
+  vec3 ng;     // geometric normal facing the viewer
+  vec3 wo;     // towards the eye
+  vec3 baseColor;
+  float metallic, roughness, transmission, ior;
+};
+
+// phi_j f_r k / h^2 of photon j at the surface s (0 when it fails the surface test).
+vec3 photonContribution(GpuPhoton p, SplatSurface s) {
+  float h = p.positionRadius.w;
+  vec3 d = s.x - p.positionRadius.xyz;
+  float planeDistance = dot(d, p.normal.xyz);
+  if (abs(planeDistance) > u_planeTolerance * h) return vec3(0.0);
+  if (dot(s.ng, p.normal.xyz) < u_normalCosine) return vec3(0.0);
+  vec3 inPlane = d - planeDistance * p.normal.xyz;
+  float k = kernel2d(dot(inPlane, inPlane) / (h * h));
+  if (k <= 0.0) return vec3(0.0);
+  vec3 wi = p.wi.xyz;
+  float NdotL = dot(s.n, wi);
+  if (NdotL <= 0.0) return vec3(0.0);
+  // gltfBrdfCos is f cos(theta_i); density estimation needs f alone (the photon flux per area already
+  // carries the cosine).
+  float metallic = s.metallic, roughness = s.roughness;
+  vec3 base = s.baseColor;
+  vec3 f;
+  if (roughness < u_minGlossyRoughness) {
+    // Too sharp to estimate from photons: keep the diffuse lobe (what a smooth dielectric's base
+    // reflects) and leave the near-mirror reflection of indirect light out.
+    float r = (s.ior - 1.0) / (s.ior + 1.0);
+    f = (1.0 - metallic) * (1.0 - s.transmission) * (1.0 - r * r) * base * INV_PI;
+  } else {
+    f = gltfBrdfCos(s.n, s.wo, wi, base, metallic, roughness, s.transmission, s.ior) / NdotL;
+  }
+  return p.power.rgb * f * (k / (h * h));
+}
+
+// A coverage point (uniform by area over its surface, weight A / n): w k / h^2 at s, where s passes the
+// same surface test regardless of which side the surface is seen from. Summed over a surface's points
+// this estimates the kernel mass that lies on the surface around s (1 in the interior).
+float coverageContribution(GpuPhoton p, SplatSurface s) {
+  float h = p.positionRadius.w;
+  vec3 d = s.x - p.positionRadius.xyz;
+  float planeDistance = dot(d, p.normal.xyz);
+  if (abs(planeDistance) > u_planeTolerance * h) return 0.0;
+  if (abs(dot(s.ng, p.normal.xyz)) < u_normalCosine) return 0.0;
+  vec3 inPlane = d - planeDistance * p.normal.xyz;
+  return p.power.a * kernel2d(dot(inPlane, inPlane) / (h * h)) / (h * h);
+}
+#endif

@@ -1,0 +1,22 @@
+// One quad per photon, an instanced 4-vertex strip pulled from the splat buffer: the square of side 2h
+// in the photon's tangent plane that encloses its kernel disk (the paper's enclosing triangle, §2.2).
+#include "photon_gi/photon.glsl"
+
+uniform mat4 u_viewProj;
+flat out int v_photon;
+
+void main() {
+  int photon = gl_InstanceID;
+  vec2 c = vec2((gl_VertexID & 1) != 0 ? 1.0 : -1.0, (gl_VertexID & 2) != 0 ? 1.0 : -1.0);
+  GpuPhoton p = photons[photon];
+  vec3 n = p.normal.xyz;
+  // Duff et al. 2017 orthonormal basis.
+  float sgn = n.z >= 0.0 ? 1.0 : -1.0;
+  float a = -1.0 / (sgn + n.z);
+  float b = n.x * n.y * a;
+  vec3 t = vec3(1.0 + sgn * n.x * n.x * a, sgn * b, -sgn * n.x);
+  vec3 bt = vec3(b, sgn + n.y * n.y * a, -n.y);
+  vec3 world = p.positionRadius.xyz + p.positionRadius.w * (c.x * t + c.y * bt);
+  v_photon = photon;
+  gl_Position = u_viewProj * vec4(world, 1.0);
+}
