@@ -13,6 +13,7 @@ void to_json(nlohmann::json& j, const FrameStats& s) {
   for (const auto& p : s.passes) passes.push_back(p);
   j = nlohmann::json{{"passes", passes},
                      {"skipped", s.skipped},
+                     {"light_paths", s.lightPaths},
                      {"cache", cache},
                      {"scene_load_ms", s.sceneLoadMs},
                      {"upload_ms", s.uploadMs},

@@ -91,6 +91,7 @@ struct CacheEvent {
 struct FrameStats {
   std::vector<PassStats> passes;
   std::map<std::string, std::string> skipped;  // pass name -> reason
+  std::map<std::string, std::string> lightPaths;  // light-path class -> technique that supplies it
   std::vector<CacheEvent> cache;
   double sceneLoadMs = 0, uploadMs = 0, renderMs = 0, readbackMs = 0, encodeMs = 0;
   std::size_t triangles = 0;

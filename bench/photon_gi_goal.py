@@ -3,7 +3,10 @@
 machine: on the built-in Cornell box at SIZE x SIZE, how long does the default GI take to reach the RMSE
 of the reference path tracer at 256 spp, with photons cached and the camera changed?
 
-    bench/photon_gi_goal.py [--server URL] [--size 256] [--truth-spp 2048] [--scene cornell_box]
+    bench/photon_gi_goal.py [--server URL] [--size 256] [--truth-spp 2048] [--truth FILE.exr] [--scene cornell_box]
+
+Start radiantd with a long --request-timeout (the ground truth takes minutes on a CPU); --truth reuses
+a ground-truth EXR rendered before (the reference's `reference` AOV of the same scene, size and camera).
 
 Steps (every image scored against the same converged ground truth, uploaded as an image):
   1. ground truth: the reference at --truth-spp (seed 99, independent of the seeds below);
@@ -46,15 +49,21 @@ def main():
     ap.add_argument("--size", type=int, default=256)
     ap.add_argument("--truth-spp", type=int, default=2048)
     ap.add_argument("--scene", default="cornell_box")
+    ap.add_argument("--truth", help="a ground-truth EXR to reuse instead of rendering one")
     a = ap.parse_args()
     S = a.server
     info = call(S, "/v1/info")
     renderer = info.get("device", {}).get("renderer", "?")
     base = {"scene": {"builtin": a.scene}, "width": a.size, "height": a.size}
 
-    truth, ms = render(S, dict(base, seed=99, passes={"reference": {"spp": a.truth_spp}, "photon_gi": False},
-                               outputs=[{"format": "exr", "half": False, "aovs": ["reference"]}]))
-    exr = call(S, truth["frames"][0]["url"], ctype="image/x-exr")
+    if a.truth:
+        with open(a.truth, "rb") as f:
+            exr = f.read()
+        ms = 0.0
+    else:
+        truth, ms = render(S, dict(base, seed=99, passes={"reference": {"spp": a.truth_spp}, "photon_gi": False},
+                                   outputs=[{"format": "exr", "half": False, "aovs": ["reference"]}]))
+        exr = call(S, truth["frames"][0]["url"], ctype="image/x-exr")
     digest = call(S, "/v1/images", exr, method="PUT", ctype="image/x-exr")
     digest = json.loads(digest)["digest"] if isinstance(digest, bytes) else digest["digest"]
     print(f"ground truth: reference {a.truth_spp} spp, {ms / 1000:.1f} s", file=sys.stderr)

@@ -186,8 +186,10 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     for (auto& t : im.techniques) all.push_back(t.get());
     FramePlan plan = planFrame(all, scene, request);
     stats.skipped = plan.skipped;
+    stats.lightPaths = plan.lightPaths;
 
     im.resources.beginFrame(gpu, view, &stats.cache);
+    im.resources.setLightPathOwners(plan.lightPaths);
     im.profiler.beginFrame();
     // PassStats must not move while the profiler holds pointers to them.
     stats.passes.resize(plan.passes.size());

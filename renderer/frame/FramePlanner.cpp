@@ -90,6 +90,9 @@ FramePlan planFrame(const std::vector<Technique*>& techniques, const Scene& scen
   }
   for (Technique* t : techniques)
     if (keep.count(t)) plan.passes.push_back(t);
+  // Every light path is counted once: each class goes to the first planned technique claiming it.
+  for (Technique* t : plan.passes)
+    for (const auto& cls : t->info().lightPaths) plan.lightPaths.emplace(cls, t->info().name);
   return plan;
 }
 

@@ -16,6 +16,7 @@ namespace radiant {
 struct FramePlan {
   std::vector<Technique*> passes;              // in execution order
   std::map<std::string, std::string> skipped;  // pass name -> reason
+  std::map<std::string, std::string> lightPaths;  // light-path class -> the technique that owns it
 };
 
 // AOVs that are not a technique's output but exist in every frame.

@@ -44,6 +44,13 @@ public:
   gl::Buffer& buffer(const std::string& name);
   bool hasBuffer(const std::string& name) const { return buffers_.count(name) != 0; }
 
+  // Which technique owns each light-path class this frame (FramePlan::lightPaths).
+  void setLightPathOwners(std::map<std::string, std::string> owners) { lightPaths_ = std::move(owners); }
+  bool ownsLightPath(const std::string& technique, const std::string& cls) const {
+    auto it = lightPaths_.find(cls);
+    return it != lightPaths_.end() && it->second == technique;
+  }
+
   // Outputs written this frame (the planner and readback consult it).
   void markWritten(const std::string& name) { written_.insert(name); }
   bool written(const std::string& name) const { return written_.count(name) != 0; }
@@ -84,6 +91,7 @@ private:
   std::map<std::string, gl::Buffer> buffers_;
   std::map<std::string, Entry> cache_;
   std::set<std::string> written_;
+  std::map<std::string, std::string> lightPaths_;
 };
 
 }  // namespace radiant

@@ -24,6 +24,10 @@ struct TechniqueInfo {
   std::vector<std::string> outputs;   // resources / AOVs it writes ("direct")
   bool addsToBeauty = false;  // accumulates its result into "beauty"
   bool onByDefault = false;   // wanted in every frame; requirements() then decides (e.g. AO: only with ambient light)
+  // Light-path classes it can supply (ARCHITECTURE.md, "Every light path is counted once"), e.g.
+  // "LD+DE". The planner gives each class to the first planned technique that claims it, in
+  // registry order; a technique adds a class to beauty only when it owns it (FrameResources).
+  std::vector<std::string> lightPaths = {};
 };
 
 // Run or skip, and the reason if skipped. The planner records the reason in the frame stats.

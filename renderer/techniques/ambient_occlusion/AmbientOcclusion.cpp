@@ -223,7 +223,8 @@ const TechniqueInfo& AmbientOcclusionPass::info() const {
       {"direct"},  // runs after direct, which initialises beauty
       {"ao"},
       true,
-      true};
+      true,
+      {"L(sky)DE"}};
   return i;
 }
 
@@ -326,7 +327,10 @@ void AmbientOcclusionPass::execute(PassContext& ctx) {
 
   // 2. Resolve at full resolution: depth-aware 4x4 filter (or depth-aware upsampling), write `ao` and
   //    add the ambient term to beauty.
-  const bool addAmbient = res.written("beauty") && (view.ambient.x > 0.f || view.ambient.y > 0.f || view.ambient.z > 0.f);
+  // The sky's direct light goes to beauty only when this pass owns it (photon_gi owns it when it runs:
+  // its environment photons see the real visibility, AO only a neighbourhood of radius R).
+  const bool addAmbient = res.written("beauty") && res.ownsLightPath("ambient_occlusion", "L(sky)DE") &&
+                          (view.ambient.x > 0.f || view.ambient.y > 0.f || view.ambient.z > 0.f);
   gl::Framebuffer& resolve = res.framebuffer("ao_resolve");
   resolve.bind();
   glViewport(0, 0, w, h);

@@ -18,7 +18,8 @@ const TechniqueInfo& DirectPass::info() const {
                                {"shadow_maps"},
                                {"direct"},
                                true,
-                               true};
+                               true,
+                               {"LE", "L(point)DE"}};
   return i;
 }
 

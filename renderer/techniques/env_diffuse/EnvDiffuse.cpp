@@ -48,7 +48,8 @@ const TechniqueInfo& EnvDiffusePass::info() const {
                                {"shadow_maps"},
                                {"indirect_diffuse"},
                                true,
-                               false};
+                               false,
+                               {"LD+DE"}};
   return i;
 }
 

@@ -52,7 +52,8 @@ const TechniqueInfo& PhotonGiPass::info() const {
                                {"direct"},  // runs after direct, which initialises beauty
                                {"indirect"},
                                true,
-                               true};
+                               true,
+                               {"LD+DE", "L(area)DE", "L(sky)DE"}};
   return i;
 }
 
@@ -115,7 +116,8 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   records_ = cache.set.recordsOfFirst(s.photons);
 
   // --- The splats: which records, their kernel radius per surface (eq. 3), coverage points.
-  const nlohmann::json splatKey = {{"photons", photonKey}, {"count", s.photons}, {"C", s.C},
+  const bool ownsSky = res.ownsLightPath("photon_gi", "L(sky)DE");
+  const nlohmann::json splatKey = {{"photons", photonKey}, {"count", s.photons}, {"C", s.C}, {"sky", ownsSky},
                                    {"ppm", s.ppm}, {"alpha", s.ppmAlpha}, {"base", s.ppmBase},
                                    {"renormalize", splat_.renormalize}};
   upload_ = false;
@@ -125,10 +127,13 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
     const auto t0 = Clock::now();
     auto c = std::make_unique<SplatCache>();
     // Splatted: photons with at least one earlier reflection (the paper's optimised mode: direct light
-    // from punctual lights and the sky is the raster passes'), and direct light from emissive
-    // triangles, which no raster pass computes.
+    // from punctual lights is the raster pass's), direct light from emissive triangles, which no raster
+    // pass computes, and the sky's direct light when this pass owns it (the planner gives it to
+    // photon_gi ahead of ambient_occlusion, whose visibility ends at its radius).
     auto splatted = [&](const rt::PhotonRecord& r) {
-      return r.bounce >= 1 || lights.emitters()[r.light].kind == rt::SceneLights::Kind::Triangle;
+      if (r.bounce >= 1) return true;
+      const auto kind = lights.emitters()[r.light].kind;
+      return kind == rt::SceneLights::Kind::Triangle || (kind == rt::SceneLights::Kind::Environment && ownsSky);
     };
     std::vector<double> count(scene.meshes.size(), 0.0), area(scene.meshes.size(), 0.0);
     for (std::size_t i = 0; i < records_; ++i)

@@ -34,7 +34,8 @@ const TechniqueInfo& SpecularPass::info() const {
       {"shadow_maps"},
       {"specular"},
       true,
-      true};
+      true,
+      {"LS+E", "LDS+E"}};
   return i;
 }
 

@@ -238,6 +238,39 @@ TEST(PhotonGi, SplatAndGatherAgreeOnTheSamePhotons) {
   EXPECT_LT(maxRel, 1e-3);  // float summation order only
 }
 
+// ---- The technique on whole scenes --------------------------------------------------------------
+
+double mean(const Image& img) {
+  double s = 0;
+  for (float v : img.pixels) s += v;
+  return s / img.pixels.size();
+}
+
+TEST(PhotonGi, IntegratingSphereSplatsOnlyIndirectLight) {
+  // A point light of power Phi = 4 pi I at the centre of a closed sphere of albedo rho = 1/2 (f0 = 0,
+  // so the glTF dielectric reflects 0.500 at every angle, tests/unit/raytracing): bounce k carries
+  // Phi rho^k, so the indirect irradiance (k >= 1, the bounce filter) is Phi rho / (1 - rho) / A = Phi / A
+  // and a wall seen from the centre has L = rho / pi Phi / A. The direct light (bounce 0, Phi / A) must
+  // not be splatted: it would double L.
+  testing::SceneBuilder b;
+  Material m = testing::lambertian(glm::vec3(0.5f));
+  m.doubleSided = true;
+  const int mat = b.material(m);
+  b.sphere(glm::vec3(0.f), 1.f, mat, 64, 32);
+  b.pointLight(glm::vec3(0.f), 1.f);
+  Scene scene = b.build("integrating-sphere");
+  const double area = photon_gi::meshArea(scene.meshes[0]);
+  api::RenderRequest r;
+  r.width = r.height = 32;
+  r.camera = api::CameraOverride{{0.f, 0.f, 0.f}, {0.f, 0.f, -1.f}, {0.f, 1.f, 0.f}, 60.f};
+  r.passes["photon_gi"] = {{"photons", 400000}, {"max_bounces", 30}};
+  r.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"indirect"}, false}};
+  const RenderOutput out = renderer().render(scene, r);
+  const double expected = 0.5 / M_PI * (4 * M_PI) / area;
+  std::printf("integrating sphere: L_indirect %.4f, expected %.4f\n", mean(aov(out, "indirect")), expected);
+  EXPECT_NEAR(mean(aov(out, "indirect")), expected, 0.03 * expected);
+}
+
 // ---- The technique on the built-in Cornell box ---------------------------------------------------
 
 api::RenderRequest cornellRequest(int size, nlohmann::json params = nlohmann::json::object()) {
@@ -246,12 +279,6 @@ api::RenderRequest cornellRequest(int size, nlohmann::json params = nlohmann::js
   r.passes["photon_gi"] = std::move(params);
   r.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty", "direct", "indirect"}, false}};
   return r;
-}
-
-double mean(const Image& img) {
-  double s = 0;
-  for (float v : img.pixels) s += v;
-  return s / img.pixels.size();
 }
 
 TEST(PhotonGi, CornellBoxIndirectAndBeautyAgainstTheReference) {
@@ -310,6 +337,32 @@ TEST(PhotonGi, GlossyBoxIndirectAgainstTheReference) {
               mean(ours) / mean(truth));
   // The glossy lobe (alpha = 0.09) is narrower than most kernels are wide, so photons blur it: 15%.
   EXPECT_NEAR(a / b, 1.0, 0.15);
+}
+
+TEST(PhotonGi, SkyLightIsCountedOnceWithAmbientOcclusion) {
+  // With a sky, ambient_occlusion adds the sky's direct light (ambient x AO) and photon_gi the sky's
+  // light after one or more reflections (environment photons with bounce >= 1): together with
+  // `direct` the beauty must hold each path once. The Cornell box is open at the front, so the sky
+  // lights it; the frame mean is compared with the reference's beauty.
+  const Scene scene = loadBuiltinScene("cornell_box");
+  api::RenderRequest r = cornellRequest(32, {{"photons", 300000}});
+  r.ambient = glm::vec3(2.f);
+  r.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty", "indirect"}, false}};
+  r.compare = api::CompareSpec{"reference", "beauty", 512, 8};
+  const RenderOutput out = renderer().render(scene, r);
+  ASSERT_NE(pass(out, "ambient_occlusion"), nullptr);
+  const double ratio = mean(aov(out, "beauty")) / mean(aov(out, "reference"));
+  api::RenderRequest noSky = r;
+  noSky.ambient = glm::vec3(0.f);
+  const RenderOutput dark = renderer().render(scene, noSky);
+  // The sky's share of the frame: what a double count (or a missing term) would add (or remove).
+  const double skyShare = 1.0 - mean(aov(dark, "reference")) / mean(aov(out, "reference"));
+  std::printf("sky: beauty / reference = %.3f, the sky's share of the reference = %.3f\n", ratio, skyShare);
+  EXPECT_GT(skyShare, 0.15);
+  EXPECT_NEAR(ratio, 1.0, 0.04);
+  EXPECT_EQ(out.stats.lightPaths.at("L(sky)DE"), "photon_gi");
+  EXPECT_EQ(out.stats.lightPaths.at("LD+DE"), "photon_gi");
+  EXPECT_EQ(out.stats.lightPaths.at("L(point)DE"), "direct");
 }
 
 TEST(PhotonGi, CameraChangeReusesPhotonsAndMorePhotonsExtendThem) {
