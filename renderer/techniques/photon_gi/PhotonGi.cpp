@@ -77,14 +77,14 @@ Requirements PhotonGiPass::requirements(const Scene& scene, const api::RenderReq
 void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
   Settings s;
   s.photons = static_cast<std::uint64_t>(params.get<std::int64_t>("photons", 250000));
-  s.C = params.get<float>("C", 20.f);
+  s.C = params.get<float>("C", 10.f);
   s.ppm = params.get<std::string>("h_schedule", "paper") == "ppm";
   s.ppmAlpha = params.get<double>("ppm_alpha", 2.0 / 3.0);
   s.ppmBase = params.get<double>("ppm_base_photons", 250000.0);
   s.maxBounces = params.get<int>("max_bounces", 8);
   if (!(s.C > 0.f) || !std::isfinite(s.C)) badParam("C", "C must be a positive number");
   settings_ = s;
-  splat_.method = params.get<std::string>("method", "splat") == "gather" ? photon_gi::Method::Gather
+  splat_.method = params.get<std::string>("method", "gather") == "gather" ? photon_gi::Method::Gather
                                                                        : photon_gi::Method::Splat;
   splat_.kernel = params.get<std::string>("kernel", "biweight") == "epanechnikov" ? photon_gi::Kernel::Epanechnikov
                                                                                   : photon_gi::Kernel::Biweight;

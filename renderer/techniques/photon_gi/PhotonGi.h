@@ -36,7 +36,7 @@ public:
 private:
   struct Settings {
     std::uint64_t photons = 0;
-    float C = 20.f;
+    float C = 10.f;
     bool ppm = false;
     double ppmAlpha = 2.0 / 3.0, ppmBase = 250000;
     int maxBounces = 8;

@@ -263,7 +263,7 @@ TEST(PhotonGi, IntegratingSphereSplatsOnlyIndirectLight) {
   api::RenderRequest r;
   r.width = r.height = 32;
   r.camera = api::CameraOverride{{0.f, 0.f, 0.f}, {0.f, 0.f, -1.f}, {0.f, 1.f, 0.f}, 60.f};
-  r.passes["photon_gi"] = {{"photons", 400000}, {"max_bounces", 30}};
+  r.passes["photon_gi"] = {{"photons", 400000}, {"max_bounces", 30}, {"C", 20}};
   r.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"indirect"}, false}};
   const RenderOutput out = renderer().render(scene, r);
   const double expected = 0.5 / M_PI * (4 * M_PI) / area;

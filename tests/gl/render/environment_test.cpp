@@ -111,7 +111,7 @@ TEST(Environment, ReferenceLightsByTheMapAndAmbientPassesByItsAverage) {
   // With photon_gi (on by default) the map's direct light comes from environment photons, which see
   // its directions: the upward-facing plane gets the red upper hemisphere only, like the reference.
   req.disabledPasses.clear();
-  req.passes["photon_gi"] = {{"photons", 400000}};
+  req.passes["photon_gi"] = {{"photons", 400000}, {"C", 20}};
   RenderOutput gi = renderer().render(scene, req, nullptr, FrameInputs{nullptr, &env});
   double giRed = 0, giBlue = 0;
   for (int y = 2; y < 6; ++y)
