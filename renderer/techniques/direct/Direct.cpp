@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "renderer/frame/GpuTypes.h"
 #include "renderer/frame/PassContext.h"
 #include "renderer/techniques/direct/DirectLighting.h"
 
@@ -81,7 +82,7 @@ void DirectPass::execute(PassContext& ctx) {
     // Rows in image order (row 0 = up): texel row v * height is image row v * height.
     environment.upload(0, 0, 0, 0, env.width, env.height, 1, GL_RGBA, GL_FLOAT, rgba.data());
   }
-  environment.bindUnit(8);
+  environment.bindUnit(gpu::kUnitEnvironment);
   prog.set("u_hasEnvironment", view.environment ? 1 : 0);
   prog.setMat4("u_invViewProj", &view.invViewProj[0][0]);
   prog.set("u_eye", &view.eye[0], 3);

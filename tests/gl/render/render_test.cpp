@@ -70,6 +70,38 @@ TEST(RenderCore, PointLightCalibrationAndCosCubedFalloff) {
   EXPECT_FLOAT_EQ(aov(out, "beauty").at(10, 10)[1], direct.at(10, 10)[1]);
 }
 
+TEST(RenderCore, PointLightRangeWindowIsTheSpecsUnsquaredWindow) {
+  // KHR_lights_punctual, "Range Property": attenuation = max(min(1 - (d / range)^4, 1), 0) / d^2. With
+  // range 2 and the calibration light above, L = cos^3(theta) (1 - d^4 / 16): 15/16 at the foot point
+  // (the squared window some engines use would give 0.879 there), 0 beyond d = 2.
+  const int size = 64;
+  const float half = 2.f;
+  Scene scene = planeScene().pointLight({0, 1, 0}, glm::pi<float>()).topDownOrtho(5.f, half).build("range");
+  scene.lights[0].range = 2.f;
+  RenderOutput out = renderer().render(scene, request(size));
+  expectAllFinite(out);
+  const Image& direct = aov(out, "direct");
+  int inside = 0, outside = 0;
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      const glm::vec2 w = topDownPixelToWorld(x, y, size, half);
+      const float d2 = 1.f + glm::dot(w, w);
+      const float window = std::max(0.f, 1.f - d2 * d2 / 16.f);
+      const float expected = std::pow(d2, -1.5f) * window;
+      const float got = direct.at(x, y)[0];
+      if (glm::dot(w, w) < 0.05f * 0.05f) EXPECT_NEAR(got, 15.f / 16.f, 0.01f) << "foot point " << x << "," << y;
+      if (window > 0.1f) {
+        EXPECT_NEAR(got / expected, 1.0f, 0.02f) << "pixel " << x << "," << y;
+        ++inside;
+      } else if (d2 > 4.05f) {
+        EXPECT_EQ(got, 0.f) << "beyond range, pixel " << x << "," << y;
+        ++outside;
+      }
+    }
+  EXPECT_GT(inside, 1000);
+  EXPECT_GT(outside, 200);
+}
+
 TEST(RenderCore, SpotLightConeEdges) {
   // KHR_lights_punctual smooth falloff: t = clamp((cos a - cos outer) / (cos inner - cos outer)), t^2.
   const float inner = 0.3f, outer = 0.5f, I = glm::pi<float>();
