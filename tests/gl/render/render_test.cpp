@@ -2,11 +2,19 @@
 // physics of the scene: glTF light units, the Lambertian BRDF, the KHR_lights_punctual falloffs.
 #include <cmath>
 #include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <OpenImageIO/imageio.h>
 
 #include <gtest/gtest.h>
 
+#include "api/Aovs.h"
 #include "renderer/Renderer.h"
+#include "renderer/frame/FrameResources.h"
 #include "renderer/io/ImageIO.h"
+#include "tests/support/Expect.h"
 #include "tests/support/RenderTestSupport.h"
 #include "tests/support/SceneBuilder.h"
 
@@ -255,6 +263,57 @@ TEST(RenderCore, GrazingViewsStayFinite) {
   RenderOutput out = renderer().render(scene, req);
   expectAllFinite(out);
   for (float v : aov(out, "direct").pixels) EXPECT_GE(v, 0.f);
+}
+
+// The AOV table (api/Aovs.cpp) is enforced, not advisory.
+TEST(AovTable, CompareWithoutGroundTruthIsRefusedNotScoredAgainstBeauty) {
+  Scene scene = planeScene().pointLight({0, 1, 0}, glm::pi<float>()).topDownOrtho(5.f, 1.f).build("aov-compare");
+  for (const char* aov : {"specular", "albedo"}) {
+    api::RenderRequest req = request(16, {"beauty"});
+    req.compare = api::CompareSpec{"reference", aov, 1, 1};
+    try {
+      renderer().render(scene, req);
+      ADD_FAILURE() << "compare.aov " << aov << " was scored";
+    } catch (const api::ApiError& e) {
+      EXPECT_EQ(e.status, 422) << aov;
+      EXPECT_EQ(e.pointer, "/compare/aov") << aov;
+      EXPECT_NE(std::string(e.what()).find("no ground truth"), std::string::npos) << e.what();
+    }
+  }
+  // An AOV with a ground truth is scored against its own reference mode.
+  api::RenderRequest req = request(16, {"direct"});
+  req.compare = api::CompareSpec{"reference", "direct", 1, 1};
+  const RenderOutput out = renderer().render(scene, req);
+  EXPECT_EQ(out.stats.metrics.at("reference_mode"), "direct");
+}
+
+TEST(AovTable, FrameResourcesRefuseAnAovInAnotherFormatOrRespecifiedWithinAFrame) {
+  renderer();  // a current GL context
+  gl::ShaderLibrary shaders;
+  FrameResources res(shaders);
+  res.texture("beauty", GL_TEXTURE_2D, GL_RGBA32F, 8, 8);
+  res.texture("beauty", GL_TEXTURE_2D, GL_RGBA32F, 8, 8);  // the same declaration: reused
+  const std::string resized = testing::thrownMessage<std::logic_error>(
+      [&] { res.texture("beauty", GL_TEXTURE_2D, GL_RGBA32F, 16, 16); });
+  EXPECT_NE(resized.find("same frame"), std::string::npos) << resized;
+  const std::string format = testing::thrownMessage<std::logic_error>(
+      [&] { res.texture("ao", GL_TEXTURE_2D, GL_RGBA16F, 8, 8); });
+  EXPECT_NE(format.find("R32F"), std::string::npos) << format;
+  // Resources that are no AOV's are free to change.
+  res.texture("scratch", GL_TEXTURE_2D, GL_RGBA16F, 8, 8);
+  res.texture("scratch", GL_TEXTURE_2D, GL_RGBA16F, 8, 8);
+}
+
+TEST(ImageIO, ExrChannelNamesComeFromTheAovTable) {
+  Image ao = Image::make("ao", 2, 1, 1), normal = Image::make("normal", 2, 1, 3), beauty = Image::make("beauty", 2, 1, 3);
+  const std::string exrPath = ::testing::TempDir() + "/names.exr";
+  io::writeFile(exrPath, io::encodeExr({beauty, ao, normal}, false));
+  auto in = OIIO::ImageInput::open(exrPath);
+  ASSERT_TRUE(in);
+  const auto& stored = in->spec().channelnames;
+  // EXR keeps channels sorted by name; compare as sets.
+  EXPECT_EQ(std::set<std::string>(stored.begin(), stored.end()),
+            (std::set<std::string>{"R", "G", "B", "ao.Y", "normal.R", "normal.G", "normal.B"}));
 }
 
 TEST(ImageIO, PngClampsAndExrKeepsLayers) {
