@@ -17,7 +17,9 @@ const TechniqueInfo& DirectPass::info() const {
                                "Direct lighting from punctual lights (glTF BRDF, PCF shadow maps) plus emission",
                                {"gbuffer_position", "normal", "albedo", "material", "emission", "geometric_normal"},
                                {"shadow_maps"},
-                               {"direct"},
+                               // environment_map: the request's environment, uploaded here for every pass
+                               // that shows it (a frame resource, not an AOV).
+                               {"direct", "environment_map"},
                                true,
                                true};
   return i;

@@ -32,7 +32,7 @@ const TechniqueInfo& SpecularPass::info() const {
       "specular",
       "Multiple specular reflections and refractions traced in layered distance maps (thesis ch. 5)",
       {"gbuffer_position", "normal", "albedo", "material", "emission"},
-      {"shadow_maps"},
+      {"shadow_maps", "environment_map"},  // rays that leave the scene see the environment map
       {"specular"},
       true,
       true};
@@ -250,7 +250,7 @@ void SpecularPass::execute(PassContext& ctx) {
     prog.set("u_viewForward", &forward[0], 3);
     prog.set("u_orthographic", view.camera.projection == ProjectionType::Orthographic ? 1 : 0);
     prog.set("u_background", &view.ambient[0], 3);
-    // The direct pass uploaded the environment map (it declares the texture in every frame).
+    // The direct pass uploads the environment map (declared: direct's output, this pass's optional input).
     const bool environment = view.environment && res.hasTexture("environment_map");
     if (environment) res.texture("environment_map").bindUnit(gpu::kUnitEnvironment);
     prog.set("u_hasEnvironment", environment ? 1 : 0);
