@@ -262,7 +262,7 @@ Shading RayScene::shade(const SurfaceHit& hit, const glm::vec3& wo, TransportMod
   Shading s;
   // Factors x textures: the one C++ decoder (renderer/scene/MaterialDecode.h, twin of material.glsl).
   const gpu::MaterialParams params =
-      decodeMaterial(mat, [&](const TextureRef& ref, bool srgb) { return textureAt(ref, hit, srgb); });
+      decodeBsdfInputs(mat, [&](const TextureRef& ref, bool srgb) { return textureAt(ref, hit, srgb); });
   s.bsdf.baseColor = glm::vec3(params.baseColor);
   s.bsdf.metallic = params.surface.x;
   s.bsdf.roughness = params.surface.y;

@@ -31,10 +31,11 @@ glm::vec3 decodeEmission(const Material& m, Texel&& texel) {
   return e;
 }
 
-// glTF 3.9.2-3.9.3: metallic = blue, roughness = green of metallicRoughnessTexture; occlusion =
-// 1 + strength (texel.r - 1); KHR_materials_transmission: red channel of transmissionTexture.
+// What the BSDF reads (baseColor, surface), without the emission and occlusion lookups: the ray
+// tracer's shade() needs only these. emission is (0, 0, 0, 1). glTF 3.9.2: metallic = blue, roughness
+// = green of metallicRoughnessTexture; KHR_materials_transmission: red channel of transmissionTexture.
 template <class Texel>
-gpu::MaterialParams decodeMaterial(const Material& m, Texel&& texel) {
+gpu::MaterialParams decodeBsdfInputs(const Material& m, Texel&& texel) {
   const glm::vec4 base = decodeBaseColor(m, texel);
   float metallic = m.metallicFactor, roughness = m.roughnessFactor;
   if (m.metallicRoughnessTexture.valid()) {
@@ -44,14 +45,23 @@ gpu::MaterialParams decodeMaterial(const Material& m, Texel&& texel) {
   }
   float transmission = m.transmissionFactor;
   if (m.transmissionTexture.valid()) transmission *= texel(m.transmissionTexture, false).r;
-  float occlusion = 1.f;
-  if (m.occlusionTexture.valid()) occlusion = 1.f + m.occlusionTexture.scale * (texel(m.occlusionTexture, false).r - 1.f);
   const float ior = m.ior > 0.f ? m.ior : gpu::kDefaultIor;
   gpu::MaterialParams p;
   p.baseColor = glm::vec4(glm::clamp(glm::vec3(base), 0.f, 1.f), base.a);
-  p.emission = glm::vec4(decodeEmission(m, texel), occlusion);
+  p.emission = glm::vec4(0.f, 0.f, 0.f, 1.f);
   p.surface = glm::vec4(std::clamp(metallic, 0.f, 1.f), std::clamp(roughness, 0.f, 1.f),
                         std::clamp(transmission, 0.f, 1.f), ior);
+  return p;
+}
+
+// The whole material at a point (decodeMaterial() of material.glsl): the BSDF inputs, the emission and
+// the occlusion = 1 + strength (texel.r - 1) (glTF 3.9.3).
+template <class Texel>
+gpu::MaterialParams decodeMaterial(const Material& m, Texel&& texel) {
+  gpu::MaterialParams p = decodeBsdfInputs(m, texel);
+  float occlusion = 1.f;
+  if (m.occlusionTexture.valid()) occlusion = 1.f + m.occlusionTexture.scale * (texel(m.occlusionTexture, false).r - 1.f);
+  p.emission = glm::vec4(decodeEmission(m, texel), occlusion);
   return p;
 }
 
