@@ -4,7 +4,9 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <stdexcept>
 
+#include "api/Aovs.h"
 #include "api/Validate.h"
 #include "renderer/frame/FramePlanner.h"
 #include "renderer/frame/FrameResources.h"
@@ -23,16 +25,15 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
 
-// How an AOV is read back: which resource, which channels.
+// How an AOV is read back: which resource, which channels (the AOV table, api/Aovs.cpp).
 struct AovSource {
   std::string texture;
   int firstChannel, channels;
 };
 AovSource aovSource(const std::string& aov) {
-  if (aov == "depth") return {"gbuffer_position", 3, 1};  // linear view depth, 0 where no surface
-  if (aov == "ao") return {"ao", 0, 1};
-  if (aov == "reference") return {"reference", 0, 3};
-  return {aov, 0, 3};
+  const api::AovInfo* a = api::findAov(aov);
+  if (!a) throw std::logic_error("Renderer: AOV '" + aov + "' is not in the AOV table (api/Aovs.cpp)");
+  return {a->resource, a->firstChannel, a->channels};
 }
 
 // Replaces NaN and Inf by 0 and counts them: output is never NaN or Inf, and the stats say if a pass
@@ -61,8 +62,21 @@ void compare(FrameResources& resources, const Scene& scene, const FrameView& vie
   if (target) {
     reference = *target;
   } else {
+    // The ground truth of the AOV (the AOV table): a reference mode, or none, which is an error rather
+    // than a score against something else (the specular AOV used to be scored against full beauty).
+    const api::AovInfo* info = api::findAov(c.aov);
+    if (!info || info->groundTruth.empty()) {
+      std::string have;
+      for (const api::AovInfo& a : api::aovTable())
+        if (!a.groundTruth.empty()) have += (have.empty() ? "" : ", ") + a.name;
+      throw api::ApiError(422, "invalid-compare", "No ground truth",
+                          "the reference renderer has no ground truth for the AOV '" + c.aov +
+                              "' (AOVs with one: " + have + "); compare it against an uploaded image instead",
+                          "/compare/aov");
+    }
     ReferenceRequest r;
-    r.aov = c.aov;
+    r.aov = info->groundTruth;
+    m["reference_mode"] = r.aov;
     r.spp = c.spp;
     r.maxBounces = c.maxBounces;
     if (c.aov == "ao") {
@@ -209,10 +223,15 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
       Technique* t = plan.passes[i];
       gl::DebugGroup group(t->info().name);
       PassContext ctx{scene, gpu, view, params[i], im.resources, im.shaders, stats.passes[i]};
+      im.resources.beginPass();
       {
         GpuProfiler::Scope scope(im.profiler, stats.passes[i]);
         t->execute(ctx);
       }
+      // A pass writes only what it declares (its outputs; beauty if it adds to it): programmer error.
+      if (const std::string bad = undeclaredWrite(t->info(), im.resources.passWrites()); !bad.empty())
+        throw std::logic_error("Renderer: pass " + t->info().name + " wrote '" + bad +
+                               "', which its TechniqueInfo does not declare");
       gl::checkError(("execute " + t->info().name).c_str());
     }
 

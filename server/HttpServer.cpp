@@ -12,6 +12,7 @@
 #include <httplib.h>
 #include <nlohmann/json.hpp>
 
+#include "api/Aovs.h"
 #include "api/Sha256.h"
 #include "api/Validate.h"
 #include "server/FrameStore.h"
@@ -440,6 +441,7 @@ struct HttpServer::Impl {
                 {"device", device ? deviceJson(*device) : json(nullptr)},
                 {"limits", limitsJson()},
                 {"techniques", techniquesJson()},
+                {"aovs", api::aovTableJson()},
                 {"request_schema", api::renderRequestSchema()}});
     }));
 

@@ -3,9 +3,24 @@
 #include <algorithm>
 #include <set>
 
+#include "api/Aovs.h"
+
 namespace radiant {
 
-bool isFrameAov(const std::string& aov) { return aov == "beauty"; }
+// Accumulate AOVs (beauty) exist in every frame: passes add into them, none owns them (api/Aovs.cpp).
+bool isFrameAov(const std::string& aov) {
+  const api::AovInfo* a = api::findAov(aov);
+  return a && a->blend == api::AovBlend::Accumulate;
+}
+
+std::string undeclaredWrite(const TechniqueInfo& info, const std::set<std::string>& written) {
+  for (const std::string& name : written) {
+    if (std::find(info.outputs.begin(), info.outputs.end(), name) != info.outputs.end()) continue;
+    if (info.addsToBeauty && isFrameAov(name)) continue;
+    return name;
+  }
+  return {};
+}
 
 FramePlan planFrame(const std::vector<Technique*>& techniques, const Scene& scene,
                     const api::RenderRequest& request) {
@@ -20,13 +35,13 @@ FramePlan planFrame(const std::vector<Technique*>& techniques, const Scene& scen
   for (std::size_t i = 0; i < request.outputs.size(); ++i)
     for (std::size_t k = 0; k < request.outputs[i].aovs.size(); ++k) {
       const std::string& aov = request.outputs[i].aovs[k];
-      if (!isFrameAov(aov) && !producerOf.count(aov))
+      if (!api::findAov(aov) || (!isFrameAov(aov) && !producerOf.count(aov)))
         throw api::ApiError(422, "unknown-aov", "Unknown AOV",
                             "no technique produces the AOV '" + aov + "'",
                             "/outputs/" + std::to_string(i) + "/aovs/" + std::to_string(k));
       wantedOutputs.insert(aov);
     }
-  if (request.compare) wantedOutputs.insert(request.compare->aov == "beauty" ? "beauty" : request.compare->aov);
+  if (request.compare) wantedOutputs.insert(request.compare->aov);
   const bool beautyWanted = true;  // every frame has a beauty image
 
   std::set<Technique*> wanted;

@@ -5,6 +5,7 @@
 // requirements() says skip is dropped with its reason; a pass whose required input has no producer is
 // dropped with "needs <input>, which <producer> did not produce: <reason>".
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -19,8 +20,13 @@ struct FramePlan {
   std::map<std::string, std::string> lightPaths;  // light-path class -> the technique that owns it
 };
 
-// AOVs that are not a technique's output but exist in every frame.
+// AOVs that are not a technique's output but exist in every frame (the AOV table's accumulate AOVs).
 bool isFrameAov(const std::string& aov);
+
+// The first of `written` (what a pass marked written) that its info does not declare: neither one of
+// its outputs nor, when it addsToBeauty, an accumulate AOV. "" when every write is declared. The
+// Renderer fails the frame with std::logic_error on one.
+std::string undeclaredWrite(const TechniqueInfo& info, const std::set<std::string>& written);
 
 // `techniques` is in the canonical execution order (renderer/techniques/Registry.cpp).
 // Throws api::ApiError (422) for a requested pass or AOV that no technique knows.

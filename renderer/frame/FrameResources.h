@@ -33,7 +33,9 @@ public:
   const FrameView& view() const { return *view_; }
   gl::ShaderLibrary& shaders() { return shaders_; }
 
-  // Declare-or-reuse a texture. Re-declaring with a different spec reallocates.
+  // Declare-or-reuse a texture. Re-declaring with a different spec in a later frame reallocates; within
+  // one frame it throws std::logic_error (it would drop what earlier passes wrote, e.g. accumulated
+  // beauty), and so does declaring an AOV's resource in another format than the AOV table's.
   gl::Texture& texture(const std::string& name, GLenum target, GLenum internalFormat, int width,
                        int height, int depth = 1, int levels = 1);
   // An already declared texture; throws std::logic_error naming it otherwise.
@@ -52,8 +54,15 @@ public:
   }
 
   // Outputs written this frame (the planner and readback consult it).
-  void markWritten(const std::string& name) { written_.insert(name); }
+  void markWritten(const std::string& name) {
+    written_.insert(name);
+    passWrites_.insert(name);
+  }
   bool written(const std::string& name) const { return written_.count(name) != 0; }
+  // What the current pass marked written (the Renderer calls beginPass() before each execute() and
+  // checks these against the pass's declared outputs).
+  void beginPass() { passWrites_.clear(); }
+  const std::set<std::string>& passWrites() const { return passWrites_; }
 
   // Cached derived data: returns the entry under `key` if it was built from `inputsDigest`, else
   // builds it with `build` and stores it. Logs "key" as a hit or a miss.
@@ -92,6 +101,8 @@ private:
   std::map<std::string, Entry> cache_;
   std::set<std::string> written_;
   std::map<std::string, std::string> lightPaths_;
+  std::set<std::string> declaredThisFrame_;
+  std::set<std::string> passWrites_;
 };
 
 }  // namespace radiant

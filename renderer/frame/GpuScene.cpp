@@ -5,7 +5,6 @@
 #include <string>
 
 namespace radiant {
-namespace {
 
 gpu::Light toGpuLight(const Light& l) {
   gpu::Light g{};
@@ -19,6 +18,22 @@ gpu::Light toGpuLight(const Light& l) {
   g.spotCone = glm::vec4(std::cos(l.outerConeAngle), std::cos(l.innerConeAngle), 0.f, 0.f);
   return g;
 }
+
+gpu::Material toGpuMaterial(const Material& m) {
+  gpu::Material g{};
+  g.baseColorFactor = m.baseColorFactor;
+  g.emission = glm::vec4(m.emission(), 0.f);
+  g.metallicRoughness = glm::vec4(m.metallicFactor, m.roughnessFactor, m.transmissionFactor, m.ior);
+  g.scales = glm::vec4(m.normalTexture.scale, m.occlusionTexture.scale, m.alphaCutoff,
+                       static_cast<float>(static_cast<int>(m.alphaMode)));
+  auto uvSet = [](const TextureRef& r) { return r.valid() ? r.texCoord : -1; };
+  g.texturesA = glm::ivec4(uvSet(m.baseColorTexture), uvSet(m.metallicRoughnessTexture), uvSet(m.normalTexture),
+                           uvSet(m.occlusionTexture));
+  g.texturesB = glm::ivec4(uvSet(m.emissiveTexture), m.doubleSided ? 1 : 0, uvSet(m.transmissionTexture), 0);
+  return g;
+}
+
+namespace {
 
 template <class T>
 gl::Buffer makeBuffer(const std::string& label, const std::vector<T>& data) {
@@ -62,22 +77,9 @@ GpuScene::GpuScene(const Scene& scene) : sceneKey(nextSceneKey(scene)) {
   };
 
   std::vector<gpu::Material> mats;
-  auto addMaterial = [&](const Material& m) {
-    gpu::Material g{};
-    g.baseColorFactor = m.baseColorFactor;
-    g.emission = glm::vec4(m.emission(), 0.f);
-    g.metallicRoughness = glm::vec4(m.metallicFactor, m.roughnessFactor, m.transmissionFactor, m.ior);
-    g.scales = glm::vec4(m.normalTexture.scale, m.occlusionTexture.scale, m.alphaCutoff,
-                         static_cast<float>(static_cast<int>(m.alphaMode)));
-    auto uvSet = [](const TextureRef& r) { return r.valid() ? r.texCoord : -1; };
-    g.texturesA = glm::ivec4(uvSet(m.baseColorTexture), uvSet(m.metallicRoughnessTexture),
-                             uvSet(m.normalTexture), uvSet(m.occlusionTexture));
-    g.texturesB = glm::ivec4(uvSet(m.emissiveTexture), m.doubleSided ? 1 : 0, 0, 0);
-    mats.push_back(g);
-  };
-  for (const Material& m : scene.materials) addMaterial(m);
+  for (const Material& m : scene.materials) mats.push_back(toGpuMaterial(m));
   const int defaultMaterial = static_cast<int>(mats.size());
-  addMaterial(Material{});
+  mats.push_back(toGpuMaterial(Material{}));
   materials = makeBuffer("materials", mats);
 
   for (const MeshInstance& mi : scene.meshes) {
@@ -113,6 +115,7 @@ GpuScene::GpuScene(const Scene& scene) : sceneKey(nextSceneKey(scene)) {
     g.textures[gpu::kSlotNormal] = gpuTexture(m.normalTexture, false);
     g.textures[gpu::kSlotOcclusion] = gpuTexture(m.occlusionTexture, false);
     g.textures[gpu::kSlotEmissive] = gpuTexture(m.emissiveTexture, true);
+    g.textures[gpu::kSlotTransmission] = gpuTexture(m.transmissionTexture, false);
     triangles += mi.triangleCount();
     meshes.push_back(std::move(g));
   }
@@ -121,6 +124,12 @@ GpuScene::GpuScene(const Scene& scene) : sceneKey(nextSceneKey(scene)) {
   if (lightData.empty()) lightData.push_back(gpu::Light{});  // a zero-size SSBO is not bindable
   lights = gl::Buffer("lights", lightData.size() * sizeof(gpu::Light), lightData.data(), 0);
   gl::checkError("GpuScene upload");
+}
+
+void GpuScene::bindMaterialTextures(std::size_t meshIndex) const {
+  const GpuMesh& m = meshes[meshIndex];
+  for (int s = 0; s < gpu::kSlotCount; ++s)
+    if (m.textures[s] >= 0) textures[m.textures[s]].bindUnit(gpu::kUnitMaterial0 + s);
 }
 
 void GpuScene::draw(const gl::Program& program, bool withTextures) const {
@@ -135,10 +144,7 @@ void GpuScene::drawMeshes(const gl::Program& program, bool withTextures,
     if (!select(i)) continue;
     const GpuMesh& m = meshes[i];
     if (materialLoc >= 0) glProgramUniform1i(program.id(), materialLoc, m.material);
-    if (withTextures) {
-      for (int s = 0; s < gpu::kSlotCount; ++s)
-        if (m.textures[s] >= 0) textures[m.textures[s]].bindUnit(gpu::kMaterialTextureUnit0 + s);
-    }
+    if (withTextures) bindMaterialTextures(i);
     m.vao.bind();
     glDrawElements(GL_TRIANGLES, m.indexCount, GL_UNSIGNED_INT, nullptr);
   }

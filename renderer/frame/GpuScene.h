@@ -18,8 +18,18 @@ struct GpuMesh {
   gl::VertexArray vao;
   GLsizei indexCount = 0;
   int material = -1;  // index into the materials buffer (the default material is appended last)
-  std::array<int, gpu::kSlotCount> textures{-1, -1, -1, -1, -1};  // index into GpuScene::textures
+  std::array<int, gpu::kSlotCount> textures = noTextures();  // index into GpuScene::textures, -1 = none
+  static std::array<int, gpu::kSlotCount> noTextures() {
+    std::array<int, gpu::kSlotCount> t;
+    t.fill(-1);
+    return t;
+  }
 };
+
+// The std430 records of a scene light and material (shaders/common/shared.h). Exposed so the GPU/CPU
+// parity test feeds the GPU exactly what a render does.
+gpu::Light toGpuLight(const Light& light);
+gpu::Material toGpuMaterial(const Material& material);
 
 class GpuScene {
 public:
@@ -35,8 +45,11 @@ public:
   std::vector<gpu::Light> lightData;  // CPU copy of `lights` (at least one entry: zero-size SSBOs are invalid)
   std::size_t triangles = 0;
 
-  static constexpr GLuint kMaterialBinding = 0;
-  static constexpr GLuint kLightBinding = 1;
+  static constexpr GLuint kMaterialBinding = gpu::kBindingMaterials;
+  static constexpr GLuint kLightBinding = gpu::kBindingLights;
+
+  // Binds mesh `meshIndex`'s material textures to units kUnitMaterial0 + slot (what draw() does per mesh).
+  void bindMaterialTextures(std::size_t meshIndex) const;
 
   // Binds the materials buffer and, per draw, the mesh's textures; issues one draw per mesh.
   // The program must declare `uniform int u_material;`.

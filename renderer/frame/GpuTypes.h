@@ -1,41 +1,29 @@
 #pragma once
-// Structs shared by C++ and GLSL (shaders/common/scene.glsl mirrors them). std430 layout: every
-// member is a vec4/mat4 or packed into one, so C++ and GLSL agree without padding rules.
+// The C++ reading of shaders/common/shared.h, the one definition of the structs and constants C++ and
+// GLSL share (std430: every member is a vec4/ivec4/mat4, so the two layouts agree without padding
+// rules). The static_asserts below pin the layout GLSL sees.
+#include <cstddef>
+
 #include <glm/glm.hpp>
 
 namespace radiant::gpu {
 
-enum : int { kLightDirectional = 0, kLightPoint = 1, kLightSpot = 2 };
-// Texture slots bound per draw (units kMaterialTextureUnit0 + slot).
-enum : int { kSlotBaseColor = 0, kSlotMetallicRoughness, kSlotNormal, kSlotOcclusion, kSlotEmissive, kSlotCount };
-constexpr int kMaterialTextureUnit0 = 8;
+using vec4 = glm::vec4;
+using ivec4 = glm::ivec4;
+using mat4 = glm::mat4;
+#include "shaders/common/shared.h"
 
-struct Material {
-  glm::vec4 baseColorFactor;
-  glm::vec4 emission;           // rgb = emissiveFactor * emissiveStrength
-  glm::vec4 metallicRoughness;  // x metallic, y roughness, z transmission, w ior
-  glm::vec4 scales;             // x normal scale, y occlusion strength, z alpha cutoff, w alpha mode (0 opaque, 1 mask, 2 blend)
-  glm::ivec4 texturesA;         // texCoord index per slot (base, mr, normal, occlusion) or -1 when absent
-  glm::ivec4 texturesB;         // x emissive texCoord or -1, y doubleSided, zw unused
-};
-static_assert(sizeof(Material) == 96, "std430 Material must be 96 bytes");
-
-struct Light {
-  glm::vec4 positionType;    // xyz world position, w type
-  glm::vec4 directionRange;  // xyz direction light travels (unit), w range (0 = infinite)
-  glm::vec4 radiantIntensity;  // rgb = color * intensity, w unused
-  glm::vec4 spotCone;        // x cos(outer), y cos(inner), zw unused
-};
 static_assert(sizeof(Light) == 64, "std430 Light must be 64 bytes");
-
-// Written by the shadow_maps pass, one per light (same index as Light).
-enum : int { kShadowNone = 0, kShadowCube = 1, kShadow2D = 2 };
-struct ShadowInfo {
-  glm::mat4 viewProj;  // 2D maps: world -> light clip (x,y in [-1,1], z unused: maps store distance)
-  glm::vec4 params;    // x kind, y layer in its array, z world size of one texel at unit distance
-                       // (perspective) or absolute (orthographic), w normal-offset bias in texels
-  glm::vec4 params2;   // x orthographic (1) or perspective (0), y constant bias in texels, zw unused
-};
 static_assert(sizeof(ShadowInfo) == 96, "std430 ShadowInfo must be 96 bytes");
+static_assert(sizeof(Material) == 96, "std430 Material must be 96 bytes");
+static_assert(offsetof(Material, texturesA) == 64 && offsetof(Material, texturesB) == 80,
+              "std430 Material: texture slots follow the four factor vec4s");
+static_assert(sizeof(MaterialParams) == 48, "std430 MaterialParams must be 48 bytes");
+static_assert(offsetof(MaterialParams, emission) == 16 && offsetof(MaterialParams, surface) == 32,
+              "std430 MaterialParams: baseColor, emission, surface");
+static_assert(kUnitMaterial0 + kSlotCount <= kUnitEnvironment, "material texture units overlap the environment");
+static_assert(kUnitShadow2D < kUnitMaterial0, "shadow units overlap the material units");
+// Kept for existing callers: the first material texture unit.
+inline constexpr int kMaterialTextureUnit0 = kUnitMaterial0;
 
 }  // namespace radiant::gpu

@@ -10,6 +10,8 @@
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
+#include "api/Aovs.h"
+
 namespace radiant::io {
 namespace OIIO = OIIO_NAMESPACE;
 
@@ -35,8 +37,11 @@ std::string writeToMemory(const char* nameHint, const OIIO::ImageSpec& spec, OII
   return std::string(bytes.begin(), bytes.end());
 }
 
-// EXR channel names of one AOV: beauty is the default layer (R,G,B) so viewers show it first.
+// EXR channel names of one AOV: the AOV table's (api/Aovs.cpp; beauty is the default layer R,G,B so
+// viewers show it first). An image the table does not name (an upload) gets "<name>.R/G/B/A" or ".Y".
 std::vector<std::string> channelNames(const Image& img) {
+  if (const api::AovInfo* a = api::findAov(img.aov); a && static_cast<int>(a->exr.size()) == img.channels)
+    return a->exr;
   static const char* rgb[] = {"R", "G", "B", "A"};
   std::vector<std::string> names;
   const std::string prefix = img.aov == "beauty" ? "" : img.aov + ".";

@@ -26,17 +26,20 @@
 // Roughness: roughness == 0 makes the specular lobes Dirac deltas (perfect mirror / smooth dielectric,
 // the alpha -> 0 limit of the microfacet lobes, whose albedo tends to F(n.v)). Any roughness > 0 uses
 // alpha = max(roughness^2, kMinAlpha) with kMinAlpha = 1e-3, so D stays finite in float
-// (D_max = 1 / (pi alpha^2) ~ 3e5) and nothing produces NaN.
+// (D_max = 1 / (pi alpha^2) ~ 3e5) and nothing produces NaN. kMinAlpha is gpu::kMinGgxAlpha, the one
+// constant GLSL's brdf.glsl reads too (shaders/common/shared.h).
 #include <algorithm>
 #include <cmath>
 
 #include <glm/glm.hpp>
 
+#include "renderer/frame/GpuTypes.h"
+
 namespace radiant::rt {
 
 inline constexpr float kPi = 3.14159265358979323846f;
 inline constexpr float kInvPi = 1.f / kPi;
-inline constexpr float kMinAlpha = 1e-3f;
+inline constexpr float kMinAlpha = gpu::kMinGgxAlpha;
 
 inline float luminance(const glm::vec3& c) { return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b; }
 inline float maxComponent(const glm::vec3& c) { return std::max(c.r, std::max(c.g, c.b)); }

@@ -8,6 +8,8 @@
 
 #include <embree3/rtcore.h>
 
+#include "renderer/scene/MaterialDecode.h"
+
 namespace radiant::rt {
 namespace {
 
@@ -164,7 +166,7 @@ glm::vec3 RayScene::emissionAt(const SurfaceHit& h, const glm::vec3& dir) const 
   const Material& mat = materialOf(h.mesh);
   if (!mat.isEmissive()) return glm::vec3(0.f);
   if (!mat.doubleSided && glm::dot(dir, h.ng) >= 0.f) return glm::vec3(0.f);
-  return mat.emission() * glm::vec3(textureAt(mat.emissiveTexture, h, true));
+  return decodeEmission(mat, [&](const TextureRef& ref, bool srgb) { return textureAt(ref, h, srgb); });
 }
 
 SurfaceHit RayScene::makeHit(int mesh, int prim, float u, float v, const glm::vec3& origin) const {
@@ -229,7 +231,7 @@ bool RayScene::intersect(Ray ray, SurfaceHit& hit, Sampler& sampler, RayCounter&
 bool RayScene::passesThrough(const SurfaceHit& hit, Sampler& sampler) const {
   const Material& mat = materialOf(hit.mesh);
   if (mat.alphaMode == AlphaMode::Opaque) return false;
-  const float a = mat.baseColorFactor.a * textureAt(mat.baseColorTexture, hit, true).a;
+  const float a = decodeBaseColor(mat, [&](const TextureRef& ref, bool srgb) { return textureAt(ref, hit, srgb); }).a;
   if (mat.alphaMode == AlphaMode::Mask) return a < mat.alphaCutoff;
   return sampler.next() >= a;  // Blend: stochastic coverage
 }
@@ -258,17 +260,15 @@ Shading RayScene::shade(const SurfaceHit& hit, const glm::vec3& wo, TransportMod
   const Material& mat = materialOf(hit.mesh);
   const MeshInstance& m = scene_->meshes[hit.mesh];
   Shading s;
-  const glm::vec4 base = mat.baseColorFactor * textureAt(mat.baseColorTexture, hit, true);
-  s.bsdf.baseColor = glm::clamp(glm::vec3(base), 0.f, 1.f);
-  const glm::vec4 mr = textureAt(mat.metallicRoughnessTexture, hit, false);
-  s.bsdf.metallic = std::clamp(mat.metallicFactor * mr.b, 0.f, 1.f);
-  s.bsdf.roughness = std::clamp(mat.roughnessFactor * mr.g, 0.f, 1.f);
-  s.bsdf.transmission =
-      std::clamp(mat.transmissionFactor * (mat.transmissionTexture.valid()
-                                               ? textureAt(mat.transmissionTexture, hit, false).r : 1.f),
-                 0.f, 1.f);
+  // Factors x textures: the one C++ decoder (renderer/scene/MaterialDecode.h, twin of material.glsl).
+  const gpu::MaterialParams params =
+      decodeBsdfInputs(mat, [&](const TextureRef& ref, bool srgb) { return textureAt(ref, hit, srgb); });
+  s.bsdf.baseColor = glm::vec3(params.baseColor);
+  s.bsdf.metallic = params.surface.x;
+  s.bsdf.roughness = params.surface.y;
+  s.bsdf.transmission = params.surface.z;
   s.bsdf.mode = mode;
-  s.bsdf.ior = mat.ior > 0.f ? mat.ior : 1.5f;
+  s.bsdf.ior = params.surface.w;
   const bool front = glm::dot(wo, hit.ng) >= 0.f;
   s.bsdf.eta = front ? s.bsdf.ior : 1.f / s.bsdf.ior;
   s.ngFacing = front ? hit.ng : -hit.ng;

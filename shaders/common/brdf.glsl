@@ -1,15 +1,24 @@
-// The glTF 2.0 metallic-roughness BRDF, spec Appendix B, with KHR_materials_ior (dielectric F0 from
-// ior) and KHR_materials_transmission (the diffuse lobe is replaced by transmission, which a punctual
-// light cannot reach through a smooth surface, so it contributes nothing to direct light).
-// The CPU reference (renderer/reference/Brdf.h) implements the same equations.
+// The glTF 2.0 metallic-roughness BSDF, spec Appendix B, with KHR_materials_ior (dielectric F0 from
+// ior) and KHR_materials_transmission, evaluated as f(wo, wi) |cos(theta_i)| for a light direction.
+// It is the GLSL twin of rt::GltfBsdf::eval (renderer/raytracing/Bsdf.h), term for term, in radiance
+// mode; tests/gl/materials/parity_test.cpp holds the two to float tolerance on random inputs:
+//   diffuse      (1 - metallic)(1 - transmission)(1 - F_schlick(f0_ior, v.h)) baseColor / pi
+//   specular     D V [metallic F_schlick(baseColor, v.h) + (1 - metallic)(1 - transmission) F_schlick(f0_ior, v.h)
+//                     + (1 - metallic) transmission F_exact(v.h, eta)]
+//   transmission (wi below the surface) Walter et al. 2007 eq. 21, tinted by baseColor, / eta^2
+// where the reflection off the transmissive part uses the exact unpolarised Fresnel factor (as the
+// reference, which models a transmissive surface as the interface of a solid of index ior).
+// Roughness 0 makes the specular and transmission lobes Dirac deltas: they carry no value towards a
+// light direction (a punctual light seen in a perfect mirror has zero measure), only the diffuse
+// lobe remains. Otherwise alpha = max(roughness^2, kMinGgxAlpha) (common/shared.h).
 #ifndef RADIANT_COMMON_BRDF
 #define RADIANT_COMMON_BRDF
 #include "common/constants.glsl"
+#include "common/shared.h"
 
-// alpha = roughness^2, clamped so a roughness-0 surface stays finite under a punctual light.
-const float MIN_ALPHA = 2e-3;
-
+// glTF Appendix B: D = alpha^2 chi+(n.h) / (pi ((n.h)^2 (alpha^2 - 1) + 1)^2).
 float ggxD(float NdotH, float alpha) {
+  if (NdotH <= 0.0) return 0.0;
   float a2 = alpha * alpha;
   float d = NdotH * NdotH * (a2 - 1.0) + 1.0;
   return a2 / (PI * d * d);
@@ -17,6 +26,7 @@ float ggxD(float NdotH, float alpha) {
 
 // Height-correlated Smith visibility V = G / (4 NdotL NdotV) (spec Appendix B, "Specular BRDF").
 float smithVisibility(float NdotL, float NdotV, float alpha) {
+  if (NdotL <= 0.0 || NdotV <= 0.0) return 0.0;
   float a2 = alpha * alpha;
   float gv = NdotL * sqrt(NdotV * NdotV * (1.0 - a2) + a2);
   float gl = NdotV * sqrt(NdotL * NdotL * (1.0 - a2) + a2);
@@ -24,31 +34,95 @@ float smithVisibility(float NdotL, float NdotV, float alpha) {
   return s > 0.0 ? 0.5 / s : 0.0;
 }
 
-vec3 schlickFresnel(vec3 f0, float VdotH) {
-  float m = clamp(1.0 - VdotH, 0.0, 1.0);
-  float m2 = m * m;
-  return f0 + (1.0 - f0) * (m2 * m2 * m);
+// Smith Lambda for GGX (Heitz 2014, eq. 72) and the height-correlated G2 (eq. 99).
+float ggxLambda(float cosTheta, float alpha) {
+  float c2 = cosTheta * cosTheta;
+  if (c2 <= 0.0) return 1e30;
+  float tan2 = max(0.0, 1.0 - c2) / c2;
+  return 0.5 * (-1.0 + sqrt(1.0 + alpha * alpha * tan2));
+}
+float smithG2HeightCorrelated(float cosO, float cosI, float alpha) {
+  return 1.0 / (1.0 + ggxLambda(abs(cosO), alpha) + ggxLambda(abs(cosI), alpha));
 }
 
-// f(wi, wo) * cos(theta_i) for the glTF material. n, wo, wi unit vectors.
-vec3 gltfBrdfCos(vec3 n, vec3 wo, vec3 wi, vec3 baseColor, float metallic, float roughness,
-                 float transmission, float ior) {
-  float NdotL = dot(n, wi);
-  float NdotV = dot(n, wo);
-  if (NdotL <= 0.0 || NdotV <= 0.0) return vec3(0.0);
-  vec3 h = normalize(wi + wo);
-  float NdotH = max(dot(n, h), 0.0);
-  float VdotH = max(dot(wo, h), 0.0);
-  float alpha = max(roughness * roughness, MIN_ALPHA);
-  float specular = ggxD(NdotH, alpha) * smithVisibility(NdotL, NdotV, alpha);
+float schlickWeight(float cosTheta) {
+  float m = clamp(1.0 - abs(cosTheta), 0.0, 1.0);
+  float m2 = m * m;
+  return m2 * m2 * m;
+}
+vec3 schlickFresnel(vec3 f0, float cosTheta) { return f0 + (1.0 - f0) * schlickWeight(cosTheta); }
+float schlickFresnel(float f0, float cosTheta) { return f0 + (1.0 - f0) * schlickWeight(cosTheta); }
+float f0FromIor(float ior) {
   float r = (ior - 1.0) / (ior + 1.0);
-  float f0Dielectric = r * r;
-  // fresnel_mix(ior, base, layer) = mix(base, layer, F_schlick(f0(ior), VdotH))
-  float fd = schlickFresnel(vec3(f0Dielectric), VdotH).x;
-  vec3 diffuse = baseColor * INV_PI * (1.0 - transmission);
-  vec3 dielectric = mix(diffuse, vec3(specular), fd);
-  // conductor_fresnel(f0 = baseColor, bsdf = specular)
-  vec3 metal = specular * schlickFresnel(baseColor, VdotH);
-  return mix(dielectric, metal, metallic) * NdotL;
+  return r * r;
+}
+
+// Exact unpolarised Fresnel reflectance, eta = n_t / n_i, cos_i >= 0; 1 under total internal reflection.
+float fresnelDielectric(float cosThetaI, float eta) {
+  cosThetaI = clamp(cosThetaI, 0.0, 1.0);
+  float sin2T = (1.0 - cosThetaI * cosThetaI) / (eta * eta);
+  if (sin2T >= 1.0) return 1.0;
+  float cosT = sqrt(max(0.0, 1.0 - sin2T));
+  float rs = (cosThetaI - eta * cosT) / (cosThetaI + eta * cosT);
+  float rp = (eta * cosThetaI - cosT) / (eta * cosThetaI + cosT);
+  return 0.5 * (rs * rs + rp * rp);
+}
+
+// f(wo, wi) |n.wi| for the decoded material p. n, wo, wi unit vectors, wo on n's side; wi below the
+// surface is transmission. eta = n_(far side) / n_(wo side): ior seen from outside, 1 / ior inside.
+vec3 gltfBsdfCos(vec3 n, vec3 wo, vec3 wi, MaterialParams p, float eta) {
+  float NdotV = dot(n, wo);
+  float NdotL = dot(n, wi);
+  if (NdotV <= 0.0 || NdotL == 0.0) return vec3(0.0);
+  vec3 base = p.baseColor.rgb;
+  float m = p.surface.x, roughness = p.surface.y, t = p.surface.z, ior = p.surface.w;
+  bool delta = roughness <= 0.0;
+  float alpha = max(roughness * roughness, kMinGgxAlpha);
+  if (NdotL > 0.0) {
+    vec3 h = normalize(wo + wi);
+    float VdotH = dot(wo, h);
+    float fd = schlickFresnel(f0FromIor(ior), VdotH);
+    // fresnel_mix: the diffuse lobe weighted by (1 - F_dielectric), Lambert c_diff / pi.
+    vec3 f = (1.0 - m) * (1.0 - t) * (1.0 - fd) * base * INV_PI;
+    if (!delta) {
+      float dv = ggxD(dot(n, h), alpha) * smithVisibility(NdotL, NdotV, alpha);
+      vec3 fresnel = m * schlickFresnel(base, VdotH) + vec3((1.0 - m) * (1.0 - t) * fd) +
+                     vec3((1.0 - m) * t * fresnelDielectric(VdotH, eta));
+      f += fresnel * dv;
+    }
+    return f * NdotL;
+  }
+  if (t <= 0.0 || delta) return vec3(0.0);
+  // Walter et al. 2007, eq. 21 with h = normalise(eta wi + wo) (eq. 16) and the height-correlated G2;
+  // radiance is compressed by 1 / eta^2 on refraction (Veach 1997, eq. 5.14).
+  vec3 h = eta * wi + wo;
+  if (dot(h, h) == 0.0) return vec3(0.0);
+  h = normalize(h);
+  if (dot(n, h) < 0.0) h = -h;
+  float woh = dot(wo, h), wih = dot(wi, h);
+  if (woh <= 0.0 || wih >= 0.0) return vec3(0.0);
+  float fe = fresnelDielectric(woh, eta);
+  float s = wih + woh / eta;
+  float denom = s * s * abs(NdotL) * NdotV;
+  float ft = (1.0 - fe) * ggxD(dot(n, h), alpha) * smithG2HeightCorrelated(NdotV, NdotL, alpha) *
+             abs(wih * woh) / denom / (eta * eta);
+  return (1.0 - m) * t * ft * base * abs(NdotL);
+}
+
+// The surface seen from outside (eta = ior), as every raster pass sees it.
+vec3 gltfBrdfCos(vec3 n, vec3 wo, vec3 wi, MaterialParams p) { return gltfBsdfCos(n, wo, wi, p, p.surface.w); }
+
+MaterialParams materialParams(vec3 baseColor, float metallic, float roughness, float transmission, float ior) {
+  MaterialParams p;
+  p.baseColor = vec4(baseColor, 1.0);
+  p.emission = vec4(0.0, 0.0, 0.0, 1.0);
+  p.surface = vec4(metallic, roughness, transmission, ior);
+  return p;
+}
+
+// The former positional signature, kept for callers not yet on MaterialParams.
+vec3 gltfBrdfCos(vec3 n, vec3 wo, vec3 wi, vec3 baseColor, float metallic, float roughness, float transmission,
+                 float ior) {
+  return gltfBrdfCos(n, wo, wi, materialParams(baseColor, metallic, roughness, transmission, ior));
 }
 #endif

@@ -6,8 +6,8 @@
 #include "common/brdf.glsl"
 #include "common/lights.glsl"
 
-layout(binding = 6) uniform samplerCubeArray t_shadowCube;
-layout(binding = 7) uniform sampler2DArray t_shadow2D;
+layout(binding = kUnitShadowCube) uniform samplerCubeArray t_shadowCube;
+layout(binding = kUnitShadow2D) uniform sampler2DArray t_shadow2D;
 uniform int u_lightCount;
 uniform int u_hasShadows;
 uniform int u_pcfRadius;
@@ -62,15 +62,19 @@ float shadowVisibility(int li, vec3 p, vec3 ng, float lightDist) {
 
 // Sum over lights of f(wi, wo) cos(theta_i) E_light V_shadow (no emission). n is the shading normal
 // (facing wo), ng the geometric normal on the same side (used for the shadow normal offset).
-vec3 directLighting(vec3 p, vec3 n, vec3 ng, vec3 wo, vec3 albedo, float metallic, float roughness,
-                    float transmission, float ior) {
+vec3 directLighting(vec3 p, vec3 n, vec3 ng, vec3 wo, MaterialParams material) {
   vec3 L = vec3(0.0);
   for (int i = 0; i < u_lightCount; ++i) {
     LightSample s = sampleLight(lights[i], p);
-    vec3 f = gltfBrdfCos(n, wo, s.wi, albedo, metallic, roughness, transmission, ior);
+    vec3 f = gltfBrdfCos(n, wo, s.wi, material);
     if (all(equal(f, vec3(0.0)))) continue;
     L += f * s.intensity * shadowVisibility(i, p, ng, s.dist);
   }
   return L;
+}
+// The former positional signature, kept for callers not yet on MaterialParams.
+vec3 directLighting(vec3 p, vec3 n, vec3 ng, vec3 wo, vec3 albedo, float metallic, float roughness,
+                    float transmission, float ior) {
+  return directLighting(p, n, ng, wo, materialParams(albedo, metallic, roughness, transmission, ior));
 }
 #endif

@@ -9,20 +9,22 @@
 // (radiant intensity * falloff / d^2; without the cosine).
 struct LightSample { vec3 wi; float dist; vec3 intensity; };
 
-// The spec's recommended range window: clamp(1 - (d/range)^4, 0, 1)^2, range 0 = infinite.
+// KHR_lights_punctual's recommended range window (README, "Range Property"):
+//   attenuation = max(min(1 - (d / range)^4, 1), 0) / d^2, range 0 = infinite.
+// Not squared (that is Karis 2013's window, not the spec's). The one GLSL definition; rt::rangeWindow
+// (renderer/raytracing/Lights.h) is the C++ one, and the parity test holds them equal.
 float rangeWindow(float d, float range) {
-  if (range <= 0.0) return 1.0;
+  if (!(range > 0.0)) return 1.0;
   float q = d / range;
-  float w = clamp(1.0 - q * q * q * q, 0.0, 1.0);
-  return w * w;
+  return clamp(1.0 - (q * q) * (q * q), 0.0, 1.0);
 }
 
-// The spec's smooth spot falloff between cos(outer) and cos(inner), squared.
+// The spec's smooth spot falloff between cos(outer) and cos(inner), squared (README, "Inner and
+// Outer Cone Angles"); rt::spotFalloff is the C++ twin.
 float spotFalloff(Light l, vec3 wi) {
   float cd = dot(l.directionRange.xyz, -wi);
-  float scale = 1.0 / max(1e-3, l.spotCone.y - l.spotCone.x);
-  float offset = -l.spotCone.x * scale;
-  float a = clamp(cd * scale + offset, 0.0, 1.0);
+  float scale = 1.0 / max(0.001, l.spotCone.y - l.spotCone.x);
+  float a = clamp(cd * scale - l.spotCone.x * scale, 0.0, 1.0);
   return a * a;
 }
 

@@ -1,38 +1,18 @@
-// Mirrors renderer/frame/GpuTypes.h (std430). Keep the two in step; the C++ side static_asserts sizes.
+// The scene buffers. Their records are defined once for GLSL and C++ in common/shared.h
+// (renderer/frame/GpuTypes.h static_asserts the C++ side).
 #ifndef RADIANT_COMMON_SCENE
 #define RADIANT_COMMON_SCENE
+#include "common/shared.h"
 
-#define LIGHT_DIRECTIONAL 0
-#define LIGHT_POINT 1
-#define LIGHT_SPOT 2
-#define SHADOW_NONE 0
-#define SHADOW_CUBE 1
-#define SHADOW_2D 2
+#define LIGHT_DIRECTIONAL kLightDirectional
+#define LIGHT_POINT kLightPoint
+#define LIGHT_SPOT kLightSpot
+#define SHADOW_NONE kShadowNone
+#define SHADOW_CUBE kShadowCube
+#define SHADOW_2D kShadow2D
 
-struct Material {
-  vec4 baseColorFactor;
-  vec4 emission;           // rgb = emissiveFactor * emissiveStrength
-  vec4 metallicRoughness;  // x metallic, y roughness, z transmission, w ior
-  vec4 scales;             // x normal scale, y occlusion strength, z alpha cutoff, w alpha mode
-  ivec4 texturesA;         // uv set per slot (base, mr, normal, occlusion), -1 = none
-  ivec4 texturesB;         // x emissive uv set, y doubleSided
-};
-
-struct Light {
-  vec4 positionType;
-  vec4 directionRange;
-  vec4 radiantIntensity;
-  vec4 spotCone;  // x cos(outer), y cos(inner)
-};
-
-struct ShadowInfo {
-  mat4 viewProj;
-  vec4 params;   // x kind, y layer, z texel world size (per unit distance if perspective), w normal offset (texels)
-  vec4 params2;  // x orthographic, y constant bias (texels)
-};
-
-layout(std430, binding = 0) readonly buffer Materials { Material materials[]; };
-layout(std430, binding = 1) readonly buffer Lights { Light lights[]; };
-layout(std430, binding = 2) readonly buffer Shadows { ShadowInfo shadows[]; };
+layout(std430, binding = kBindingMaterials) readonly buffer Materials { Material materials[]; };
+layout(std430, binding = kBindingLights) readonly buffer Lights { Light lights[]; };
+layout(std430, binding = kBindingShadows) readonly buffer Shadows { ShadowInfo shadows[]; };
 
 #endif

@@ -18,7 +18,7 @@ uniform int u_orthographic;
 uniform vec3 u_background;  // radiance seen where no surface is (the uniform sky)
 uniform int u_hasEnvironment;  // 1: the background is the environment map instead
 uniform mat4 u_invViewProj;
-layout(binding = 8) uniform sampler2D t_environment;
+layout(binding = kUnitEnvironment) uniform sampler2D t_environment;
 
 layout(location = 0) out vec4 o_direct;
 layout(location = 1) out vec4 o_beauty;
@@ -52,7 +52,7 @@ void main() {
   float nv = dot(n, wo);
   if (nv < 1e-3) n = normalize(n + wo * (1e-3 - nv));
 
-  vec3 L = emission + directLighting(p, n, ng, wo, albedo, mat.x, mat.y, mat.w, emissionIor.a);
+  vec3 L = emission + directLighting(p, n, ng, wo, materialParams(albedo, mat.x, mat.y, mat.w, emissionIor.a));
   o_direct = vec4(L, 1.0);
   o_beauty = o_direct;
 }

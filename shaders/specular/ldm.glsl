@@ -19,6 +19,7 @@
 //                  read with nearest texels: filtering normals or object indices is meaningless).
 #ifndef RADIANT_SPECULAR_LDM
 #define RADIANT_SPECULAR_LDM
+#include "common/shared.h"
 
 // Reflection/refraction data of a specular surface in the thesis' representation (5.2). Mixtures are
 // reduced to one of the two ideal cases: a refractor (any transmission) keeps its ior and its
@@ -46,9 +47,9 @@ vec3 octDecode(vec2 p) {
 const float kEmptyDistance = 3.0e38;
 
 #ifdef LDM_TRACING
-layout(binding = 13) uniform samplerCubeArray t_ldmMaterial;
-layout(binding = 14) uniform samplerCubeArray t_ldmGeometry;
-layout(binding = 15) uniform samplerCubeArray t_ldmDistance;  // linear filtering, see below
+layout(binding = kUnitLdmMaterial) uniform samplerCubeArray t_ldmMaterial;
+layout(binding = kUnitLdmGeometry) uniform samplerCubeArray t_ldmGeometry;
+layout(binding = kUnitLdmDistance) uniform samplerCubeArray t_ldmDistance;  // linear filtering, see below
 
 struct SpecularObject {
   vec4 referenceRadius;  // xyz reference point (world), w bounding radius of the object

@@ -3,6 +3,7 @@
 // reference point: emission plus direct lighting of the punctual lights with the shared
 // shadow-mapped code (common/direct_lighting.glsl).
 #include "common/direct_lighting.glsl"
+#include "common/material.glsl"
 #include "specular/ldm.glsl"
 
 in vec3 v_position;
@@ -16,24 +17,17 @@ uniform int u_faceMode;    // 0 front faces only, 1 back faces only, 2 both (as 
 uniform int u_peel;        // 1: keep only surfaces beyond the previous layer (depth peeling)
 uniform int u_objectCode;  // specular object index + 1 of this mesh, 0 = diffuse
 
-layout(binding = 8) uniform sampler2D t_baseColor;
-layout(binding = 9) uniform sampler2D t_metallicRoughness;
-layout(binding = 12) uniform sampler2D t_emissive;
-layout(binding = 13) uniform sampler2D t_peel;  // previous layer of this face (z = distance, 0 = empty)
+layout(binding = kUnitPeel) uniform sampler2D t_peel;  // previous layer of this face (z = distance, 0 = empty)
 
 layout(location = 0) out vec4 o_material;
 layout(location = 1) out vec4 o_geometry;
 layout(location = 2) out float o_distance;  // cleared to kEmptyDistance
 
-vec2 uvSet(int set) { return set == 1 ? v_uv1 : v_uv0; }
-
 void main() {
   if (u_faceMode == 0 && !gl_FrontFacing) discard;
   if (u_faceMode == 1 && gl_FrontFacing) discard;
   Material m = materials[u_material];
-  vec4 base = m.baseColorFactor;
-  if (m.texturesA.x >= 0) base *= texture(t_baseColor, uvSet(m.texturesA.x));
-  if (int(m.scales.w) == 1 && base.a < m.scales.z) discard;
+  if (materialMasked(m, decodeBaseColor(m, v_uv0, v_uv1).a)) discard;
 
   vec3 toP = v_position - u_reference;
   float dist = length(toP);
@@ -48,18 +42,9 @@ void main() {
   faceNormal = dot(faceNormal, faceNormal) > 1e-30 ? normalize(faceNormal) : vec3(0, 1, 0);
   vec3 n = dot(v_normal, v_normal) > 1e-30 ? normalize(v_normal) : faceNormal;
 
-  float metallic = m.metallicRoughness.x;
-  float roughness = m.metallicRoughness.y;
-  if (m.texturesA.y >= 0) {
-    vec4 mr = texture(t_metallicRoughness, uvSet(m.texturesA.y));
-    roughness *= mr.g;
-    metallic *= mr.b;
-  }
-  float transmission = m.metallicRoughness.z;
-  float ior = m.metallicRoughness.w;
-
+  MaterialParams p = decodeMaterial(m, v_uv0, v_uv1);
   if (u_objectCode > 0) {
-    o_material = specularTexel(base.rgb, clamp(metallic, 0.0, 1.0), transmission, ior);
+    o_material = specularTexel(p.baseColor.rgb, p.surface.x, p.surface.z, p.surface.w);
   } else {
     // Two-sided shading towards the viewer of the map, the reference point (view-dependent terms
     // are therefore evaluated for that viewer: the usual distance-map approximation).
@@ -68,13 +53,9 @@ void main() {
     vec3 ng = dot(faceNormal, wo) < 0.0 ? -faceNormal : faceNormal;
     float nv = dot(ns, wo);
     if (nv < 1e-3) ns = normalize(ns + wo * (1e-3 - nv));
-    vec3 emission = m.emission.rgb;
-    if (m.texturesB.x >= 0) emission *= texture(t_emissive, uvSet(m.texturesB.x)).rgb;
     // glTF emission leaves the front face only unless the material is double-sided (as the reference).
-    bool emits = gl_FrontFacing || m.texturesB.y != 0;
-    vec3 L = (emits ? emission : vec3(0.0)) +
-             directLighting(v_position, ns, ng, wo, base.rgb, clamp(metallic, 0.0, 1.0),
-                            clamp(roughness, 0.0, 1.0), transmission, ior);
+    bool emits = gl_FrontFacing || materialDoubleSided(m);
+    vec3 L = (emits ? p.emission.rgb : vec3(0.0)) + directLighting(v_position, ns, ng, wo, p);
     o_material = vec4(L, 0.0);
   }
   o_geometry = vec4(octEncode(n), max(dist, 1e-30), float(u_objectCode));

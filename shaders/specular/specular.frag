@@ -29,7 +29,7 @@ uniform vec3 u_viewForward;
 uniform int u_orthographic;
 uniform vec3 u_background;  // radiance where a ray leaves the scene (the sky), as `direct` uses
 uniform int u_hasEnvironment;  // 1: a ray leaving the scene sees the environment map instead
-layout(binding = 8) uniform sampler2D t_environment;
+layout(binding = kUnitEnvironment) uniform sampler2D t_environment;
 uniform int u_maxDepth;
 uniform float u_minWeight;  // branches whose path weight falls below this are dropped
 

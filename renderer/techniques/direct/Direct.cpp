@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "renderer/frame/GpuTypes.h"
 #include "renderer/frame/PassContext.h"
 #include "renderer/techniques/direct/DirectLighting.h"
 
@@ -16,7 +17,9 @@ const TechniqueInfo& DirectPass::info() const {
                                "Direct lighting from punctual lights (glTF BRDF, PCF shadow maps) plus emission",
                                {"gbuffer_position", "normal", "albedo", "material", "emission", "geometric_normal"},
                                {"shadow_maps"},
-                               {"direct"},
+                               // environment_map: the request's environment, uploaded here for every pass
+                               // that shows it (a frame resource, not an AOV).
+                               {"direct", "environment_map"},
                                true,
                                true,
                                {"LE", "L(point)DE"}};
@@ -82,7 +85,7 @@ void DirectPass::execute(PassContext& ctx) {
     // Rows in image order (row 0 = up): texel row v * height is image row v * height.
     environment.upload(0, 0, 0, 0, env.width, env.height, 1, GL_RGBA, GL_FLOAT, rgba.data());
   }
-  environment.bindUnit(8);
+  environment.bindUnit(gpu::kUnitEnvironment);
   prog.set("u_hasEnvironment", view.environment ? 1 : 0);
   prog.setMat4("u_invViewProj", &view.invViewProj[0][0]);
   prog.set("u_eye", &view.eye[0], 3);

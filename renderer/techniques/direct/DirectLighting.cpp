@@ -12,8 +12,8 @@ void declareDirectLightingResources(FrameResources& res) {
 
 void bindDirectLighting(const gl::Program& program, FrameResources& res, const GpuScene& gpu, int lightCount,
                         int pcfRadius) {
-  res.texture("shadow_cube").bindUnit(6);
-  res.texture("shadow_2d").bindUnit(7);
+  res.texture("shadow_cube").bindUnit(gpu::kUnitShadowCube);
+  res.texture("shadow_2d").bindUnit(gpu::kUnitShadow2D);
   gpu.materials.bindBase(GL_SHADER_STORAGE_BUFFER, GpuScene::kMaterialBinding);
   gpu.lights.bindBase(GL_SHADER_STORAGE_BUFFER, GpuScene::kLightBinding);
   res.buffer("shadow_info").bindBase(GL_SHADER_STORAGE_BUFFER, 2);

@@ -7,6 +7,7 @@
 #include <limits>
 #include <string>
 
+#include "renderer/frame/GpuTypes.h"
 #include "renderer/frame/PassContext.h"
 #include "renderer/techniques/direct/DirectLighting.h"
 #include "renderer/techniques/shadow_maps/ShadowMaps.h"
@@ -21,7 +22,7 @@ struct SpecularMapsCacheEntry {};  // the maps live in FrameResources; the entry
 // it keeps a glass object's 2^(max_depth+1) rays down to the few that matter.
 constexpr float kMinBranchWeight = 1e-3f;
 
-constexpr int kMapTextureUnitPeel = 13;
+constexpr int kMapTextureUnitPeel = gpu::kUnitPeel;
 constexpr float kEmptyDistance = 3.0e38f;  // shaders/specular/ldm.glsl
 
 }  // namespace
@@ -31,7 +32,7 @@ const TechniqueInfo& SpecularPass::info() const {
       "specular",
       "Multiple specular reflections and refractions traced in layered distance maps (thesis ch. 5)",
       {"gbuffer_position", "normal", "albedo", "material", "emission"},
-      {"shadow_maps"},
+      {"shadow_maps", "environment_map"},  // rays that leave the scene see the environment map
       {"specular"},
       true,
       true,
@@ -237,9 +238,9 @@ void SpecularPass::execute(PassContext& ctx) {
     glDisable(GL_BLEND);
     const char* inputs[] = {"gbuffer_position", "normal", "albedo", "material", "emission"};
     for (GLuint i = 0; i < std::size(inputs); ++i) res.texture(inputs[i]).bindUnit(i);
-    material.bindUnit(13);
-    geometry.bindUnit(14);
-    distance.bindUnit(15);
+    material.bindUnit(gpu::kUnitLdmMaterial);
+    geometry.bindUnit(gpu::kUnitLdmGeometry);
+    distance.bindUnit(gpu::kUnitLdmDistance);
     objectBuffer.bindBase(GL_SHADER_STORAGE_BUFFER, 3);
     minmax.bindBase(GL_SHADER_STORAGE_BUFFER, 4);
     const gl::Program& prog = ctx.shaders.program({"specular/map.vert", "specular/specular.frag"});
@@ -250,9 +251,9 @@ void SpecularPass::execute(PassContext& ctx) {
     prog.set("u_viewForward", &forward[0], 3);
     prog.set("u_orthographic", view.camera.projection == ProjectionType::Orthographic ? 1 : 0);
     prog.set("u_background", &view.ambient[0], 3);
-    // The direct pass uploaded the environment map (it declares the texture in every frame).
+    // The direct pass uploads the environment map (declared: direct's output, this pass's optional input).
     const bool environment = view.environment && res.hasTexture("environment_map");
-    if (environment) res.texture("environment_map").bindUnit(8);
+    if (environment) res.texture("environment_map").bindUnit(gpu::kUnitEnvironment);
     prog.set("u_hasEnvironment", environment ? 1 : 0);
     prog.set("u_maxDepth", maxDepth_);
     prog.set("u_minWeight", kMinBranchWeight);

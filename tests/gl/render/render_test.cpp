@@ -2,11 +2,19 @@
 // physics of the scene: glTF light units, the Lambertian BRDF, the KHR_lights_punctual falloffs.
 #include <cmath>
 #include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <OpenImageIO/imageio.h>
 
 #include <gtest/gtest.h>
 
+#include "api/Aovs.h"
 #include "renderer/Renderer.h"
+#include "renderer/frame/FrameResources.h"
 #include "renderer/io/ImageIO.h"
+#include "tests/support/Expect.h"
 #include "tests/support/RenderTestSupport.h"
 #include "tests/support/SceneBuilder.h"
 
@@ -68,6 +76,38 @@ TEST(RenderCore, PointLightCalibrationAndCosCubedFalloff) {
   EXPECT_EQ(checked, size * size);
   // Beauty is direct when nothing else runs.
   EXPECT_FLOAT_EQ(aov(out, "beauty").at(10, 10)[1], direct.at(10, 10)[1]);
+}
+
+TEST(RenderCore, PointLightRangeWindowIsTheSpecsUnsquaredWindow) {
+  // KHR_lights_punctual, "Range Property": attenuation = max(min(1 - (d / range)^4, 1), 0) / d^2. With
+  // range 2 and the calibration light above, L = cos^3(theta) (1 - d^4 / 16): 15/16 at the foot point
+  // (the squared window some engines use would give 0.879 there), 0 beyond d = 2.
+  const int size = 64;
+  const float half = 2.f;
+  Scene scene = planeScene().pointLight({0, 1, 0}, glm::pi<float>()).topDownOrtho(5.f, half).build("range");
+  scene.lights[0].range = 2.f;
+  RenderOutput out = renderer().render(scene, request(size));
+  expectAllFinite(out);
+  const Image& direct = aov(out, "direct");
+  int inside = 0, outside = 0;
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      const glm::vec2 w = topDownPixelToWorld(x, y, size, half);
+      const float d2 = 1.f + glm::dot(w, w);
+      const float window = std::max(0.f, 1.f - d2 * d2 / 16.f);
+      const float expected = std::pow(d2, -1.5f) * window;
+      const float got = direct.at(x, y)[0];
+      if (glm::dot(w, w) < 0.05f * 0.05f) EXPECT_NEAR(got, 15.f / 16.f, 0.01f) << "foot point " << x << "," << y;
+      if (window > 0.1f) {
+        EXPECT_NEAR(got / expected, 1.0f, 0.02f) << "pixel " << x << "," << y;
+        ++inside;
+      } else if (d2 > 4.05f) {
+        EXPECT_EQ(got, 0.f) << "beyond range, pixel " << x << "," << y;
+        ++outside;
+      }
+    }
+  EXPECT_GT(inside, 1000);
+  EXPECT_GT(outside, 200);
 }
 
 TEST(RenderCore, SpotLightConeEdges) {
@@ -223,6 +263,57 @@ TEST(RenderCore, GrazingViewsStayFinite) {
   RenderOutput out = renderer().render(scene, req);
   expectAllFinite(out);
   for (float v : aov(out, "direct").pixels) EXPECT_GE(v, 0.f);
+}
+
+// The AOV table (api/Aovs.cpp) is enforced, not advisory.
+TEST(AovTable, CompareWithoutGroundTruthIsRefusedNotScoredAgainstBeauty) {
+  Scene scene = planeScene().pointLight({0, 1, 0}, glm::pi<float>()).topDownOrtho(5.f, 1.f).build("aov-compare");
+  for (const char* aov : {"specular", "albedo"}) {
+    api::RenderRequest req = request(16, {"beauty"});
+    req.compare = api::CompareSpec{"reference", aov, 1, 1};
+    try {
+      renderer().render(scene, req);
+      ADD_FAILURE() << "compare.aov " << aov << " was scored";
+    } catch (const api::ApiError& e) {
+      EXPECT_EQ(e.status, 422) << aov;
+      EXPECT_EQ(e.pointer, "/compare/aov") << aov;
+      EXPECT_NE(std::string(e.what()).find("no ground truth"), std::string::npos) << e.what();
+    }
+  }
+  // An AOV with a ground truth is scored against its own reference mode.
+  api::RenderRequest req = request(16, {"direct"});
+  req.compare = api::CompareSpec{"reference", "direct", 1, 1};
+  const RenderOutput out = renderer().render(scene, req);
+  EXPECT_EQ(out.stats.metrics.at("reference_mode"), "direct");
+}
+
+TEST(AovTable, FrameResourcesRefuseAnAovInAnotherFormatOrRespecifiedWithinAFrame) {
+  renderer();  // a current GL context
+  gl::ShaderLibrary shaders;
+  FrameResources res(shaders);
+  res.texture("beauty", GL_TEXTURE_2D, GL_RGBA32F, 8, 8);
+  res.texture("beauty", GL_TEXTURE_2D, GL_RGBA32F, 8, 8);  // the same declaration: reused
+  const std::string resized = testing::thrownMessage<std::logic_error>(
+      [&] { res.texture("beauty", GL_TEXTURE_2D, GL_RGBA32F, 16, 16); });
+  EXPECT_NE(resized.find("same frame"), std::string::npos) << resized;
+  const std::string format = testing::thrownMessage<std::logic_error>(
+      [&] { res.texture("ao", GL_TEXTURE_2D, GL_RGBA16F, 8, 8); });
+  EXPECT_NE(format.find("R32F"), std::string::npos) << format;
+  // Resources that are no AOV's are free to change.
+  res.texture("scratch", GL_TEXTURE_2D, GL_RGBA16F, 8, 8);
+  res.texture("scratch", GL_TEXTURE_2D, GL_RGBA16F, 8, 8);
+}
+
+TEST(ImageIO, ExrChannelNamesComeFromTheAovTable) {
+  Image ao = Image::make("ao", 2, 1, 1), normal = Image::make("normal", 2, 1, 3), beauty = Image::make("beauty", 2, 1, 3);
+  const std::string exrPath = ::testing::TempDir() + "/names.exr";
+  io::writeFile(exrPath, io::encodeExr({beauty, ao, normal}, false));
+  auto in = OIIO::ImageInput::open(exrPath);
+  ASSERT_TRUE(in);
+  const auto& stored = in->spec().channelnames;
+  // EXR keeps channels sorted by name; compare as sets.
+  EXPECT_EQ(std::set<std::string>(stored.begin(), stored.end()),
+            (std::set<std::string>{"R", "G", "B", "ao.Y", "normal.R", "normal.G", "normal.B"}));
 }
 
 TEST(ImageIO, PngClampsAndExrKeepsLayers) {

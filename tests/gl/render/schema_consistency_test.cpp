@@ -1,12 +1,15 @@
 // The API schema is the single source of truth for technique names, parameters and AOVs; the
 // renderer's registry must say the same thing, or a valid request could name a pass nothing runs.
 #include <algorithm>
+#include <map>
 #include <set>
 
 #include <gtest/gtest.h>
 
+#include "api/Aovs.h"
 #include "api/Validate.h"
 #include "renderer/Renderer.h"
+#include "renderer/frame/FramePlanner.h"
 
 namespace radiant {
 namespace {
@@ -23,6 +26,103 @@ TEST(SchemaConsistency, EveryAovTheSchemaOffersHasAProducer) {
   for (const auto& t : Renderer::techniques()) produced.insert(t.outputs.begin(), t.outputs.end());
   for (const auto& t : api::techniqueSchemas())
     for (const auto& aov : t.outputs) EXPECT_TRUE(produced.count(aov)) << t.name << " offers " << aov;
+}
+
+// The AOV table (api/Aovs.cpp) against the schema and the registry, in both directions.
+std::set<std::string> schemaAovs() {
+  std::set<std::string> names;
+  const auto& e = api::renderRequestSchema()["properties"]["outputs"]["items"]["properties"]["aovs"]["items"]["enum"];
+  for (const auto& n : e) names.insert(n.get<std::string>());
+  return names;
+}
+
+TEST(SchemaConsistency, EveryAovTheSchemaNamesHasOneProducerOrAnAccumulateRule) {
+  std::map<std::string, std::vector<std::string>> producers;
+  for (const auto& t : Renderer::techniques())
+    for (const auto& aov : t.outputs) producers[aov].push_back(t.name);
+  const std::set<std::string> names = schemaAovs();
+  EXPECT_GE(names.size(), 13u);
+  for (const std::string& name : names) {
+    const api::AovInfo* a = api::findAov(name);
+    ASSERT_NE(a, nullptr) << "the schema offers AOV '" << name << "', which the AOV table does not declare";
+    EXPECT_TRUE(a->requestable) << name;
+    const auto it = producers.find(name);
+    const std::size_t owners = it == producers.end() ? 0 : it->second.size();
+    if (a->blend == api::AovBlend::Accumulate) {
+      EXPECT_EQ(owners, 0u) << name << " accumulates: no technique may own it";
+    } else {
+      ASSERT_EQ(owners, 1u) << name << " must have exactly one producer";
+      EXPECT_EQ(it->second[0], a->producer) << name;
+    }
+  }
+  // A technique output is either an AOV of the table, produced by that technique, or an internal
+  // resource (depth_buffer) that no request can name.
+  for (const auto& [aov, by] : producers) {
+    const api::AovInfo* a = api::findAov(aov);
+    if (!a) {
+      EXPECT_FALSE(names.count(aov)) << by[0] << " writes " << aov;
+      continue;
+    }
+    EXPECT_EQ(a->blend, api::AovBlend::Overwrite) << aov;
+    EXPECT_EQ(by, std::vector<std::string>{a->producer}) << aov;
+  }
+}
+
+TEST(SchemaConsistency, EveryRequestableAovInTheTableIsInTheSchema) {
+  std::set<std::string> registered;
+  for (const auto& t : Renderer::techniques()) registered.insert(t.name);
+  const std::set<std::string> names = schemaAovs();
+  // Declared ahead of their technique (photon_gi on the lead's branch): named here, nowhere else.
+  const std::set<std::string> awaitingTechnique{"indirect"};
+  for (const api::AovInfo& a : api::aovTable()) {
+    if (!a.requestable) {
+      EXPECT_FALSE(names.count(a.name)) << a.name << " is not requestable but the schema offers it";
+      continue;
+    }
+    if (a.blend == api::AovBlend::Overwrite && !registered.count(a.producer)) {
+      EXPECT_TRUE(awaitingTechnique.count(a.name)) << a.name << ": producer " << a.producer << " is not registered";
+      EXPECT_FALSE(names.count(a.name)) << a.name;
+      continue;
+    }
+    EXPECT_TRUE(names.count(a.name)) << "the AOV table declares '" << a.name << "', the schema does not offer it";
+  }
+}
+
+TEST(SchemaConsistency, AovTableIsWellFormed) {
+  std::set<std::string> names, exrChannels;
+  int accumulate = 0;
+  for (std::size_t i = 0; i < api::aovTable().size(); ++i) {
+    const api::AovInfo& a = api::aovTable()[i];
+    EXPECT_EQ(a.id, static_cast<int>(i)) << a.name;
+    EXPECT_TRUE(names.insert(a.name).second) << "duplicate AOV " << a.name;
+    EXPECT_TRUE(a.channels == 1 || a.channels == 3) << a.name;
+    EXPECT_EQ(a.exr.size(), static_cast<std::size_t>(a.channels)) << a.name;
+    for (const auto& c : a.exr) EXPECT_TRUE(exrChannels.insert(c).second) << "EXR channel " << c << " used twice";
+    EXPECT_LE(a.firstChannel + a.channels, a.format == api::AovFormat::R32F ? 1 : 4) << a.name;
+    accumulate += a.blend == api::AovBlend::Accumulate;
+    if (a.blend == api::AovBlend::Accumulate) EXPECT_TRUE(a.producer.empty()) << a.name;
+    if (!a.groundTruth.empty()) {
+      // A ground truth is a mode of the reference pass (its schema's aov enum).
+      const auto& modes = api::findTechnique("reference")->params.at("aov").at("enum");
+      EXPECT_NE(std::find(modes.begin(), modes.end(), a.groundTruth), modes.end())
+          << a.name << " ground truth " << a.groundTruth;
+    }
+  }
+  EXPECT_EQ(accumulate, 1);  // beauty
+  EXPECT_EQ(api::findAov("beauty")->exr, (std::vector<std::string>{"R", "G", "B"}));
+  EXPECT_EQ(api::findAov("depth")->exr, std::vector<std::string>{"depth.Z"});
+  EXPECT_EQ(api::findAov("specular")->groundTruth, "");  // scored against nothing rather than full beauty
+  EXPECT_EQ(api::findAov("no_such_aov"), nullptr);
+}
+
+// A pass that writes what it did not declare fails the frame (the Renderer throws on it).
+TEST(SchemaConsistency, UndeclaredWritesAreFound) {
+  TechniqueInfo info{"specular", "", {}, {}, {"specular"}, /*addsToBeauty=*/true, false};
+  EXPECT_EQ(undeclaredWrite(info, {"specular", "beauty"}), "");
+  EXPECT_EQ(undeclaredWrite(info, {"specular", "direct"}), "direct");
+  info.addsToBeauty = false;
+  EXPECT_EQ(undeclaredWrite(info, {"specular", "beauty"}), "beauty");  // beauty needs addsToBeauty
+  EXPECT_EQ(undeclaredWrite(info, {}), "");
 }
 
 TEST(SchemaConsistency, DefaultsComeFromTheSchema) {

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <future>
+#include <map>
 #include <set>
 #include <thread>
 
@@ -130,6 +131,15 @@ TEST(ServerCore, HealthReadyInfo) {
   json i = body(info);
   EXPECT_EQ(i["name"], "radiantd");
   EXPECT_EQ(i["limits"]["max_width"], 4096);
+  // The AOV table (api/Aovs.cpp): beauty accumulates into EXR's default layer; depth is one channel.
+  std::map<std::string, json> aovs;
+  for (const auto& a : i["aovs"]) aovs[a["name"].get<std::string>()] = a;
+  EXPECT_EQ(aovs["beauty"]["blend"], "accumulate");
+  EXPECT_EQ(aovs["beauty"]["channels"], json({"R", "G", "B"}));
+  EXPECT_EQ(aovs["depth"]["channels"], json({"depth.Z"}));
+  EXPECT_EQ(aovs["ao"]["format"], "R32F");
+  EXPECT_EQ(aovs["specular"]["ground_truth"], nullptr);
+  EXPECT_EQ(aovs["error"]["requestable"], false);
   bool sawDirect = false, sawReference = false;
   for (const auto& t : i["techniques"]) {
     if (t["name"] == "direct") {

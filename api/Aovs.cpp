@@ -1,0 +1,81 @@
+#include "api/Aovs.h"
+
+#include <algorithm>
+
+namespace radiant::api {
+
+const std::vector<AovInfo>& aovTable() {
+  using F = AovFormat;
+  using B = AovBlend;
+  // name, format, resource, first channel, channels, EXR names, blend, producer, requestable, ground truth.
+  // Beauty is EXR's default layer (R, G, B) so viewers show it first; the others are "<aov>.<channel>".
+  static const std::vector<AovInfo> table = [] {
+    std::vector<AovInfo> t = {
+        {0, "beauty", F::Rgba32F, "beauty", 0, 3, {"R", "G", "B"}, B::Accumulate, "", true, "beauty"},
+        {0, "direct", F::Rgba32F, "direct", 0, 3, {"direct.R", "direct.G", "direct.B"}, B::Overwrite, "direct", true,
+         "direct"},
+        {0, "indirect_diffuse", F::Rgba32F, "indirect_diffuse", 0, 3,
+         {"indirect_diffuse.R", "indirect_diffuse.G", "indirect_diffuse.B"}, B::Overwrite, "env_diffuse", true,
+         "indirect"},
+        // photon_gi (the lead's branch): its own image of bounces >= 2; it also adds into beauty.
+        {0, "indirect", F::Rgba32F, "indirect", 0, 3, {"indirect.R", "indirect.G", "indirect.B"}, B::Overwrite,
+         "photon_gi", true, "indirect"},
+        // No ground truth yet: the reference renders whole path classes, the specular AOV is the light
+        // seen through specular surfaces only (needs a per-pixel mask: Technique::groundTruth, #20).
+        {0, "specular", F::Rgba32F, "specular", 0, 3, {"specular.R", "specular.G", "specular.B"}, B::Overwrite,
+         "specular", true, ""},
+        {0, "ao", F::R32F, "ao", 0, 1, {"ao.Y"}, B::Overwrite, "ambient_occlusion", true, "ao"},
+        {0, "depth", F::Rgba32F, "gbuffer_position", 3, 1, {"depth.Z"}, B::Overwrite, "gbuffer", true, ""},
+        {0, "gbuffer_position", F::Rgba32F, "gbuffer_position", 0, 3,
+         {"gbuffer_position.R", "gbuffer_position.G", "gbuffer_position.B"}, B::Overwrite, "gbuffer", true, ""},
+        {0, "normal", F::Rgba16F, "normal", 0, 3, {"normal.R", "normal.G", "normal.B"}, B::Overwrite, "gbuffer", true,
+         ""},
+        {0, "geometric_normal", F::Rgba16F, "geometric_normal", 0, 3,
+         {"geometric_normal.R", "geometric_normal.G", "geometric_normal.B"}, B::Overwrite, "gbuffer", true, ""},
+        {0, "albedo", F::Rgba16F, "albedo", 0, 3, {"albedo.R", "albedo.G", "albedo.B"}, B::Overwrite, "gbuffer", true,
+         ""},
+        // metallic, roughness, occlusion (transmission, the fourth channel, is not read back).
+        {0, "material", F::Rgba16F, "material", 0, 3, {"material.R", "material.G", "material.B"}, B::Overwrite,
+         "gbuffer", true, ""},
+        {0, "emission", F::Rgba16F, "emission", 0, 3, {"emission.R", "emission.G", "emission.B"}, B::Overwrite,
+         "gbuffer", true, ""},
+        {0, "reference", F::Rgba32F, "reference", 0, 3, {"reference.R", "reference.G", "reference.B"}, B::Overwrite,
+         "reference", true, ""},
+        // compare() writes it (per-pixel luminance-weighted absolute error); never requested.
+        {0, "error", F::R32F, "", 0, 1, {"error.Y"}, B::Overwrite, "compare", false, ""},
+    };
+    for (std::size_t i = 0; i < t.size(); ++i) t[i].id = static_cast<int>(i);
+    return t;
+  }();
+  return table;
+}
+
+const AovInfo* findAov(std::string_view name) {
+  const auto& t = aovTable();
+  auto it = std::find_if(t.begin(), t.end(), [&](const AovInfo& a) { return a.name == name; });
+  return it == t.end() ? nullptr : &*it;
+}
+
+const char* toString(AovFormat f) {
+  switch (f) {
+    case AovFormat::R32F: return "R32F";
+    case AovFormat::Rgba16F: return "RGBA16F";
+    default: return "RGBA32F";
+  }
+}
+const char* toString(AovBlend b) { return b == AovBlend::Accumulate ? "accumulate" : "overwrite"; }
+
+nlohmann::json aovTableJson() {
+  nlohmann::json out = nlohmann::json::array();
+  for (const AovInfo& a : aovTable())
+    out.push_back({{"name", a.name},
+                   {"format", toString(a.format)},
+                   {"channels", a.exr},
+                   {"blend", toString(a.blend)},
+                   {"producer", a.producer.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.producer)},
+                   {"requestable", a.requestable},
+                   {"ground_truth", a.groundTruth.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.groundTruth)}});
+  return out;
+}
+
+}  // namespace radiant::api

@@ -1,0 +1,68 @@
+#pragma once
+// The one C++ material decoder: a glTF Material (factors x textures) at a surface point, as the
+// MaterialParams record GLSL also reads (shaders/common/shared.h). It is the twin of decodeMaterial()
+// in shaders/common/material.glsl, formula for formula; the ray-tracing core (RayScene::shade,
+// emissionAt, alpha) calls it, and tests/gl/materials/parity_test.cpp holds the two equal.
+//
+// `texel(ref, srgb)` returns the texture `ref` at the point (sRGB decoded when srgb), vec4(1) when
+// the slot is empty; it is how each caller samples (bilinear on the CPU, the GPU's samplers there).
+#include <algorithm>
+
+#include <glm/glm.hpp>
+
+#include "renderer/frame/GpuTypes.h"
+#include "renderer/scene/Scene.h"
+
+namespace radiant {
+
+// baseColorFactor x baseColorTexture, unclamped (the alpha test reads it).
+template <class Texel>
+glm::vec4 decodeBaseColor(const Material& m, Texel&& texel) {
+  glm::vec4 base = m.baseColorFactor;
+  if (m.baseColorTexture.valid()) base *= texel(m.baseColorTexture, true);
+  return base;
+}
+
+// emissiveFactor x emissiveStrength x emissiveTexture.
+template <class Texel>
+glm::vec3 decodeEmission(const Material& m, Texel&& texel) {
+  glm::vec3 e = m.emission();
+  if (m.emissiveTexture.valid()) e *= glm::vec3(texel(m.emissiveTexture, true));
+  return e;
+}
+
+// What the BSDF reads (baseColor, surface), without the emission and occlusion lookups: the ray
+// tracer's shade() needs only these. emission is (0, 0, 0, 1). glTF 3.9.2: metallic = blue, roughness
+// = green of metallicRoughnessTexture; KHR_materials_transmission: red channel of transmissionTexture.
+template <class Texel>
+gpu::MaterialParams decodeBsdfInputs(const Material& m, Texel&& texel) {
+  const glm::vec4 base = decodeBaseColor(m, texel);
+  float metallic = m.metallicFactor, roughness = m.roughnessFactor;
+  if (m.metallicRoughnessTexture.valid()) {
+    const glm::vec4 mr = texel(m.metallicRoughnessTexture, false);
+    roughness *= mr.g;
+    metallic *= mr.b;
+  }
+  float transmission = m.transmissionFactor;
+  if (m.transmissionTexture.valid()) transmission *= texel(m.transmissionTexture, false).r;
+  const float ior = m.ior > 0.f ? m.ior : gpu::kDefaultIor;
+  gpu::MaterialParams p;
+  p.baseColor = glm::vec4(glm::clamp(glm::vec3(base), 0.f, 1.f), base.a);
+  p.emission = glm::vec4(0.f, 0.f, 0.f, 1.f);
+  p.surface = glm::vec4(std::clamp(metallic, 0.f, 1.f), std::clamp(roughness, 0.f, 1.f),
+                        std::clamp(transmission, 0.f, 1.f), ior);
+  return p;
+}
+
+// The whole material at a point (decodeMaterial() of material.glsl): the BSDF inputs, the emission and
+// the occlusion = 1 + strength (texel.r - 1) (glTF 3.9.3).
+template <class Texel>
+gpu::MaterialParams decodeMaterial(const Material& m, Texel&& texel) {
+  gpu::MaterialParams p = decodeBsdfInputs(m, texel);
+  float occlusion = 1.f;
+  if (m.occlusionTexture.valid()) occlusion = 1.f + m.occlusionTexture.scale * (texel(m.occlusionTexture, false).r - 1.f);
+  p.emission = glm::vec4(decodeEmission(m, texel), occlusion);
+  return p;
+}
+
+}  // namespace radiant

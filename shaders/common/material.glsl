@@ -1,0 +1,90 @@
+// The one GLSL material decoder: a glTF material (factors x textures, common/shared.h) at a surface
+// point, as MaterialParams. Every pass that shades scene geometry calls it (gbuffer, env_diffuse
+// cube maps, specular distance maps); renderer/scene/MaterialDecode.h is the C++ twin used by the
+// ray-tracing core, and tests/gl/materials/parity_test.cpp holds the two equal.
+//
+// The material textures are bound by GpuScene::bindMaterialTextures() at kUnitMaterial0 + slot.
+// MATERIAL_SAMPLE(sampler, uv) is texture(); a stage without implicit derivatives (compute) defines
+// it before the include, e.g. as textureLod(sampler, uv, 0.0).
+#ifndef RADIANT_COMMON_MATERIAL
+#define RADIANT_COMMON_MATERIAL
+#include "common/scene.glsl"
+
+#ifndef MATERIAL_SAMPLE
+#define MATERIAL_SAMPLE(sampler, uv) texture(sampler, uv)
+#endif
+
+layout(binding = kUnitMaterial0 + kSlotBaseColor) uniform sampler2D t_matBaseColor;
+layout(binding = kUnitMaterial0 + kSlotMetallicRoughness) uniform sampler2D t_matMetallicRoughness;
+layout(binding = kUnitMaterial0 + kSlotNormal) uniform sampler2D t_matNormal;
+layout(binding = kUnitMaterial0 + kSlotOcclusion) uniform sampler2D t_matOcclusion;
+layout(binding = kUnitMaterial0 + kSlotEmissive) uniform sampler2D t_matEmissive;
+layout(binding = kUnitMaterial0 + kSlotTransmission) uniform sampler2D t_matTransmission;
+
+vec2 materialUv(int set, vec2 uv0, vec2 uv1) { return set == 1 ? uv1 : uv0; }
+
+bool materialDoubleSided(Material m) { return m.texturesB.y != 0; }
+int materialAlphaMode(Material m) { return int(m.scales.w); }  // 0 opaque, 1 mask, 2 blend
+// glTF 3.9.4: MASK surfaces below the cutoff are not rendered.
+bool materialMasked(Material m, float alpha) { return materialAlphaMode(m) == 1 && alpha < m.scales.z; }
+
+// baseColorFactor x baseColorTexture (sRGB decoded by the texture format), rgb and alpha. Unclamped:
+// the alpha test reads it before the rest is decoded.
+vec4 decodeBaseColor(Material m, vec2 uv0, vec2 uv1) {
+  vec4 base = m.baseColorFactor;
+  if (m.texturesA.x >= 0) base *= MATERIAL_SAMPLE(t_matBaseColor, materialUv(m.texturesA.x, uv0, uv1));
+  return base;
+}
+
+// emissiveFactor x emissiveStrength x emissiveTexture.
+vec3 decodeEmission(Material m, vec2 uv0, vec2 uv1) {
+  vec3 e = m.emission.rgb;
+  if (m.texturesB.x >= 0) e *= MATERIAL_SAMPLE(t_matEmissive, materialUv(m.texturesB.x, uv0, uv1)).rgb;
+  return e;
+}
+
+// The whole material at a point. glTF 3.9.2-3.9.3: metallic is the blue, roughness the green channel
+// of metallicRoughnessTexture; occlusion = 1 + strength (texel.r - 1); KHR_materials_transmission
+// reads the red channel of transmissionTexture.
+MaterialParams decodeMaterial(Material m, vec2 uv0, vec2 uv1) {
+  vec4 base = decodeBaseColor(m, uv0, uv1);
+  float metallic = m.metallicRoughness.x, roughness = m.metallicRoughness.y;
+  if (m.texturesA.y >= 0) {
+    vec4 mr = MATERIAL_SAMPLE(t_matMetallicRoughness, materialUv(m.texturesA.y, uv0, uv1));
+    roughness *= mr.g;
+    metallic *= mr.b;
+  }
+  float transmission = m.metallicRoughness.z;
+  if (m.texturesB.z >= 0) transmission *= MATERIAL_SAMPLE(t_matTransmission, materialUv(m.texturesB.z, uv0, uv1)).r;
+  float occlusion = 1.0;
+  if (m.texturesA.w >= 0)
+    occlusion = 1.0 + m.scales.y * (MATERIAL_SAMPLE(t_matOcclusion, materialUv(m.texturesA.w, uv0, uv1)).r - 1.0);
+  float ior = m.metallicRoughness.w > 0.0 ? m.metallicRoughness.w : kDefaultIor;
+  MaterialParams p;
+  p.baseColor = vec4(clamp(base.rgb, 0.0, 1.0), base.a);
+  p.emission = vec4(decodeEmission(m, uv0, uv1), occlusion);
+  p.surface = vec4(clamp(metallic, 0.0, 1.0), clamp(roughness, 0.0, 1.0), clamp(transmission, 0.0, 1.0), ior);
+  return p;
+}
+
+vec3 materialSafeNormalize(vec3 v, vec3 fallback) {
+  float l2 = dot(v, v);
+  return l2 > 1e-30 ? v * inversesqrt(l2) : fallback;
+}
+
+// The normal-mapped shading normal (glTF 3.9.3): n is the interpolated vertex normal (on the front
+// side of the winding), tangent the interpolated vertex tangent (xyz, w handedness). The back face of a
+// double-sided surface sees the whole tangent frame reversed (t, b and n, as the glTF sample viewer
+// and RayScene::shade): the mapped normal is negated, not re-mapped around -n.
+vec3 decodeShadingNormal(Material m, vec3 n, vec4 tangent, vec2 uv0, vec2 uv1, bool frontFacing) {
+  vec3 mapped = n;
+  if (m.texturesA.z >= 0) {
+    vec3 t = materialSafeNormalize(tangent.xyz - n * dot(n, tangent.xyz), vec3(1, 0, 0));
+    vec3 b = cross(n, t) * (tangent.w < 0.0 ? -1.0 : 1.0);
+    vec3 tn = MATERIAL_SAMPLE(t_matNormal, materialUv(m.texturesA.z, uv0, uv1)).xyz * 2.0 - 1.0;
+    tn.xy *= m.scales.x;
+    mapped = materialSafeNormalize(t * tn.x + b * tn.y + n * tn.z, n);
+  }
+  return frontFacing ? mapped : -mapped;
+}
+#endif

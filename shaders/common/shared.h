@@ -1,0 +1,102 @@
+// The one definition of what C++ and GLSL share: the std430 records of the scene buffers, the decoded
+// material, the texture units and the constants of the material model. Both languages include this
+// file (ARCHITECTURE.md, "One material model in two languages"):
+//   GLSL: #include "common/shared.h" (through common/scene.glsl), after the library's #version line;
+//   C++:  renderer/frame/GpuTypes.h includes it inside namespace radiant::gpu, with vec4 = glm::vec4,
+//         and static_asserts the sizes and offsets.
+// Rules that keep the two readings identical: every struct member is a vec4/ivec4/mat4 (std430 then
+// has no padding), the file includes nothing (the shader library expands #include even inside
+// #ifdef __cplusplus), and constants are declared with RADIANT_CONST.
+#ifndef RADIANT_COMMON_SHARED_H
+#define RADIANT_COMMON_SHARED_H
+
+#ifdef __cplusplus
+#define RADIANT_CONST inline constexpr
+#else
+#define RADIANT_CONST const
+#endif
+
+// ---------------------------------------------------------------------------------------------------
+// Material model constants.
+
+// GGX alpha = max(roughness^2, kMinGgxAlpha) for roughness > 0, so D stays finite in float
+// (D_max = 1 / (pi alpha^2) ~ 3e5). Roughness exactly 0 is a Dirac lobe on both sides.
+RADIANT_CONST float kMinGgxAlpha = 1e-3;
+// Index of refraction when a material gives none (glTF default, KHR_materials_ior).
+RADIANT_CONST float kDefaultIor = 1.5;
+
+// ---------------------------------------------------------------------------------------------------
+// Texture units. Every sampler of every program has its own unit, so a pass can bind anything it
+// declares without overwriting another's input. Units 0-5 are a pass's own full-screen inputs.
+RADIANT_CONST int kUnitShadowCube = 6;
+RADIANT_CONST int kUnitShadow2D = 7;
+// Material textures: unit kUnitMaterial0 + slot (slots below).
+RADIANT_CONST int kUnitMaterial0 = 8;
+RADIANT_CONST int kSlotBaseColor = 0;
+RADIANT_CONST int kSlotMetallicRoughness = 1;
+RADIANT_CONST int kSlotNormal = 2;
+RADIANT_CONST int kSlotOcclusion = 3;
+RADIANT_CONST int kSlotEmissive = 4;
+RADIANT_CONST int kSlotTransmission = 5;  // KHR_materials_transmission, red channel
+RADIANT_CONST int kSlotCount = 6;
+RADIANT_CONST int kUnitEnvironment = 14;  // equirect environment radiance (direct, specular)
+RADIANT_CONST int kUnitPeel = 15;         // specular: previous layer of a distance-map face
+RADIANT_CONST int kUnitLdmMaterial = 16;  // specular: layered distance maps
+RADIANT_CONST int kUnitLdmGeometry = 17;
+RADIANT_CONST int kUnitLdmDistance = 18;
+RADIANT_CONST int kUnitCount = 19;        // units used; GL 4.5 guarantees 16, every driver we run has 32
+
+// Shader storage bindings of the scene buffers.
+RADIANT_CONST int kBindingMaterials = 0;
+RADIANT_CONST int kBindingLights = 1;
+RADIANT_CONST int kBindingShadows = 2;
+
+// ---------------------------------------------------------------------------------------------------
+// Lights.
+RADIANT_CONST int kLightDirectional = 0;
+RADIANT_CONST int kLightPoint = 1;
+RADIANT_CONST int kLightSpot = 2;
+
+// One KHR_lights_punctual light (GpuScene's toGpuLight fills it).
+struct Light {
+  vec4 positionType;      // xyz world position, w type
+  vec4 directionRange;    // xyz direction light travels (unit), w range (0 = infinite)
+  vec4 radiantIntensity;  // rgb = color * intensity, w unused
+  vec4 spotCone;          // x cos(outer), y cos(inner), zw unused
+};
+
+// Written by the shadow_maps pass, one per light (same index as Light).
+RADIANT_CONST int kShadowNone = 0;
+RADIANT_CONST int kShadowCube = 1;
+RADIANT_CONST int kShadow2D = 2;
+struct ShadowInfo {
+  mat4 viewProj;  // 2D maps: world -> light clip (x,y in [-1,1], z unused: maps store distance)
+  vec4 params;    // x kind, y layer in its array, z world size of one texel at unit distance
+                  // (perspective) or absolute (orthographic), w normal-offset bias in texels
+  vec4 params2;   // x orthographic (1) or perspective (0), y constant bias in texels, zw unused
+};
+
+// ---------------------------------------------------------------------------------------------------
+// Materials.
+
+// A glTF material as stored (GpuScene's toGpuMaterial fills it): factors and, per texture slot, the
+// uv set it reads or -1 when the slot is empty. decodeMaterial() (common/material.glsl in GLSL,
+// renderer/scene/MaterialDecode.h in C++) turns it into MaterialParams at a surface point.
+struct Material {
+  vec4 baseColorFactor;
+  vec4 emission;           // rgb = emissiveFactor * emissiveStrength
+  vec4 metallicRoughness;  // x metallic, y roughness, z transmission factor, w ior
+  vec4 scales;             // x normal scale, y occlusion strength, z alpha cutoff, w alpha mode (0 opaque, 1 mask, 2 blend)
+  ivec4 texturesA;         // uv set per slot (base colour, metallic-roughness, normal, occlusion), -1 = none
+  ivec4 texturesB;         // x emissive uv set, y doubleSided, z transmission uv set, w unused
+};
+
+// The material decoded at a surface point (factors x textures): what the BRDF reads. gltfBrdfCos
+// (common/brdf.glsl) and rt::GltfBsdf (renderer/raytracing/Bsdf.h) take these values.
+struct MaterialParams {
+  vec4 baseColor;  // rgb linear base colour clamped to [0,1], a alpha (coverage)
+  vec4 emission;   // rgb emitted radiance, a ambient occlusion (1 = none)
+  vec4 surface;    // x metallic, y roughness (both clamped to [0,1]), z transmission in [0,1], w ior
+};
+
+#endif
