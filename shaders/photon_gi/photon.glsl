@@ -13,7 +13,7 @@
 // std430 mirror of photon_gi::GpuSplat (renderer/techniques/photon_gi/Splatting.h).
 struct GpuPhoton {
   vec4 positionRadius;  // xyz world position, w kernel radius h
-  vec4 normal;          // xyz unit normal on the side the photon arrived from
+  vec4 normal;          // xyz unit normal on the side the photon arrived from; w = 1: diffuse lobe only
   vec4 wi;              // xyz unit direction towards where it came from
   vec4 power;           // rgb phi_j = flux / photons used; a > 0: a coverage point of weight A / n
 };
@@ -61,9 +61,9 @@ vec3 photonContribution(GpuPhoton p, SplatSurface s) {
   float metallic = s.metallic, roughness = s.roughness;
   vec3 base = s.baseColor;
   vec3 f;
-  if (roughness < u_minGlossyRoughness) {
-    // Too sharp to estimate from photons: keep the diffuse lobe (what a smooth dielectric's base
-    // reflects) and leave the near-mirror reflection of indirect light out.
+  if (roughness < u_minGlossyRoughness || p.normal.w > 0.5) {
+    // Too sharp to estimate from photons, or a glossy reflection another technique owns: keep the
+    // diffuse lobe (what a dielectric's base reflects) and leave the specular reflection out.
     float r = (s.ior - 1.0) / (s.ior + 1.0);
     f = (1.0 - metallic) * (1.0 - s.transmission) * (1.0 - r * r) * base * INV_PI;
   } else {

@@ -53,7 +53,7 @@ const TechniqueInfo& PhotonGiPass::info() const {
                                {"indirect"},
                                true,
                                true,
-                               {"LD+DE", "L(area)DE", "L(sky)DE"}};
+                               {"LD+DE", "L(area)DE", "L(sky)DE", "L(sky)GE"}};
   return i;
 }
 
@@ -117,7 +117,12 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
 
   // --- The splats: which records, their kernel radius per surface (eq. 3), coverage points.
   const bool ownsSky = res.ownsLightPath("photon_gi", "L(sky)DE");
+  // The glossy reflection of the sky (L(sky)GE) may belong to a prefiltered environment term in
+  // `direct`, which comes first in the registry: then sky photons at their first hit are splatted with
+  // the diffuse lobe only.
+  const bool ownsSkyGlossy = res.ownsLightPath("photon_gi", "L(sky)GE");
   const nlohmann::json splatKey = {{"photons", photonKey}, {"count", s.photons}, {"C", s.C}, {"sky", ownsSky},
+                                   {"sky_glossy", ownsSkyGlossy},
                                    {"ppm", s.ppm}, {"alpha", s.ppmAlpha}, {"base", s.ppmBase},
                                    {"renormalize", splat_.renormalize}};
   upload_ = false;
@@ -153,7 +158,9 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
     for (std::size_t i = 0; i < records_; ++i) {
       const rt::PhotonRecord& r = cache.set.records[i];
       if (!splatted(r) || !(h[r.mesh] > 0.f)) continue;
-      out.push_back(photon_gi::photonSplat(r.position, h[r.mesh], r.normal, r.wi, r.flux * invPhotons));
+      const bool diffuseOnly = r.bounce == 0 && !ownsSkyGlossy &&
+                               lights.emitters()[r.light].kind == rt::SceneLights::Kind::Environment;
+      out.push_back(photon_gi::photonSplat(r.position, h[r.mesh], r.normal, r.wi, r.flux * invPhotons, diffuseOnly));
     }
     c->photonSplats = out.size();
     if (splat_.renormalize)

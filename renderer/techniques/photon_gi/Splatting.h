@@ -20,14 +20,17 @@ namespace radiant::photon_gi {
 // std430 mirror of GpuPhoton in shaders/photon_gi/photon.glsl.
 struct GpuSplat {
   glm::vec4 positionRadius;  // xyz world position, w kernel radius h
-  glm::vec4 normal;          // xyz unit normal on the side the photon arrived from
+  glm::vec4 normal;          // xyz unit normal on the side the photon arrived from, w 1 = diffuse lobe only
   glm::vec4 wi;              // xyz unit direction towards where the photon came from
   glm::vec4 power;           // rgb phi = flux / photons used; a > 0: coverage point of weight A / n
 };
 static_assert(sizeof(GpuSplat) == 64, "std430 GpuSplat must be 4 vec4");
 
-inline GpuSplat photonSplat(const glm::vec3& p, float h, const glm::vec3& n, const glm::vec3& wi, const glm::vec3& phi) {
-  return {glm::vec4(p, h), glm::vec4(n, 0.f), glm::vec4(wi, 0.f), glm::vec4(phi, 0.f)};
+// diffuseOnly: the photon is splatted with the diffuse lobe of the BRDF only (its glossy reflection is
+// another technique's light path).
+inline GpuSplat photonSplat(const glm::vec3& p, float h, const glm::vec3& n, const glm::vec3& wi, const glm::vec3& phi,
+                            bool diffuseOnly = false) {
+  return {glm::vec4(p, h), glm::vec4(n, diffuseOnly ? 1.f : 0.f), glm::vec4(wi, 0.f), glm::vec4(phi, 0.f)};
 }
 
 // Appends n coverage points spread uniformly by area over `mesh` (stratified in the area CDF, R2

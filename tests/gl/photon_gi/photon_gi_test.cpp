@@ -114,6 +114,28 @@ TEST(PhotonGi, SinglePhotonDepositsItsPower) {
     }
 }
 
+TEST(PhotonGi, DiffuseOnlyPhotonsLeaveTheGlossyLobeToItsOwner) {
+  // A photon flagged diffuse-only (a sky photon whose glossy reflection `direct`'s prefiltered
+  // environment owns) adds nothing to a metal, and the same photon unflagged adds its glossy lobe.
+  testing::SceneBuilder b;
+  Material metal = testing::lambertian(glm::vec3(0.9f));
+  metal.metallicFactor = 1.f;
+  metal.roughnessFactor = 0.5f;
+  const int m = b.material(metal);
+  b.quad(glm::vec3(0.f), {kHalf, 0, 0}, {0, 0, -kHalf}, m, "metal");
+  b.topDownOrtho(2.f, kViewHalf);
+  SplatHarness h(b.build(), 64);
+  double sums[2] = {0, 0};
+  for (int flagged = 0; flagged < 2; ++flagged) {
+    const Image img = h.run({photon_gi::photonSplat(glm::vec3(0.f), 0.4f, glm::vec3(0, 1, 0), glm::vec3(0, 1, 0),
+                                                   glm::vec3(1.f), flagged == 1)},
+                            settings(photon_gi::Method::Gather, false));
+    for (float v : img.pixels) sums[flagged] += v;
+  }
+  EXPECT_GT(sums[0], 1.0);
+  EXPECT_EQ(sums[1], 0.0);
+}
+
 struct FieldStats {
   double interior = 0, interiorStd = 0;
   double edge = 0, edgeExpected = 0;      // mean over pixels within a pixel of the edge x = +1
