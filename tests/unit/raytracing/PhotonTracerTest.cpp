@@ -15,15 +15,7 @@ namespace {
 using testing::addMaterial;
 using testing::lambert;
 
-GltfBsdf bsdfOf(const Material& m) {
-  GltfBsdf b;
-  b.baseColor = glm::vec3(m.baseColorFactor);
-  b.metallic = m.metallicFactor;
-  b.roughness = m.roughnessFactor;
-  b.transmission = m.transmissionFactor;
-  b.ior = m.ior;
-  return b;
-}
+using testing::bsdfOf;
 
 // Sum of the flux of the records with a given bounce count, per emitted photon.
 glm::dvec3 fluxOfBounce(const PhotonSet& set, std::uint32_t bounce) {

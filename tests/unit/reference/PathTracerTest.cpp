@@ -39,15 +39,7 @@ double fresnelUnpolarised(double cosI, double n1, double n2) {
   return 0.5 * (rs * rs + rp * rp);
 }
 
-GltfBsdf bsdfOf(const Material& m) {
-  GltfBsdf b;
-  b.baseColor = glm::vec3(m.baseColorFactor);
-  b.metallic = m.metallicFactor;
-  b.roughness = m.roughnessFactor;
-  b.transmission = m.transmissionFactor;
-  b.ior = m.ior;
-  return b;
-}
+using testing::bsdfOf;
 
 // E(mu) tabulated by quadrature on [mu0, 1] and interpolated.
 struct AlbedoTable {

@@ -48,6 +48,17 @@ inline Material smoothGlass(float ior) {
   return m;
 }
 
+// The BSDF of a material's factors (no textures), outside any scene.
+inline rt::GltfBsdf bsdfOf(const Material& m) {
+  rt::GltfBsdf b;
+  b.baseColor = glm::vec3(m.baseColorFactor);
+  b.metallic = m.metallicFactor;
+  b.roughness = m.roughnessFactor;
+  b.transmission = m.transmissionFactor;
+  b.ior = m.ior;
+  return b;
+}
+
 inline int addMaterial(Scene& s, const Material& m) {
   s.materials.push_back(m);
   return static_cast<int>(s.materials.size()) - 1;
