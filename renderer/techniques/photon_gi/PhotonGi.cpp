@@ -189,6 +189,9 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
 
 void PhotonGiPass::execute(PassContext& ctx) {
   photon_gi::splatAndResolve(ctx.resources, ctx.shaders, ctx.view, splat_, *grid_, upload_, true);
+  // The GPU holds the splats now: the CPU copy would double the memory of every cached photon set. A
+  // lost GL context clears the cache entry too (FrameResources::clear), so it is rebuilt, not re-uploaded.
+  if (upload_) std::vector<photon_gi::GpuSplat>().swap(grid_->splats);
   auto& c = ctx.stats.counters;
   c["photons"] = static_cast<double>(settings_.photons);
   c["photons_traced"] = static_cast<double>(traced_);
@@ -200,7 +203,7 @@ void PhotonGiPass::execute(PassContext& ctx) {
   c["coverage_points"] = static_cast<double>(coveragePoints_);
   c["bytes_per_photon"] =
       settings_.photons ? double(records_ * sizeof(rt::PhotonRecord)) / double(settings_.photons) : 0.0;
-  c["splat_bytes"] = static_cast<double>(grid_->splats.size() * sizeof(photon_gi::GpuSplat));
+  c["splat_bytes"] = static_cast<double>(grid_->count * sizeof(photon_gi::GpuSplat));
   c["splats_uploaded"] = upload_ ? 1.0 : 0.0;
   c["h_min"] = hMin_;
   c["h_max"] = hMax_;

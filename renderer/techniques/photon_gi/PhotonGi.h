@@ -42,7 +42,7 @@ private:
     int maxBounces = 8;
   } settings_;
   photon_gi::SplatSettings splat_;
-  const photon_gi::SplatGrid* grid_ = nullptr;  // in the cache, valid for this frame
+  photon_gi::SplatGrid* grid_ = nullptr;  // in the cache, valid for this frame
   bool upload_ = false;                          // the grid changed: upload it in execute()
   std::size_t records_ = 0, photonSplats_ = 0, coveragePoints_ = 0;
   std::uint64_t traced_ = 0;  // photons traced by this frame (0 when the set was cached)

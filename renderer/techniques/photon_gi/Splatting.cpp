@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include <glm/gtc/type_ptr.hpp>
 
@@ -94,11 +95,12 @@ SplatGrid buildSplatGrid(std::vector<GpuSplat> splats) {
   std::vector<std::uint32_t> next(g.cellStart.begin(), g.cellStart.end() - 1);
   g.splats.resize(splats.size());
   for (const GpuSplat& s : splats) g.splats[next[cellOf(s)]++] = s;
+  g.count = g.splats.size();
   return g;
 }
 
 void declareSplatResources(FrameResources& res, const SplatGrid& grid) {
-  const std::size_t splatBytes = std::max<std::size_t>(grid.splats.size(), 1) * sizeof(GpuSplat);
+  const std::size_t splatBytes = std::max<std::size_t>(grid.count, 1) * sizeof(GpuSplat);
   if (!res.hasBuffer("photon_gi_splats") || res.buffer("photon_gi_splats").size() < splatBytes)
     res.buffer("photon_gi_splats", capacity(splatBytes));
   const std::size_t cellBytes = grid.cellStart.size() * sizeof(std::uint32_t);
@@ -125,6 +127,8 @@ void splatAndResolve(FrameResources& res, gl::ShaderLibrary& shaders, const Fram
   gl::Buffer& splats = res.buffer("photon_gi_splats");
   gl::Buffer& cells = res.buffer("photon_gi_cells");
   if (upload) {
+    if (grid.splats.size() != grid.count)
+      throw std::logic_error("photon_gi::splatAndResolve: the grid's splats were released before upload");
     if (!grid.splats.empty()) splats.upload(grid.splats.data(), grid.splats.size() * sizeof(GpuSplat));
     cells.upload(grid.cellStart.data(), grid.cellStart.size() * sizeof(std::uint32_t));
   }
@@ -146,7 +150,7 @@ void splatAndResolve(FrameResources& res, gl::ShaderLibrary& shaders, const Fram
   };
   gl::Texture& accum = res.texture("photon_gi_accum");
   const float zero[4] = {0.f, 0.f, 0.f, 0.f};
-  const GLsizei count = static_cast<GLsizei>(grid.splats.size());
+  const GLsizei count = static_cast<GLsizei>(grid.count);
   if (settings.method == Method::Splat) {
     gl::Framebuffer& fb = res.framebuffer("photon_gi_splat");
     fb.bind();

@@ -50,7 +50,8 @@ struct SplatSettings {
 
 // The splats sorted by grid cell, and the grid (cell c holds splats cellStart[c] .. cellStart[c+1]-1).
 struct SplatGrid {
-  std::vector<GpuSplat> splats;
+  std::vector<GpuSplat> splats;  // may be released once uploaded (count stays)
+  std::size_t count = 0;         // splats in the grid
   std::vector<std::uint32_t> cellStart;
   glm::vec3 origin{0.f};
   float cellSize = 1.f;
