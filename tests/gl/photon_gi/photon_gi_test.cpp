@@ -161,9 +161,10 @@ double biweightMassInside(double a, double b) {
 }
 
 // Photons uniform on the plane, all arriving along the normal, each of power phi.
-FieldStats constantField(SplatHarness& h, int n, float C, photon_gi::Method method, bool renormalize, Image* out = nullptr) {
+FieldStats constantField(SplatHarness& h, int n, float C, photon_gi::Method method, bool renormalize, Image* out = nullptr,
+                         bool ppm = false, double ppmBase = 0.0) {
   const double area = 4.0;
-  const float radius = static_cast<float>(C * std::sqrt(area / n));  // eq. 3
+  const float radius = PhotonGiPass::kernelRadius(C, area, n, ppm, n, ppmBase, 2.0 / 3.0);  // eq. 3 (or progressive)
   const float phi = 1.f;
   std::mt19937 rng(12345);
   std::uniform_real_distribution<float> u(-kHalf, kHalf);
@@ -247,6 +248,25 @@ TEST(PhotonGi, ConstantFieldMeanNoiseEdgesAndCorners) {
   EXPECT_NEAR(r.interior, 1.0, 0.02);
   EXPECT_NEAR(r.edge, 1.0, 0.06);
   EXPECT_NEAR(r.corner, 1.0, 0.1);
+}
+
+TEST(PhotonGi, PaperRadiusHasANoiseFloorProgressiveRadiusDoesNot) {
+  // Eq. 3 keeps pi C^2 photons per kernel whatever N is: the relative noise stays 0.757 / C. With
+  // h_schedule = ppm, h^2 grows by (N / N0)^alpha, so the photons per kernel grow as N^alpha and the noise
+  // falls as N^(-alpha/2): 4x the photons give 4^(-1/3) = 0.63 of the noise (alpha = 2/3).
+  EXPECT_NEAR(PhotonGiPass::kernelRadius(30.f, 4.0, 900.0, false, 0, 0, 0), 2.0, 1e-6);
+  EXPECT_NEAR(PhotonGiPass::kernelRadius(30.f, 4.0, 900.0, true, 8000.0, 1000.0, 2.0 / 3.0), 2.0 * 2.0, 1e-5);
+  SplatHarness h(plane(), kSize);
+  const int n = 6000;
+  const FieldStats paper1 = constantField(h, n, 10.f, photon_gi::Method::Gather, false);
+  const FieldStats paper4 = constantField(h, 4 * n, 10.f, photon_gi::Method::Gather, false);
+  const FieldStats ppm1 = constantField(h, n, 10.f, photon_gi::Method::Gather, false, nullptr, true, n);
+  const FieldStats ppm4 = constantField(h, 4 * n, 10.f, photon_gi::Method::Gather, false, nullptr, true, n);
+  std::printf("noise: paper %.4f -> %.4f, ppm %.4f -> %.4f\n", paper1.interiorStd, paper4.interiorStd, ppm1.interiorStd,
+              ppm4.interiorStd);
+  EXPECT_NEAR(paper4.interiorStd / paper1.interiorStd, 1.0, 0.15);
+  EXPECT_NEAR(ppm4.interiorStd / ppm1.interiorStd, std::pow(4.0, -1.0 / 3.0), 0.1);
+  EXPECT_NEAR(ppm4.interior, 1.0, 0.02);
 }
 
 TEST(PhotonGi, SplatAndGatherAgreeOnTheSamePhotons) {
