@@ -267,7 +267,7 @@ struct PathTracer::Impl {
   }
   glm::vec4 textureAt(const TextureRef& ref, const SurfaceHit& h, bool srgb) const {
     if (!ref.valid() || ref.texture >= static_cast<int>(scene->textures.size())) return glm::vec4(1.f);
-    return sampleTexture(scene->textures[ref.texture], uvAt(h, ref.texCoord), srgb);
+    return sampleTexture(scene->textures[ref.texture], ref.transformUv(uvAt(h, ref.texCoord)), srgb);
   }
 
   float alphaAt(const Material& mat, const SurfaceHit& h) const {
@@ -577,6 +577,10 @@ struct PathTracer::Impl {
         break;
       }
       const Material& mat = materialOf(hit.mesh);
+      if (mat.unlit) {  // KHR_materials_unlit: the base colour leaves the surface, nothing scatters
+        if (inRange(k, o)) L += beta * glm::vec3(mat.baseColorFactor * textureAt(mat.baseColorTexture, hit, true));
+        break;
+      }
       if (inRange(k, o)) {
         const glm::vec3 Le = emissionAt(mat, hit, ray.dir);
         if (maxComponent(Le) > 0.f) {

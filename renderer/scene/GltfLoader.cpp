@@ -15,18 +15,13 @@
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>  // Debian ships tinygltf as a shared library: no TINYGLTF_IMPLEMENTATION here
 
+#include "renderer/scene/GltfExtensions.h"
+
 namespace radiant {
 namespace {
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;
-
-// Extensions whose meaning we implement; anything else in extensionsRequired is refused.
-constexpr std::string_view kSupportedExtensions[] = {
-    "KHR_lights_punctual", "KHR_materials_transmission", "KHR_materials_ior",
-    "KHR_materials_emissive_strength",
-    "KHR_mesh_quantization",  // any component type is read and normalised (see readElements)
-};
 
 std::string pointer(std::string_view base, std::size_t index) {
   return std::string(base) + "/" + std::to_string(index);
@@ -202,8 +197,9 @@ void checkExternalUri(const std::string& uri, const std::string& ptr, const fs::
                       const fs::path& root) {
   if (root.empty())
     throw SceneError(ptr, "external URI \"" + uri +
-                              "\" refused: no asset root is configured (embed the data as a data "
-                              "URI or in a GLB)");
+                              "\" refused: no asset root is configured (upload one GLB: `radiant render "
+                              "FILE.gltf` packs a .gltf and its files; or put the files under radiantd "
+                              "--asset-root DIR and name the scene with scene.asset)");
   // A scheme is letters, digits, + - . followed by ':' (RFC 3986 section 3.1).
   const auto colon = uri.find(':');
   if (colon != std::string::npos && colon > 0 && std::isalpha(static_cast<unsigned char>(uri[0])) &&
@@ -236,17 +232,10 @@ std::uint64_t jsonUnsigned(const json& o, const char* key, std::uint64_t fallbac
   return it != o.end() && it->is_number_unsigned() ? it->get<std::uint64_t>() : fallback;
 }
 
-void validateDocument(const json& doc, const fs::path& baseDir, const fs::path& root) {
+void validateDocument(const json& doc, const fs::path& baseDir, const fs::path& root,
+                      std::vector<std::string>& warnings) {
   if (!doc.is_object()) throw SceneError("", "a glTF document must be a JSON object");
-  if (const auto it = doc.find("extensionsRequired"); it != doc.end() && it->is_array()) {
-    for (std::size_t i = 0; i < it->size(); ++i) {
-      const auto& e = (*it)[i];
-      const std::string name = e.is_string() ? e.get<std::string>() : e.dump();
-      if (std::find(std::begin(kSupportedExtensions), std::end(kSupportedExtensions), name) ==
-          std::end(kSupportedExtensions))
-        throw SceneError(pointer("/extensionsRequired", i), "unsupported required extension " + name);
-    }
-  }
+  gltf::checkExtensions(doc, warnings);  // the extension table: GltfExtensions.cpp
   for (const char* key : {"buffers", "images"}) {
     const auto it = doc.find(key);
     if (it == doc.end() || !it->is_array()) continue;
@@ -629,7 +618,10 @@ private:
   TextureRef textureRef(const tinygltf::Value& info, const std::string& ptr) {
     if (!info.IsObject() || !info.Has("index")) return {};
     const int texCoord = info.Has("texCoord") ? info.Get("texCoord").GetNumberAsInt() : 0;
-    return textureRef(info.Get("index").GetNumberAsInt(), texCoord, 1.f, ptr, false);
+    TextureRef r = textureRef(info.Get("index").GetNumberAsInt(), texCoord, 1.f, ptr, false);
+    if (r.valid() && info.Has("extensions") && info.Get("extensions").Has("KHR_texture_transform"))
+      gltf::applyTextureTransform(&info.Get("extensions").Get("KHR_texture_transform"), r, ptr);
+    return r;
   }
 
   void convertTextures() {
@@ -701,6 +693,16 @@ private:
                                         false);
       mat.emissiveTexture = textureRef(g.emissiveTexture.index, g.emissiveTexture.texCoord, 1.f,
                                        ptr + "/emissiveTexture", true);
+      // KHR_texture_transform per texture slot, KHR_materials_unlit (GltfExtensions.h).
+      auto transform = [&](const tinygltf::ExtensionMap& ext, TextureRef& ref, const std::string& at) {
+        if (ref.valid()) gltf::applyTextureTransform(extension(ext, "KHR_texture_transform"), ref, at);
+      };
+      transform(pbr.baseColorTexture.extensions, mat.baseColorTexture, pp + "/baseColorTexture");
+      transform(pbr.metallicRoughnessTexture.extensions, mat.metallicRoughnessTexture, pp + "/metallicRoughnessTexture");
+      transform(g.normalTexture.extensions, mat.normalTexture, ptr + "/normalTexture");
+      transform(g.occlusionTexture.extensions, mat.occlusionTexture, ptr + "/occlusionTexture");
+      transform(g.emissiveTexture.extensions, mat.emissiveTexture, ptr + "/emissiveTexture");
+      mat.unlit = extension(g.extensions, "KHR_materials_unlit") != nullptr;
       mat.doubleSided = g.doubleSided;
       if (g.alphaMode == "MASK") mat.alphaMode = AlphaMode::Mask;
       else if (g.alphaMode == "BLEND") mat.alphaMode = AlphaMode::Blend;
@@ -768,6 +770,7 @@ private:
   }
 
   void visitNode(int index, const tinygltf::Node& node, const glm::mat4& world, const std::string& ptr) {
+    scene_.nodeNames.push_back(node.name);
     if (node.mesh >= 0) {
       if (std::size_t(node.mesh) >= m_.meshes.size())
         throw SceneError(ptr + "/mesh", "mesh " + std::to_string(node.mesh) + " does not exist");
@@ -1037,7 +1040,8 @@ Scene load(std::string_view bytes, const fs::path& baseDir, const fs::path& root
     throw SceneError("", std::string(glb ? "the GLB JSON chunk" : "the file") +
                              " is neither valid JSON nor GLB: " + e.what());
   }
-  validateDocument(doc, baseDir, root);
+  std::vector<std::string> warnings;
+  validateDocument(doc, baseDir, root, warnings);
 
   FsContext fsContext;
   fsContext.root = root;
@@ -1070,6 +1074,7 @@ Scene load(std::string_view bytes, const fs::path& baseDir, const fs::path& root
     throw SceneError("", "invalid glTF: " + (err.empty() ? std::string("unknown error") : err));
   }
   Scene scene = Converter(model, options.maxBytes).run();
+  scene.warnings.insert(scene.warnings.begin(), warnings.begin(), warnings.end());
   scene.digest = "sha256:" + digest.finishHex();
   scene.features = computeFeatures(scene);
   return scene;

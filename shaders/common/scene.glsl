@@ -15,7 +15,8 @@ struct Material {
   vec4 metallicRoughness;  // x metallic, y roughness, z transmission, w ior
   vec4 scales;             // x normal scale, y occlusion strength, z alpha cutoff, w alpha mode
   ivec4 texturesA;         // uv set per slot (base, mr, normal, occlusion), -1 = none
-  ivec4 texturesB;         // x emissive uv set, y doubleSided
+  ivec4 texturesB;         // x emissive uv set, y doubleSided, z unlit (KHR_materials_unlit)
+  vec4 uvTransform[10];    // KHR_texture_transform: rows 2 slot, 2 slot + 1 of the affine uv map
 };
 
 struct Light {
@@ -32,6 +33,18 @@ struct ShadowInfo {
 };
 
 layout(std430, binding = 0) readonly buffer Materials { Material materials[]; };
+
+#define SLOT_BASE_COLOR 0
+#define SLOT_METALLIC_ROUGHNESS 1
+#define SLOT_NORMAL 2
+#define SLOT_OCCLUSION 3
+#define SLOT_EMISSIVE 4
+
+// The uv a material's texture slot samples at (KHR_texture_transform; identity rows without it).
+vec2 materialUv(Material m, int slot, vec2 uv) {
+  vec3 h = vec3(uv, 1.0);
+  return vec2(dot(m.uvTransform[2 * slot].xyz, h), dot(m.uvTransform[2 * slot + 1].xyz, h));
+}
 layout(std430, binding = 1) readonly buffer Lights { Light lights[]; };
 layout(std430, binding = 2) readonly buffer Shadows { ShadowInfo shadows[]; };
 

@@ -40,7 +40,13 @@ void main() {
     return;
   }
   vec3 p = P.xyz;
-  vec3 n = texelFetch(t_normal, px, 0).xyz;
+  vec4 nUnlit = texelFetch(t_normal, px, 0);
+  if (nUnlit.w < 0.5) {  // KHR_materials_unlit (gbuffer.frag): the stored base colour as it is
+    o_direct = vec4(texelFetch(t_emission, px, 0).rgb, 1.0);
+    o_beauty = o_direct;
+    return;
+  }
+  vec3 n = nUnlit.xyz;
   vec3 albedo = texelFetch(t_albedo, px, 0).rgb;
   vec4 mat = texelFetch(t_material, px, 0);
   vec4 emissionIor = texelFetch(t_emission, px, 0);

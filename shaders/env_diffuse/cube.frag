@@ -36,7 +36,7 @@ vec3 safeNormalize(vec3 v, vec3 fallback) {
 void main() {
   Material m = materials[u_material];
   vec4 base = m.baseColorFactor;
-  if (m.texturesA.x >= 0) base *= texture(t_baseColor, uvSet(m.texturesA.x));
+  if (m.texturesA.x >= 0) base *= texture(t_baseColor, materialUv(m, SLOT_BASE_COLOR, uvSet(m.texturesA.x)));
   if (int(m.scales.w) == 1 && base.a < m.scales.z) discard;
   if (!gl_FrontFacing && m.texturesB.y == 0) discard;  // glTF single-sided, as in the G-buffer
 
@@ -50,7 +50,7 @@ void main() {
   if (m.texturesA.z >= 0) {
     vec3 t = safeNormalize(v_tangent.xyz - n * dot(n, v_tangent.xyz), vec3(1, 0, 0));
     vec3 b = cross(n, t) * (v_tangent.w < 0.0 ? -1.0 : 1.0);
-    vec3 tn = texture(t_normal, uvSet(m.texturesA.z)).xyz * 2.0 - 1.0;
+    vec3 tn = texture(t_normal, materialUv(m, SLOT_NORMAL, uvSet(m.texturesA.z))).xyz * 2.0 - 1.0;
     tn.xy *= m.scales.x;
     n = safeNormalize(t * tn.x + b * tn.y + n * tn.z, n);
   }
@@ -59,7 +59,7 @@ void main() {
 
   float metallic = m.metallicRoughness.x, roughness = m.metallicRoughness.y;
   if (m.texturesA.y >= 0) {
-    vec4 mr = texture(t_metallicRoughness, uvSet(m.texturesA.y));
+    vec4 mr = texture(t_metallicRoughness, materialUv(m, SLOT_METALLIC_ROUGHNESS, uvSet(m.texturesA.y)));
     roughness *= mr.g;
     metallic *= mr.b;
   }
@@ -67,7 +67,7 @@ void main() {
   roughness = clamp(roughness, 0.0, 1.0);
   float transmission = m.metallicRoughness.z;
   vec3 emission = m.emission.rgb;
-  if (m.texturesB.x >= 0) emission *= texture(t_emissive, uvSet(m.texturesB.x)).rgb;
+  if (m.texturesB.x >= 0) emission *= texture(t_emissive, materialUv(m, SLOT_EMISSIVE, uvSet(m.texturesB.x))).rgb;
 
   vec3 L = emission + directLighting(v_position, n, faceNormal, wo, base.rgb, metallic, roughness, transmission,
                                      m.metallicRoughness.w);

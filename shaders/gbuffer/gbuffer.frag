@@ -33,7 +33,7 @@ vec3 safeNormalize(vec3 v, vec3 fallback) {
 void main() {
   Material m = materials[u_material];
   vec4 base = m.baseColorFactor;
-  if (m.texturesA.x >= 0) base *= texture(t_baseColor, uvSet(m.texturesA.x));
+  if (m.texturesA.x >= 0) base *= texture(t_baseColor, materialUv(m, SLOT_BASE_COLOR, uvSet(m.texturesA.x)));
   int alphaMode = int(m.scales.w);
   if (alphaMode == 1 && base.a < m.scales.z) discard;
 
@@ -48,7 +48,7 @@ void main() {
   if (m.texturesA.z >= 0) {
     vec3 t = safeNormalize(v_tangent.xyz - n * dot(n, v_tangent.xyz), vec3(1, 0, 0));
     vec3 b = cross(n, t) * (v_tangent.w < 0.0 ? -1.0 : 1.0);
-    vec3 tn = texture(t_normal, uvSet(m.texturesA.z)).xyz * 2.0 - 1.0;
+    vec3 tn = texture(t_normal, materialUv(m, SLOT_NORMAL, uvSet(m.texturesA.z))).xyz * 2.0 - 1.0;
     tn.xy *= m.scales.x;
     n = safeNormalize(t * tn.x + b * tn.y + n * tn.z, n);
   }
@@ -56,14 +56,14 @@ void main() {
   float metallic = m.metallicRoughness.x;
   float roughness = m.metallicRoughness.y;
   if (m.texturesA.y >= 0) {
-    vec4 mr = texture(t_metallicRoughness, uvSet(m.texturesA.y));
+    vec4 mr = texture(t_metallicRoughness, materialUv(m, SLOT_METALLIC_ROUGHNESS, uvSet(m.texturesA.y)));
     roughness *= mr.g;
     metallic *= mr.b;
   }
   float occlusion = 1.0;
-  if (m.texturesA.w >= 0) occlusion = 1.0 + m.scales.y * (texture(t_occlusion, uvSet(m.texturesA.w)).r - 1.0);
+  if (m.texturesA.w >= 0) occlusion = 1.0 + m.scales.y * (texture(t_occlusion, materialUv(m, SLOT_OCCLUSION, uvSet(m.texturesA.w))).r - 1.0);
   vec3 emission = m.emission.rgb;
-  if (m.texturesB.x >= 0) emission *= texture(t_emissive, uvSet(m.texturesB.x)).rgb;
+  if (m.texturesB.x >= 0) emission *= texture(t_emissive, materialUv(m, SLOT_EMISSIVE, uvSet(m.texturesB.x))).rgb;
 
   // Geometric normal on the side the viewer sees: used for shadow normal-offset bias.
   vec3 geo = dot(faceNormal, u_eye - v_position) < 0.0 ? -faceNormal : faceNormal;
@@ -75,4 +75,12 @@ void main() {
   o_material = vec4(clamp(metallic, 0.0, 1.0), clamp(roughness, 0.0, 1.0), occlusion, m.metallicRoughness.z);
   o_emission = vec4(emission, m.metallicRoughness.w);
   o_geoNormal = vec4(geo, 0.0);
+  if (m.texturesB.z != 0) {
+    // KHR_materials_unlit: the base colour is the radiance leaving the surface and nothing lights it;
+    // normal.w = 0 tells the shading passes, and a black non-metal albedo keeps ambient terms out.
+    o_normal.w = 0.0;
+    o_albedo = vec4(0.0, 0.0, 0.0, base.a);
+    o_material = vec4(0.0, 1.0, 1.0, 0.0);
+    o_emission = vec4(base.rgb, 1.5);
+  }
 }

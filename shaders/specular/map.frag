@@ -32,7 +32,7 @@ void main() {
   if (u_faceMode == 1 && gl_FrontFacing) discard;
   Material m = materials[u_material];
   vec4 base = m.baseColorFactor;
-  if (m.texturesA.x >= 0) base *= texture(t_baseColor, uvSet(m.texturesA.x));
+  if (m.texturesA.x >= 0) base *= texture(t_baseColor, materialUv(m, SLOT_BASE_COLOR, uvSet(m.texturesA.x)));
   if (int(m.scales.w) == 1 && base.a < m.scales.z) discard;
 
   vec3 toP = v_position - u_reference;
@@ -51,7 +51,7 @@ void main() {
   float metallic = m.metallicRoughness.x;
   float roughness = m.metallicRoughness.y;
   if (m.texturesA.y >= 0) {
-    vec4 mr = texture(t_metallicRoughness, uvSet(m.texturesA.y));
+    vec4 mr = texture(t_metallicRoughness, materialUv(m, SLOT_METALLIC_ROUGHNESS, uvSet(m.texturesA.y)));
     roughness *= mr.g;
     metallic *= mr.b;
   }
@@ -69,7 +69,7 @@ void main() {
     float nv = dot(ns, wo);
     if (nv < 1e-3) ns = normalize(ns + wo * (1e-3 - nv));
     vec3 emission = m.emission.rgb;
-    if (m.texturesB.x >= 0) emission *= texture(t_emissive, uvSet(m.texturesB.x)).rgb;
+    if (m.texturesB.x >= 0) emission *= texture(t_emissive, materialUv(m, SLOT_EMISSIVE, uvSet(m.texturesB.x))).rgb;
     // glTF emission leaves the front face only unless the material is double-sided (as the reference).
     bool emits = gl_FrontFacing || m.texturesB.y != 0;
     vec3 L = (emits ? emission : vec3(0.0)) +
