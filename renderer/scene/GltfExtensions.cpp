@@ -18,6 +18,8 @@ const std::vector<std::string>& supportedExtensions() {
       "KHR_mesh_quantization",  // any component type is read and normalised
       "KHR_texture_transform",
       "KHR_materials_unlit",
+      "KHR_draco_mesh_compression",  // decoded at load (GltfCompression.cpp)
+      "EXT_meshopt_compression",     // decoded at load (GltfCompression.cpp)
   };
   return k;
 }

@@ -15,7 +15,9 @@
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>  // Debian ships tinygltf as a shared library: no TINYGLTF_IMPLEMENTATION here
 
+#include "renderer/scene/GltfCompression.h"
 #include "renderer/scene/GltfExtensions.h"
+#include "renderer/scene/GltfPackage.h"
 
 namespace radiant {
 namespace {
@@ -1042,6 +1044,23 @@ Scene load(std::string_view bytes, const fs::path& baseDir, const fs::path& root
   }
   std::vector<std::string> warnings;
   validateDocument(doc, baseDir, root, warnings);
+  // EXT_meshopt_compression is decoded into a plain GLB before tinygltf sees the file, KHR_draco_mesh_compression
+  // into the model right after (GltfCompression.h).
+  std::string decodedBytes;
+  std::string_view source = bytes;
+  bool sourceGlb = glb;
+  const bool meshopt = gltf::usesMeshopt(doc), draco = gltf::usesDraco(doc);
+  if (meshopt || draco) {
+    try {
+      decodedBytes = packGltf(bytes, baseDir, root, options.maxBytes, true).bytes;
+    } catch (const PackError& e) {
+      throw SceneError(e.pointer, e.what());
+    }
+    if (meshopt) decodedBytes = gltf::decodeMeshopt(decodedBytes, options.maxBytes);
+    if (draco) decodedBytes = gltf::prepareDraco(decodedBytes);
+    source = decodedBytes;
+    sourceGlb = true;
+  }
 
   FsContext fsContext;
   fsContext.root = root;
@@ -1058,11 +1077,11 @@ Scene load(std::string_view bytes, const fs::path& baseDir, const fs::path& root
   bool ok = false;
   try {
     const std::string base = baseDir.string();
-    ok = glb ? loader.LoadBinaryFromMemory(&model, &err, &warn,
-                                           reinterpret_cast<const unsigned char*>(bytes.data()),
-                                           static_cast<unsigned int>(bytes.size()), base)
-             : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(),
-                                          static_cast<unsigned int>(bytes.size()), base);
+    ok = sourceGlb ? loader.LoadBinaryFromMemory(&model, &err, &warn,
+                                                 reinterpret_cast<const unsigned char*>(source.data()),
+                                                 static_cast<unsigned int>(source.size()), base)
+                   : loader.LoadASCIIFromString(&model, &err, &warn, source.data(),
+                                                static_cast<unsigned int>(source.size()), base);
   } catch (const std::exception& e) {
     err += e.what();
     ok = false;
@@ -1073,6 +1092,7 @@ Scene load(std::string_view bytes, const fs::path& baseDir, const fs::path& root
       if (c == '\n') c = ';';
     throw SceneError("", "invalid glTF: " + (err.empty() ? std::string("unknown error") : err));
   }
+  gltf::decodeDraco(model, options.maxBytes);
   Scene scene = Converter(model, options.maxBytes).run();
   scene.warnings.insert(scene.warnings.begin(), warnings.begin(), warnings.end());
   scene.digest = "sha256:" + digest.finishHex();

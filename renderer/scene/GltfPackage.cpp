@@ -157,7 +157,8 @@ fs::path resolveRelativeUri(const std::string& uri, const std::string& ptr, cons
   return resolved;
 }
 
-PackResult packGltf(std::string_view bytes, const fs::path& baseDir, const fs::path& root, std::size_t maxBytes) {
+PackResult packGltf(std::string_view bytes, const fs::path& baseDir, const fs::path& root, std::size_t maxBytes,
+                    bool force) {
   const bool glb = bytes.size() >= 4 && bytes.substr(0, 4) == "glTF";
   std::string_view jsonText = bytes, bin;
   bool hasBin = false;
@@ -179,7 +180,7 @@ PackResult packGltf(std::string_view bytes, const fs::path& baseDir, const fs::p
   if (doc.is_discarded() || !doc.is_object())
     throw PackError("", std::string(glb ? "the GLB JSON chunk" : "the file") + " is not a glTF JSON object");
   PackResult result;
-  if (!hasExternalUri(doc)) {
+  if (!force && !hasExternalUri(doc)) {
     result.bytes = std::string(bytes);
     return result;
   }

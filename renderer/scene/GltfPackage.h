@@ -42,9 +42,11 @@ std::filesystem::path resolveRelativeUri(const std::string& uri, const std::stri
                                          const std::filesystem::path& baseDir, const std::filesystem::path& root);
 
 // Packs `bytes` (.gltf JSON or GLB) whose URIs are relative to `baseDir`, reading only inside `root`.
-// At most `maxBytes` are read from external files in total.
+// At most `maxBytes` are read from external files in total. `force`: write a GLB with every data
+// buffer in its BIN chunk even when nothing external is referenced (the meshopt decoder needs that).
 PackResult packGltf(std::string_view bytes, const std::filesystem::path& baseDir,
-                    const std::filesystem::path& root, std::size_t maxBytes = std::size_t(1) << 31);
+                    const std::filesystem::path& root, std::size_t maxBytes = std::size_t(1) << 31,
+                    bool force = false);
 
 // Reads `file` (.gltf or .glb) and packs it with root = `root` (empty: the file's folder). The file
 // itself must lie inside the root.

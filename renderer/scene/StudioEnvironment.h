@@ -11,7 +11,7 @@
 //   key:    a soft round area light of angular radius 15 degrees towards (1, 1.25, 1)/|.| (above,
 //           in front of and to the right of the automatic camera, which looks down -Z from +Z),
 //           radiance 8 at its centre falling off as a smoothstep to 0 at its rim.
-// Its solid-angle mean radiance is about 0.44 (environmentAverage()), the value passes that model
+// Its solid-angle mean radiance is 0.466 (environmentAverage()), the value passes that model
 // a uniform sky (ambient occlusion) use; the reference path tracer samples the map itself.
 #include <string>
 
