@@ -220,5 +220,86 @@ TEST_F(Content, ClientRefusesUrisOutsideTheGltfFolderBeforeUploading) {
   EXPECT_EQ(json::parse(res->body).value("pointer", ""), "/scene/asset");
 }
 
+// The client's lighting and camera options each reach the request and show in the stats.
+TEST_F(Content, ClientLightingCameraAndRequestOptions) {
+  const fs::path box = fs::path(RADIANT_GLTF_SAMPLES_DIR) / "BoxTextured" / "glTF" / "BoxTextured.gltf";
+  if (!fs::exists(box)) GTEST_SKIP() << "no BoxTextured sample";
+  auto run = [&](const std::string& tag, const std::string& options) {
+    const fs::path exr = *dir_ / (tag + ".exr"), stats = *dir_ / (tag + ".json");
+    const ProcessRun r = client(daemon_->url(), "render '" + box.string() + "' -o '" + exr.string() +
+                                                    "' --float --aov beauty --aov depth --stats '" + stats.string() +
+                                                    "' " + options,
+                                *dir_);
+    EXPECT_EQ(r.code, 0) << tag << ": " << r.err;
+    return std::pair{readFrame(exr, stats), json::parse(testing::slurp(stats))};
+  };
+  // A uniform environment of radiance 2 (an EXR the client uploads by digest): the background is 2.
+  Image env = Image::make("beauty", 8, 4, 3);
+  for (float& v : env.pixels) v = 2.f;
+  io::writeFile((*dir_ / "uniform2.exr").string(), io::encodeExr({env}, false));
+  {
+    auto [f, all] = run("env", "--size 32x32 --environment '" + (*dir_ / "uniform2.exr").string() + "' --camera 'yfov=20'");
+    EXPECT_EQ(f.stats["lighting"], "environment");
+    EXPECT_EQ(all["request"]["environment"].get<std::string>().rfind("sha256:", 0), 0u);
+    EXPECT_NEAR(f.beauty.at(0, 0)[0], 2.f, 1e-3f) << "the corner sees the sky";
+    EXPECT_EQ(f.stats["camera"]["source"], "request+auto");
+    EXPECT_NEAR(f.stats["camera"]["yfov_deg"].get<double>(), 20.0, 1e-4);
+  }
+  {
+    auto [f, all] = run("ambient", "--size 32x32 --ambient 0.5,0.25,0.125");
+    EXPECT_EQ(f.stats["lighting"], "ambient");
+    EXPECT_NEAR(f.beauty.at(0, 0)[1], 0.25f, 1e-6f);
+  }
+  {
+    auto [f, all] = run("dark", "--size 32x32 --no-default-lighting");
+    EXPECT_EQ(f.stats["lighting"], "none");
+    EXPECT_EQ(objectMean(f).first, 0.0);
+  }
+  {
+    // --request: a whole request from a file, with -o's outputs and the camera option on top.
+    std::ofstream(*dir_ / "req.json") << json{{"width", 40}, {"height", 24}, {"seed", 7},
+                                              {"camera", {{"position", {0.0, 0.0, 4.0}}}}}.dump();
+    auto [f, all] = run("request", "--request '" + (*dir_ / "req.json").string() + "' --camera 'target=0,0.5,0'");
+    EXPECT_EQ(f.beauty.width, 40);
+    EXPECT_EQ(f.beauty.height, 24);
+    EXPECT_EQ(all["request"]["seed"], 7);
+    EXPECT_EQ(f.stats["camera"]["position"], json::array({0.0, 0.0, 4.0}));
+    EXPECT_NEAR(f.stats["camera"]["target"][1].get<double>(), 0.5, 1e-6);
+  }
+  // Bad option values are usage errors.
+  EXPECT_EQ(client(daemon_->url(), "render '" + box.string() + "' -o x.png --camera 'fov=3'", *dir_).code, 2);
+  EXPECT_EQ(client(daemon_->url(), "render '" + box.string() + "' -o x.png --ambient 1,2", *dir_).code, 2);
+}
+
+// radiant sweep packs a .gltf scene file with its files too: the points name the packed GLB's digest.
+TEST_F(Content, SweepPacksGltfSceneFiles) {
+  const fs::path box = fs::path(RADIANT_GLTF_SAMPLES_DIR) / "BoxTextured" / "glTF" / "BoxTextured.gltf";
+  if (!fs::exists(box)) GTEST_SKIP() << "no BoxTextured sample";
+  std::ofstream(*dir_ / "sweep.json") << json{{"base", {{"scene", {{"file", box.string()}}}, {"width", 16}, {"height", 16}}},
+                                              {"axes", {{"exposure", {0, 1}}}},
+                                              {"repeats", 1},
+                                              {"warmup", 0}}.dump();
+  const ProcessRun r = client(daemon_->url(), "sweep '" + (*dir_ / "sweep.json").string() + "' -o '" +
+                                                  (*dir_ / "sweep.jsonl").string() + "'",
+                              *dir_);
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream in(*dir_ / "sweep.jsonl");
+  std::string line;
+  int points = 0;
+  while (std::getline(in, line)) {
+    const json rec = json::parse(line);
+    EXPECT_FALSE(rec.contains("error")) << line;
+    // The digest of the packed GLB: the same one `radiant render` uploads (a GLB on the server).
+    auto c = daemon_->client();
+    const std::string digest = rec["request"]["scene"]["digest"];
+    auto res = c.Get(("/v1/scenes/" + digest).c_str());
+    ASSERT_TRUE(res);
+    ASSERT_EQ(res->status, 200);
+    EXPECT_EQ(res->body.substr(0, 4), "glTF");
+    ++points;
+  }
+  EXPECT_EQ(points, 2);
+}
+
 }  // namespace
 }  // namespace radiant
