@@ -2,6 +2,7 @@
 // Writes the `direct` AOV and initialises `beauty` with the same value (later passes add to beauty).
 #include "common/direct_lighting.glsl"
 #include "common/environment.glsl"
+#include "common/ibl.glsl"
 
 in vec2 v_uv;
 
@@ -19,6 +20,8 @@ uniform vec3 u_background;  // radiance seen where no surface is (the uniform sk
 uniform int u_hasEnvironment;  // 1: the background is the environment map instead
 uniform mat4 u_invViewProj;
 layout(binding = 8) uniform sampler2D t_environment;
+layout(binding = 9) uniform sampler2D t_dfg;
+layout(binding = 10) uniform sampler2DArray t_prefiltered;
 
 layout(location = 0) out vec4 o_direct;
 layout(location = 1) out vec4 o_beauty;
@@ -59,6 +62,11 @@ void main() {
   if (nv < 1e-3) n = normalize(n + wo * (1e-3 - nv));
 
   vec3 L = emission + directLighting(p, n, ng, wo, albedo, mat.x, mat.y, mat.w, emissionIor.a);
+  // The environment's specular reflection (split-sum), times the material's baked occlusion. Mirror-
+  // like metals and transmissive surfaces belong to the specular pass (Material::isSpecular()).
+  bool specularOwned = (mat.x > 0.5 && mat.y < 0.2) || mat.w > 0.0;
+  if (u_iblMode != IBL_NONE && !specularOwned)
+    L += mat.z * iblSpecular(t_dfg, t_prefiltered, n, wo, albedo, mat.x, mat.y, emissionIor.a);
   o_direct = vec4(L, 1.0);
   o_beauty = o_direct;
 }

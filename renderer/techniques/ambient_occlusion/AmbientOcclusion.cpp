@@ -9,6 +9,7 @@
 #include <glm/gtc/constants.hpp>
 
 #include "renderer/frame/PassContext.h"
+#include "renderer/techniques/direct/ImageBasedLighting.h"
 
 namespace radiant {
 namespace ao {
@@ -219,7 +220,7 @@ const TechniqueInfo& AmbientOcclusionPass::info() const {
   static const TechniqueInfo i{
       "ambient_occlusion",
       "Screen-space ambient occlusion (volumetric, containment, crytek, gtao) applied to the ambient light",
-      {"gbuffer_position", "normal", "albedo", "material", "geometric_normal"},
+      {"gbuffer_position", "normal", "albedo", "material", "geometric_normal", "emission"},
       {"direct"},  // runs after direct, which initialises beauty
       {"ao"},
       true,
@@ -277,6 +278,7 @@ void AmbientOcclusionPass::prepare(const Scene&, const Params& params, FrameReso
   resolve.setDrawBuffers({GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1});
   resolve.checkComplete("AmbientOcclusionPass::prepare (resolve)");
   res.buffer("ao_samples", sizeof(ao::SampleBlock));
+  ibl::prepare(res);  // the SH irradiance and the DFG table's diffuse Fresnel weight
 }
 
 void AmbientOcclusionPass::execute(PassContext& ctx) {
@@ -347,7 +349,11 @@ void AmbientOcclusionPass::execute(PassContext& ctx) {
   rp.set("u_scale", scale_);
   rp.set("u_blur", blur_ ? 1 : 0);
   rp.set("u_radius", radius_);
-  rp.set("u_ambient", &view.ambient[0], 3);
+  res.texture("emission").bindUnit(6);
+  ibl::bind(res, rp, 7, -1);
+  rp.set("u_eye", &view.eye[0], 3);
+  rp.set("u_viewForward", &forward[0], 3);
+  rp.set("u_orthographic", ortho ? 1 : 0);
   glDrawArrays(GL_TRIANGLES, 0, 3);
   glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   glDisablei(GL_BLEND, 1);

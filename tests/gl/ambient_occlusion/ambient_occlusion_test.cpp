@@ -199,6 +199,8 @@ AoFrame renderAo(const Scene& scene, int size, json params, glm::vec3 ambient = 
   api::RenderRequest req;
   req.width = req.height = size;
   req.ambient = ambient;
+  // Beauty holds what this pass adds: the environment's specular reflection is the direct pass's.
+  req.passes["direct"] = json{{"image_based_lighting", false}};
   req.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty", "ao", "gbuffer_position", "normal"}, false}};
   req.passes["ambient_occlusion"] = std::move(params);
   RenderOutput out = renderer().render(scene, req);
