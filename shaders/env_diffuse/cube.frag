@@ -75,6 +75,7 @@ void main() {
     vec3 kd = base.rgb * (1.0 - metallic) * (1.0 - transmission);
     L += kd * INV_PI * gatherIrradiance(v_position, n, ENV_METHOD_POLYGON, u_horizonClip != 0);
   }
+  if (m.texturesB.z != 0) L = base.rgb;  // KHR_materials_unlit: its base colour, lit by nothing
   o_radiance = vec4(L, 1.0);
   o_geometry = vec4(dist, n);
 }

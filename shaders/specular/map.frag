@@ -75,6 +75,7 @@ void main() {
     vec3 L = (emits ? emission : vec3(0.0)) +
              directLighting(v_position, ns, ng, wo, base.rgb, clamp(metallic, 0.0, 1.0),
                             clamp(roughness, 0.0, 1.0), transmission, ior);
+    if (m.texturesB.z != 0) L = base.rgb;  // KHR_materials_unlit: its base colour, lit by nothing
     o_material = vec4(L, 0.0);
   }
   o_geometry = vec4(octEncode(n), max(dist, 1e-30), float(u_objectCode));

@@ -217,6 +217,34 @@ TEST(Unlit, EqualsBaseColourWhateverLightsTheScene) {
   EXPECT_GT(aov(lit, "beauty").at(28, 28)[1], 0.5f * 1.5f);
 }
 
+TEST(Unlit, AMirrorReflectsTheUnlitBaseColour) {
+  // A white mirror floor seen straight down reflects an unlit ceiling above the camera: Schlick F = 1
+  // for a white metal, so the reflection is the ceiling's base colour exactly, with no light anywhere
+  // (default lighting off: a shaded ceiling would be black).
+  testing::SceneBuilder b;
+  Material mirror;
+  mirror.metallicFactor = 1.f;
+  mirror.roughnessFactor = 0.f;
+  Material ceiling = testing::lambertian(glm::vec3(0.2f, 0.4f, 0.6f));
+  ceiling.unlit = true;
+  ceiling.doubleSided = true;
+  b.quad({0, 0, 0}, {50, 0, 0}, {0, 0, -50}, b.material(mirror), "mirror");
+  b.quad({0, 3, 0}, {50, 0, 0}, {0, 0, 50}, b.material(ceiling), "ceiling");  // faces down, behind the camera
+  b.topDownOrtho(2.f, 1.f);
+  const Scene scene = b.build("unlit-mirror");
+  api::RenderRequest req = exrRequest(8);
+  req.defaultLighting = false;
+  req.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty", "specular"}, false}};
+  const RenderOutput out = renderer().render(scene, req);
+  const Image& spec = aov(out, "specular");
+  for (int y = 2; y < 6; ++y)
+    for (int x = 2; x < 6; ++x) {
+      EXPECT_NEAR(spec.at(x, y)[0], 0.2f, 2e-3f);
+      EXPECT_NEAR(spec.at(x, y)[1], 0.4f, 2e-3f);
+      EXPECT_NEAR(spec.at(x, y)[2], 0.6f, 2e-3f);
+    }
+}
+
 // ---- image-based lighting: the white furnace ---------------------------------------------------------
 
 // Directional albedo of the glTF BSDF at n.v = mu, by the reference's own sampler (renderer/reference/
