@@ -72,7 +72,7 @@ GpuScene::GpuScene(const Scene& scene) : sceneKey(nextSceneKey(scene)) {
     auto uvSet = [](const TextureRef& r) { return r.valid() ? r.texCoord : -1; };
     g.texturesA = glm::ivec4(uvSet(m.baseColorTexture), uvSet(m.metallicRoughnessTexture),
                              uvSet(m.normalTexture), uvSet(m.occlusionTexture));
-    g.texturesB = glm::ivec4(uvSet(m.emissiveTexture), m.doubleSided ? 1 : 0, m.unlit ? 1 : 0, 0);
+    g.texturesB = glm::ivec4(uvSet(m.emissiveTexture), m.doubleSided ? 1 : 0, m.unlit ? 1 : 0, m.isSpecular() ? 1 : 0);
     const TextureRef* slots[gpu::kSlotCount] = {&m.baseColorTexture, &m.metallicRoughnessTexture, &m.normalTexture,
                                                 &m.occlusionTexture, &m.emissiveTexture};
     for (int s = 0; s < gpu::kSlotCount; ++s) {

@@ -16,7 +16,8 @@ struct Material {
   glm::vec4 metallicRoughness;  // x metallic, y roughness, z transmission, w ior
   glm::vec4 scales;             // x normal scale, y occlusion strength, z alpha cutoff, w alpha mode (0 opaque, 1 mask, 2 blend)
   glm::ivec4 texturesA;         // texCoord index per slot (base, mr, normal, occlusion) or -1 when absent
-  glm::ivec4 texturesB;         // x emissive texCoord or -1, y doubleSided, z unlit (KHR_materials_unlit), w unused
+  glm::ivec4 texturesB;         // x emissive texCoord or -1, y doubleSided, z unlit (KHR_materials_unlit),
+                                // w Material::isSpecular() (the specular pass owns its reflections)
   // KHR_texture_transform per slot: rows 2 slot and 2 slot + 1 of uv' = M (u, v, 1) (xyz used).
   glm::vec4 uvTransform[2 * kSlotCount];
 };

@@ -15,7 +15,7 @@ struct Material {
   vec4 metallicRoughness;  // x metallic, y roughness, z transmission, w ior
   vec4 scales;             // x normal scale, y occlusion strength, z alpha cutoff, w alpha mode
   ivec4 texturesA;         // uv set per slot (base, mr, normal, occlusion), -1 = none
-  ivec4 texturesB;         // x emissive uv set, y doubleSided, z unlit (KHR_materials_unlit)
+  ivec4 texturesB;         // x emissive uv set, y doubleSided, z unlit (KHR_materials_unlit), w specular-owned
   vec4 uvTransform[10];    // KHR_texture_transform: rows 2 slot, 2 slot + 1 of the affine uv map
 };
 

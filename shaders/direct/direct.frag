@@ -54,7 +54,8 @@ void main() {
   vec4 mat = texelFetch(t_material, px, 0);
   vec4 emissionIor = texelFetch(t_emission, px, 0);
   vec3 emission = emissionIor.rgb;
-  vec3 ng = texelFetch(t_geoNormal, px, 0).xyz;
+  vec4 ngOwned = texelFetch(t_geoNormal, px, 0);
+  vec3 ng = ngOwned.xyz;
   vec3 wo = u_orthographic != 0 ? -u_viewForward : normalize(u_eye - p);
   // Interpolated or mapped normals can face away from the viewer at silhouettes; bend them back just
   // enough to be visible instead of shading them black (NdotV >= 1e-3).
@@ -63,8 +64,9 @@ void main() {
 
   vec3 L = emission + directLighting(p, n, ng, wo, albedo, mat.x, mat.y, mat.w, emissionIor.a);
   // The environment's specular reflection (split-sum), times the material's baked occlusion. Mirror-
-  // like metals and transmissive surfaces belong to the specular pass (Material::isSpecular()).
-  bool specularOwned = (mat.x > 0.5 && mat.y < 0.2) || mat.w > 0.0;
+  // like metals and transmissive materials belong to the specular pass (Material::isSpecular(), the
+  // same per-material rule the planner and that pass use; the G-buffer carries it in ng.w).
+  bool specularOwned = ngOwned.w > 0.5;
   if (u_iblMode != IBL_NONE && !specularOwned)
     L += mat.z * iblSpecular(t_dfg, t_prefiltered, n, wo, albedo, mat.x, mat.y, emissionIor.a);
   o_direct = vec4(L, 1.0);

@@ -21,7 +21,8 @@ layout(location = 1) out vec4 o_normal;    // xyz shading normal, w = 1
 layout(location = 2) out vec4 o_albedo;    // rgb base colour
 layout(location = 3) out vec4 o_material;  // metallic, roughness, occlusion, transmission
 layout(location = 4) out vec4 o_emission;  // rgb emitted radiance, a = ior (KHR_materials_ior)
-layout(location = 5) out vec4 o_geoNormal; // xyz geometric normal facing the viewer side
+layout(location = 5) out vec4 o_geoNormal; // xyz geometric normal facing the viewer side, w = 1 when the
+                                           // specular pass owns the surface's reflections (isSpecular())
 
 vec2 uvSet(int set) { return set == 1 ? v_uv1 : v_uv0; }
 
@@ -74,7 +75,7 @@ void main() {
   o_albedo = vec4(base.rgb, base.a);
   o_material = vec4(clamp(metallic, 0.0, 1.0), clamp(roughness, 0.0, 1.0), occlusion, m.metallicRoughness.z);
   o_emission = vec4(emission, m.metallicRoughness.w);
-  o_geoNormal = vec4(geo, 0.0);
+  o_geoNormal = vec4(geo, m.texturesB.w != 0 ? 1.0 : 0.0);
   if (m.texturesB.z != 0) {
     // KHR_materials_unlit: the base colour is the radiance leaving the surface and nothing lights it;
     // normal.w = 0 tells the shading passes, and a black non-metal albedo keeps ambient terms out.

@@ -375,6 +375,72 @@ TEST(ImageBasedLighting, MeshWithoutMaterialFollowsTheSpecAndIsNotBlackUnderDefa
   EXPECT_LT(centre, 8.8f * (ab.x + ab.y));  // and below the key's peak
 }
 
+// Split-sum against the reference path tracer on a white-ish metal sphere under a sun-and-sky map,
+// at roughness 0.2, 0.5 and 1 (issue 12 asks to state the error). The errors, measured on this
+// machine, are printed and recorded in docs/TECHNIQUES.md; the bounds are those measurements with a
+// margin for the reference's Monte Carlo noise (256 spp: ~1% on the sphere mean) and llvmpipe, so the
+// test catches a regression of the tables or the prefilter, not the method's known bias.
+Image sunSky() {
+  Image env = Image::make("environment", 128, 64, 3);
+  const glm::vec3 sun = glm::normalize(glm::vec3(0.6f, 0.8f, 0.4f));
+  for (int y = 0; y < env.height; ++y)
+    for (int x = 0; x < env.width; ++x) {
+      const float u = (x + 0.5f) / env.width, v = (y + 0.5f) / env.height;
+      const float phi = (u - 0.5f) * 2.f * glm::pi<float>(), theta = v * glm::pi<float>();
+      const glm::vec3 d(std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi));
+      glm::vec3 L = d.y > 0.f ? glm::mix(glm::vec3(0.6f, 0.7f, 0.9f), glm::vec3(0.2f, 0.35f, 0.8f), d.y)
+                              : glm::vec3(0.15f, 0.12f, 0.1f);
+      if (glm::dot(d, sun) > std::cos(glm::radians(4.f))) L += glm::vec3(60.f, 55.f, 45.f);
+      float* p = env.at(x, y);
+      p[0] = L.x; p[1] = L.y; p[2] = L.z;
+    }
+  return env;
+}
+
+TEST(ImageBasedLighting, SplitSumAgainstTheReferenceOnAMetalSphereUnderASunSky) {
+  const Image env = sunSky();
+  // Measured (2026-12-01, llvmpipe): sphere-mean error -1.2%, -2.6%, -6.4%; relative L1 7.4%, 10.7%,
+  // 27%; PSNR 34.0, 30.9, 25.2 dB. The error grows with roughness: Karis' n = v = R prefilter misses
+  // the lobe's stretching at grazing angles, which widens with alpha.
+  const float bound[3] = {0.04f, 0.06f, 0.12f}, boundL1[3] = {0.12f, 0.16f, 0.35f};
+  int k = 0;
+  for (float roughness : {0.2f, 0.5f, 1.f}) {
+    testing::SceneBuilder b;
+    Material metal;
+    metal.baseColorFactor = glm::vec4(0.9f, 0.9f, 0.9f, 1.f);
+    metal.metallicFactor = 1.f;
+    metal.roughnessFactor = roughness;
+    b.sphere({0, 0, 0}, 1.f, b.material(metal), 96, 48);
+    const Scene scene = b.build("sunsky-metal-" + std::to_string(roughness));
+    api::RenderRequest req;
+    req.width = req.height = 48;
+    req.environment = "sha256:" + std::string(64, 'a');
+    req.camera = api::CameraOverride{{0, 0, 4}, {0, 0, 0}, {0, 1, 0}, 35.f};
+    req.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty", "normal"}, false}};
+    req.compare = api::CompareSpec{"reference", "beauty", 256, 1};
+    const RenderOutput out = renderer().render(scene, req, nullptr, FrameInputs{nullptr, &env});
+    const Image& beauty = aov(out, "beauty");
+    const Image& ref = aov(out, "reference");
+    const Image& normal = aov(out, "normal");
+    double a = 0.0, r = 0.0, absErr = 0.0;
+    for (int y = 0; y < 48; ++y)
+      for (int x = 0; x < 48; ++x) {
+        if (glm::length(glm::vec3(normal.at(x, y)[0], normal.at(x, y)[1], normal.at(x, y)[2])) < 0.5f) continue;
+        for (int c = 0; c < 3; ++c) {
+          a += beauty.at(x, y)[c];
+          r += ref.at(x, y)[c];
+          absErr += std::abs(beauty.at(x, y)[c] - ref.at(x, y)[c]);
+        }
+      }
+    const double meanErr = std::abs(a - r) / r, l1 = absErr / r;
+    std::cout << "roughness " << roughness << ": sphere mean radiance raster/reference - 1 = " << (a / r - 1.0)
+              << ", relative L1 " << l1 << ", PSNR " << out.stats.metrics["psnr"] << " dB\n";
+    EXPECT_LT(meanErr, bound[k]) << "roughness " << roughness;
+    EXPECT_LT(l1, boundL1[k]) << "roughness " << roughness;
+    ++k;
+  }
+}
+
 // ---- camera overrides and stats --------------------------------------------------------------------
 
 TEST(Camera, PartialOverrideKeepsTheAutomaticFramingAndStatsReportIt) {
