@@ -606,6 +606,7 @@ private:
     if (index < 0) return {};
     if (std::size_t(index) >= scene_.textures.size())
       throw SceneError(ptr + "/index", "texture " + std::to_string(index) + " does not exist");
+    if (!textureUsable_[std::size_t(index)]) return {};  // dropped with a warning (convertTextures)
     if (texCoord < 0 || texCoord > 1)
       throw SceneError(ptr + "/texCoord", "TEXCOORD_" + std::to_string(texCoord) +
                                               " is not supported (only TEXCOORD_0 and TEXCOORD_1)");
@@ -630,8 +631,18 @@ private:
     for (std::size_t i = 0; i < m_.textures.size(); ++i) {
       const auto& t = m_.textures[i];
       const std::string ptr = pointer("/textures", i);
-      if (t.source < 0 || std::size_t(t.source) >= m_.images.size())
-        throw SceneError(ptr + "/source", "texture " + std::to_string(i) + " has no usable source image");
+      if (t.source < 0) {
+        // Valid glTF (source is optional; an extension such as KHR_texture_basisu may name the only
+        // image): the materials render without this texture, and the frame says so.
+        scene_.warnings.push_back(ptr + ": texture " + std::to_string(i) +
+                                  " has no image this renderer can use: materials render without it");
+        scene_.textures.emplace_back();
+        textureUsable_.push_back(false);
+        continue;
+      }
+      if (std::size_t(t.source) >= m_.images.size())
+        throw SceneError(ptr + "/source", "texture " + std::to_string(i) + " names image " + std::to_string(t.source) +
+                                              ", which does not exist");
       const auto& img = m_.images[std::size_t(t.source)];
       const std::string iptr = pointer("/images", std::size_t(t.source));
       if (img.image.empty() || img.width <= 0 || img.height <= 0 || img.component != 4)
@@ -665,6 +676,7 @@ private:
         if (s.magFilter >= 0) out.magFilter = s.magFilter;
       }
       scene_.textures.push_back(std::move(out));
+      textureUsable_.push_back(true);
     }
   }
 
@@ -994,6 +1006,7 @@ private:
   const tinygltf::Model& m_;
   std::size_t maxBytes_;
   Scene scene_;
+  std::vector<bool> textureUsable_;  // per glTF texture: false when dropped with a warning
 };
 
 // ---- top level ------------------------------------------------------------------------------

@@ -176,5 +176,21 @@ TEST(GltfCompression, UnsupportedOptionalExtensionIsAWarningNotSilence) {
   EXPECT_NE(s.warnings[0].find("KHR_materials_clearcoat"), std::string::npos) << s.warnings[0];
 }
 
+// glTF-Validator accepts a texture without a source (an extension may hold its only image): the file
+// renders, the material without that texture, and a warning names it.
+TEST(GltfWarnings, TextureWithoutSourceIsDroppedWithAWarning) {
+  GltfBuilder b;
+  const int mat = b.material({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}});
+  const int m = b.mesh(json::array({test::trianglePrimitive<std::uint8_t>(b, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {0, 1, 2},
+                                                                            {}, {{0, 0}, {1, 0}, {0, 1}}, mat)}));
+  b.scene({b.node({{"mesh", m}})});
+  b.doc["textures"] = json::array({{{"extensions", {{"KHR_texture_basisu", {{"source", 0}}}}}}});
+  b.doc["extensionsUsed"] = {"KHR_texture_basisu"};
+  const Scene s = loadSceneFromMemory(b.gltf());
+  EXPECT_FALSE(s.materials[0].baseColorTexture.valid());
+  ASSERT_EQ(s.warnings.size(), 2u);  // the unsupported extension, and the texture it leaves without an image
+  EXPECT_NE(s.warnings[1].find("/textures/0"), std::string::npos) << s.warnings[1];
+}
+
 }  // namespace
 }  // namespace radiant
