@@ -571,6 +571,7 @@ TEST_F(ParityTest, SamplerUnitsAreUniqueAcrossTheFramesPrograms) {
       {"gbuffer/gbuffer.vert", "gbuffer/gbuffer.frag"},   {"common/fullscreen.vert", "direct/direct.frag"},
       {"specular/map.vert", "specular/map.frag"},         {"specular/map.vert", "specular/specular.frag"},
       {"env_diffuse/cube.vert", "env_diffuse/cube.frag"}, {"env_diffuse/cube.vert", "env_diffuse/receiver.frag"},
+      {"common/fullscreen.vert", "ambient_occlusion/ao_resolve.frag"},  // image-based lighting's DFG table
   };
   std::map<int, std::string> sharedUnitOwner;  // unit >= 6 -> sampler name
   int samplers = 0;
