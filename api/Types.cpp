@@ -23,7 +23,11 @@ void to_json(nlohmann::json& j, const FrameStats& s) {
                      {"triangles", s.triangles},
                      {"lights", s.lights},
                      {"device", s.device},
-                     {"metrics", s.metrics}};
+                     {"metrics", s.metrics},
+                     {"lighting", s.lighting},
+                     {"camera", s.camera},
+                     {"scene", s.scene},
+                     {"warnings", s.warnings}};
 }
 
 }  // namespace radiant::api

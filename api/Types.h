@@ -29,16 +29,19 @@ struct ApiError : std::runtime_error {
 };
 
 struct SceneRef {
-  enum class Kind { Digest, Builtin, Inline };
+  enum class Kind { Digest, Builtin, Inline, Asset };
   Kind kind = Kind::Builtin;
-  std::string value;  // "sha256:..." | builtin name | base64 GLB (decoded by the server)
+  std::string value;  // "sha256:..." | builtin name | base64 GLB (decoded by the server) | path under --asset-root
 };
 
+// A request's camera. Fields the request did not set (has* false) keep the scene's camera: the file's
+// first camera, or the automatic framing of the scene bounds (renderer/frame/FrameView.cpp).
 struct CameraOverride {
   glm::vec3 position{0.f, 1.f, 3.f};
   glm::vec3 target{0.f, 1.f, 0.f};
   glm::vec3 up{0.f, 1.f, 0.f};
   float yfovDegrees = 40.f;
+  bool hasPosition = true, hasTarget = true, hasUp = true, hasYfov = true;
 };
 
 enum class ImageFormat { Exr, Png };
@@ -71,6 +74,9 @@ struct RenderRequest {
   std::uint64_t seed = 0;
   glm::vec3 ambient{0.f};  // uniform sky radiance L^a (W/sr/m^2), used by ambient passes
   std::string environment;  // digest of an uploaded equirect map ("" none); replaces ambient
+  // With no lights, emission, ambient or environment, light the scene with the default studio
+  // environment (renderer/scene/StudioEnvironment.h); false renders such a scene black.
+  bool defaultLighting = true;
   std::optional<CompareSpec> compare;
   bool async = false;
 };
@@ -98,6 +104,12 @@ struct FrameStats {
   int lights = 0;
   std::map<std::string, std::string> device;  // vendor, renderer, version, device, reason
   nlohmann::json metrics;  // error metrics when a compare block was given (null otherwise)
+  // What lit the frame: "scene" (its lights or emission), "ambient", "environment", "default" (the
+  // studio environment, see RenderRequest::defaultLighting) or "none".
+  std::string lighting;
+  nlohmann::json camera;  // the camera used: position, target, up, yfov_deg, source
+  nlohmann::json scene;   // name, digest, bounds {min, max}, node names
+  std::vector<std::string> warnings;  // things the scene has that this frame could not honour
 };
 
 void to_json(nlohmann::json& j, const PassStats& s);

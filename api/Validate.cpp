@@ -264,18 +264,25 @@ RenderRequest parseRenderRequest(const json& body, const RequestLimits& limits) 
   const json& scene = v["scene"];
   if (scene.contains("digest")) r.scene = {SceneRef::Kind::Digest, scene["digest"]};
   else if (scene.contains("builtin")) r.scene = {SceneRef::Kind::Builtin, scene["builtin"]};
+  else if (scene.contains("asset")) r.scene = {SceneRef::Kind::Asset, scene["asset"]};
   else r.scene = {SceneRef::Kind::Inline, scene["inline_glb"]};
   if (v.contains("camera")) {
     const json& c = v["camera"];
     CameraOverride cam;
-    cam.position = vec3(c["position"]);
-    cam.target = vec3(c["target"]);
-    cam.up = vec3(c["up"]);
-    cam.yfovDegrees = c["yfov_deg"].get<float>();
-    if (glm::length(cam.target - cam.position) == 0.f)
+    cam.hasPosition = c.contains("position");
+    cam.hasTarget = c.contains("target");
+    cam.hasUp = c.contains("up");
+    cam.hasYfov = c.contains("yfov_deg");
+    if (cam.hasPosition) cam.position = vec3(c["position"]);
+    if (cam.hasTarget) cam.target = vec3(c["target"]);
+    if (cam.hasUp) cam.up = vec3(c["up"]);
+    if (cam.hasYfov) cam.yfovDegrees = c["yfov_deg"].get<float>();
+    if (cam.hasPosition && cam.hasTarget && glm::length(cam.target - cam.position) == 0.f)
       throw ApiError(422, "invalid-value", "Invalid value", "/camera/target: equals the camera position", "/camera/target");
-    if (glm::length(glm::cross(cam.target - cam.position, cam.up)) == 0.f)
+    if (cam.hasPosition && cam.hasTarget && cam.hasUp && glm::length(glm::cross(cam.target - cam.position, cam.up)) == 0.f)
       throw ApiError(422, "invalid-value", "Invalid value", "/camera/up: parallel to the view direction", "/camera/up");
+    if (cam.hasUp && glm::length(cam.up) == 0.f)
+      throw ApiError(422, "invalid-value", "Invalid value", "/camera/up: must not be zero", "/camera/up");
     r.camera = cam;
   }
   r.width = v["width"];
@@ -297,6 +304,7 @@ RenderRequest parseRenderRequest(const json& body, const RequestLimits& limits) 
   r.seed = v["seed"].get<std::uint64_t>();
   r.ambient = vec3(v["ambient"]);
   r.environment = v["environment"].get<std::string>();
+  r.defaultLighting = v["default_lighting"].get<bool>();
   if (!r.environment.empty() && r.ambient != glm::vec3(0.f))
     throw ApiError(422, "invalid-value", "Invalid value",
                    "/environment: give the sky either as ambient or as an environment map, not both", "/environment");

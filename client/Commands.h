@@ -24,6 +24,10 @@ int cmdBench(const GlobalOptions& g, const std::vector<std::string>& args);
 // Helpers shared by commands.
 std::string readFile(const std::string& path);            // throws UsageError
 void writeFile(const std::string& path, const std::string& bytes);  // throws UsageError
+// The bytes to upload for a scene file: a .gltf (or .glb) that references external files is packed
+// with them into one GLB (renderer/scene/GltfPackage.h); throws UsageError naming the bad URI.
+// `note` (may be null) receives a one-line description of what was packed.
+std::string sceneFileBytes(const std::string& path, std::string* note = nullptr);
 // Uploads `bytes` unless the server already has its digest; returns the digest.
 std::string ensureSceneUploaded(const HttpClient& http, const std::string& bytes, const std::string& fileName,
                                 bool verbose);

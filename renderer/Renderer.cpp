@@ -16,6 +16,7 @@
 #include "renderer/frame/PassContext.h"
 #include "renderer/gl/ShaderLibrary.h"
 #include "renderer/metrics/Metrics.h"
+#include "renderer/scene/StudioEnvironment.h"
 #include "renderer/techniques/reference/ReferencePass.h"
 #include "renderer/techniques/Registry.h"
 
@@ -176,8 +177,47 @@ std::vector<TechniqueDescription> Renderer::techniques() {
   return out;
 }
 
-RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& request, const std::atomic<bool>* cancel,
-                              const FrameInputs& inputs) {
+namespace {
+nlohmann::json vec3Json(const glm::vec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); }
+
+nlohmann::json cameraStats(const FrameView& view) {
+  const Camera& c = view.camera;
+  nlohmann::json j{{"source", view.cameraSource},
+                   {"projection", c.projection == ProjectionType::Perspective ? "perspective" : "orthographic"},
+                   {"position", vec3Json(view.eye)},
+                   {"target", vec3Json(view.target)},
+                   {"up", vec3Json(glm::normalize(glm::vec3(c.world[1])))},
+                   {"forward", vec3Json(-glm::normalize(glm::vec3(c.world[2])))},
+                   {"znear", c.znear}};
+  if (!c.name.empty()) j["name"] = c.name;
+  if (c.projection == ProjectionType::Perspective) j["yfov_deg"] = glm::degrees(c.yfov);
+  else j["ymag"] = c.ymag;
+  return j;
+}
+
+nlohmann::json sceneStats(const Scene& scene) {
+  const Bounds& b = scene.features.bounds;
+  nlohmann::json nodes = nlohmann::json::array();
+  if (!scene.nodeNames.empty()) {
+    for (const auto& n : scene.nodeNames) nodes.push_back(n);
+  } else {  // scenes built in code have no node list: their instances' names
+    for (const auto& m : scene.meshes)
+      if (std::find(nodes.begin(), nodes.end(), m.name) == nodes.end()) nodes.push_back(m.name);
+  }
+  return {{"name", scene.name},
+          {"digest", scene.digest},
+          {"bounds", b.empty() ? nlohmann::json(nullptr)
+                               : nlohmann::json{{"min", vec3Json(b.min)}, {"max", vec3Json(b.max)},
+                                                {"center", vec3Json(b.center())}, {"radius", b.radius()}}},
+          {"nodes", nodes},
+          {"meshes", scene.meshes.size()},
+          {"materials", scene.materials.size()},
+          {"textures", scene.textures.size()}};
+}
+}  // namespace
+
+RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requestIn, const std::atomic<bool>* cancel,
+                              const FrameInputs& inputsIn) {
   Impl& im = *impl_;
   im.device->makeCurrent();
   RenderOutput out;
@@ -187,6 +227,26 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
                   {"platform", dev.platform}, {"reason", dev.reason}};
   stats.triangles = scene.features.triangles;
   stats.lights = static_cast<int>(scene.lights.size());
+  stats.scene = sceneStats(scene);
+  stats.warnings = scene.warnings;
+
+  // Default lighting (renderer/scene/StudioEnvironment.h): a scene that brings no light, rendered
+  // without ambient or environment, is lit by the studio map as if the request had named it.
+  api::RenderRequest effective = requestIn;
+  FrameInputs inputs = inputsIn;
+  const bool sceneLit = !scene.lights.empty() || scene.features.hasEmissive();
+  const bool ambientGiven = requestIn.ambient != glm::vec3(0.f);
+  if (sceneLit) stats.lighting = "scene";
+  else if (!requestIn.environment.empty()) stats.lighting = "environment";
+  else if (ambientGiven) stats.lighting = "ambient";
+  else if (requestIn.defaultLighting) {
+    stats.lighting = "default";
+    effective.environment = kStudioEnvironmentKey;
+    inputs.environment = &studioEnvironment();
+  } else {
+    stats.lighting = "none";
+  }
+  const api::RenderRequest& request = effective;
 
   try {
     const auto frameStart = Clock::now();
@@ -194,6 +254,7 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
       throw api::ApiError(422, "invalid-value", "Environment not supplied",
                           "the environment image " + request.environment + " was not supplied", "/environment");
     const FrameView view = makeFrameView(scene, request, inputs.environment);
+    stats.camera = cameraStats(view);
     const GpuScene& gpu = im.gpuScene(scene, stats);
 
     std::vector<Technique*> all;

@@ -15,6 +15,8 @@ std::string usage() {
   --host ADDR               bind address (default 127.0.0.1)
   --port N                  TCP port, 0 = ephemeral (default 8080)
   --cache-dir DIR           persist uploaded scenes here across restarts
+  --asset-root DIR          serve glTF files under DIR to requests naming scene.asset (a path
+                            relative to DIR; the files it references must lie inside DIR too)
   --token-file FILE         require "Authorization: Bearer <contents of FILE>"
   --config FILE             JSON file with any of these options (keys use '_': "max_queue")
   --max-body-bytes N        largest request body (default 67108864)
@@ -77,6 +79,7 @@ void apply(ServerConfig& c, const std::string& name, const std::string& v, std::
   if (name == "host") c.host = v;
   else if (name == "port") c.port = static_cast<int>(toInt(flag, v, 0, 65535));
   else if (name == "cache-dir") c.cacheDir = v;
+  else if (name == "asset-root") c.assetRoot = v;
   else if (name == "token-file") tokenFile = v;
   else if (name == "max-body-bytes") c.maxBodyBytes = static_cast<std::size_t>(toInt(flag, v, 1024, 1ll << 40));
   else if (name == "max-width") c.limits.maxWidth = static_cast<int>(toInt(flag, v, 1, 4096));

@@ -15,6 +15,7 @@ struct ServerConfig {
   std::string host = "127.0.0.1";
   int port = 8080;                     // 0 = ephemeral
   std::string cacheDir;                // "" = scenes in memory only
+  std::string assetRoot;               // scene.asset paths resolve here ("" = scene.asset refused)
   std::string token;                   // bearer token ("" = no auth), read from token_file
   std::size_t maxBodyBytes = 64u << 20;
   api::RequestLimits limits;

@@ -19,6 +19,7 @@
 #include "server/Metrics.h"
 #include "server/RenderService.h"
 #include "server/ContentStore.h"
+#include "renderer/scene/GltfPackage.h"
 
 namespace radiant::server {
 
@@ -257,6 +258,33 @@ struct HttpServer::Impl {
           return decode(ref.value, hooks.builtinSceneSource(*name), "/scene/digest");
         throw api::ApiError(404, "unknown-scene", "Unknown scene",
                             "/scene/digest: no scene " + ref.value + " (upload it with PUT /v1/scenes)", "/scene/digest");
+      }
+      case api::SceneRef::Kind::Asset: {
+        // A file under --asset-root, packed with the files it references into one GLB: the digest covers
+        // every byte, so the decoded-scene cache never serves a scene whose files have changed.
+        if (config.assetRoot.empty())
+          throw api::ApiError(422, "no-asset-root", "No asset root",
+                              "/scene/asset: this daemon serves no files (start radiantd with --asset-root DIR), "
+                              "or upload the scene: `radiant render FILE.gltf` packs it and its files into one GLB",
+                              "/scene/asset");
+        PackResult packed;
+        try {
+          std::error_code ec;
+          const std::filesystem::path root = std::filesystem::canonical(config.assetRoot, ec);
+          if (ec) throw PackError("", "the asset root " + config.assetRoot + " does not exist");
+          const std::filesystem::path file = resolveRelativeUri(ref.value, "/scene/asset", root, root);
+          packed = packGltfFile(file, root, std::max<std::size_t>(config.maxBodyBytes, std::size_t(256) << 20));
+        } catch (const PackError& e) {
+          const bool missing = e.pointer.empty();
+          const bool path = e.pointer == "/scene/asset";
+          throw api::ApiError(missing ? 404 : 422, missing ? "unknown-scene" : "invalid-scene",
+                              missing ? "Unknown scene" : "Invalid scene",
+                              "/scene/asset: " + (path ? std::string() : ref.value + (missing ? "" : " at " + e.pointer) + ": ") +
+                                  e.what(),
+                              "/scene/asset");
+        }
+        const std::string digest = api::sceneDigest(packed.bytes);
+        return decode(digest, packed.bytes, "/scene/asset");
       }
       case api::SceneRef::Kind::Inline: {
         std::string bytes = base64Decode(ref.value, "/scene/inline_glb");

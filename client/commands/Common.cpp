@@ -3,6 +3,7 @@
 
 #include "api/Sha256.h"
 #include "client/Commands.h"
+#include "renderer/scene/GltfPackage.h"
 
 namespace radiant::client {
 
@@ -16,6 +17,18 @@ void writeFile(const std::string& path, const std::string& bytes) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   if (!out) throw UsageError("cannot write " + path);
+}
+
+std::string sceneFileBytes(const std::string& path, std::string* note) {
+  try {
+    PackResult r = packGltfFile(path);
+    if (note && r.packed)
+      *note = "packed " + path + " and " + std::to_string(r.externalFiles) + " referenced file" +
+              (r.externalFiles == 1 ? "" : "s") + " into one GLB (" + std::to_string(r.bytes.size()) + " bytes)";
+    return std::move(r.bytes);
+  } catch (const PackError& e) {
+    throw UsageError(path + (e.pointer.empty() ? "" : ": " + e.pointer) + ": " + e.what());
+  }
 }
 
 std::string ensureSceneUploaded(const HttpClient& http, const std::string& bytes, const std::string& fileName,

@@ -8,6 +8,7 @@
 
 #include <unistd.h>
 
+#include "api/Sha256.h"
 #include "client/Commands.h"
 
 namespace radiant::client {
@@ -15,12 +16,73 @@ namespace radiant::client {
 namespace {
 
 const char* kUsage =
-    "usage: radiant render (SCENE.gltf|SCENE.glb|--builtin NAME) -o OUT.exr|OUT.png\n"
+    "usage: radiant render (SCENE.gltf|SCENE.glb|--builtin NAME|--asset PATH) -o OUT.exr|OUT.png\n"
     "         [--set pass.param=value ...] [--pass NAME ...] [--aov NAME ...] [--size WxH]\n"
     "         [--exposure EV] [--seed N] [--float] [--stats stats.json] [--async] [--quiet]\n"
     "         [--no-pass NAME ...] [--compare SPP]\n"
+    "         [--ambient R,G,B] [--environment MAP.hdr|MAP.exr] [--no-default-lighting]\n"
+    "         [--camera position=X,Y,Z;target=X,Y,Z;up=X,Y,Z;yfov=DEG] [--request REQUEST.json]\n"
     "  --no-pass NAME   turn an on-by-default pass off (photon_gi, specular, ...)\n"
-    "  --compare SPP    score beauty against the reference path tracer at SPP samples (stats.metrics)\n";
+    "  --compare SPP    score beauty against the reference path tracer at SPP samples (stats.metrics)\n"
+    "  A .gltf that references .bin or image files is packed with them into one GLB before upload\n"
+    "  (only relative paths inside its folder). --camera takes any subset of its keys; the others keep\n"
+    "  the automatic framing. --request sends REQUEST.json with the other options applied on top.\n"
+    "  --asset PATH names a file under the daemon's --asset-root instead of uploading one.\n";
+
+// "X,Y,Z" -> [X, Y, Z] (finite numbers).
+nlohmann::json triple(const std::string& what, const std::string& text) {
+  double v[3];
+  char tail = 0;
+  if (std::sscanf(text.c_str(), "%lf,%lf,%lf%c", &v[0], &v[1], &v[2], &tail) != 3 || !std::isfinite(v[0]) ||
+      !std::isfinite(v[1]) || !std::isfinite(v[2]))
+    throw UsageError(what + " expects three numbers X,Y,Z, got \"" + text + "\"");
+  return nlohmann::json::array({v[0], v[1], v[2]});
+}
+
+// --camera "position=0,1,3;target=0,0,0;yfov=35" -> the request's camera object (only the keys given).
+nlohmann::json cameraOption(const std::string& text) {
+  nlohmann::json cam = nlohmann::json::object();
+  std::size_t start = 0;
+  while (start < text.size()) {
+    std::size_t end = text.find(';', start);
+    if (end == std::string::npos) end = text.size();
+    const std::string item = text.substr(start, end - start);
+    start = end + 1;
+    if (item.empty()) continue;
+    const auto eq = item.find('=');
+    const std::string key = item.substr(0, eq), value = eq == std::string::npos ? "" : item.substr(eq + 1);
+    if (key == "position" || key == "target" || key == "up") {
+      cam[key] = triple("--camera " + key, value);
+    } else if (key == "yfov") {
+      try {
+        std::size_t used = 0;
+        const double d = std::stod(value, &used);
+        if (used != value.size() || !std::isfinite(d)) throw std::invalid_argument(value);
+        cam["yfov_deg"] = d;
+      } catch (const std::exception&) {
+        throw UsageError("--camera yfov expects degrees, got \"" + value + "\"");
+      }
+    } else {
+      throw UsageError("--camera: unknown key \"" + key + "\" (position, target, up, yfov)");
+    }
+  }
+  if (cam.empty()) throw UsageError("--camera needs at least one of position=, target=, up=, yfov=");
+  return cam;
+}
+
+// Uploads an environment map unless the server has it; returns its digest.
+std::string ensureImageUploaded(const HttpClient& http, const std::string& path, bool verbose) {
+  const std::string bytes = readFile(path);
+  const std::string digest = api::sceneDigest(bytes);
+  const HttpResponse head = http.head("/v1/images/" + digest);
+  if (head.status == 200) return digest;
+  if (head.status != 404) HttpClient::expectOk(head);
+  const bool exr = bytes.size() >= 4 && bytes.compare(0, 4, "\x76\x2f\x31\x01") == 0;
+  const HttpResponse r = http.put("/v1/images", bytes, exr ? "image/x-exr" : "image/vnd.radiance");
+  HttpClient::expectOk(r);
+  if (verbose) std::cerr << "uploaded " << path << " as " << digest << " (" << bytes.size() << " bytes)\n";
+  return digest;
+}
 
 std::string extensionOf(const std::string& path) {
   auto dot = path.rfind('.');
@@ -69,7 +131,9 @@ nlohmann::json typedValue(const nlohmann::json& info, const std::string& pass, c
 }  // namespace
 
 int cmdRender(const GlobalOptions& g, const std::vector<std::string>& args) {
-  std::string sceneFile, builtin, out, statsFile;
+  std::string sceneFile, builtin, asset, out, statsFile, environmentFile, requestFile;
+  std::optional<nlohmann::json> ambient, camera;
+  bool noDefaultLighting = false;
   std::vector<std::pair<std::string, std::string>> sets;  // "pass.param", value
   std::vector<std::string> passes, aovs, disabled;
   int width = 0, height = 0, compareSpp = 0;
@@ -85,6 +149,15 @@ int cmdRender(const GlobalOptions& g, const std::vector<std::string>& args) {
     const std::string& a = args[i];
     if (a == "-o" || a == "--output") out = need(i);
     else if (a == "--builtin") builtin = need(i);
+    else if (a == "--asset") asset = need(i);
+    else if (a == "--ambient") {
+      ambient = triple("--ambient", need(i));
+      for (const auto& v : *ambient)
+        if (v.get<double>() < 0) throw UsageError("--ambient: radiance must not be negative");
+    } else if (a == "--environment") environmentFile = need(i);
+    else if (a == "--camera") camera = cameraOption(need(i));
+    else if (a == "--request") requestFile = need(i);
+    else if (a == "--no-default-lighting") noDefaultLighting = true;
     else if (a == "--set") {
       const std::string& kv = need(i);
       auto eq = kv.find('=');
@@ -130,18 +203,27 @@ int cmdRender(const GlobalOptions& g, const std::vector<std::string>& args) {
     else if (sceneFile.empty()) sceneFile = a;
     else throw UsageError("render: more than one scene given\n" + std::string(kUsage));
   }
-  if (sceneFile.empty() == builtin.empty()) throw UsageError(std::string("render: give a scene file or --builtin NAME\n") + kUsage);
+  nlohmann::json request = nlohmann::json::object();
+  if (!requestFile.empty()) {
+    request = nlohmann::json::parse(readFile(requestFile), nullptr, false);
+    if (request.is_discarded() || !request.is_object())
+      throw UsageError("--request: " + requestFile + " does not hold a JSON object");
+  }
+  const int sources = !sceneFile.empty() + !builtin.empty() + !asset.empty();
+  if (sources > 1 || (sources == 0 && !request.contains("scene")))
+    throw UsageError(std::string("render: give one scene: a file, --builtin NAME, --asset PATH, or a scene in --request\n") + kUsage);
   if (out.empty()) throw UsageError(std::string("render: -o OUT.exr|OUT.png is required\n") + kUsage);
   const std::string format = extensionOf(out);
   if (format != "exr" && format != "png") throw UsageError("render: -o must end in .exr or .png, got \"" + out + "\"");
   if (format == "png" && aovs.size() > 1) throw UsageError("render: a png holds one AOV; use .exr for several");
-  const std::string sceneBytes = sceneFile.empty() ? "" : readFile(sceneFile);
+  std::string packNote;
+  const std::string sceneBytes = sceneFile.empty() ? "" : sceneFileBytes(sceneFile, &packNote);
+  if (!packNote.empty() && !quiet) std::cerr << packNote << "\n";
 
   HttpClient http(g.server, g.token);
-  nlohmann::json request;
   if (!sets.empty() || !passes.empty() || !disabled.empty()) {
     const nlohmann::json info = HttpClient::expectOk(http.get("/v1/info")).json();
-    nlohmann::json p = nlohmann::json::object();
+    nlohmann::json p = request.contains("passes") && request["passes"].is_object() ? request["passes"] : nlohmann::json::object();
     for (const auto& name : passes) p[name] = nlohmann::json::object();
     for (const auto& name : disabled) p[name] = false;
     for (const auto& [key, value] : sets) {
@@ -151,7 +233,16 @@ int cmdRender(const GlobalOptions& g, const std::vector<std::string>& args) {
     request["passes"] = p;
   }
   if (!builtin.empty()) request["scene"] = {{"builtin", builtin}};
-  else request["scene"] = {{"digest", ensureSceneUploaded(http, sceneBytes, sceneFile, !quiet)}};
+  else if (!asset.empty()) request["scene"] = {{"asset", asset}};
+  else if (!sceneFile.empty()) request["scene"] = {{"digest", ensureSceneUploaded(http, sceneBytes, sceneFile, !quiet)}};
+  if (ambient) request["ambient"] = *ambient;
+  if (!environmentFile.empty()) request["environment"] = ensureImageUploaded(http, environmentFile, !quiet);
+  if (camera) {
+    nlohmann::json c = request.contains("camera") && request["camera"].is_object() ? request["camera"] : nlohmann::json::object();
+    c.update(*camera);
+    request["camera"] = c;
+  }
+  if (noDefaultLighting) request["default_lighting"] = false;
   if (width > 0) {
     request["width"] = width;
     request["height"] = height;
@@ -161,8 +252,12 @@ int cmdRender(const GlobalOptions& g, const std::vector<std::string>& args) {
   if (compareSpp > 0) request["compare"] = {{"against", "reference"}, {"aov", "beauty"}, {"spp", compareSpp}};
   nlohmann::json output{{"format", format}, {"aovs", aovs.empty() ? std::vector<std::string>{"beauty"} : aovs}};
   if (format == "exr") output["half"] = !fullFloat;
-  request["outputs"] = nlohmann::json::array({output});
-  request["async"] = async;
+  // A --request's own outputs are kept when they agree with -o (the first frame is what -o receives).
+  const bool keepOutputs = aovs.empty() && request.contains("outputs") && request["outputs"].is_array() &&
+                           !request["outputs"].empty() && request["outputs"][0].is_object() &&
+                           request["outputs"][0].value("format", "") == format;
+  if (!keepOutputs) request["outputs"] = nlohmann::json::array({output});
+  if (requestFile.empty() || async) request["async"] = async;
 
   const auto t0 = std::chrono::steady_clock::now();
   HttpResponse r = http.post("/v1/renders", request.dump(), "application/json");
@@ -200,6 +295,9 @@ int cmdRender(const GlobalOptions& g, const std::vector<std::string>& args) {
                          {"timings", result.value("timings", nlohmann::json::object())}, {"frames", result["frames"]}};
     writeFile(statsFile, stats.dump(2) + "\n");
   }
+  if (!quiet && result.contains("stats") && result["stats"].value("lighting", "") == "default")
+    std::cerr << "note: the scene has no lights, ambient or environment; it was lit by the default studio "
+                 "environment (see docs/API.md; --ambient, --environment or --no-default-lighting change that)\n";
   if (!quiet) {
     const double wallMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     std::cout << "wrote " << out << " (" << frame.body.size() << " bytes, render " << result["id"].get<std::string>()

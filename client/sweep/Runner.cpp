@@ -313,7 +313,7 @@ private:
         std::lock_guard lock(s.uploadMutex);
         if (!s.uploaded.count(p.sceneFile)) {
           try {
-            ensureSceneUploaded(*s.http, readFile(p.sceneFile), p.sceneFile, false);
+            ensureSceneUploaded(*s.http, sceneFileBytes(p.sceneFile), p.sceneFile, false);
           } catch (const UnreachableError& e) {
             throw ServerGone(e.what());
           }

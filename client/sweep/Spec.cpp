@@ -208,7 +208,7 @@ std::vector<Point> expand(const Spec& spec) {
       fs::path file = p.request["scene"]["file"].get<std::string>();
       if (file.is_relative()) file = spec.dir / file;
       auto it = digests.find(file.string());
-      if (it == digests.end()) it = digests.emplace(file.string(), api::sceneDigest(readFile(file.string()))).first;
+      if (it == digests.end()) it = digests.emplace(file.string(), api::sceneDigest(sceneFileBytes(file.string()))).first;
       p.sceneFile = file.string();
       p.request["scene"] = {{"digest", it->second}};
     }

@@ -7,6 +7,8 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "api/Types.h"
+
 namespace radiant {
 
 glm::mat4 reversedZPerspective(float yfov, float aspect, float znear) {
@@ -43,14 +45,48 @@ FrameView makeFrameView(const Scene& scene, const api::RenderRequest& request, c
   }
   const float aspect = static_cast<float>(request.width) / static_cast<float>(request.height);
   Camera cam = scene.camera;
+  const Bounds& bounds = scene.features.bounds;
+  const glm::vec3 center = bounds.center();
+  // The point a camera looks at: the bounds centre for the automatic one, else the point on its axis
+  // nearest to that centre (at least a unit ahead).
+  auto targetOf = [&](const Camera& c) {
+    const glm::vec3 eye(c.world[3]), forward = -glm::normalize(glm::vec3(c.world[2]));
+    if (!c.fromFile) return bounds.empty() ? eye + forward : center;
+    return eye + forward * std::max(glm::dot(center - eye, forward), 1e-3f * std::max(bounds.radius(), 1.f));
+  };
+  v.cameraSource = scene.camera.fromFile ? "file" : "auto";
+  v.target = targetOf(cam);
   if (request.camera) {
     const auto& o = *request.camera;
+    const bool whole = o.hasPosition && o.hasTarget && o.hasUp && o.hasYfov;
+    const float baseYfov = scene.camera.projection == ProjectionType::Perspective ? scene.camera.yfov : 0.6911f;
+    const float yfov = o.hasYfov ? glm::radians(o.yfovDegrees) : baseYfov;
+    // The camera whose fields the override keeps: the file's, or the automatic framing for this
+    // image's aspect and field of view (so a narrower yfov alone moves the camera back to keep the fit).
+    const Camera base = scene.camera.fromFile ? scene.camera : defaultCameraFor(bounds, aspect, yfov);
+    const glm::vec3 position = o.hasPosition ? o.position : glm::vec3(base.world[3]);
+    const glm::vec3 target = o.hasTarget ? o.target : targetOf(base);
+    glm::vec3 up = o.hasUp ? o.up : glm::normalize(glm::vec3(base.world[1]));
+    if (!(glm::length(target - position) > 0.f))
+      throw api::ApiError(422, "invalid-value", "Invalid value",
+                          std::string("/camera: the camera position equals its target (") +
+                              (o.hasPosition ? "target" : "position") + " taken from the scene camera)",
+                          o.hasPosition ? "/camera/position" : "/camera/target");
+    const glm::vec3 dir = glm::normalize(target - position);
+    if (glm::length(glm::cross(dir, glm::normalize(up))) < 1e-6f) {
+      if (o.hasUp)
+        throw api::ApiError(422, "invalid-value", "Invalid value", "/camera/up: parallel to the view direction", "/camera/up");
+      up = std::abs(dir.y) < 0.99f ? glm::vec3(0, 1, 0) : glm::vec3(0, 0, -1);  // looking straight up or down
+    }
     cam = Camera{};
+    cam.name = "request";
     cam.projection = ProjectionType::Perspective;
-    cam.yfov = glm::radians(o.yfovDegrees);
-    cam.world = glm::inverse(glm::lookAt(o.position, o.target, o.up));
+    cam.yfov = yfov;
+    cam.world = glm::inverse(glm::lookAt(position, target, up));
     // Near plane relative to the scene size keeps depth precision at any scale.
-    cam.znear = std::max(1e-6f, 1e-3f * std::max(scene.features.bounds.radius(), 1e-6f));
+    cam.znear = std::max(1e-6f, 1e-3f * std::max(bounds.radius(), 1e-6f));
+    v.target = target;
+    v.cameraSource = whole ? "request" : "request+" + v.cameraSource;
   }
   // The image decides the aspect (glTF allows it; a stretched image is never what a user wants), and
   // the reference renderer receives the same camera.

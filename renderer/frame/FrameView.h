@@ -23,6 +23,8 @@ struct FrameView {
   glm::vec3 ambient{0.f};              // uniform sky radiance: request.ambient, or the map's average
   const Image* environment = nullptr;  // equirect radiance map (renderer/scene/Environment.h), or null
   std::string environmentKey;          // its digest, for cache keys
+  glm::vec3 target{0.f};               // the point looked at (for stats.camera)
+  std::string cameraSource;            // "file", "auto", "request", or "request+file" / "request+auto" when partial
 };
 
 // Reversed-Z, infinite far plane (see above).

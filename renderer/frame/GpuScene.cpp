@@ -30,6 +30,19 @@ gpu::Material toGpuMaterial(const Material& m) {
   g.texturesA = glm::ivec4(uvSet(m.baseColorTexture), uvSet(m.metallicRoughnessTexture), uvSet(m.normalTexture),
                            uvSet(m.occlusionTexture));
   g.texturesB = glm::ivec4(uvSet(m.emissiveTexture), m.doubleSided ? 1 : 0, uvSet(m.transmissionTexture), 0);
+  g.flags = glm::ivec4(m.unlit ? 1 : 0, m.isSpecular() ? 1 : 0, 0, 0);
+  // KHR_texture_transform: the same rows TextureRef::transformUv applies on the CPU, slot by slot.
+  const TextureRef* slots[gpu::kSlotCount] = {};
+  slots[gpu::kSlotBaseColor] = &m.baseColorTexture;
+  slots[gpu::kSlotMetallicRoughness] = &m.metallicRoughnessTexture;
+  slots[gpu::kSlotNormal] = &m.normalTexture;
+  slots[gpu::kSlotOcclusion] = &m.occlusionTexture;
+  slots[gpu::kSlotEmissive] = &m.emissiveTexture;
+  slots[gpu::kSlotTransmission] = &m.transmissionTexture;
+  for (int s = 0; s < gpu::kSlotCount; ++s) {
+    g.uvTransform[2 * s] = glm::vec4(slots[s]->uvRow0, 0.f);
+    g.uvTransform[2 * s + 1] = glm::vec4(slots[s]->uvRow1, 0.f);
+  }
   return g;
 }
 

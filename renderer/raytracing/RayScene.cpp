@@ -159,7 +159,12 @@ glm::vec4 RayScene::textureAt(const TextureRef& ref, const SurfaceHit& h, bool s
     const std::uint32_t* i = &m.indices[static_cast<size_t>(h.prim) * 3];
     uv = h.b0 * uvs[i[0]] + h.b1 * uvs[i[1]] + h.b2 * uvs[i[2]];
   }
-  return sampleTexture(scene_->textures[ref.texture], uv, srgb);
+  // KHR_texture_transform (identity rows without it): the rows GLSL's materialSlotUv applies.
+  return sampleTexture(scene_->textures[ref.texture], ref.transformUv(uv), srgb);
+}
+
+glm::vec3 RayScene::unlitRadiance(const SurfaceHit& h) const {
+  return decodeUnlitRadiance(materialOf(h.mesh), [&](const TextureRef& ref, bool srgb) { return textureAt(ref, h, srgb); });
 }
 
 glm::vec3 RayScene::emissionAt(const SurfaceHit& h, const glm::vec3& dir) const {

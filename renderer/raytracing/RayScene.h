@@ -83,7 +83,10 @@ public:
   Shading shade(const SurfaceHit& hit, const glm::vec3& wo, TransportMode mode = TransportMode::Radiance) const;
   // Emitted radiance towards -dir (zero from the back of a single-sided emitter).
   glm::vec3 emissionAt(const SurfaceHit& hit, const glm::vec3& dir) const;
+  // Texture `ref` at the hit: its uv set through its KHR_texture_transform, then the glTF sampler.
   glm::vec4 textureAt(const TextureRef& ref, const SurfaceHit& hit, bool srgb) const;
+  // KHR_materials_unlit: the radiance an unlit surface shows (its decoded base colour, from both sides).
+  glm::vec3 unlitRadiance(const SurfaceHit& hit) const;
 
   // A point on triangle `prim` of `mesh` from barycentrics (b0, b1), as a hit.
   SurfaceHit pointOn(int mesh, int prim, glm::vec2 b) const;

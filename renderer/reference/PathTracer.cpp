@@ -142,6 +142,11 @@ struct PathTracer::Impl {
         }
         break;
       }
+      const Material& mat = rays->materialOf(hit.mesh);
+      if (mat.unlit) {  // KHR_materials_unlit: the base colour leaves the surface, nothing scatters
+        if (inRange(k, o)) L += beta * rays->unlitRadiance(hit);
+        break;
+      }
       if (inRange(k, o)) {
         const glm::vec3 Le = rays->emissionAt(hit, ray.dir);
         if (maxComponent(Le) > 0.f) {

@@ -15,18 +15,15 @@
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>  // Debian ships tinygltf as a shared library: no TINYGLTF_IMPLEMENTATION here
 
+#include "renderer/scene/GltfCompression.h"
+#include "renderer/scene/GltfExtensions.h"
+#include "renderer/scene/GltfPackage.h"
+
 namespace radiant {
 namespace {
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;
-
-// Extensions whose meaning we implement; anything else in extensionsRequired is refused.
-constexpr std::string_view kSupportedExtensions[] = {
-    "KHR_lights_punctual", "KHR_materials_transmission", "KHR_materials_ior",
-    "KHR_materials_emissive_strength",
-    "KHR_mesh_quantization",  // any component type is read and normalised (see readElements)
-};
 
 std::string pointer(std::string_view base, std::size_t index) {
   return std::string(base) + "/" + std::to_string(index);
@@ -202,8 +199,9 @@ void checkExternalUri(const std::string& uri, const std::string& ptr, const fs::
                       const fs::path& root) {
   if (root.empty())
     throw SceneError(ptr, "external URI \"" + uri +
-                              "\" refused: no asset root is configured (embed the data as a data "
-                              "URI or in a GLB)");
+                              "\" refused: no asset root is configured (upload one GLB: `radiant render "
+                              "FILE.gltf` packs a .gltf and its files; or put the files under radiantd "
+                              "--asset-root DIR and name the scene with scene.asset)");
   // A scheme is letters, digits, + - . followed by ':' (RFC 3986 section 3.1).
   const auto colon = uri.find(':');
   if (colon != std::string::npos && colon > 0 && std::isalpha(static_cast<unsigned char>(uri[0])) &&
@@ -236,17 +234,10 @@ std::uint64_t jsonUnsigned(const json& o, const char* key, std::uint64_t fallbac
   return it != o.end() && it->is_number_unsigned() ? it->get<std::uint64_t>() : fallback;
 }
 
-void validateDocument(const json& doc, const fs::path& baseDir, const fs::path& root) {
+void validateDocument(const json& doc, const fs::path& baseDir, const fs::path& root,
+                      std::vector<std::string>& warnings) {
   if (!doc.is_object()) throw SceneError("", "a glTF document must be a JSON object");
-  if (const auto it = doc.find("extensionsRequired"); it != doc.end() && it->is_array()) {
-    for (std::size_t i = 0; i < it->size(); ++i) {
-      const auto& e = (*it)[i];
-      const std::string name = e.is_string() ? e.get<std::string>() : e.dump();
-      if (std::find(std::begin(kSupportedExtensions), std::end(kSupportedExtensions), name) ==
-          std::end(kSupportedExtensions))
-        throw SceneError(pointer("/extensionsRequired", i), "unsupported required extension " + name);
-    }
-  }
+  gltf::checkExtensions(doc, warnings);  // the extension table: GltfExtensions.cpp
   for (const char* key : {"buffers", "images"}) {
     const auto it = doc.find(key);
     if (it == doc.end() || !it->is_array()) continue;
@@ -615,6 +606,7 @@ private:
     if (index < 0) return {};
     if (std::size_t(index) >= scene_.textures.size())
       throw SceneError(ptr + "/index", "texture " + std::to_string(index) + " does not exist");
+    if (!textureUsable_[std::size_t(index)]) return {};  // dropped with a warning (convertTextures)
     if (texCoord < 0 || texCoord > 1)
       throw SceneError(ptr + "/texCoord", "TEXCOORD_" + std::to_string(texCoord) +
                                               " is not supported (only TEXCOORD_0 and TEXCOORD_1)");
@@ -629,15 +621,28 @@ private:
   TextureRef textureRef(const tinygltf::Value& info, const std::string& ptr) {
     if (!info.IsObject() || !info.Has("index")) return {};
     const int texCoord = info.Has("texCoord") ? info.Get("texCoord").GetNumberAsInt() : 0;
-    return textureRef(info.Get("index").GetNumberAsInt(), texCoord, 1.f, ptr, false);
+    TextureRef r = textureRef(info.Get("index").GetNumberAsInt(), texCoord, 1.f, ptr, false);
+    if (r.valid() && info.Has("extensions") && info.Get("extensions").Has("KHR_texture_transform"))
+      gltf::applyTextureTransform(&info.Get("extensions").Get("KHR_texture_transform"), r, ptr);
+    return r;
   }
 
   void convertTextures() {
     for (std::size_t i = 0; i < m_.textures.size(); ++i) {
       const auto& t = m_.textures[i];
       const std::string ptr = pointer("/textures", i);
-      if (t.source < 0 || std::size_t(t.source) >= m_.images.size())
-        throw SceneError(ptr + "/source", "texture " + std::to_string(i) + " has no usable source image");
+      if (t.source < 0) {
+        // Valid glTF (source is optional; an extension such as KHR_texture_basisu may name the only
+        // image): the materials render without this texture, and the frame says so.
+        scene_.warnings.push_back(ptr + ": texture " + std::to_string(i) +
+                                  " has no image this renderer can use: materials render without it");
+        scene_.textures.emplace_back();
+        textureUsable_.push_back(false);
+        continue;
+      }
+      if (std::size_t(t.source) >= m_.images.size())
+        throw SceneError(ptr + "/source", "texture " + std::to_string(i) + " names image " + std::to_string(t.source) +
+                                              ", which does not exist");
       const auto& img = m_.images[std::size_t(t.source)];
       const std::string iptr = pointer("/images", std::size_t(t.source));
       if (img.image.empty() || img.width <= 0 || img.height <= 0 || img.component != 4)
@@ -671,6 +676,7 @@ private:
         if (s.magFilter >= 0) out.magFilter = s.magFilter;
       }
       scene_.textures.push_back(std::move(out));
+      textureUsable_.push_back(true);
     }
   }
 
@@ -701,6 +707,16 @@ private:
                                         false);
       mat.emissiveTexture = textureRef(g.emissiveTexture.index, g.emissiveTexture.texCoord, 1.f,
                                        ptr + "/emissiveTexture", true);
+      // KHR_texture_transform per texture slot, KHR_materials_unlit (GltfExtensions.h).
+      auto transform = [&](const tinygltf::ExtensionMap& ext, TextureRef& ref, const std::string& at) {
+        if (ref.valid()) gltf::applyTextureTransform(extension(ext, "KHR_texture_transform"), ref, at);
+      };
+      transform(pbr.baseColorTexture.extensions, mat.baseColorTexture, pp + "/baseColorTexture");
+      transform(pbr.metallicRoughnessTexture.extensions, mat.metallicRoughnessTexture, pp + "/metallicRoughnessTexture");
+      transform(g.normalTexture.extensions, mat.normalTexture, ptr + "/normalTexture");
+      transform(g.occlusionTexture.extensions, mat.occlusionTexture, ptr + "/occlusionTexture");
+      transform(g.emissiveTexture.extensions, mat.emissiveTexture, ptr + "/emissiveTexture");
+      mat.unlit = extension(g.extensions, "KHR_materials_unlit") != nullptr;
       mat.doubleSided = g.doubleSided;
       if (g.alphaMode == "MASK") mat.alphaMode = AlphaMode::Mask;
       else if (g.alphaMode == "BLEND") mat.alphaMode = AlphaMode::Blend;
@@ -768,6 +784,7 @@ private:
   }
 
   void visitNode(int index, const tinygltf::Node& node, const glm::mat4& world, const std::string& ptr) {
+    scene_.nodeNames.push_back(node.name);
     if (node.mesh >= 0) {
       if (std::size_t(node.mesh) >= m_.meshes.size())
         throw SceneError(ptr + "/mesh", "mesh " + std::to_string(node.mesh) + " does not exist");
@@ -989,6 +1006,7 @@ private:
   const tinygltf::Model& m_;
   std::size_t maxBytes_;
   Scene scene_;
+  std::vector<bool> textureUsable_;  // per glTF texture: false when dropped with a warning
 };
 
 // ---- top level ------------------------------------------------------------------------------
@@ -1037,7 +1055,25 @@ Scene load(std::string_view bytes, const fs::path& baseDir, const fs::path& root
     throw SceneError("", std::string(glb ? "the GLB JSON chunk" : "the file") +
                              " is neither valid JSON nor GLB: " + e.what());
   }
-  validateDocument(doc, baseDir, root);
+  std::vector<std::string> warnings;
+  validateDocument(doc, baseDir, root, warnings);
+  // EXT_meshopt_compression is decoded into a plain GLB before tinygltf sees the file, KHR_draco_mesh_compression
+  // into the model right after (GltfCompression.h).
+  std::string decodedBytes;
+  std::string_view source = bytes;
+  bool sourceGlb = glb;
+  const bool meshopt = gltf::usesMeshopt(doc), draco = gltf::usesDraco(doc);
+  if (meshopt || draco) {
+    try {
+      decodedBytes = packGltf(bytes, baseDir, root, options.maxBytes, true).bytes;
+    } catch (const PackError& e) {
+      throw SceneError(e.pointer, e.what());
+    }
+    if (meshopt) decodedBytes = gltf::decodeMeshopt(decodedBytes, options.maxBytes);
+    if (draco) decodedBytes = gltf::prepareDraco(decodedBytes);
+    source = decodedBytes;
+    sourceGlb = true;
+  }
 
   FsContext fsContext;
   fsContext.root = root;
@@ -1054,11 +1090,11 @@ Scene load(std::string_view bytes, const fs::path& baseDir, const fs::path& root
   bool ok = false;
   try {
     const std::string base = baseDir.string();
-    ok = glb ? loader.LoadBinaryFromMemory(&model, &err, &warn,
-                                           reinterpret_cast<const unsigned char*>(bytes.data()),
-                                           static_cast<unsigned int>(bytes.size()), base)
-             : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(),
-                                          static_cast<unsigned int>(bytes.size()), base);
+    ok = sourceGlb ? loader.LoadBinaryFromMemory(&model, &err, &warn,
+                                                 reinterpret_cast<const unsigned char*>(source.data()),
+                                                 static_cast<unsigned int>(source.size()), base)
+                   : loader.LoadASCIIFromString(&model, &err, &warn, source.data(),
+                                                static_cast<unsigned int>(source.size()), base);
   } catch (const std::exception& e) {
     err += e.what();
     ok = false;
@@ -1069,7 +1105,9 @@ Scene load(std::string_view bytes, const fs::path& baseDir, const fs::path& root
       if (c == '\n') c = ';';
     throw SceneError("", "invalid glTF: " + (err.empty() ? std::string("unknown error") : err));
   }
+  gltf::decodeDraco(model, options.maxBytes);
   Scene scene = Converter(model, options.maxBytes).run();
+  scene.warnings.insert(scene.warnings.begin(), warnings.begin(), warnings.end());
   scene.digest = "sha256:" + digest.finishHex();
   scene.features = computeFeatures(scene);
   return scene;

@@ -6,6 +6,8 @@
 //
 // `texel(ref, srgb)` returns the texture `ref` at the point (sRGB decoded when srgb), vec4(1) when
 // the slot is empty; it is how each caller samples (bilinear on the CPU, the GPU's samplers there).
+// It applies the slot's KHR_texture_transform (TextureRef::transformUv, as RayScene::textureAt does):
+// the uv rows travel with the TextureRef, as they travel per slot in gpu::Material::uvTransform.
 #include <algorithm>
 
 #include <glm/glm.hpp>
@@ -21,6 +23,13 @@ glm::vec4 decodeBaseColor(const Material& m, Texel&& texel) {
   glm::vec4 base = m.baseColorFactor;
   if (m.baseColorTexture.valid()) base *= texel(m.baseColorTexture, true);
   return base;
+}
+
+// KHR_materials_unlit: the radiance leaving an unlit surface is its base colour, clamped as
+// MaterialParams::baseColor (the G-buffer stores decodeMaterial's baseColor as its emission).
+template <class Texel>
+glm::vec3 decodeUnlitRadiance(const Material& m, Texel&& texel) {
+  return glm::clamp(glm::vec3(decodeBaseColor(m, texel)), 0.f, 1.f);
 }
 
 // emissiveFactor x emissiveStrength x emissiveTexture.

@@ -37,8 +37,9 @@ SceneFeatures computeFeatures(const Scene& scene) {
   return f;
 }
 
-Camera defaultCameraFor(const Bounds& bounds, float aspect) {
+Camera defaultCameraFor(const Bounds& bounds, float aspect, float yfov) {
   Camera cam;
+  cam.yfov = yfov;
   cam.name = "default";
   cam.projection = ProjectionType::Perspective;
   cam.fromFile = false;

@@ -46,9 +46,16 @@ struct Texture {
 
 struct TextureRef {
   int texture = -1;   // index into Scene::textures, -1 = none
-  int texCoord = 0;   // which UV set
+  int texCoord = 0;   // which UV set (KHR_texture_transform's texCoord when it sets one)
   float scale = 1.f;  // normalTexture.scale or occlusionTexture.strength
+  // KHR_texture_transform as the two rows of the affine map uv' = T R S uv (identity without it);
+  // the GLSL side reads the same rows (gpu::Material::uvTransform).
+  glm::vec3 uvRow0{1.f, 0.f, 0.f}, uvRow1{0.f, 1.f, 0.f};
   bool valid() const { return texture >= 0; }
+  glm::vec2 transformUv(const glm::vec2& uv) const {
+    const glm::vec3 h(uv, 1.f);
+    return {glm::dot(uvRow0, h), glm::dot(uvRow1, h)};
+  }
 };
 
 enum class AlphaMode { Opaque, Mask, Blend };
@@ -66,6 +73,7 @@ struct Material {
   TextureRef baseColorTexture, metallicRoughnessTexture, normalTexture, occlusionTexture,
       emissiveTexture, transmissionTexture;
   bool doubleSided = false;
+  bool unlit = false;  // KHR_materials_unlit: the surface shows its base colour, lit by nothing
   AlphaMode alphaMode = AlphaMode::Opaque;
   float alphaCutoff = 0.5f;
 
@@ -75,6 +83,7 @@ struct Material {
   bool isEmissive() const { return emission() != glm::vec3(0.f) || emissiveTexture.valid(); }
   bool isTransmissive() const { return transmissionFactor > 0.f; }
   bool isSpecular() const {
+    if (unlit) return false;
     return (metallicFactor > 0.5f && roughnessFactor < kSpecularRoughness) || isTransmissive();
   }
 };
@@ -148,6 +157,10 @@ struct Scene {
   std::vector<Light> lights;
   Camera camera;  // the first camera in the file, or a default that frames the bounds
   SceneFeatures features;
+  std::vector<std::string> nodeNames;  // every node of the default scene, depth-first order ("" unnamed)
+  // What the loader could not honour (an unsupported optional extension, ...): frames list them in
+  // stats.warnings, so nothing is dropped silently.
+  std::vector<std::string> warnings;
 
   // glTF's default material (used when MeshInstance::material == -1).
   const Material& material(int index) const {
@@ -161,6 +174,7 @@ struct Scene {
 SceneFeatures computeFeatures(const Scene& scene);
 
 // A camera that frames `bounds` from the +Z side, looking at the centre, for the given aspect.
-Camera defaultCameraFor(const Bounds& bounds, float aspect);
+// yfov in radians (the default is glTF viewers' customary 39.6 degrees).
+Camera defaultCameraFor(const Bounds& bounds, float aspect, float yfov = 0.6911f);
 
 }  // namespace radiant

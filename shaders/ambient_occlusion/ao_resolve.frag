@@ -2,9 +2,14 @@
 // with the 4x4 interleaved pattern, averages all 16 kernel rotations), or depth-aware upsampling of a
 // half-resolution estimate. Writes `ao` and, when blending is enabled on attachment 1, adds the ambient
 // term to beauty: L^r = a L^a O (thesis eq. 4.1 with L^in = L^a mu), where a is the diffuse albedo
-// baseColor (1 - metallic) (1 - transmission) times the material's baked occlusion. Metals have no
-// diffuse lobe, so they receive no ambient term here (their ambient response is specular, outside the
-// thesis' diffuse model).
+// baseColor (1 - metallic) (1 - transmission) times the material's baked occlusion. For an environment
+// map L^a becomes E(n) / pi, its SH irradiance by the shading normal, and the glTF Fresnel weight of the
+// diffuse base multiplies it (renderer/techniques/direct/ImageBasedLighting.h; 1 - ~1e-3 head-on).
+// Metals have no diffuse lobe: their response to the environment is specular, which the direct pass
+// adds (split-sum), unoccluded.
+#include "common/shared.h"
+#include "common/ibl.glsl"
+
 in vec2 v_uv;
 
 layout(binding = 0) uniform sampler2D t_ao;  // working resolution
@@ -13,11 +18,15 @@ layout(binding = 2) uniform sampler2D t_normal;
 layout(binding = 3) uniform sampler2D t_albedo;
 layout(binding = 4) uniform sampler2D t_material;  // metallic, roughness, occlusion, transmission
 layout(binding = 5) uniform sampler2D t_geoNormal;
+layout(binding = kUnitAoEmission) uniform sampler2D t_emission;  // a = ior
+layout(binding = kUnitIblDfg) uniform sampler2D t_dfg;
+uniform vec3 u_eye;
+uniform vec3 u_viewForward;
+uniform int u_orthographic;
 
 uniform int u_scale;
 uniform int u_blur;
 uniform float u_radius;
-uniform vec3 u_ambient;
 
 layout(location = 0) out float o_ao;
 layout(location = 1) out vec4 o_beauty;
@@ -77,5 +86,10 @@ void main() {
   vec3 albedo = texelFetch(t_albedo, px, 0).rgb;
   vec4 m = texelFetch(t_material, px, 0);
   vec3 diffuseAlbedo = albedo * (1.0 - m.x) * (1.0 - m.w) * m.z;
-  o_beauty = vec4(u_ambient * diffuseAlbedo * a, 0.0);
+  // The environment's diffuse light: SH irradiance by the shading normal (E / pi = L^a for a uniform
+  // sky), with the Fresnel weight glTF's fresnel_mix leaves the diffuse base (ImageBasedLighting.h).
+  vec3 n = texelFetch(t_normal, px, 0).xyz;
+  vec3 wo = u_orthographic != 0 ? -u_viewForward : normalize(u_eye - P.xyz);
+  float w = iblDiffuseWeight(t_dfg, max(dot(n, wo), 0.0), texelFetch(t_emission, px, 0).a);
+  o_beauty = vec4(iblIrradiance(n) * INV_PI * w * diffuseAlbedo * a, 0.0);
 }

@@ -23,7 +23,19 @@ layout(binding = kUnitMaterial0 + kSlotTransmission) uniform sampler2D t_matTran
 
 vec2 materialUv(int set, vec2 uv0, vec2 uv1) { return set == 1 ? uv1 : uv0; }
 
+// The uv texture slot `slot` samples: its uv set, then its KHR_texture_transform rows (identity
+// without the extension). TextureRef::transformUv (renderer/scene/Scene.h) is the C++ twin.
+vec2 materialSlotUv(Material m, int slot, int set, vec2 uv0, vec2 uv1) {
+  vec3 h = vec3(materialUv(set, uv0, uv1), 1.0);
+  return vec2(dot(m.uvTransform[2 * slot].xyz, h), dot(m.uvTransform[2 * slot + 1].xyz, h));
+}
+
 bool materialDoubleSided(Material m) { return m.texturesB.y != 0; }
+// KHR_materials_unlit: the surface shows its base colour (decodeBaseColor, clamped as MaterialParams'
+// baseColor) as the radiance leaving it, and nothing lights it.
+bool materialUnlit(Material m) { return m.flags.x != 0; }
+// Material::isSpecular(): the specular pass owns the surface's reflections.
+bool materialSpecularOwned(Material m) { return m.flags.y != 0; }
 int materialAlphaMode(Material m) { return int(m.scales.w); }  // 0 opaque, 1 mask, 2 blend
 // glTF 3.9.4: MASK surfaces below the cutoff are not rendered.
 bool materialMasked(Material m, float alpha) { return materialAlphaMode(m) == 1 && alpha < m.scales.z; }
@@ -32,14 +44,14 @@ bool materialMasked(Material m, float alpha) { return materialAlphaMode(m) == 1 
 // the alpha test reads it before the rest is decoded.
 vec4 decodeBaseColor(Material m, vec2 uv0, vec2 uv1) {
   vec4 base = m.baseColorFactor;
-  if (m.texturesA.x >= 0) base *= MATERIAL_SAMPLE(t_matBaseColor, materialUv(m.texturesA.x, uv0, uv1));
+  if (m.texturesA.x >= 0) base *= MATERIAL_SAMPLE(t_matBaseColor, materialSlotUv(m, kSlotBaseColor, m.texturesA.x, uv0, uv1));
   return base;
 }
 
 // emissiveFactor x emissiveStrength x emissiveTexture.
 vec3 decodeEmission(Material m, vec2 uv0, vec2 uv1) {
   vec3 e = m.emission.rgb;
-  if (m.texturesB.x >= 0) e *= MATERIAL_SAMPLE(t_matEmissive, materialUv(m.texturesB.x, uv0, uv1)).rgb;
+  if (m.texturesB.x >= 0) e *= MATERIAL_SAMPLE(t_matEmissive, materialSlotUv(m, kSlotEmissive, m.texturesB.x, uv0, uv1)).rgb;
   return e;
 }
 
@@ -50,15 +62,15 @@ MaterialParams decodeMaterial(Material m, vec2 uv0, vec2 uv1) {
   vec4 base = decodeBaseColor(m, uv0, uv1);
   float metallic = m.metallicRoughness.x, roughness = m.metallicRoughness.y;
   if (m.texturesA.y >= 0) {
-    vec4 mr = MATERIAL_SAMPLE(t_matMetallicRoughness, materialUv(m.texturesA.y, uv0, uv1));
+    vec4 mr = MATERIAL_SAMPLE(t_matMetallicRoughness, materialSlotUv(m, kSlotMetallicRoughness, m.texturesA.y, uv0, uv1));
     roughness *= mr.g;
     metallic *= mr.b;
   }
   float transmission = m.metallicRoughness.z;
-  if (m.texturesB.z >= 0) transmission *= MATERIAL_SAMPLE(t_matTransmission, materialUv(m.texturesB.z, uv0, uv1)).r;
+  if (m.texturesB.z >= 0) transmission *= MATERIAL_SAMPLE(t_matTransmission, materialSlotUv(m, kSlotTransmission, m.texturesB.z, uv0, uv1)).r;
   float occlusion = 1.0;
   if (m.texturesA.w >= 0)
-    occlusion = 1.0 + m.scales.y * (MATERIAL_SAMPLE(t_matOcclusion, materialUv(m.texturesA.w, uv0, uv1)).r - 1.0);
+    occlusion = 1.0 + m.scales.y * (MATERIAL_SAMPLE(t_matOcclusion, materialSlotUv(m, kSlotOcclusion, m.texturesA.w, uv0, uv1)).r - 1.0);
   float ior = m.metallicRoughness.w > 0.0 ? m.metallicRoughness.w : kDefaultIor;
   MaterialParams p;
   p.baseColor = vec4(clamp(base.rgb, 0.0, 1.0), base.a);
@@ -81,7 +93,7 @@ vec3 decodeShadingNormal(Material m, vec3 n, vec4 tangent, vec2 uv0, vec2 uv1, b
   if (m.texturesA.z >= 0) {
     vec3 t = materialSafeNormalize(tangent.xyz - n * dot(n, tangent.xyz), vec3(1, 0, 0));
     vec3 b = cross(n, t) * (tangent.w < 0.0 ? -1.0 : 1.0);
-    vec3 tn = MATERIAL_SAMPLE(t_matNormal, materialUv(m.texturesA.z, uv0, uv1)).xyz * 2.0 - 1.0;
+    vec3 tn = MATERIAL_SAMPLE(t_matNormal, materialSlotUv(m, kSlotNormal, m.texturesA.z, uv0, uv1)).xyz * 2.0 - 1.0;
     tn.xy *= m.scales.x;
     mapped = materialSafeNormalize(t * tn.x + b * tn.y + n * tn.z, n);
   }

@@ -44,7 +44,10 @@ RADIANT_CONST int kUnitPeel = 15;         // specular: previous layer of a dista
 RADIANT_CONST int kUnitLdmMaterial = 16;  // specular: layered distance maps
 RADIANT_CONST int kUnitLdmGeometry = 17;
 RADIANT_CONST int kUnitLdmDistance = 18;
-RADIANT_CONST int kUnitCount = 19;        // units used; GL 4.5 guarantees 16, every driver we run has 32
+RADIANT_CONST int kUnitIblDfg = 19;       // image-based lighting: split-sum DFG table (direct, ambient_occlusion)
+RADIANT_CONST int kUnitIblPrefiltered = 20;  // image-based lighting: GGX-prefiltered environment (direct)
+RADIANT_CONST int kUnitAoEmission = 21;   // ambient_occlusion resolve: the emission target (a = ior)
+RADIANT_CONST int kUnitCount = 22;        // units used; GL 4.5 guarantees 16, every driver we run has 32
 
 // Shader storage bindings of the scene buffers.
 RADIANT_CONST int kBindingMaterials = 0;
@@ -89,6 +92,11 @@ struct Material {
   vec4 scales;             // x normal scale, y occlusion strength, z alpha cutoff, w alpha mode (0 opaque, 1 mask, 2 blend)
   ivec4 texturesA;         // uv set per slot (base colour, metallic-roughness, normal, occlusion), -1 = none
   ivec4 texturesB;         // x emissive uv set, y doubleSided, z transmission uv set, w unused
+  ivec4 flags;             // x unlit (KHR_materials_unlit), y Material::isSpecular() (the specular pass
+                           // owns its reflections), zw unused
+  // KHR_texture_transform per slot: rows 2 slot and 2 slot + 1 of uv' = M (u, v, 1) (xyz used, w 0);
+  // identity rows for a slot without the extension.
+  vec4 uvTransform[2 * kSlotCount];
 };
 
 // The material decoded at a surface point (factors x textures): what the BRDF reads. gltfBrdfCos

@@ -2,6 +2,7 @@
 // Writes the `direct` AOV and initialises `beauty` with the same value (later passes add to beauty).
 #include "common/direct_lighting.glsl"
 #include "common/environment.glsl"
+#include "common/ibl.glsl"
 
 in vec2 v_uv;
 
@@ -19,6 +20,8 @@ uniform vec3 u_background;  // radiance seen where no surface is (the uniform sk
 uniform int u_hasEnvironment;  // 1: the background is the environment map instead
 uniform mat4 u_invViewProj;
 layout(binding = kUnitEnvironment) uniform sampler2D t_environment;
+layout(binding = kUnitIblDfg) uniform sampler2D t_dfg;
+layout(binding = kUnitIblPrefiltered) uniform sampler2DArray t_prefiltered;
 
 layout(location = 0) out vec4 o_direct;
 layout(location = 1) out vec4 o_beauty;
@@ -40,12 +43,19 @@ void main() {
     return;
   }
   vec3 p = P.xyz;
-  vec3 n = texelFetch(t_normal, px, 0).xyz;
+  vec4 nUnlit = texelFetch(t_normal, px, 0);
+  if (nUnlit.w < 0.5) {  // KHR_materials_unlit (gbuffer.frag): the stored base colour as it is
+    o_direct = vec4(texelFetch(t_emission, px, 0).rgb, 1.0);
+    o_beauty = o_direct;
+    return;
+  }
+  vec3 n = nUnlit.xyz;
   vec3 albedo = texelFetch(t_albedo, px, 0).rgb;
   vec4 mat = texelFetch(t_material, px, 0);
   vec4 emissionIor = texelFetch(t_emission, px, 0);
   vec3 emission = emissionIor.rgb;
-  vec3 ng = texelFetch(t_geoNormal, px, 0).xyz;
+  vec4 ngOwned = texelFetch(t_geoNormal, px, 0);
+  vec3 ng = ngOwned.xyz;
   vec3 wo = u_orthographic != 0 ? -u_viewForward : normalize(u_eye - p);
   // Interpolated or mapped normals can face away from the viewer at silhouettes; bend them back just
   // enough to be visible instead of shading them black (NdotV >= 1e-3).
@@ -53,6 +63,13 @@ void main() {
   if (nv < 1e-3) n = normalize(n + wo * (1e-3 - nv));
 
   vec3 L = emission + directLighting(p, n, ng, wo, materialParams(albedo, mat.x, mat.y, mat.w, emissionIor.a));
+  // The environment's specular reflection (split-sum), times the material's baked occlusion: light
+  // path L(sky)GE, which this pass owns (u_iblMode is IBL_NONE otherwise). Mirror-like metals and
+  // transmissive materials belong to the specular pass (Material::isSpecular(), the same per-material
+  // rule the planner and that pass use; the G-buffer carries it in ng.w).
+  bool specularOwned = ngOwned.w > 0.5;
+  if (u_iblMode != IBL_NONE && !specularOwned)
+    L += mat.z * iblSpecular(t_dfg, t_prefiltered, n, wo, albedo, mat.x, mat.y, emissionIor.a);
   o_direct = vec4(L, 1.0);
   o_beauty = o_direct;
 }

@@ -44,6 +44,7 @@ void main() {
     vec3 kd = p.baseColor.rgb * (1.0 - p.surface.x) * (1.0 - p.surface.z);
     L += kd * INV_PI * gatherIrradiance(v_position, n, ENV_METHOD_POLYGON, u_horizonClip != 0);
   }
+  if (materialUnlit(m)) L = p.baseColor.rgb;  // KHR_materials_unlit: its base colour, lit by nothing
   o_radiance = vec4(L, 1.0);
   o_geometry = vec4(dist, n);
 }

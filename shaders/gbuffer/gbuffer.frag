@@ -11,11 +11,12 @@ uniform vec3 u_eye;
 uniform vec3 u_viewForward;  // unit vector the camera looks along
 
 layout(location = 0) out vec4 o_position;  // xyz world, w = view depth (> 0 on geometry, 0 = none)
-layout(location = 1) out vec4 o_normal;    // xyz shading normal, w = 1
+layout(location = 1) out vec4 o_normal;    // xyz shading normal, w = 1 (0: unlit, KHR_materials_unlit)
 layout(location = 2) out vec4 o_albedo;    // rgb base colour
 layout(location = 3) out vec4 o_material;  // metallic, roughness, occlusion, transmission
 layout(location = 4) out vec4 o_emission;  // rgb emitted radiance, a = ior (KHR_materials_ior)
-layout(location = 5) out vec4 o_geoNormal; // xyz geometric normal facing the viewer side
+layout(location = 5) out vec4 o_geoNormal; // xyz geometric normal facing the viewer side, w = 1 when the
+                                           // specular pass owns the surface's reflections (isSpecular())
 
 void main() {
   Material m = materials[u_material];
@@ -37,5 +38,13 @@ void main() {
   o_albedo = p.baseColor;
   o_material = vec4(p.surface.x, p.surface.y, p.emission.a, p.surface.z);
   o_emission = vec4(p.emission.rgb, p.surface.w);
-  o_geoNormal = vec4(geo, 0.0);
+  o_geoNormal = vec4(geo, materialSpecularOwned(m) ? 1.0 : 0.0);
+  if (materialUnlit(m)) {
+    // KHR_materials_unlit: the base colour is the radiance leaving the surface and nothing lights it;
+    // normal.w = 0 tells the shading passes, and a black non-metal albedo keeps ambient terms out.
+    o_normal.w = 0.0;
+    o_albedo = vec4(0.0, 0.0, 0.0, p.baseColor.a);
+    o_material = vec4(0.0, 1.0, 1.0, 0.0);
+    o_emission = vec4(p.baseColor.rgb, kDefaultIor);
+  }
 }

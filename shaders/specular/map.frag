@@ -56,6 +56,7 @@ void main() {
     // glTF emission leaves the front face only unless the material is double-sided (as the reference).
     bool emits = gl_FrontFacing || materialDoubleSided(m);
     vec3 L = (emits ? p.emission.rgb : vec3(0.0)) + directLighting(v_position, ns, ng, wo, p);
+    if (materialUnlit(m)) L = p.baseColor.rgb;  // KHR_materials_unlit: its base colour, lit by nothing
     o_material = vec4(L, 0.0);
   }
   o_geometry = vec4(octEncode(n), max(dist, 1e-30), float(u_objectCode));

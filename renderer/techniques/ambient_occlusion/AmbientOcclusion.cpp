@@ -8,7 +8,9 @@
 
 #include <glm/gtc/constants.hpp>
 
+#include "renderer/frame/GpuTypes.h"
 #include "renderer/frame/PassContext.h"
+#include "renderer/techniques/direct/ImageBasedLighting.h"
 
 namespace radiant {
 namespace ao {
@@ -219,7 +221,7 @@ const TechniqueInfo& AmbientOcclusionPass::info() const {
   static const TechniqueInfo i{
       "ambient_occlusion",
       "Screen-space ambient occlusion (volumetric, containment, crytek, gtao) applied to the ambient light",
-      {"gbuffer_position", "normal", "albedo", "material", "geometric_normal"},
+      {"gbuffer_position", "normal", "albedo", "material", "geometric_normal", "emission"},
       {"direct"},  // runs after direct, which initialises beauty
       {"ao"},
       true,
@@ -278,6 +280,7 @@ void AmbientOcclusionPass::prepare(const Scene&, const Params& params, FrameReso
   resolve.setDrawBuffers({GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1});
   resolve.checkComplete("AmbientOcclusionPass::prepare (resolve)");
   res.buffer("ao_samples", sizeof(ao::SampleBlock));
+  ibl::prepare(res);  // the SH irradiance and the DFG table's diffuse Fresnel weight
 }
 
 void AmbientOcclusionPass::execute(PassContext& ctx) {
@@ -351,7 +354,11 @@ void AmbientOcclusionPass::execute(PassContext& ctx) {
   rp.set("u_scale", scale_);
   rp.set("u_blur", blur_ ? 1 : 0);
   rp.set("u_radius", radius_);
-  rp.set("u_ambient", &view.ambient[0], 3);
+  res.texture("emission").bindUnit(gpu::kUnitAoEmission);
+  ibl::bind(res, rp, gpu::kUnitIblDfg, -1);
+  rp.set("u_eye", &view.eye[0], 3);
+  rp.set("u_viewForward", &forward[0], 3);
+  rp.set("u_orthographic", ortho ? 1 : 0);
   glDrawArrays(GL_TRIANGLES, 0, 3);
   glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   glDisablei(GL_BLEND, 1);

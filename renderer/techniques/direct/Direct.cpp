@@ -6,6 +6,7 @@
 #include "renderer/frame/GpuTypes.h"
 #include "renderer/frame/PassContext.h"
 #include "renderer/techniques/direct/DirectLighting.h"
+#include "renderer/techniques/direct/ImageBasedLighting.h"
 
 namespace radiant {
 namespace {
@@ -22,7 +23,7 @@ const TechniqueInfo& DirectPass::info() const {
                                {"direct", "environment_map"},
                                true,
                                true,
-                               {"LE", "L(point)DE"}};
+                               {"LE", "L(point)DE", "L(sky)GE"}};
   return i;
 }
 
@@ -34,6 +35,7 @@ Requirements DirectPass::requirements(const Scene&, const api::RenderRequest&) c
 
 void DirectPass::prepare(const Scene&, const Params& params, FrameResources& res) {
   pcfRadius_ = params.get<int>("pcf_radius", 1);
+  imageBasedLighting_ = params.get<bool>("image_based_lighting", true);
   const int w = res.view().width, h = res.view().height;
   gl::Framebuffer& fb = res.framebuffer("direct");
   fb.attach(GL_COLOR_ATTACHMENT0, res.texture("direct", GL_TEXTURE_2D, GL_RGBA32F, w, h));
@@ -41,6 +43,7 @@ void DirectPass::prepare(const Scene&, const Params& params, FrameResources& res
   fb.setDrawBuffers({GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1});
   fb.checkComplete("DirectPass::prepare");
   declareDirectLightingResources(res);
+  ibl::prepare(res);
   // The environment map, uploaded once per map (a marker entry keyed by its digest); a 1x1 placeholder
   // keeps the sampler complete when there is none.
   const FrameView& view = res.view();
@@ -86,6 +89,11 @@ void DirectPass::execute(PassContext& ctx) {
     environment.upload(0, 0, 0, 0, env.width, env.height, 1, GL_RGBA, GL_FLOAT, rgba.data());
   }
   environment.bindUnit(gpu::kUnitEnvironment);
+  ibl::bind(res, prog, gpu::kUnitIblDfg, gpu::kUnitIblPrefiltered);
+  // The environment's specular lobe (split-sum) is the light path L(sky)GE: added only when this pass
+  // owns it (the diffuse lobe, L(sky)DE, is ambient_occlusion's or photon_gi's).
+  const bool iblSpecular = imageBasedLighting_ && res.ownsLightPath("direct", "L(sky)GE");
+  if (!iblSpecular) prog.set("u_iblMode", ibl::kNone);
   prog.set("u_hasEnvironment", view.environment ? 1 : 0);
   prog.setMat4("u_invViewProj", &view.invViewProj[0][0]);
   prog.set("u_eye", &view.eye[0], 3);
@@ -95,6 +103,7 @@ void DirectPass::execute(PassContext& ctx) {
   prog.set("u_background", &view.ambient[0], 3);
   glDrawArrays(GL_TRIANGLES, 0, 3);
   ctx.stats.counters["lights"] = static_cast<double>(ctx.scene.lights.size());
+  ctx.stats.counters["ibl_mode"] = iblSpecular ? ibl::modeFor(res) : 0;
   res.markWritten("direct");
   res.markWritten("beauty");
 }

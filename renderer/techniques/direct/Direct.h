@@ -15,6 +15,7 @@ public:
   void execute(PassContext&) override;
 private:
   int pcfRadius_ = 1;
+  bool imageBasedLighting_ = true;
   const Image* environmentUpload_ = nullptr;  // the map to upload in execute() (null: texture current)
 };
 

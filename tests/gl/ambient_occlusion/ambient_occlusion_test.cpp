@@ -199,6 +199,8 @@ AoFrame renderAo(const Scene& scene, int size, json params, glm::vec3 ambient = 
   api::RenderRequest req;
   req.width = req.height = size;
   req.ambient = ambient;
+  // Beauty holds what this pass adds: the environment's specular reflection is the direct pass's.
+  req.passes["direct"] = json{{"image_based_lighting", false}};
   req.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty", "ao", "gbuffer_position", "normal"}, false}};
   req.passes["ambient_occlusion"] = std::move(params);
   // These tests measure AO's own ambient term; with photon_gi in the frame the photons would own the
@@ -586,6 +588,7 @@ TEST(AmbientOcclusion, PlannerSkipsWithoutAmbientOrAov) {
   req.width = req.height = 16;
   req.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty"}, false}};
   req.disabledPasses.insert("photon_gi");  // AO's ambient term alone (photon_gi owns the sky when it runs)
+  req.defaultLighting = false;  // else the lightless scene gets the studio environment (and its ambient)
   RenderOutput out = renderer().render(scene, req);
   EXPECT_FALSE(ran(out));
   ASSERT_EQ(out.stats.skipped.count("ambient_occlusion"), 1u);

@@ -9,7 +9,8 @@
 // GpuScene (toGpuLight, toGpuMaterial, the sRGB/linear texture formats, the glTF samplers), and the
 // CPU reads the same Scene through RayScene. Inputs deliberately include metals, transmission,
 // roughness exactly 0 and 1, roughness below sqrt(kMinGgxAlpha) (the alpha clamp), grazing angles,
-// textures on every slot with every wrap mode and both filters, both uv sets.
+// textures on every slot with every wrap mode and both filters, both uv sets, and KHR_texture_transform
+// rows on every slot of a third of the materials.
 //
 // Tolerances are float tolerances, not modelling slack: relative 1e-4 (BRDF; 2e-3 for the texel-
 // exact material values) plus, for the BRDF, the change of the CPU value itself when wi moves by 1e-5
@@ -40,6 +41,7 @@
 #include "renderer/raytracing/Bsdf.h"
 #include "renderer/raytracing/Lights.h"
 #include "renderer/raytracing/RayScene.h"
+#include "renderer/scene/GltfExtensions.h"
 #include "renderer/scene/MaterialDecode.h"
 
 namespace radiant {
@@ -347,7 +349,8 @@ TEST_F(ParityTest, MaterialDecodingMatchesCpuOnRandomInputs) {
     }
     return r;
   };
-  int textured = 0;
+  int textured = 0, transformedSlots = 0;
+  std::vector<int> transformedMaterials;
   for (int i = 0; i < kMaterials; ++i) {
     Material m;
     m.name = "random" + std::to_string(i);
@@ -374,6 +377,28 @@ TEST_F(ParityTest, MaterialDecodingMatchesCpuOnRandomInputs) {
     for (const TextureRef* r : {&m.baseColorTexture, &m.metallicRoughnessTexture, &m.occlusionTexture,
                                 &m.emissiveTexture, &m.transmissionTexture, &m.normalTexture})
       textured += r->valid();
+    // KHR_texture_transform on every slot of a third of the materials, with the loader's own rows
+    // (gltf::textureTransformRows). The transforms map the 8x8 grid of texel centres onto itself (odd
+    // integer scales, mirrors, quarter turns, offsets in eighths), so texel-centre points stay exact.
+    if (i % 3 == 0) {
+      struct Transform { glm::vec2 offset; float rotation; glm::vec2 scale; };
+      const Transform transforms[] = {{{0.375f, -1.25f}, 0.f, {1.f, 1.f}},
+                                      {{0.125f, 0.5f}, 0.5f * rt::kPi, {3.f, -1.f}},
+                                      {{-0.5f, 0.25f}, rt::kPi, {-1.f, 3.f}},
+                                      {{0.125f, 0.f}, -0.5f * rt::kPi, {1.f, 5.f}}};
+      int k = i / 3;
+      for (TextureRef* r : {&m.baseColorTexture, &m.metallicRoughnessTexture, &m.normalTexture, &m.occlusionTexture,
+                            &m.emissiveTexture, &m.transmissionTexture}) {
+        const Transform& t = transforms[k++ % 4];
+        gltf::textureTransformRows(t.offset, t.rotation, t.scale, r->uvRow0, r->uvRow1);
+        // Exact rows: float cos(pi/2) is -4.4e-8, which would move a texel-centre lookup by ~2e-6 of a
+        // texel, beyond the texel-centre tolerance (the rows are multiples of 1/8 in exact arithmetic).
+        r->uvRow0 = glm::round(r->uvRow0 * 8.f) / 8.f;
+        r->uvRow1 = glm::round(r->uvRow1 * 8.f) / 8.f;
+        transformedSlots += r->valid();
+      }
+      transformedMaterials.push_back(i);
+    }
     scene.materials.push_back(m);
     // One triangle per material whose barycentrics map to uv0 = (-1,-1) + 4 (b1, b2) and uv1 =
     // (-1,-1) + 4 (b2, b1), so uvs in [-1, 1]^2 exercise the wrap modes.
@@ -393,6 +418,7 @@ TEST_F(ParityTest, MaterialDecodingMatchesCpuOnRandomInputs) {
     scene.meshes.push_back(mesh);
   }
   EXPECT_GT(textured, 80);
+  EXPECT_GT(transformedSlots, 25);
   scene.features = computeFeatures(scene);
   const rt::RayScene rays(scene);
   const GpuScene gpuScene(scene);
@@ -443,7 +469,8 @@ TEST_F(ParityTest, MaterialDecodingMatchesCpuOnRandomInputs) {
     normals.download(gpuNormals.data(), gpuNormals.size() * sizeof(glm::vec4));
   }
 
-  int failures = 0, checked = 0, normalsCompared = 0, mappedNormalsCompared = 0;
+  int failures = 0, checked = 0, normalsCompared = 0, mappedNormalsCompared = 0, movedByTransform = 0,
+      transformedCases = 0;
   struct Worst { int failures = 0; float relative = 0.f, absolute = 0.f; };
   std::map<std::string, Worst> byWhat;  // per quantity
   auto expectNear = [&](int i, const char* what, float g, float c, float tol) {
@@ -467,6 +494,23 @@ TEST_F(ParityTest, MaterialDecodingMatchesCpuOnRandomInputs) {
     const gpu::MaterialParams cpu =
         decodeMaterial(m, [&](const TextureRef& ref, bool srgb) { return rays.textureAt(ref, hit, srgb); });
     const gpu::MaterialParams& g = gpu[i];
+    if (std::count(transformedMaterials.begin(), transformedMaterials.end(), mi)) {
+      // The transform really moves the lookups: the same material with identity rows decodes to
+      // something else at most points (so the GPU/CPU agreement below is not two decoders ignoring it).
+      Material plain = m;
+      for (TextureRef* r : {&plain.baseColorTexture, &plain.metallicRoughnessTexture, &plain.normalTexture,
+                            &plain.occlusionTexture, &plain.emissiveTexture, &plain.transmissionTexture}) {
+        r->uvRow0 = glm::vec3(1.f, 0.f, 0.f);
+        r->uvRow1 = glm::vec3(0.f, 1.f, 0.f);
+      }
+      const gpu::MaterialParams untransformed =
+          decodeMaterial(plain, [&](const TextureRef& ref, bool srgb) { return rays.textureAt(ref, hit, srgb); });
+      const float moved = std::max({rt::maxComponent(glm::abs(glm::vec3(untransformed.baseColor - cpu.baseColor))),
+                                    rt::maxComponent(glm::abs(glm::vec3(untransformed.emission - cpu.emission))),
+                                    rt::maxComponent(glm::abs(glm::vec3(untransformed.surface - cpu.surface)))});
+      ++transformedCases;
+      movedByTransform += moved > 0.05f;
+    }
     // Texel centres: linear texels are exact up to float rounding (measured 1.5e-7); sRGB texels
     // differ by llvmpipe's sRGB decode, which is an approximation (measured up to 1.55e-3 of 1).
     // Between centres the GPU's 8-bit filter weights allow 1/128 of each value's range.
@@ -510,6 +554,8 @@ TEST_F(ParityTest, MaterialDecodingMatchesCpuOnRandomInputs) {
   EXPECT_EQ(failures, 0) << "of " << checked << " comparisons";
   EXPECT_GT(normalsCompared, 9000);
   EXPECT_GT(mappedNormalsCompared, 5000);
+  EXPECT_GT(transformedCases, 3000);
+  EXPECT_GT(movedByTransform, transformedCases / 2);
 }
 
 // --------------------------------------------------------------------------------------------------
@@ -525,6 +571,7 @@ TEST_F(ParityTest, SamplerUnitsAreUniqueAcrossTheFramesPrograms) {
       {"gbuffer/gbuffer.vert", "gbuffer/gbuffer.frag"},   {"common/fullscreen.vert", "direct/direct.frag"},
       {"specular/map.vert", "specular/map.frag"},         {"specular/map.vert", "specular/specular.frag"},
       {"env_diffuse/cube.vert", "env_diffuse/cube.frag"}, {"env_diffuse/cube.vert", "env_diffuse/receiver.frag"},
+      {"common/fullscreen.vert", "ambient_occlusion/ao_resolve.frag"},  // image-based lighting's DFG table
   };
   std::map<int, std::string> sharedUnitOwner;  // unit >= 6 -> sampler name
   int samplers = 0;

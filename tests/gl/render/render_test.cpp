@@ -225,9 +225,13 @@ TEST(RenderCore, StatsTimeEveryPassAndSkipWithReasons) {
   EXPECT_EQ(out.stats.lights, 1);
   EXPECT_FALSE(out.stats.device.at("renderer").empty());
 
-  // No lights: the shadow maps are skipped with a reason and direct still runs.
+  // No lights (and the default studio lighting turned off): the shadow maps are skipped with a
+  // reason and direct still runs.
   Scene dark = planeScene().topDownOrtho(5.f, 1.f).build("dark");
-  RenderOutput d = renderer().render(dark, request(16));
+  api::RenderRequest unlitRequest = request(16);
+  unlitRequest.defaultLighting = false;
+  RenderOutput d = renderer().render(dark, unlitRequest);
+  EXPECT_EQ(d.stats.lighting, "none");
   ASSERT_TRUE(d.stats.skipped.count("shadow_maps"));
   EXPECT_EQ(d.stats.skipped.at("shadow_maps"), "the scene has no punctual lights");
   for (float v : aov(d, "beauty").pixels) EXPECT_EQ(v, 0.f);

@@ -1,0 +1,268 @@
+#include "renderer/scene/GltfCompression.h"
+
+#include <cstring>
+#include <vector>
+
+#include <draco/compression/decode.h>
+#include <meshoptimizer.h>
+#include <tiny_gltf.h>  // shared library: no TINYGLTF_IMPLEMENTATION
+
+#include "renderer/scene/GltfLoader.h"
+
+namespace radiant::gltf {
+namespace {
+
+using json = nlohmann::json;
+
+std::uint32_t le32(const char* p) {
+  const auto* u = reinterpret_cast<const unsigned char*>(p);
+  return std::uint32_t(u[0]) | std::uint32_t(u[1]) << 8 | std::uint32_t(u[2]) << 16 | std::uint32_t(u[3]) << 24;
+}
+void put32(std::string& s, std::uint32_t v) {
+  for (int i = 0; i < 4; ++i) s.push_back(char((v >> (8 * i)) & 255));
+}
+
+std::uint64_t unsignedAt(const json& o, const char* key, const std::string& ptr, bool required = true) {
+  const auto it = o.find(key);
+  if (it == o.end() || !it->is_number_unsigned()) {
+    if (!required) return 0;
+    throw SceneError(ptr + "/" + key, std::string(key) + " must be a non-negative integer");
+  }
+  return it->get<std::uint64_t>();
+}
+
+std::pair<json, std::string> splitGlb(std::string_view glb) {
+  if (glb.size() < 20 || glb.substr(0, 4) != "glTF") throw SceneError("", "expected a GLB");
+  const std::uint32_t jsonLength = le32(glb.data() + 12);
+  json doc = json::parse(glb.substr(20, jsonLength));
+  const std::size_t binHeader = 20 + ((jsonLength + 3) & ~3u);
+  std::string bin;
+  if (binHeader + 8 <= glb.size())
+    bin = std::string(glb.substr(binHeader + 8, std::min<std::size_t>(le32(glb.data() + binHeader), glb.size() - binHeader - 8)));
+  return {std::move(doc), std::move(bin)};
+}
+
+std::string joinGlb(const json& doc, std::string bin) {
+  bin.resize((bin.size() + 3) & ~std::size_t(3), '\0');
+  std::string text = doc.dump();
+  text.resize((text.size() + 3) & ~std::size_t(3), ' ');
+  std::string result = "glTF";
+  put32(result, 2);
+  put32(result, std::uint32_t(28 + text.size() + bin.size()));
+  put32(result, std::uint32_t(text.size()));
+  put32(result, 0x4E4F534Au);
+  result += text;
+  put32(result, std::uint32_t(bin.size()));
+  put32(result, 0x004E4942u);
+  result += bin;
+  return result;
+}
+
+}  // namespace
+
+bool usesDraco(const json& doc) {
+  const auto meshes = doc.find("meshes");
+  if (meshes == doc.end() || !meshes->is_array()) return false;
+  for (const auto& m : *meshes)
+    if (m.is_object() && m.contains("primitives") && m["primitives"].is_array())
+      for (const auto& p : m["primitives"])
+        if (p.is_object() && p.contains("extensions") && p["extensions"].is_object() &&
+            p["extensions"].contains("KHR_draco_mesh_compression"))
+          return true;
+  return false;
+}
+
+std::string prepareDraco(std::string_view glb) {
+  auto [doc, bin] = splitGlb(glb);
+  for (auto& m : doc["meshes"])
+    if (m.is_object() && m.contains("primitives"))
+      for (auto& p : m["primitives"])
+        if (p.is_object() && p.contains("extensions") && p["extensions"].is_object() &&
+            p["extensions"].contains("KHR_draco_mesh_compression"))
+          p.erase("indices");
+  return joinGlb(doc, std::move(bin));
+}
+
+bool usesMeshopt(const json& doc) {
+  const auto views = doc.find("bufferViews");
+  if (views == doc.end() || !views->is_array()) return false;
+  for (const auto& v : *views)
+    if (v.is_object() && v.contains("extensions") && v["extensions"].is_object() &&
+        v["extensions"].contains("EXT_meshopt_compression"))
+      return true;
+  return false;
+}
+
+std::string decodeMeshopt(std::string_view glb, std::size_t maxBytes) {
+  if (glb.size() < 20 || glb.substr(0, 4) != "glTF") throw SceneError("", "EXT_meshopt_compression: expected a GLB");
+  const std::uint32_t jsonLength = le32(glb.data() + 12);
+  json doc = json::parse(glb.substr(20, jsonLength));
+  const std::size_t binHeader = 20 + ((jsonLength + 3) & ~3u);
+  std::string_view bin;
+  if (binHeader + 8 <= glb.size()) bin = glb.substr(binHeader + 8, std::min<std::size_t>(le32(glb.data() + binHeader), glb.size() - binHeader - 8));
+  std::string out(bin);
+  std::size_t budget = maxBytes;
+  json& views = doc["bufferViews"];
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    json& v = views[i];
+    if (!v.is_object() || !v.contains("extensions") || !v["extensions"].contains("EXT_meshopt_compression")) continue;
+    const std::string ptr = "/bufferViews/" + std::to_string(i) + "/extensions/EXT_meshopt_compression";
+    const json& e = v["extensions"]["EXT_meshopt_compression"];
+    if (unsignedAt(e, "buffer", ptr) != 0)
+      throw SceneError(ptr + "/buffer", "the compressed bytes must be in a buffer with data");
+    const std::uint64_t offset = unsignedAt(e, "byteOffset", ptr, false), length = unsignedAt(e, "byteLength", ptr);
+    const std::uint64_t stride = unsignedAt(e, "byteStride", ptr), count = unsignedAt(e, "count", ptr);
+    const std::string mode = e.value("mode", ""), filter = e.value("filter", "NONE");
+    if (offset > bin.size() || length > bin.size() - offset)
+      throw SceneError(ptr, "the compressed bytes [" + std::to_string(offset) + ", " + std::to_string(offset + length) +
+                                ") lie outside the buffer of " + std::to_string(bin.size()) + " bytes");
+    if (stride == 0 || stride > 256 || count > budget / stride)
+      throw SceneError(ptr, "count " + std::to_string(count) + " x byteStride " + std::to_string(stride) +
+                                " is outside the limits (stride 1..256, total within the size limit)");
+    budget -= count * stride;
+    std::vector<unsigned char> decoded(count * stride);
+    const auto* src = reinterpret_cast<const unsigned char*>(bin.data() + offset);
+    int rc = -1;
+    if (mode == "ATTRIBUTES") {
+      if (stride % 4 != 0) throw SceneError(ptr + "/byteStride", "ATTRIBUTES needs a byteStride that is a multiple of 4");
+      rc = meshopt_decodeVertexBuffer(decoded.data(), count, stride, src, length);
+    } else if (mode == "TRIANGLES" || mode == "INDICES") {
+      if (stride != 2 && stride != 4) throw SceneError(ptr + "/byteStride", mode + " needs a byteStride of 2 or 4");
+      if (mode == "TRIANGLES" && count % 3 != 0) throw SceneError(ptr + "/count", "TRIANGLES needs a count that is a multiple of 3");
+      rc = mode == "TRIANGLES" ? meshopt_decodeIndexBuffer(decoded.data(), count, stride, src, length)
+                               : meshopt_decodeIndexSequence(decoded.data(), count, stride, src, length);
+    } else {
+      throw SceneError(ptr + "/mode", "unknown mode \"" + mode + "\" (ATTRIBUTES, TRIANGLES or INDICES)");
+    }
+    if (rc != 0) throw SceneError(ptr, "the meshopt stream is corrupt (meshoptimizer error " + std::to_string(rc) + ")");
+    if (filter == "OCTAHEDRAL") meshopt_decodeFilterOct(decoded.data(), count, stride);
+    else if (filter == "QUATERNION") meshopt_decodeFilterQuat(decoded.data(), count, stride);
+    else if (filter == "EXPONENTIAL") meshopt_decodeFilterExp(decoded.data(), count, stride);
+    else if (filter != "NONE") throw SceneError(ptr + "/filter", "unknown filter \"" + filter + "\"");
+    if ((filter == "OCTAHEDRAL" && stride != 4 && stride != 8) || (filter == "QUATERNION" && stride != 8) ||
+        (filter == "EXPONENTIAL" && stride % 4 != 0))
+      throw SceneError(ptr + "/filter", "filter " + filter + " does not fit byteStride " + std::to_string(stride));
+    out.resize((out.size() + 15) & ~std::size_t(15), '\0');
+    const std::size_t at = out.size();
+    out.append(reinterpret_cast<const char*>(decoded.data()), decoded.size());
+    v["buffer"] = 0;
+    v["byteOffset"] = at;
+    v["byteLength"] = decoded.size();
+    if (mode == "ATTRIBUTES") v["byteStride"] = stride;
+    else v.erase("byteStride");
+    v["extensions"].erase("EXT_meshopt_compression");
+    if (v["extensions"].empty()) v.erase("extensions");
+  }
+  // Only buffer 0 holds data now; fallback buffers are referenced by nothing.
+  out.resize((out.size() + 3) & ~std::size_t(3), '\0');
+  doc["buffers"] = json::array({{{"byteLength", out.size()}}});
+  for (const char* key : {"extensionsUsed", "extensionsRequired"})
+    if (doc.contains(key) && doc[key].is_array()) {
+      json kept = json::array();
+      for (const auto& e : doc[key])
+        if (e != "EXT_meshopt_compression") kept.push_back(e);
+      doc[key] = kept;
+    }
+  std::string text = doc.dump();
+  text.resize((text.size() + 3) & ~std::size_t(3), ' ');
+  std::string result = "glTF";
+  put32(result, 2);
+  put32(result, std::uint32_t(28 + text.size() + out.size()));
+  put32(result, std::uint32_t(text.size()));
+  put32(result, 0x4E4F534Au);
+  result += text;
+  put32(result, std::uint32_t(out.size()));
+  put32(result, 0x004E4942u);
+  result += out;
+  return result;
+}
+
+void decodeDraco(tinygltf::Model& model, std::size_t maxBytes) {
+  std::size_t budget = maxBytes;
+  for (std::size_t mi = 0; mi < model.meshes.size(); ++mi)
+    for (std::size_t pi = 0; pi < model.meshes[mi].primitives.size(); ++pi) {
+      tinygltf::Primitive& prim = model.meshes[mi].primitives[pi];
+      const auto ext = prim.extensions.find("KHR_draco_mesh_compression");
+      if (ext == prim.extensions.end()) continue;
+      const std::string ptr = "/meshes/" + std::to_string(mi) + "/primitives/" + std::to_string(pi) +
+                              "/extensions/KHR_draco_mesh_compression";
+      const tinygltf::Value& e = ext->second;
+      if (!e.IsObject() || !e.Has("bufferView") || !e.Get("bufferView").IsNumber() || !e.Has("attributes"))
+        throw SceneError(ptr, "needs bufferView and attributes");
+      const int viewIndex = e.Get("bufferView").GetNumberAsInt();
+      if (viewIndex < 0 || std::size_t(viewIndex) >= model.bufferViews.size())
+        throw SceneError(ptr + "/bufferView", "bufferView " + std::to_string(viewIndex) + " does not exist");
+      const tinygltf::BufferView& view = model.bufferViews[std::size_t(viewIndex)];
+      if (view.buffer < 0 || std::size_t(view.buffer) >= model.buffers.size() ||
+          view.byteOffset + view.byteLength > model.buffers[std::size_t(view.buffer)].data.size())
+        throw SceneError(ptr + "/bufferView", "bufferView " + std::to_string(viewIndex) + " lies outside its buffer");
+      draco::DecoderBuffer buffer;
+      buffer.Init(reinterpret_cast<const char*>(model.buffers[std::size_t(view.buffer)].data.data() + view.byteOffset),
+                  view.byteLength);
+      draco::Decoder decoder;
+      auto decoded = decoder.DecodeMeshFromBuffer(&buffer);
+      if (!decoded.ok()) throw SceneError(ptr, std::string("the Draco bitstream cannot be decoded: ") + decoded.status().error_msg());
+      const std::unique_ptr<draco::Mesh> mesh = std::move(decoded).value();
+      const std::size_t points = mesh->num_points(), faces = mesh->num_faces();
+      const std::size_t need = faces * 3 * 4 + points * 16 * e.Get("attributes").Keys().size();
+      if (need > budget) throw SceneError(ptr, "the decoded mesh (" + std::to_string(need) + " bytes) is over the size limit");
+      budget -= need;
+
+      // One new buffer per primitive holding the decoded attributes (float) and indices (u32).
+      tinygltf::Buffer out;
+      auto addView = [&](const void* data, std::size_t bytes) {
+        while (out.data.size() % 4) out.data.push_back(0);
+        tinygltf::BufferView v;
+        v.buffer = int(model.buffers.size());
+        v.byteOffset = out.data.size();
+        v.byteLength = bytes;
+        const auto* p = static_cast<const unsigned char*>(data);
+        out.data.insert(out.data.end(), p, p + bytes);
+        model.bufferViews.push_back(v);
+        return int(model.bufferViews.size()) - 1;
+      };
+      const tinygltf::Value& attrs = e.Get("attributes");
+      for (const std::string& name : attrs.Keys()) {
+        const auto it = prim.attributes.find(name);
+        if (it == prim.attributes.end()) continue;  // Draco may carry attributes the primitive does not use
+        const int accIndex = it->second;
+        if (accIndex < 0 || std::size_t(accIndex) >= model.accessors.size())
+          throw SceneError(ptr + "/attributes/" + name, "accessor " + std::to_string(accIndex) + " does not exist");
+        const draco::PointAttribute* a = attrs.Get(name).IsNumber()
+                                             ? mesh->GetAttributeByUniqueId(std::uint32_t(attrs.Get(name).GetNumberAsInt()))
+                                             : nullptr;
+        if (!a) throw SceneError(ptr + "/attributes/" + name, "the Draco stream has no attribute with this id");
+        tinygltf::Accessor& acc = model.accessors[std::size_t(accIndex)];
+        const int comps = tinygltf::GetNumComponentsInType(std::uint32_t(acc.type));
+        if (comps <= 0 || comps > 4) throw SceneError(ptr + "/attributes/" + name, "unsupported accessor type");
+        std::vector<float> values(points * std::size_t(comps), 0.f);
+        for (std::size_t i = 0; i < points; ++i)
+          if (!a->ConvertValue<float>(a->mapped_index(draco::PointIndex(std::uint32_t(i))), std::int8_t(comps),
+                                      &values[i * std::size_t(comps)]))
+            throw SceneError(ptr + "/attributes/" + name, "the Draco attribute cannot be converted to float");
+        // Normalised integer attributes come back in [0, 1] / [-1, 1] from ConvertValue: store them as floats.
+        acc.bufferView = addView(values.data(), values.size() * sizeof(float));
+        acc.byteOffset = 0;
+        acc.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
+        acc.normalized = false;
+        acc.count = points;
+        acc.sparse.isSparse = false;
+      }
+      std::vector<std::uint32_t> indices(faces * 3);
+      for (std::size_t f = 0; f < faces; ++f) {
+        const auto& face = mesh->face(draco::FaceIndex(std::uint32_t(f)));
+        for (int k = 0; k < 3; ++k) indices[f * 3 + std::size_t(k)] = face[k].value();
+      }
+      tinygltf::Accessor idx;
+      idx.bufferView = addView(indices.data(), indices.size() * 4);
+      idx.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+      idx.type = TINYGLTF_TYPE_SCALAR;
+      idx.count = indices.size();
+      model.accessors.push_back(idx);
+      prim.indices = int(model.accessors.size()) - 1;
+      prim.mode = TINYGLTF_MODE_TRIANGLES;
+      model.buffers.push_back(std::move(out));
+    }
+}
+
+}  // namespace radiant::gltf

@@ -1,0 +1,498 @@
+// glTF content on screen, with numbers: the default studio lighting of a lightless scene, unlit
+// materials, texture transforms moving a known texel to a known pixel, and partial camera overrides.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "renderer/Renderer.h"
+#include "renderer/io/ImageIO.h"
+#include "renderer/scene/Environment.h"
+#include "renderer/scene/GltfLoader.h"
+#include "renderer/raytracing/Bsdf.h"
+#include "renderer/scene/StudioEnvironment.h"
+#include "renderer/techniques/direct/ImageBasedLighting.h"
+#include "tests/support/RenderTestSupport.h"
+#include "tests/support/SceneBuilder.h"
+#include "tests/unit/scene/GltfTestBuilder.h"
+
+namespace radiant {
+namespace {
+
+using testing::aov;
+using testing::renderer;
+using json = nlohmann::json;
+using rt::GltfBsdf;
+
+api::RenderRequest exrRequest(int size) {
+  api::RenderRequest req;
+  req.width = req.height = size;
+  req.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty"}, false}};
+  return req;
+}
+
+// ---- default lighting --------------------------------------------------------------------------
+
+TEST(DefaultLighting, StudioMapIsNeutralAndItsMeanIsAsDocumented) {
+  const Image& map = studioEnvironment();
+  ASSERT_EQ(map.width, kStudioEnvironmentWidth);
+  for (std::size_t i = 0; i < map.pixels.size(); i += 3) {
+    ASSERT_EQ(map.pixels[i], map.pixels[i + 1]);  // grey: never tints a material
+    ASSERT_EQ(map.pixels[i], map.pixels[i + 2]);
+    ASSERT_GT(map.pixels[i], 0.f);
+  }
+  // StudioEnvironment.h: fill 0.5 + 0.3 y above (hemisphere mean 0.65), 0.2 below, so the fill alone
+  // averages (0.65 + 0.2) / 2 = 0.425 over the sphere; the key adds 8 * (its smoothstep-weighted solid
+  // angle ~0.082 sr) / (4 pi) ~ 0.052 (at most 8 * 0.214 sr / 4 pi = 0.136).
+  const float mean = environmentAverage(map).x;
+  EXPECT_GT(mean, 0.425f + 0.02f);
+  EXPECT_LT(mean, 0.425f + 0.136f);
+  // The brightest texel is the key's centre direction (radiance 8 + the fill there).
+  EXPECT_NEAR(studioRadiance(glm::normalize(glm::vec3(1.f, 1.25f, 1.f))), 8.f + 0.5f + 0.3f * 1.25f / std::sqrt(3.5625f),
+              1e-4f);
+}
+
+// A white Lambertian quad facing the camera (+Z), no lights: lit by the studio map through the ambient
+// pass, L = albedo * E(+Z) / pi * AO with E the map's SH irradiance (AO = 1 on an open plane); the
+// split-sum specular adds B(1, 1) Lpre ~ 1e-3 for this F0 = 0 material.
+TEST(DefaultLighting, LightlessSceneIsLitAndSaysSo) {
+  testing::SceneBuilder b;
+  const int m = b.material(testing::lambertian(glm::vec3(0.8f)));
+  b.quad({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, m);
+  const Scene scene = b.build("lightless");
+  api::RenderRequest req = exrRequest(32);
+  req.camera = api::CameraOverride{{0, 0, 1.5f}, {0, 0, 0}, {0, 1, 0}, 40.f};
+  req.disabledPasses.insert("photon_gi");  // measures the raster's IBL/AO terms; photon_gi would own L(sky)DE
+  const RenderOutput out = renderer().render(scene, req);
+  EXPECT_EQ(out.stats.lighting, "default");
+  const float mean = environmentAverage(studioEnvironment()).x;
+  const float irradiance = ibl::irradianceFromSh(ibl::irradianceSh(studioEnvironment()), {0, 0, 1}).x;
+  const Image& beauty = aov(out, "beauty");
+  // Centre 8x8 pixels, away from the quad's edge where the AO kernel sees the void.
+  double sum = 0.0;
+  for (int y = 12; y < 20; ++y)
+    for (int x = 12; x < 20; ++x) sum += beauty.at(x, y)[1];
+  const double centre = sum / 64.0;
+  // The bound: the diffuse term is exactly 0.8 E / pi on an unoccluded plane; 5% covers the AO
+  // estimator's noise after its 4x4 blur and the specular term.
+  const double expected = 0.8 * irradiance / glm::pi<float>();
+  EXPECT_NEAR(centre, expected, 0.05 * expected);
+  // Not black, with margin: the studio lights a white surface facing any direction with at least its
+  // floor's 0.2 (E / pi >= 0.2 where the floor fills the hemisphere), so at least 0.8 * 0.2 / 2 here.
+  EXPECT_GT(centre, 0.08);
+  EXPECT_GT(expected, 0.8 * mean);  // the key faces this plane: brighter than the mean
+
+  // Opting out renders the lightless scene black, and says so.
+  req.defaultLighting = false;
+  const RenderOutput dark = renderer().render(scene, req);
+  EXPECT_EQ(dark.stats.lighting, "none");
+  EXPECT_EQ(aov(dark, "beauty").at(16, 16)[1], 0.f);
+  // An ambient in the request replaces the default.
+  req.defaultLighting = true;
+  req.ambient = glm::vec3(0.25f);
+  const RenderOutput amb = renderer().render(scene, req);
+  EXPECT_EQ(amb.stats.lighting, "ambient");
+  EXPECT_NEAR(aov(amb, "beauty").at(16, 16)[1], 0.8 * 0.25, 0.05 * 0.8 * 0.25);
+}
+
+// ---- a quad that exactly fills a 32x32 frame: pixel (x, y) sees uv ((x + .5) / 32, (y + .5) / 32) ----
+
+constexpr int kSize = 32;
+const api::CameraOverride kFillCamera{{0, 0, 2}, {0, 0, 0}, {0, 1, 0}, 2.f * 26.5650512f};  // tan(fov/2) = 1/2
+
+// A 4x4 texture whose texel (i, j) has sRGB red 85 i and green 85 j: its column and row can be read
+// back from a linear pixel colour.
+std::vector<std::uint8_t> gridTexels() {
+  std::vector<std::uint8_t> t(4 * 4 * 4);
+  for (int j = 0; j < 4; ++j)
+    for (int i = 0; i < 4; ++i) {
+      std::uint8_t* p = &t[(j * 4 + i) * 4];
+      p[0] = std::uint8_t(85 * i);
+      p[1] = std::uint8_t(85 * j);
+      p[2] = 0;
+      p[3] = 255;
+    }
+  return t;
+}
+
+// Which texel column / row a linear value came from (nearest of srgbToLinear(85 k / 255)).
+int texelIndex(float linear) {
+  int best = 0;
+  for (int k = 1; k < 4; ++k)
+    if (std::abs(io::srgbToLinear(85.f * k / 255.f) - linear) < std::abs(io::srgbToLinear(85.f * best / 255.f) - linear))
+      best = k;
+  return best;
+}
+
+// The filling quad with an unlit, textured material; `transform` is the KHR_texture_transform object
+// (null = none). Nearest filtering and clamping, so a pixel shows exactly one texel.
+Scene texturedQuad(const json& transform, bool unlit = true, glm::vec4 baseColor = glm::vec4(1.f)) {
+  test::GltfBuilder b;
+  json info = {{"index", 0}};
+  if (!transform.is_null()) info["extensions"] = {{"KHR_texture_transform", transform}};
+  json mat = {{"pbrMetallicRoughness", {{"baseColorTexture", info}, {"metallicFactor", 0.0},
+                                        {"baseColorFactor", {baseColor.r, baseColor.g, baseColor.b, baseColor.a}}}}};
+  if (unlit) mat["extensions"] = {{"KHR_materials_unlit", json::object()}};
+  const int m = b.material(mat);
+  const int mesh = b.mesh(json::array({test::trianglePrimitive<std::uint16_t>(
+      b, {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}}, {0, 1, 2, 0, 2, 3}, {}, {{0, 1}, {1, 1}, {1, 0}, {0, 0}}, m)}));
+  b.scene({b.node({{"name", "card"}, {"mesh", mesh}})});
+  b.doc["samplers"] = json::array({{{"magFilter", 9728}, {"minFilter", 9728}, {"wrapS", 33071}, {"wrapT", 33071}}});
+  b.doc["textures"] = json::array({{{"source", 0}, {"sampler", 0}}});
+  b.doc["images"] = json::array({{{"uri", "data:image/png;base64," + test::base64(test::encodePng(4, 4, gridTexels()))}}});
+  b.doc["extensionsUsed"] = json::array({"KHR_texture_transform", "KHR_materials_unlit"});
+  return loadSceneFromMemory(b.gltf());
+}
+
+RenderOutput renderCard(const Scene& scene, bool withReference = false) {
+  api::RenderRequest req = exrRequest(kSize);
+  req.camera = kFillCamera;
+  // Raster lookups only: photon_gi splats the default sky's photons on the unlit card's G-buffer stand-in.
+  req.disabledPasses.insert("photon_gi");
+  if (withReference) req.compare = api::CompareSpec{"reference", "beauty", 4, 2};
+  return renderer().render(scene, req);
+}
+
+struct Texel { int i, j; };
+Texel texelAt(const Image& img, int x, int y) { return {texelIndex(img.at(x, y)[0]), texelIndex(img.at(x, y)[1])}; }
+
+TEST(TextureTransform, OffsetAndScaleMoveAKnownTexelToAKnownPixel) {
+  // Without a transform pixel (3, 3) (uv ~ (0.11, 0.11)) shows texel (0, 0) and pixel (28, 3) texel (3, 0).
+  const RenderOutput plain = renderCard(texturedQuad(nullptr));
+  EXPECT_EQ(texelAt(aov(plain, "beauty"), 3, 3).i, 0);
+  EXPECT_EQ(texelAt(aov(plain, "beauty"), 28, 3).i, 3);
+  // uv' = (0.5, 0.25) + 0.5 uv: pixel (3, 3) -> uv' (0.555, 0.305) -> texel (2, 1);
+  // pixel (28, 20) (uv (0.89, 0.64)) -> uv' (0.945, 0.57) -> texel (3, 2).
+  const RenderOutput moved = renderCard(texturedQuad({{"offset", {0.5, 0.25}}, {"scale", {0.5, 0.5}}}), true);
+  for (const char* which : {"beauty", "reference"}) {
+    SCOPED_TRACE(which);
+    const Image& img = aov(moved, which);
+    EXPECT_EQ(texelAt(img, 3, 3).i, 2);
+    EXPECT_EQ(texelAt(img, 3, 3).j, 1);
+    EXPECT_EQ(texelAt(img, 28, 20).i, 3);
+    EXPECT_EQ(texelAt(img, 28, 20).j, 2);
+    // Unlit + texture: the pixel is the texel's linear value exactly (sRGB decode of 170 = 0.402).
+    EXPECT_NEAR(img.at(3, 3)[0], io::srgbToLinear(170.f / 255.f), 2e-3f);
+  }
+}
+
+TEST(TextureTransform, RotationTurnsUvCounterClockwiseAsTheSpecWrites) {
+  // rotation pi/2, offset (1, 0): u' = 1 - v, v' = u (KHR_texture_transform's T R S).
+  // Pixel (3, 12) (uv (0.11, 0.39)) -> uv' (0.61, 0.11) -> texel (2, 0); pixel (20, 28) (uv (0.64, 0.89))
+  // -> uv' (0.11, 0.64) -> texel (0, 2).
+  const RenderOutput turned =
+      renderCard(texturedQuad({{"offset", {1.0, 0.0}}, {"rotation", 1.57079632679}}));
+  const Image& img = aov(turned, "beauty");
+  EXPECT_EQ(texelAt(img, 3, 12).i, 2);
+  EXPECT_EQ(texelAt(img, 3, 12).j, 0);
+  EXPECT_EQ(texelAt(img, 20, 28).i, 0);
+  EXPECT_EQ(texelAt(img, 20, 28).j, 2);
+}
+
+// ---- unlit ---------------------------------------------------------------------------------------
+
+TEST(Unlit, EqualsBaseColourWhateverLightsTheScene) {
+  // A white texel row (texel (3, 3) is sRGB (255, 255, 0)) times a base colour factor; a bright point
+  // light in front would add diffuse and specular light to a lit material.
+  Scene scene = texturedQuad(nullptr, true, glm::vec4(0.25f, 0.5f, 0.75f, 1.f));
+  Light l;
+  l.type = LightType::Point;
+  l.intensity = 50.f;
+  l.position = {0.3f, 0.2f, 1.f};
+  scene.lights.push_back(l);
+  scene.features = computeFeatures(scene);
+  const RenderOutput out = renderCard(scene, true);
+  EXPECT_EQ(out.stats.lighting, "scene");
+  for (const char* which : {"beauty", "reference"}) {
+    SCOPED_TRACE(which);
+    const Image& img = aov(out, which);
+    // Pixel (28, 28): texel (3, 3), linear (1, 1, 0) times the factor.
+    EXPECT_NEAR(img.at(28, 28)[0], 0.25f, 2e-3f);
+    EXPECT_NEAR(img.at(28, 28)[1], 0.5f, 2e-3f);
+    EXPECT_NEAR(img.at(28, 28)[2], 0.f, 2e-3f);
+  }
+  // The same card lit: clearly brighter than its base colour where the light is.
+  const RenderOutput lit = [&] {
+    Scene s = texturedQuad(nullptr, false, glm::vec4(0.25f, 0.5f, 0.75f, 1.f));
+    s.lights = scene.lights;
+    s.features = computeFeatures(s);
+    return renderCard(s);
+  }();
+  EXPECT_GT(aov(lit, "beauty").at(28, 28)[1], 0.5f * 1.5f);
+}
+
+TEST(Unlit, AMirrorReflectsTheUnlitBaseColour) {
+  // A white mirror floor seen straight down reflects an unlit ceiling above the camera: Schlick F = 1
+  // for a white metal, so the reflection is the ceiling's base colour exactly, with no light anywhere
+  // (default lighting off: a shaded ceiling would be black).
+  testing::SceneBuilder b;
+  Material mirror;
+  mirror.metallicFactor = 1.f;
+  mirror.roughnessFactor = 0.f;
+  Material ceiling = testing::lambertian(glm::vec3(0.2f, 0.4f, 0.6f));
+  ceiling.unlit = true;
+  ceiling.doubleSided = true;
+  b.quad({0, 0, 0}, {50, 0, 0}, {0, 0, -50}, b.material(mirror), "mirror");
+  b.quad({0, 3, 0}, {50, 0, 0}, {0, 0, 50}, b.material(ceiling), "ceiling");  // faces down, behind the camera
+  b.topDownOrtho(2.f, 1.f);
+  const Scene scene = b.build("unlit-mirror");
+  api::RenderRequest req = exrRequest(8);
+  req.defaultLighting = false;
+  req.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty", "specular"}, false}};
+  const RenderOutput out = renderer().render(scene, req);
+  const Image& spec = aov(out, "specular");
+  for (int y = 2; y < 6; ++y)
+    for (int x = 2; x < 6; ++x) {
+      EXPECT_NEAR(spec.at(x, y)[0], 0.2f, 2e-3f);
+      EXPECT_NEAR(spec.at(x, y)[1], 0.4f, 2e-3f);
+      EXPECT_NEAR(spec.at(x, y)[2], 0.6f, 2e-3f);
+    }
+}
+
+// ---- image-based lighting: the white furnace ---------------------------------------------------------
+
+// Directional albedo of the glTF BSDF at n.v = mu, by the ray-tracing core's own sampler (renderer/raytracing/
+// Bsdf.h: an implementation independent of the raster's tables): the mean of f cos / pdf.
+float directionalAlbedo(const GltfBsdf& bsdf, float mu, int n = 20000) {
+  const glm::vec3 wo(std::sqrt(std::max(0.f, 1.f - mu * mu)), 0.f, mu);
+  double sum = 0.0;
+  std::uint32_t state = 12345u;
+  auto next = [&] {
+    state = state * 1664525u + 1013904223u;
+    return float(state >> 8) / 16777216.f;
+  };
+  for (int i = 0; i < n; ++i) {
+    GltfBsdf::Sample s;
+    if (bsdf.sample(wo, next(), next(), {(i + next()) / n, next()}, s) && s.wi.z > 0.f) sum += s.weight.g;
+  }
+  return float(sum / n);
+}
+
+// A sphere under a uniform environment map of radiance 1 reflects, at each pixel, its directional
+// albedo E(n.v): the raster's split-sum specular (direct) plus SH irradiance diffuse (ambient_occlusion,
+// AO = 1 on a convex sphere) must give it. Bound 2% (the brief), on the mean over the pixels with
+// n.v > 0.2 (at grazing angles the 32x32 table and the AO kernel at the silhouette dominate).
+void whiteFurnace(const Material& material, const std::string& name, double* meanErr, double* maxErr) {
+  testing::SceneBuilder b;
+  b.sphere({0, 0, 0}, 1.f, b.material(material), 96, 48);
+  const Scene scene = b.build(name);
+  Image env = Image::make("environment", 32, 16, 3);
+  for (float& v : env.pixels) v = 1.f;
+  api::RenderRequest req;
+  req.width = req.height = 64;
+  req.environment = "sha256:" + std::string(64, 'f');
+  req.camera = api::CameraOverride{{0, 0, 4}, {0, 0, 0}, {0, 1, 0}, 35.f};
+  req.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty", "normal"}, false}};
+  req.passes["ambient_occlusion"] = nlohmann::json{{"radius", 0.2}};
+  req.disabledPasses.insert("photon_gi");  // the raster's split-sum + SH terms alone (photon_gi owns L(sky)DE)
+  const RenderOutput out = renderer().render(scene, req, nullptr, FrameInputs{nullptr, &env});
+  const Image& beauty = aov(out, "beauty");
+  const Image& normal = aov(out, "normal");
+  GltfBsdf bsdf;
+  bsdf.baseColor = glm::vec3(material.baseColorFactor);
+  bsdf.metallic = material.metallicFactor;
+  bsdf.roughness = material.roughnessFactor;
+  bsdf.ior = material.ior;
+  bsdf.eta = material.ior;
+  std::vector<float> table(21);
+  for (int k = 0; k <= 20; ++k) table[std::size_t(k)] = directionalAlbedo(bsdf, std::max(0.05f * k, 1e-3f));
+  const float t = std::tan(glm::radians(17.5f));
+  double sum = 0.0, worst = 0.0;
+  int count = 0;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) {
+      const glm::vec3 n(normal.at(x, y)[0], normal.at(x, y)[1], normal.at(x, y)[2]);
+      if (glm::length(n) < 0.5f) continue;
+      const glm::vec3 dir = glm::normalize(glm::vec3((2.f * (x + 0.5f) / 64.f - 1.f) * t, (1.f - 2.f * (y + 0.5f) / 64.f) * t, -1.f));
+      const float mu = glm::dot(n, -dir);
+      if (mu < 0.2f) continue;
+      const float f = mu / 0.05f;
+      const int k = std::min(int(f), 19);
+      const float expected = table[std::size_t(k)] + (f - k) * (table[std::size_t(k) + 1] - table[std::size_t(k)]);
+      const double err = std::abs(beauty.at(x, y)[1] - expected) / expected;
+      sum += err;
+      worst = std::max(worst, err);
+      ++count;
+    }
+  ASSERT_GT(count, 500);
+  *meanErr = sum / count;
+  *maxErr = worst;
+}
+
+TEST(ImageBasedLighting, WhiteFurnaceRoughMetalAndLambertGiveTheirDirectionalAlbedo) {
+  Material metal;
+  metal.baseColorFactor = glm::vec4(1.f);
+  metal.metallicFactor = 1.f;
+  metal.roughnessFactor = 1.f;
+  double meanErr = 0, maxErr = 0;
+  whiteFurnace(metal, "furnace-metal", &meanErr, &maxErr);
+  std::cout << "rough metal: mean relative error " << meanErr << ", max " << maxErr << "\n";
+  EXPECT_LT(meanErr, 0.02);
+  whiteFurnace(testing::lambertian(glm::vec3(1.f)), "furnace-lambert", &meanErr, &maxErr);
+  std::cout << "lambert: mean relative error " << meanErr << ", max " << maxErr << "\n";
+  EXPECT_LT(meanErr, 0.02);
+}
+
+TEST(ImageBasedLighting, TablesMatchTheirClosedForms) {
+  const glm::vec3 d = ibl::dfgAt(1.f, 0.f, 4096);
+  // A smooth metal (roughness -> 0) reflects everything: A + B -> 1; head-on Fc(1) = 0 so B -> 0.
+  EXPECT_NEAR(d.x + d.y, 1.f, 0.01f);
+  EXPECT_NEAR(d.y, 0.f, 1e-3f);
+  // Uniform map: SH irradiance is pi in every direction, and the prefiltered map is 1 at every level.
+  Image env = Image::make("e", 16, 8, 3);
+  for (float& v : env.pixels) v = 1.f;
+  const auto sh = ibl::irradianceSh(env);
+  for (const glm::vec3 n : {glm::vec3(0, 1, 0), glm::vec3(0, -1, 0), glm::normalize(glm::vec3(1, 2, -3))})
+    EXPECT_NEAR(ibl::irradianceFromSh(sh, n).x, glm::pi<float>(), 1e-3f);  // midpoint rule at 512 x 256
+  const std::vector<float> pre = ibl::prefilterEnvironment(env);
+  for (std::size_t i = 0; i < pre.size(); i += 4) ASSERT_NEAR(pre[i], 1.f, 1e-5f);
+  // Directional: a map bright only above (L = 1 for y > 0) gives a normal pointing up E = pi and one
+  // pointing down E = 0, each within the SH l <= 2 truncation (Ramamoorthi and Hanrahan: ~3% of pi).
+  Image sky = Image::make("sky", 64, 32, 3);
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 64; ++x) sky.at(x, y)[0] = sky.at(x, y)[1] = sky.at(x, y)[2] = 1.f;
+  const auto s2 = ibl::irradianceSh(sky);
+  EXPECT_NEAR(ibl::irradianceFromSh(s2, {0, 1, 0}).x, glm::pi<float>(), 0.1f * glm::pi<float>());
+  EXPECT_NEAR(ibl::irradianceFromSh(s2, {0, -1, 0}).x, 0.f, 0.1f * glm::pi<float>());
+  EXPECT_NEAR(ibl::irradianceFromSh(s2, {1, 0, 0}).x, 0.5f * glm::pi<float>(), 0.05f * glm::pi<float>());
+}
+
+// glTF's default material (a mesh with no material) is metallic 1, roughness 1, white (spec 3.9.6):
+// under the default lighting its only response is specular, which the split-sum IBL supplies.
+TEST(ImageBasedLighting, MeshWithoutMaterialFollowsTheSpecAndIsNotBlackUnderDefaultLighting) {
+  test::GltfBuilder b;
+  const int mesh = b.mesh(json::array({test::trianglePrimitive<std::uint16_t>(
+      b, {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}}, {0, 1, 2, 0, 2, 3})}));
+  b.scene({b.node({{"mesh", mesh}})});
+  const Scene scene = loadSceneFromMemory(b.gltf());
+  ASSERT_EQ(scene.meshes[0].material, -1);
+  EXPECT_EQ(scene.material(-1).metallicFactor, 1.f);
+  EXPECT_EQ(scene.material(-1).roughnessFactor, 1.f);
+  api::RenderRequest req = exrRequest(kSize);
+  req.camera = kFillCamera;
+  const RenderOutput out = renderer().render(scene, req);
+  EXPECT_EQ(out.stats.lighting, "default");
+  // Head-on (n.v ~ 1 at the centre): L = Lpre(R) (A + B)(1, 1), and the studio's GGX-prefiltered radiance
+  // at roughness 1 is at least its floor's 0.2 in any direction.
+  const glm::vec3 ab = ibl::dfgAt(1.f, 1.f);
+  const float centre = aov(out, "beauty").at(16, 16)[1];
+  EXPECT_GT(centre, 0.2f * (ab.x + ab.y));
+  EXPECT_LT(centre, 8.8f * (ab.x + ab.y));  // and below the key's peak
+}
+
+// Split-sum against the reference path tracer on a white-ish metal sphere under a sun-and-sky map,
+// at roughness 0.2, 0.5 and 1 (issue 12 asks to state the error). The errors, measured on this
+// machine, are printed and recorded in docs/TECHNIQUES.md; the bounds are those measurements with a
+// margin for the reference's Monte Carlo noise (256 spp: ~1% on the sphere mean) and llvmpipe, so the
+// test catches a regression of the tables or the prefilter, not the method's known bias.
+Image sunSky() {
+  Image env = Image::make("environment", 128, 64, 3);
+  const glm::vec3 sun = glm::normalize(glm::vec3(0.6f, 0.8f, 0.4f));
+  for (int y = 0; y < env.height; ++y)
+    for (int x = 0; x < env.width; ++x) {
+      const float u = (x + 0.5f) / env.width, v = (y + 0.5f) / env.height;
+      const float phi = (u - 0.5f) * 2.f * glm::pi<float>(), theta = v * glm::pi<float>();
+      const glm::vec3 d(std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi));
+      glm::vec3 L = d.y > 0.f ? glm::mix(glm::vec3(0.6f, 0.7f, 0.9f), glm::vec3(0.2f, 0.35f, 0.8f), d.y)
+                              : glm::vec3(0.15f, 0.12f, 0.1f);
+      if (glm::dot(d, sun) > std::cos(glm::radians(4.f))) L += glm::vec3(60.f, 55.f, 45.f);
+      float* p = env.at(x, y);
+      p[0] = L.x; p[1] = L.y; p[2] = L.z;
+    }
+  return env;
+}
+
+TEST(ImageBasedLighting, SplitSumAgainstTheReferenceOnAMetalSphereUnderASunSky) {
+  const Image env = sunSky();
+  // Measured (2026-12-01, llvmpipe): sphere-mean error -1.2%, -2.6%, -6.4%; relative L1 7.4%, 10.7%,
+  // 27%; PSNR 34.0, 30.9, 25.2 dB. The error grows with roughness: Karis' n = v = R prefilter misses
+  // the lobe's stretching at grazing angles, which widens with alpha.
+  const float bound[3] = {0.04f, 0.06f, 0.12f}, boundL1[3] = {0.12f, 0.16f, 0.35f};
+  int k = 0;
+  for (float roughness : {0.2f, 0.5f, 1.f}) {
+    testing::SceneBuilder b;
+    Material metal;
+    metal.baseColorFactor = glm::vec4(0.9f, 0.9f, 0.9f, 1.f);
+    metal.metallicFactor = 1.f;
+    metal.roughnessFactor = roughness;
+    b.sphere({0, 0, 0}, 1.f, b.material(metal), 96, 48);
+    const Scene scene = b.build("sunsky-metal-" + std::to_string(roughness));
+    api::RenderRequest req;
+    req.width = req.height = 48;
+    req.environment = "sha256:" + std::string(64, 'a');
+    req.camera = api::CameraOverride{{0, 0, 4}, {0, 0, 0}, {0, 1, 0}, 35.f};
+    req.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty", "normal"}, false}};
+    req.compare = api::CompareSpec{"reference", "beauty", 256, 1};
+    req.disabledPasses.insert("photon_gi");  // the split-sum specular alone (photon_gi's sky photons add glossy light)
+    const RenderOutput out = renderer().render(scene, req, nullptr, FrameInputs{nullptr, &env});
+    const Image& beauty = aov(out, "beauty");
+    const Image& ref = aov(out, "reference");
+    const Image& normal = aov(out, "normal");
+    double a = 0.0, r = 0.0, absErr = 0.0;
+    for (int y = 0; y < 48; ++y)
+      for (int x = 0; x < 48; ++x) {
+        if (glm::length(glm::vec3(normal.at(x, y)[0], normal.at(x, y)[1], normal.at(x, y)[2])) < 0.5f) continue;
+        for (int c = 0; c < 3; ++c) {
+          a += beauty.at(x, y)[c];
+          r += ref.at(x, y)[c];
+          absErr += std::abs(beauty.at(x, y)[c] - ref.at(x, y)[c]);
+        }
+      }
+    const double meanErr = std::abs(a - r) / r, l1 = absErr / r;
+    std::cout << "roughness " << roughness << ": sphere mean radiance raster/reference - 1 = " << (a / r - 1.0)
+              << ", relative L1 " << l1 << ", PSNR " << out.stats.metrics["psnr"] << " dB\n";
+    EXPECT_LT(meanErr, bound[k]) << "roughness " << roughness;
+    EXPECT_LT(l1, boundL1[k]) << "roughness " << roughness;
+    ++k;
+  }
+}
+
+// ---- camera overrides and stats --------------------------------------------------------------------
+
+TEST(Camera, PartialOverrideKeepsTheAutomaticFramingAndStatsReportIt) {
+  testing::SceneBuilder b;
+  const int m = b.material(testing::lambertian(glm::vec3(0.8f)));
+  b.box({-1, 0, -1}, {1, 2, 1}, m, "crate");
+  const Scene scene = b.build("crate");
+  api::RenderRequest req = exrRequest(32);
+  const RenderOutput automatic = renderer().render(scene, req);
+  ASSERT_TRUE(automatic.stats.camera.is_object());
+  EXPECT_EQ(automatic.stats.camera["source"], "auto");
+  // The automatic camera looks at the bounds centre (0, 1, 0) from +Z.
+  EXPECT_NEAR(automatic.stats.camera["target"][1].get<double>(), 1.0, 1e-5);
+  const double autoZ = automatic.stats.camera["position"][2].get<double>();
+  EXPECT_NEAR(automatic.stats.camera["yfov_deg"].get<double>(), glm::degrees(0.6911), 1e-3);
+  // stats.scene: bounds and node names.
+  EXPECT_EQ(automatic.stats.scene["bounds"]["min"], json::array({-1.0, 0.0, -1.0}));
+  EXPECT_EQ(automatic.stats.scene["bounds"]["max"], json::array({1.0, 2.0, 1.0}));
+  EXPECT_EQ(automatic.stats.scene["nodes"].size(), 6u);
+
+  // Only yfov: still framed (looks at the centre), from farther away for a narrower field:
+  // the distance to fit a sphere is r / sin(fov/2), so halving tan(fov/2) roughly doubles it.
+  api::CameraOverride narrow;
+  narrow.hasPosition = narrow.hasTarget = narrow.hasUp = false;
+  narrow.yfovDegrees = 20.f;
+  req.camera = narrow;
+  const RenderOutput zoomed = renderer().render(scene, req);
+  EXPECT_EQ(zoomed.stats.camera["source"], "request+auto");
+  EXPECT_NEAR(zoomed.stats.camera["yfov_deg"].get<double>(), 20.0, 1e-4);
+  EXPECT_NEAR(zoomed.stats.camera["target"][1].get<double>(), 1.0, 1e-5);
+  const float r = scene.features.bounds.radius();
+  EXPECT_NEAR(zoomed.stats.camera["position"][2].get<double>(), r / std::sin(glm::radians(10.0)), 1e-3);
+  EXPECT_GT(zoomed.stats.camera["position"][2].get<double>(), 1.8 * (autoZ));
+  // The centre pixel sees the crate (not the sky) in both.
+  EXPECT_GT(aov(zoomed, "beauty").at(16, 16)[1], 0.f);
+
+  // Only a position: looks at the bounds centre from there.
+  api::CameraOverride moved;
+  moved.hasTarget = moved.hasUp = moved.hasYfov = false;
+  moved.position = {4.f, 1.f, 0.f};
+  req.camera = moved;
+  const RenderOutput side = renderer().render(scene, req);
+  EXPECT_NEAR(side.stats.camera["forward"][0].get<double>(), -1.0, 1e-5);
+  EXPECT_NEAR(side.stats.camera["forward"][1].get<double>(), 0.0, 1e-5);
+  EXPECT_NEAR(side.stats.camera["target"][1].get<double>(), 1.0, 1e-5);
+  EXPECT_NEAR(side.stats.camera["yfov_deg"].get<double>(), glm::degrees(0.6911), 1e-3);
+}
+
+}  // namespace
+}  // namespace radiant
