@@ -30,6 +30,7 @@ void tracePhoton(const RayScene& rays, const SceneLights& lights, const PhotonOp
     if (!rays.intersect(ray, hit, sampler, counter)) return;
     if (bounce == 0 && e.windowRange > 0.f) flux *= rangeWindow(hit.distance, e.windowRange);
     if (!(maxComponent(flux) > 0.f) || !finite(flux)) return;
+    if (rays.materialOf(hit.mesh).unlit) return;  // KHR_materials_unlit absorbs (the reference ends paths there)
     const glm::vec3 wo = -ray.dir;  // towards where the photon came from
     const Shading sh = rays.shade(hit, wo, TransportMode::Importance);
     const glm::vec3 woL = sh.frame.toLocal(wo);

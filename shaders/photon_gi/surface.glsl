@@ -16,7 +16,9 @@ bool loadSurface(ivec2 px, out SplatSurface s) {
   vec4 P = texelFetch(t_position, px, 0);
   if (P.w <= 0.0) return false;  // no geometry
   s.x = P.xyz;
-  s.n = normalize(texelFetch(t_normal, px, 0).xyz);
+  vec4 N = texelFetch(t_normal, px, 0);
+  if (N.w == 0.0) return false;  // KHR_materials_unlit: nothing lights it (gbuffer.frag)
+  s.n = normalize(N.xyz);
   s.ng = normalize(texelFetch(t_geoNormal, px, 0).xyz);
   s.wo = u_orthographic != 0 ? -u_viewForward : normalize(u_eye - P.xyz);
   s.baseColor = texelFetch(t_albedo, px, 0).rgb;

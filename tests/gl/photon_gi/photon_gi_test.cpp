@@ -451,6 +451,17 @@ TEST(PhotonGi, ScaledScenesGiveTheSameImage) {
   }
 }
 
+TEST(PhotonGi, UnlitSurfacesGetNoPhotons) {
+  // KHR_materials_unlit everywhere: the photons are absorbed at their first hit and the G-buffer marks
+  // the pixels unlit, so the indirect AOV is exactly 0.
+  Scene scene = loadBuiltinScene("cornell_box");
+  for (Material& m : scene.materials) m.unlit = true;
+  scene.digest += "-unlit";
+  const RenderOutput out = renderer().render(scene, cornellRequest(24, {{"photons", 20000}}));
+  for (float v : aov(out, "indirect").pixels) ASSERT_EQ(v, 0.f);
+  EXPECT_EQ(pass(out, "photon_gi")->counters.at("records"), 0.0);
+}
+
 TEST(PhotonGi, PlannerOwnershipAndOptOut) {
   const Scene scene = loadBuiltinScene("cornell_box");
   api::RenderRequest off = cornellRequest(16);

@@ -187,6 +187,19 @@ TEST(PhotonTracer, AlbedoOneTerminatesAndConservesEnergy) {
   for (const PhotonRecord& r : set.records) ASSERT_TRUE(std::isfinite(r.flux.x + r.flux.y + r.flux.z));
 }
 
+TEST(PhotonTracer, UnlitSurfacesAbsorbEveryPhoton) {
+  // KHR_materials_unlit: nothing lights the surface and it reflects nothing (the reference ends paths
+  // there): no records, no bounces.
+  Scene s = integratingSphere(1.f, 0.9f, 1.f);
+  s.materials[0].unlit = true;
+  const RayScene rays(s);
+  const SceneLights lights(rays, nullptr, glm::vec3(0.f));
+  PhotonSet set;
+  tracePhotons(rays, lights, PhotonOptions{}, 5000, set);
+  EXPECT_EQ(set.records.size(), 0u);
+  EXPECT_EQ(set.emitted, 5000u);
+}
+
 TEST(PhotonTracer, DegenerateGeometryAndLightsInsideGeometryStayFinite) {
   Scene s;
   const int mat = addMaterial(s, lambert(glm::vec3(0.8f)));
