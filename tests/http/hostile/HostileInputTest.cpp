@@ -181,6 +181,20 @@ TEST_F(Hostile, InvalidUtf8InPathsIsA404WithValidJson) {
   }
 }
 
+TEST_F(Hostile, EveryRecordedHttpCrasherGetsA4xxProblem) {
+  const fs::path dir = fs::path(RADIANT_SOURCE_DIR) / "tests/data/crashers/http";
+  int n = 0;
+  for (const auto& f : fs::directory_iterator(dir)) {
+    SCOPED_TRACE(f.path().filename().string());
+    const std::string raw = rawExchange(daemon_->port(), radiant::testing::slurp(f.path()));
+    EXPECT_GE(statusOf(raw), 400) << raw;
+    EXPECT_LT(statusOf(raw), 500) << raw;
+    EXPECT_TRUE(bodyOf(raw).is_object()) << raw;
+    ++n;
+  }
+  EXPECT_GE(n, 3);
+}
+
 // ---- crash 2: deeply nested request JSON ------------------------------------------------------
 
 TEST_F(Hostile, DeeplyNestedRequestsOfEveryShapeAre422AtTheirPointer) {
