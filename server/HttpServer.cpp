@@ -558,7 +558,8 @@ struct HttpServer::Impl {
       if (body.empty()) throw api::ApiError(400, "empty-body", "Empty body", "the body holds no scene");
       const std::string digest = api::sceneDigest(body);
       bool created = false;
-      if (!scenes.contains(digest)) {
+      // get(), not contains(): a file in the cache dir that no longer matches its digest is dropped there.
+      if (!scenes.get(digest)) {
         decode(digest, body, "");  // reject what the loader cannot read before storing it
         created = scenes.put(digest, body);
       }
@@ -612,7 +613,7 @@ struct HttpServer::Impl {
       if (body.empty()) throw api::ApiError(400, "empty-body", "Empty body", "the body holds no image");
       const std::string digest = api::sceneDigest(body);
       bool created = false;
-      if (!images.contains(digest)) {
+      if (!images.get(digest)) {
         if (!hooks.decodeImage) throw std::logic_error("no image decoder configured");
         const Image decoded = hooks.decodeImage(body);  // refuse what cannot be read before storing it
         created = images.put(digest, body);
