@@ -13,9 +13,9 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
 #include <nlohmann/json.hpp>
-#include "renderer/scene/GltfLimits.h"
-
 #include <tiny_gltf.h>  // Debian ships tinygltf as a shared library: no TINYGLTF_IMPLEMENTATION here
+
+#include "renderer/scene/GltfLimits.h"
 
 namespace radiant {
 namespace {
