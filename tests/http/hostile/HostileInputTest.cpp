@@ -117,6 +117,9 @@ std::vector<std::pair<std::string, std::string>> imageBombs() {
                            be16(16384) + std::string("\x03\x01\x11\x00\x02\x11\x00\x03\x11\x00\xFF\xD9", 12);
   std::string png = radiant::test::encodePng(1, 1, {0, 0, 0, 255});
   for (int k : {16, 20}) { png[k] = 0; png[k + 1] = 0; png[k + 2] = char(0x40); png[k + 3] = 0; }
+  // IHDR's CRC over its type and data (bytes 12..28), so that strict readers (libpng) accept it.
+  const uLong crc = crc32(0, reinterpret_cast<const Bytef*>(png.data() + 12), 17);
+  for (int i = 0; i < 4; ++i) png[29 + i] = char((crc >> (24 - 8 * i)) & 255);
   return {{"image/bmp", bmp}, {"image/gif", gif}, {"image/jpeg", jpeg}, {"image/png", png}};
 }
 
@@ -285,6 +288,15 @@ TEST_F(Hostile, ImageBombsOfEveryFormatInAGlbAre422BeforeDecoding) {
     expectProblem(put(glb, "model/gltf-binary"), 422, "limit-exceeded", "/images/0", "--max-decode-bytes");
   }
   EXPECT_LT(peakRssMiB(daemon_->pid()), 1024.0);  // each claimed 1 to 2 GiB decoded
+}
+
+TEST_F(Hostile, AnUploadedComparisonImageIsCheckedFromItsHeader) {
+  // A 16384^2 PNG header: OpenImageIO would decode 4 float channels plus the RGB copy (6 GiB).
+  std::string png = imageBombs()[3].second;
+  auto r = daemon_->client().Put("/v1/images", png, "image/png");
+  expectProblem(r, 422, "limit-exceeded", "", "16384x16384");
+  EXPECT_NE(r->body.find("--max-decode-bytes"), std::string::npos);
+  EXPECT_LT(peakRssMiB(daemon_->pid()), 1024.0);
 }
 
 TEST_F(Hostile, AccessorsWithoutBufferViewAreChargedBeforeExpansion) {
