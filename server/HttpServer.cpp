@@ -541,6 +541,7 @@ struct HttpServer::Impl {
           {"radiant_jobs_active", {"Jobs rendering or encoding.", double(service.active())}},
           {"radiant_ready", {"1 once the render thread has a GL context.", service.ready() ? 1.0 : 0.0}},
           {"radiant_scene_store_bytes", {"Bytes of uploaded scenes stored.", double(scenes.totalBytes())}},
+          {"radiant_scene_cache_bytes", {"Bytes of decoded scenes kept in memory (--scene-cache-bytes).", double(decoded.totalBytes())}},
           {"radiant_image_store_bytes", {"Bytes of uploaded comparison images stored.", double(images.totalBytes())}},
           {"radiant_frame_store_bytes", {"Bytes of encoded frames stored.", double(frames.totalBytes())}}};
       res.status = 200;

@@ -475,3 +475,38 @@ TEST(HostileService, CacheDirRefusesSymlinksAndFilesThatDoNotMatchTheirDigest) {
   EXPECT_EQ(c.Get("/v1/ready")->status, 200);
   fs::remove_all(dir);
 }
+
+TEST(HostileService, TheDecodedSceneCacheIsBoundedInBytes) {
+  const auto dir = radiant::testing::scratch("scenecache");
+  Daemon d(RADIANTD_PATH, {"--port", "0", "--scene-cache-bytes", "1048576"}, {}, dir / "stderr.log");
+  ASSERT_TRUE(d.waitReady(std::chrono::seconds(60)));
+  auto c = d.client();
+  // A triangle (3 x (12 + 12 + 4) = 84 bytes decoded) and a 50001-vertex soup (1400028 bytes, over
+  // the 1 MiB cache on its own).
+  std::vector<glm::vec3> soup(50001);
+  for (std::size_t i = 0; i < soup.size(); ++i) soup[i] = glm::vec3(float(i % 3 == 1), float(i % 3 == 2), -float(i) * 1e-4f);
+  GltfBuilder big;
+  big.scene({big.node({{"mesh", big.mesh(json::array({{{"attributes", {{"POSITION", big.vec3(soup)}}}}}))}})});
+  std::string digests[2];
+  const std::string files[2] = {triangle().gltf(), big.gltf()};
+  for (int k = 0; k < 2; ++k) {
+    auto up = c.Put("/v1/scenes", files[k], "model/gltf+json");
+    ASSERT_TRUE(up);
+    ASSERT_EQ(up->status, 201) << up->body;
+    digests[k] = json::parse(up->body)["digest"];
+  }
+  auto loadMs = [&](int k) {
+    auto r = c.Post("/v1/renders", json{{"scene", {{"digest", digests[k]}}}, {"width", 8}, {"height", 8}}.dump(),
+                    "application/json");
+    EXPECT_TRUE(r && r->status == 200) << (r ? r->body : "no response");
+    return r ? json::parse(r->body)["stats"]["scene_load_ms"].get<double>() : -1.0;
+  };
+  EXPECT_EQ(loadMs(0), 0.0);  // decoded at upload, kept
+  EXPECT_GT(loadMs(1), 0.0);  // too large to keep: decoded for every render
+  EXPECT_GT(loadMs(1), 0.0);
+  EXPECT_EQ(loadMs(0), 0.0);  // the big one evicted nothing
+  auto m = c.Get("/metrics");
+  ASSERT_TRUE(m);
+  EXPECT_NE(m->body.find("radiant_scene_cache_bytes 84\n"), std::string::npos) << m->body;
+  fs::remove_all(dir);
+}
