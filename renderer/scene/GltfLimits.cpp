@@ -197,9 +197,9 @@ void chargeAccessorExpansion(const json& doc, DecodeBudget& budget) {
   budget.charge(total, "", "the scene's expanded geometry");
 }
 
-// The node the loader takes its camera from: the first with a camera in depth-first order from the
-// default scene's roots (GltfLoader.cpp, walkScene), or -1.
-int firstCameraNode(const json& doc) {
+// The default scene's nodes in the loader's depth-first order (GltfLoader.cpp, walkScene): the
+// camera is the first node with one, lights are pushed one per node in this order.
+std::vector<std::size_t> depthFirstNodes(const json& doc) {
   const json& nodes = arrayOf(doc, "nodes");
   std::vector<std::size_t> roots;
   const json& scenes = arrayOf(doc, "scenes");
@@ -216,18 +216,36 @@ int firstCameraNode(const json& doc) {
     for (std::size_t i = 0; i < nodes.size(); ++i)
       if (!child[i]) roots.push_back(i);
   }
-  std::vector<std::size_t> stack(roots.rbegin(), roots.rend());
+  std::vector<std::size_t> order, stack(roots.rbegin(), roots.rend());
   std::vector<bool> seen(nodes.size(), false);
   while (!stack.empty()) {
     const std::size_t i = stack.back();
     stack.pop_back();
     if (seen[i]) continue;
     seen[i] = true;
-    if (member(nodes[i], "camera")) return int(i);
+    order.push_back(i);
     const json& children = arrayOf(nodes[i], "children");
     for (std::size_t k = children.size(); k-- > 0;)
       if (children[k].is_number_unsigned() && children[k].get<std::size_t>() < nodes.size())
         stack.push_back(children[k].get<std::size_t>());
+  }
+  return order;
+}
+
+int firstCameraNode(const json& doc) {
+  const json& nodes = arrayOf(doc, "nodes");
+  for (std::size_t i : depthFirstNodes(doc))
+    if (member(nodes[i], "camera")) return int(i);
+  return -1;
+}
+
+// The node of the scene's light number `light` (the loader adds one per node with the extension).
+int lightNode(const json& doc, std::size_t light) {
+  const json& nodes = arrayOf(doc, "nodes");
+  std::size_t n = 0;
+  for (std::size_t i : depthFirstNodes(doc)) {
+    const json* e = member(nodes[i], "extensions");
+    if (e && member(*e, "KHR_lights_punctual") && n++ == light) return int(i);
   }
   return -1;
 }
@@ -356,9 +374,12 @@ void checkSceneMagnitudes(const Scene& scene, const json& doc) {
   }
   for (std::size_t i = 0; i < scene.lights.size(); ++i) {
     const Light& l = scene.lights[i];
-    if (!finiteWithin(l.position, kMaxCoordinate) || !finiteWithin(l.direction, 2.0))
-      throw SceneError("", "light \"" + api::truncateUtf8(l.name, 60) + "\" is placed at " + show(l.position) +
-                               " in world space: not finite or beyond +-" + number(kMaxCoordinate));
+    if (!finiteWithin(l.position, kMaxCoordinate) || !finiteWithin(l.direction, 2.0)) {
+      const int node = lightNode(doc, i);
+      throw SceneError(node >= 0 ? "/nodes/" + std::to_string(node) : "",
+                       "light \"" + api::truncateUtf8(l.name, 60) + "\" is placed at " + show(l.position) +
+                           " in world space: not finite or beyond +-" + number(kMaxCoordinate));
+    }
   }
 }
 

@@ -161,6 +161,15 @@ TEST(GltfLimits, NestedScalesThatPlaceVerticesOutOfRangeNameTheNode) {
   expectInvalid(catchScene([&] { loadSceneFromMemory(b.gltf()); }), "/nodes/0", "beyond +-1e+09");
 }
 
+TEST(GltfLimits, ALightPlacedOutOfRangeByNestedScalesNamesItsNode) {
+  GltfBuilder b = triangle();
+  b.doc["extensions"]["KHR_lights_punctual"]["lights"] = {{{"type", "point"}, {"intensity", 1}}};
+  const int light = b.node({{"translation", {0, 0, 1e9}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+  const int parent = b.node({{"scale", {1e3, 1e3, 1e3}}, {"children", {light}}});
+  b.scene({0, parent});
+  expectInvalid(catchScene([&] { loadSceneFromMemory(b.gltf()); }), "/nodes/1", "in world space: not finite or beyond");
+}
+
 TEST(GltfLimits, NonFinitePositionDataIsRefusedAtTheAttribute) {
   GltfBuilder b;
   const float nan = std::numeric_limits<float>::quiet_NaN();
