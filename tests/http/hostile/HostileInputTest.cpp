@@ -510,3 +510,33 @@ TEST(HostileService, TheDecodedSceneCacheIsBoundedInBytes) {
   EXPECT_NE(m->body.find("radiant_scene_cache_bytes 84\n"), std::string::npos) << m->body;
   fs::remove_all(dir);
 }
+
+TEST(HostileService, InvalidUtf8BeforeAuthenticationIsA401AndTheDaemonLives) {
+  // The original crash needed no token: the logger wrote the path of the refused request.
+  const auto dir = radiant::testing::scratch("preauth");
+  std::ofstream(dir / "token") << "s3cret\n";
+  Daemon d(RADIANTD_PATH, {"--port", "0", "--token-file", (dir / "token").string()}, {}, dir / "stderr.log");
+  ASSERT_GT(d.port(), 0);
+  for (const std::string path : {"/%ff", "/v1/renders/%ff%fe", "/%c3"}) {
+    const std::string raw = rawExchange(d.port(), "GET " + path + " HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
+    EXPECT_EQ(statusOf(raw), 401) << raw;
+    EXPECT_EQ(bodyOf(raw)["type"], "https://radiant.dev/problems/unauthorized");
+  }
+  httplib::Client c("127.0.0.1", d.port());
+  c.set_bearer_token_auth("s3cret");
+  auto r = c.Get("/v1/ready");
+  ASSERT_TRUE(r) << "the daemon died";
+  EXPECT_NE(r->status, 401);  // 200, or 503 while the GL context is still being created
+  // Every log line is valid JSON, with the bad bytes replaced.
+  std::ifstream log(dir / "stderr.log");
+  std::string line;
+  int lines = 0;
+  while (std::getline(log, line)) {
+    if (line.find("\"path\"") == std::string::npos) continue;
+    const json j = json::parse(line, nullptr, false);
+    EXPECT_FALSE(j.is_discarded()) << line;
+    ++lines;
+  }
+  EXPECT_GE(lines, 3);
+  fs::remove_all(dir);
+}
