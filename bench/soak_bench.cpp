@@ -141,6 +141,11 @@ int main(int argc, char** argv) {
       const auto& [text, what] = bad[std::size_t(i) % bad.size()];
       note(c.Post("/v1/renders", text, "application/json"), "bad " + what, false);
     }
+    if (rssMiB(d.pid(), "VmRSS:") < 0) {
+      std::printf("soak: the daemon is gone after %d requests\n", i + 1);
+      ++otherFailures;
+      break;
+    }
     if ((i + 1) % 500 == 0) {
       samples.emplace_back(i + 1, rssMiB(d.pid(), "VmRSS:"));
       std::printf("soak: %6d requests  %7.1f s  RSS %7.1f MiB\n", i + 1,
@@ -158,6 +163,8 @@ int main(int argc, char** argv) {
               lo, hi, hi > 0 ? 100.0 * (hi - lo) / lo : 0.0, rssMiB(d.pid(), "VmHWM:"));
   for (const auto& [what, n] : counts) std::printf("soak:   %-24s %d\n", what.c_str(), n);
   const bool flat = hi <= lo * 1.05;
-  std::filesystem::remove_all(dir);
-  return fiveHundreds == 0 && framesMissing == 0 && flat ? 0 : 1;
+  const bool ok = fiveHundreds == 0 && framesMissing == 0 && otherFailures == 0 && flat;
+  if (ok) std::filesystem::remove_all(dir);
+  else std::printf("soak: FAILED; the daemon's log is %s\n", (dir / "stderr.log").c_str());
+  return ok ? 0 : 1;
 }
