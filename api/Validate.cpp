@@ -1,9 +1,11 @@
 #include "api/Validate.h"
 
+#include <algorithm>
 #include <cmath>
 #include <regex>
 #include <sstream>
 
+#include "api/JsonLimits.h"
 #include "embedded/radiant_api_schema.h"
 
 namespace radiant::api {
@@ -12,10 +14,9 @@ using nlohmann::json;
 
 namespace {
 
-std::string shown(const json& v) {
-  std::string s = v.dump();
-  return s.size() > 80 ? s.substr(0, 77) + "..." : s;
-}
+// A value quoted in an error detail: at most ~80 bytes, never cut inside a UTF-8 sequence, and
+// invalid bytes replaced, so the problem writer can always encode it.
+std::string shown(const json& v) { return truncateUtf8(dumpSafe(v), 77); }
 
 std::string at(const std::string& pointer) { return pointer.empty() ? "the request" : pointer; }
 
@@ -154,12 +155,32 @@ json validate(const json& schema, const json& input, const std::string& pointer)
   return value;
 }
 
-json parseJson(std::string_view text) {
+void checkJsonText(std::string_view text, std::size_t maxDepth) {
+  const auto problem = scanJson(text, maxDepth);
+  if (!problem) return;
+  switch (problem->kind) {
+    case JsonScanProblem::Kind::TooDeep:
+      throw ApiError(422, "limit-exceeded", "Server limit exceeded",
+                     problem->detail + "; this server's limit is radiantd --max-json-depth " + std::to_string(maxDepth),
+                     problem->pointer);
+    case JsonScanProblem::Kind::InvalidUtf8:
+      throw ApiError(400, "invalid-utf8", "Invalid UTF-8", problem->detail, problem->pointer);
+    case JsonScanProblem::Kind::NumberOverflow:
+      throw ApiError(422, "out-of-range", "Value out of range", problem->detail, problem->pointer);
+  }
+}
+
+json parseJson(std::string_view text, std::size_t maxDepth) {
+  // The scan first: nesting, UTF-8 and overflowing numbers are found without recursion and with
+  // a pointer, before nlohmann builds (and later copies) the tree.
+  checkJsonText(text, maxDepth);
   try {
     return json::parse(text.begin(), text.end());
   } catch (const json::parse_error& e) {
     throw ApiError(400, "malformed-json", "Malformed JSON",
                    "the body is not valid JSON: syntax error at byte " + std::to_string(e.byte), "");
+  } catch (const json::exception& e) {
+    throw ApiError(400, "malformed-json", "Malformed JSON", std::string("the body is not valid JSON: ") + e.what(), "");
   }
 }
 
@@ -208,6 +229,12 @@ json to_json_value(const TechniqueSchema& t) {
 const char* toString(ImageFormat f) { return f == ImageFormat::Exr ? "exr" : "png"; }
 
 json normaliseRenderRequest(const json& body, const RequestLimits& limits) {
+  // validate() copies values (recursively): a tree parsed elsewhere is held to the same depth.
+  if (jsonDepth(body, limits.maxJsonDepth) > limits.maxJsonDepth)
+    throw ApiError(422, "limit-exceeded", "Server limit exceeded",
+                   "the request is nested deeper than " + std::to_string(limits.maxJsonDepth) +
+                       " levels; this server's limit is radiantd --max-json-depth",
+                   "");
   // "passes": {"name": false} turns an on-by-default pass off, {"name": true} turns one on with its
   // defaults. The schema describes parameter objects, so booleans of known techniques are taken out
   // before validation and put back after it (an unknown name still fails validation below).
@@ -253,12 +280,43 @@ json normaliseRenderRequest(const json& body, const RequestLimits& limits) {
                      "/outputs/" + std::to_string(i) + "/aovs: a png output holds exactly one AOV, got " +
                          std::to_string(outputs[i]["aovs"].size()),
                      "/outputs/" + std::to_string(i) + "/aovs");
+  // The same AOV twice in one file, or the same file twice, only costs memory and time.
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    const json& aovs = outputs[i]["aovs"];
+    for (std::size_t k = 0; k < aovs.size(); ++k)
+      for (std::size_t j = 0; j < k; ++j)
+        if (aovs[j] == aovs[k])
+          throw ApiError(422, "invalid-value", "Invalid value",
+                         pointerAppend(pointerAppend(pointerAppend("/outputs", i), "aovs"), k) + ": AOV " +
+                             shown(aovs[k]) + " is already listed at index " + std::to_string(j),
+                         pointerAppend(pointerAppend(pointerAppend("/outputs", i), "aovs"), k));
+    for (std::size_t j = 0; j < i; ++j)
+      if (outputs[j] == outputs[i])
+        throw ApiError(422, "invalid-value", "Invalid value",
+                       pointerAppend("/outputs", i) + ": the same output as /outputs/" + std::to_string(j),
+                       pointerAppend("/outputs", i));
+  }
+  if (limits.maxOutputBytes > 0) {
+    // Uncompressed size of every file asked for: RGBA per AOV, 2 or 4 bytes per EXR channel, 4
+    // bytes per PNG pixel (the encoder's input, and its worst case with png_compression 0).
+    const std::uint64_t pixels = v["width"].get<std::uint64_t>() * v["height"].get<std::uint64_t>();
+    std::uint64_t total = 0;
+    for (const auto& o : outputs)
+      total += pixels * o["aovs"].size() * (o["format"] == "exr" ? (o["half"].get<bool>() ? 8u : 16u) : 4u);
+    if (total > limits.maxOutputBytes)
+      throw ApiError(422, "limit-exceeded", "Server limit exceeded",
+                     "/outputs: the requested files hold " + std::to_string(total) +
+                         " bytes uncompressed, above this server's limit of " + std::to_string(limits.maxOutputBytes) +
+                         " (radiantd --max-frame-bytes)",
+                     "/outputs");
+  }
   return v;
 }
 
 RenderRequest parseRenderRequest(const json& body, const RequestLimits& limits) {
   const json v = normaliseRenderRequest(body, limits);
   auto vec3 = [](const json& a) { return glm::vec3(a[0].get<float>(), a[1].get<float>(), a[2].get<float>()); };
+  auto dvec3 = [](const json& a) { return glm::dvec3(a[0].get<double>(), a[1].get<double>(), a[2].get<double>()); };
 
   RenderRequest r;
   const json& scene = v["scene"];
@@ -275,14 +333,30 @@ RenderRequest parseRenderRequest(const json& body, const RequestLimits& limits) 
     cam.hasYfov = c.contains("yfov_deg");
     if (cam.hasPosition) cam.position = vec3(c["position"]);
     if (cam.hasTarget) cam.target = vec3(c["target"]);
-    if (cam.hasUp) cam.up = vec3(c["up"]);
     if (cam.hasYfov) cam.yfovDegrees = c["yfov_deg"].get<float>();
-    if (cam.hasPosition && cam.hasTarget && glm::length(cam.target - cam.position) == 0.f)
-      throw ApiError(422, "invalid-value", "Invalid value", "/camera/target: equals the camera position", "/camera/target");
-    if (cam.hasPosition && cam.hasTarget && cam.hasUp && glm::length(glm::cross(cam.target - cam.position, cam.up)) == 0.f)
-      throw ApiError(422, "invalid-value", "Invalid value", "/camera/up: parallel to the view direction", "/camera/up");
-    if (cam.hasUp && glm::length(cam.up) == 0.f)
-      throw ApiError(422, "invalid-value", "Invalid value", "/camera/up: must not be zero", "/camera/up");
+    // In double and relative to the vectors' own lengths: the schema bounds coordinates to
+    // [-1e9, 1e9], so an up vector of length 1e-30 is a direction like any other.
+    if (cam.hasUp) {
+      const glm::dvec3 up = dvec3(c["up"]);
+      if (!(glm::length(up) > 0.0))
+        throw ApiError(422, "invalid-value", "Invalid value", "/camera/up: the zero vector has no direction", "/camera/up");
+      cam.up = glm::vec3(up / glm::length(up));
+    }
+    if (cam.hasPosition && cam.hasTarget) {
+      const glm::dvec3 view = dvec3(c["target"]) - dvec3(c["position"]);
+      const double viewLength = glm::length(view);
+      const double scale = std::max({glm::length(dvec3(c["target"])), glm::length(dvec3(c["position"])), 1e-30});
+      if (!(viewLength > 1e-6 * scale) || glm::length(cam.target - cam.position) == 0.f)
+        throw ApiError(422, "invalid-value", "Invalid value",
+                       "/camera/target: equals the camera position (to single precision)", "/camera/target");
+      // |sin| of the angle between the view and up directions: below 1e-6 (0.2 arc seconds) the
+      // camera's right vector is numerically meaningless.
+      if (cam.hasUp) {
+        const glm::dvec3 up = dvec3(c["up"]);
+        if (glm::length(glm::cross(view / viewLength, up / glm::length(up))) < 1e-6)
+          throw ApiError(422, "invalid-value", "Invalid value", "/camera/up: parallel to the view direction", "/camera/up");
+      }
+    }
     r.camera = cam;
   }
   r.width = v["width"];
@@ -317,7 +391,7 @@ RenderRequest parseRenderRequest(const json& body, const RequestLimits& limits) 
 }
 
 RenderRequest parseRenderRequest(std::string_view text, const RequestLimits& limits) {
-  return parseRenderRequest(parseJson(text), limits);
+  return parseRenderRequest(parseJson(text, limits.maxJsonDepth), limits);
 }
 
 }  // namespace radiant::api

@@ -16,6 +16,7 @@
 //   422 out-of-range     a number outside [minimum, maximum]
 //   422 invalid-value    a value not in its enum, not matching its pattern, or a wrong item/key count
 //   422 limit-exceeded   within the schema, but above a limit this server is configured with
+//   400 invalid-utf8     a string that is not UTF-8 (before parsing, see api/JsonLimits.h)
 // i.e. 400 means "this is not the shape of a request", 422 means "a request, but not one we accept".
 
 #include <string>
@@ -33,6 +34,9 @@ struct RequestLimits {
   int maxWidth = 4096;
   int maxHeight = 4096;
   int maxSamples = 65536;  // caps every "spp"/"samples" parameter and compare.spp
+  std::size_t maxJsonDepth = 64;  // nesting of the request text (radiantd --max-json-depth)
+  // Uncompressed bytes of all requested output files (radiantd --max-frame-bytes); 0 = no limit.
+  std::uint64_t maxOutputBytes = 0;
 };
 
 // The merged request schema (technique parameter schemas included under properties.passes).
@@ -58,8 +62,10 @@ nlohmann::json validate(const nlohmann::json& schema, const nlohmann::json& valu
 // std::out_of_range for a technique the schema does not declare.
 nlohmann::json techniqueParams(std::string_view technique, const nlohmann::json& given = nullptr);
 
-// JSON text -> json. Throws ApiError 400 malformed-json, detail names the byte offset.
-nlohmann::json parseJson(std::string_view text);
+// JSON text -> json. Throws ApiError 400 malformed-json (detail names the byte offset), 400
+// invalid-utf8, 422 out-of-range (a number beyond a double) or 422 limit-exceeded (nested deeper
+// than maxDepth), the last three with the pointer of the value (see api/JsonLimits.h).
+nlohmann::json parseJson(std::string_view text, std::size_t maxDepth = 64);
 
 // Validates against the request schema, applies `limits`, and converts. Throws ApiError.
 RenderRequest parseRenderRequest(const nlohmann::json& body, const RequestLimits& limits = {});

@@ -33,6 +33,14 @@ std::string usage() {
   --device-index N          EGL device index
   --device NAME             EGL device whose GL_RENDERER or GL_VENDOR contains NAME
   --gl-debug                GL debug context, messages to stderr
+  --max-json-depth N        deepest nesting of a request or a glTF document (default 64)
+  --max-decode-bytes N      memory one scene or image may decode into: pixels of every image,
+                            expanded accessors of every mesh instance (default 536870912)
+  --scene-cache-bytes N     decoded scenes kept in memory, in bytes (default 1073741824)
+  --read-timeout S          seconds to receive one request, headers and body (default 30)
+  --keep-alive-timeout S    seconds an idle keep-alive connection stays open (default 2)
+  --shutdown-grace S        after SIGTERM, seconds frame and job GETs are still served (default 10)
+  --max-connections N       connections served at once, one worker thread each (default 256)
 )";
 }
 
@@ -96,6 +104,13 @@ void apply(ServerConfig& c, const std::string& name, const std::string& v, std::
   else if (name == "device-index") c.deviceIndex = static_cast<int>(toInt(flag, v, 0, 1024));
   else if (name == "device") c.deviceName = v;
   else if (name == "gl-debug") c.glDebug = v != "false" && v != "0";
+  else if (name == "max-json-depth") c.limits.maxJsonDepth = static_cast<std::size_t>(toInt(flag, v, 8, 1000));
+  else if (name == "max-decode-bytes") c.maxDecodeBytes = static_cast<std::size_t>(toInt(flag, v, 1 << 20, 1ll << 40));
+  else if (name == "scene-cache-bytes") c.sceneCacheBytes = static_cast<std::size_t>(toInt(flag, v, 1 << 20, 1ll << 40));
+  else if (name == "read-timeout") c.readTimeoutS = toDouble(flag, v);
+  else if (name == "keep-alive-timeout") c.keepAliveTimeoutS = toDouble(flag, v);
+  else if (name == "shutdown-grace") c.shutdownGraceS = v == "0" ? 0.0 : toDouble(flag, v);
+  else if (name == "max-connections") c.maxConnections = static_cast<int>(toInt(flag, v, 4, 4096));
   else throw std::invalid_argument("unknown option " + flag);
 }
 
@@ -103,6 +118,7 @@ void apply(ServerConfig& c, const std::string& name, const std::string& v, std::
 
 std::optional<ServerConfig> parseCommandLine(const std::vector<std::string>& args) {
   ServerConfig c;
+  c.shutdownGraceS = 10;
   std::string tokenFile;
   // The config file first, so flags override it wherever they appear.
   for (std::size_t i = 0; i < args.size(); ++i) {

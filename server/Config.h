@@ -30,6 +30,15 @@ struct ServerConfig {
   std::optional<int> deviceIndex;      // EGL device index (radiantd only)
   std::string deviceName;              // substring of GL_RENDERER/GL_VENDOR
   bool glDebug = false;
+  // Hardening (docs/API.md, "Limits"): every budget a hostile input could exhaust is a flag.
+  std::size_t maxDecodeBytes = std::size_t(512) << 20;     // decoded images + expanded accessors of one scene or image
+  std::size_t sceneCacheBytes = std::size_t(1024) << 20;   // decoded scenes kept in memory, in bytes
+  double readTimeoutS = 30;            // receiving one request (headers and body), in total
+  double keepAliveTimeoutS = 2;        // an idle keep-alive connection is closed after this
+  // After SIGTERM, frame and job GETs are served this long (ending early once every frame was
+  // fetched). 0 here, for servers embedded in tests; radiantd's command line defaults it to 10.
+  double shutdownGraceS = 0;
+  int maxConnections = 256;            // connections served at once (one HTTP worker thread each)
 };
 
 // Parses argv (argv[0] skipped). Throws std::invalid_argument with a usage message on bad flags.

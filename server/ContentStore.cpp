@@ -5,6 +5,11 @@
 #include <iostream>
 #include <system_error>
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
 #include "api/Sha256.h"
 #include "api/Types.h"
 
@@ -31,7 +36,13 @@ ContentStore::ContentStore(fs::path cacheDir, std::size_t maxBytes, const std::s
   };
   std::vector<Found> found;
   for (const auto& f : fs::directory_iterator(dir_)) {
-    if (!f.is_regular_file()) continue;
+    // A symlink could make the store serve (and evict: remove) a file outside the cache dir.
+    if (f.is_symlink() || !f.is_regular_file()) {
+      if (f.is_symlink())
+        std::cerr << "{\"event\":\"cache_file_refused\",\"reason\":\"symlink\",\"file\":"
+                  << nlohmann::json(f.path().string()).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << "}\n";
+      continue;
+    }
     const std::string ext = f.path().extension().string();
     const std::string digest = "sha256:" + f.path().stem().string();
     const bool known = ext == ".glb" || ext == ".gltf" || ext == ".exr" || ext == ".hdr" || ext == ".png";
@@ -123,14 +134,31 @@ std::optional<std::string> ContentStore::get(const std::string& digest) {
   if (it == index_.end()) return std::nullopt;
   touch(it->second);
   if (it->second->bytes) return *it->second->bytes;
-  std::ifstream in(fileFor(*it->second), std::ios::binary);
-  if (!in) {  // removed behind our back: forget it
+  // O_NOFOLLOW: a symlink put in place after startup is not followed either.
+  std::optional<std::string> bytes;
+  const std::string path = fileFor(*it->second).string();
+  if (const int fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC); fd >= 0) {
+    std::string data;
+    char buf[1 << 16];
+    ssize_t n;
+    while ((n = ::read(fd, buf, sizeof buf)) > 0) data.append(buf, std::size_t(n));
+    ::close(fd);
+    if (n == 0) bytes = std::move(data);
+  }
+  // The file must still be what its name says: anything else (edited, truncated, swapped) is
+  // forgotten and removed rather than served or decoded.
+  const bool intact = bytes && api::sceneDigest(*bytes) == digest;
+  if (!intact) {
+    std::cerr << "{\"event\":\"cache_file_refused\",\"reason\":\"" << (bytes ? "digest mismatch" : "unreadable")
+              << "\",\"digest\":\"" << digest << "\"}\n";
+    std::error_code ec;
+    if (bytes) fs::remove(path, ec);
     total_ -= it->second->info.bytes;
     lru_.erase(it->second);
     index_.erase(it);
     return std::nullopt;
   }
-  return std::string((std::istreambuf_iterator<char>(in)), {});
+  return bytes;
 }
 
 std::vector<StoredBlobInfo> ContentStore::list() {

@@ -26,7 +26,16 @@ std::optional<StoredFrame> FrameStore::get(const std::string& id, const std::str
   auto it = frames_.find({id, name});
   if (it == frames_.end()) return std::nullopt;
   if (Clock::now() - it->second.stored > std::chrono::duration<double>(ttl_)) return std::nullopt;
+  it->second.fetched = true;
   return it->second.frame;
+}
+
+std::size_t FrameStore::unfetched() {
+  std::lock_guard lock(mutex_);
+  std::size_t n = 0;
+  for (const auto& [key, e] : frames_)
+    n += !e.fetched && Clock::now() - e.stored <= std::chrono::duration<double>(ttl_);
+  return n;
 }
 
 void FrameStore::eraseRender(const std::string& id) {

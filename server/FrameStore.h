@@ -27,11 +27,14 @@ public:
   void eraseRender(const std::string& id);
   void purgeExpired();
   std::size_t totalBytes();
+  // Frames stored and not yet expired that no GET has fetched (the shutdown grace waits for them).
+  std::size_t unfetched();
 
 private:
   struct Entry {
     StoredFrame frame;
     Clock::time_point stored;
+    bool fetched = false;
   };
   std::mutex mutex_;
   std::map<std::pair<std::string, std::string>, Entry> frames_;

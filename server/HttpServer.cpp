@@ -8,14 +8,17 @@
 #include <mutex>
 #include <random>
 #include <set>
+#include <thread>
 
 #include <httplib.h>
 #include <nlohmann/json.hpp>
 
 #include "api/Aovs.h"
+#include "api/JsonLimits.h"
 #include "api/Sha256.h"
 #include "api/Validate.h"
 #include "server/FrameStore.h"
+#include "server/HttpTransport.h"
 #include "server/Metrics.h"
 #include "server/RenderService.h"
 #include "server/ContentStore.h"
@@ -67,7 +70,7 @@ void beginRequest(const httplib::Request& req, httplib::Response& res) {
 
 void sendJson(httplib::Response& res, int status, const json& body) {
   res.status = status;
-  res.set_content(body.dump(2) + "\n", "application/json");
+  res.set_content(api::dumpSafe(body, 2) + "\n", "application/json");
 }
 
 void sendProblem(httplib::Response& res, int status, const std::string& type, const std::string& title,
@@ -77,7 +80,8 @@ void sendProblem(httplib::Response& res, int status, const std::string& type, co
   if (!tRequest.id.empty()) p["request_id"] = tRequest.id;
   if (!renderId.empty()) p["render_id"] = renderId;
   res.status = status;
-  res.set_content(p.dump(2) + "\n", "application/problem+json");
+  // dumpSafe: a detail may quote the client's bytes (a path, a value), which need not be UTF-8.
+  res.set_content(api::dumpSafe(p, 2) + "\n", "application/problem+json");
 }
 
 void sendProblem(httplib::Response& res, const api::ApiError& e, const std::string& renderId = "") {
@@ -137,10 +141,26 @@ json deviceJson(const DeviceInfo& d) {
               {"reason", d.reason},         {"software", d.software}};
 }
 
-// Decoded scenes by digest, least recently used dropped first.
+// Memory a decoded scene holds: its vertex arrays and texels (the strings and small structs aside).
+std::size_t sceneBytes(const Scene& s) {
+  std::size_t bytes = 0;
+  for (const auto& m : s.meshes)
+    bytes += m.positions.size() * sizeof(glm::vec3) + m.normals.size() * sizeof(glm::vec3) +
+             m.tangents.size() * sizeof(glm::vec4) + (m.uv0.size() + m.uv1.size()) * sizeof(glm::vec2) +
+             m.indices.size() * sizeof(std::uint32_t) + m.extrasJson.size();
+  for (const auto& t : s.textures) bytes += t.rgba8.size();
+  return bytes;
+}
+
+// Decoded scenes by digest, least recently used dropped first, bounded in entries and in bytes
+// (--scene-cache, --scene-cache-bytes). A scene larger than the whole budget is used, not kept.
 class DecodedScenes {
 public:
-  explicit DecodedScenes(std::size_t capacity) : capacity_(capacity) {}
+  DecodedScenes(std::size_t capacity, std::size_t maxBytes) : capacity_(capacity), maxBytes_(maxBytes) {}
+  std::size_t totalBytes() {
+    std::lock_guard lock(mutex_);
+    return bytes_;
+  }
   std::shared_ptr<const Scene> get(const std::string& digest) {
     std::lock_guard lock(mutex_);
     auto it = index_.find(digest);
@@ -149,11 +169,14 @@ public:
     return it->second->second;
   }
   void put(const std::string& digest, std::shared_ptr<const Scene> scene) {
+    const std::size_t size = sceneBytes(*scene);
     std::lock_guard lock(mutex_);
-    if (index_.count(digest)) return;
+    if (index_.count(digest) || size > maxBytes_) return;
     lru_.emplace_front(digest, std::move(scene));
     index_[digest] = lru_.begin();
-    while (lru_.size() > capacity_) {
+    bytes_ += size;
+    while (lru_.size() > capacity_ || bytes_ > maxBytes_) {
+      bytes_ -= sceneBytes(*lru_.back().second);
       index_.erase(lru_.back().first);
       lru_.pop_back();
     }
@@ -161,7 +184,7 @@ public:
 
 private:
   std::mutex mutex_;
-  std::size_t capacity_;
+  std::size_t capacity_, maxBytes_, bytes_ = 0;
   std::list<std::pair<std::string, std::shared_ptr<const Scene>>> lru_;
   std::map<std::string, std::list<std::pair<std::string, std::shared_ptr<const Scene>>>::iterator> index_;
 };
@@ -177,19 +200,25 @@ struct HttpServer::Impl {
   ContentStore images;  // comparison targets (compare.against = their digest)
   DecodedScenes decoded;
   RenderService service;
-  httplib::Server http;
+  BoundedServer http;
   std::atomic<bool> shuttingDown{false};
 
   std::mutex builtinMutex;
   std::map<std::string, std::string> builtinDigests;  // name -> digest, filled on first use
 
+  static ServerConfig derived(ServerConfig c) {
+    // One request's output files may not exceed the frame store that has to hold them.
+    if (c.limits.maxOutputBytes == 0) c.limits.maxOutputBytes = c.maxFrameBytes;
+    return c;
+  }
+
   Impl(ServerConfig c, BackendHooks h)
-      : config(std::move(c)),
+      : config(derived(std::move(c))),
         hooks(std::move(h)),
         frames(config.maxFrameBytes, config.frameTtlS),
         scenes(config.cacheDir, config.maxSceneBytes, "scenes"),
         images(config.cacheDir, config.maxSceneBytes, "images"),
-        decoded(config.sceneCacheEntries),
+        decoded(config.sceneCacheEntries, config.sceneCacheBytes),
         service(config, hooks, frames, metrics) {
     routes();
   }
@@ -228,7 +257,9 @@ struct HttpServer::Impl {
     try {
       scene = std::make_shared<Scene>(hooks.decodeScene(bytes));
     } catch (const api::ApiError& e) {
-      throw api::ApiError(e.status, e.type, e.title, e.detail(), e.pointer.empty() ? pointer : e.pointer);
+      // A render request points at its own field (/scene/inline_glb); an upload, whose body is the
+      // glTF document, at the place in the document the decoder names.
+      throw api::ApiError(e.status, e.type, e.title, e.detail(), pointer.empty() ? e.pointer : pointer);
     } catch (const std::exception& e) {
       throw api::ApiError(422, "invalid-scene", "Invalid scene", std::string("the scene cannot be loaded: ") + e.what(),
                           pointer);
@@ -312,11 +343,49 @@ struct HttpServer::Impl {
   }
 
   // ---- helpers --------------------------------------------------------------------------------
-  void checkBodySize(const httplib::Request& req) {
-    if (req.body.size() > config.maxBodyBytes)
+  // The body of a POST/PUT, counted while it is read: chunked and gzip/deflate bodies (which httplib
+  // inflates on the way) stop at --max-body-bytes instead of being read whole first.
+  std::string readBody(const httplib::Request& req, httplib::Response& res, const httplib::ContentReader& reader) {
+    std::string body;
+    bool tooLarge = false;
+    const bool ok = reader([&](const char* data, std::size_t n) {
+      if (n > config.maxBodyBytes - body.size()) {
+        tooLarge = true;
+        return false;
+      }
+      body.append(data, n);
+      return true;
+    });
+    // httplib refuses a Content-Length over the limit itself (status 413) without reading the body.
+    if (!ok && res.status == 413) tooLarge = true;
+    if (tooLarge || !ok) {
+      markCloseConnection();  // the rest of the body is still on the wire
+      res.set_header("Connection", "close");
+    }
+    if (tooLarge)
       throw api::ApiError(413, "payload-too-large", "Payload too large",
-                          "the body is " + std::to_string(req.body.size()) + " bytes, the limit is " +
-                              std::to_string(config.maxBodyBytes));
+                          "the body (after any Content-Encoding is undone) exceeds this server's limit of " +
+                              std::to_string(config.maxBodyBytes) + " bytes (radiantd --max-body-bytes)");
+    if (!ok)
+      throw api::ApiError(400, "incomplete-body", "Incomplete body",
+                          "the body could not be read completely within " + std::to_string(config.readTimeoutS) +
+                              " s (radiantd --read-timeout), or its encoding is invalid");
+    return body;
+  }
+
+  // A handler that takes the request body, read with readBody().
+  template <class F>
+  httplib::Server::HandlerWithContentReader wrapBody(F f) {
+    return [this, f](const httplib::Request& req, httplib::Response& res, const httplib::ContentReader& reader) {
+      try {
+        const std::string body = readBody(req, res, reader);
+        f(req, body, res);
+      } catch (const api::ApiError& e) {
+        sendProblem(res, e, tRequest.renderId);
+      } catch (const std::exception& e) {
+        sendProblem(res, 500, "internal-error", "Internal error", e.what(), "", tRequest.renderId);
+      }
+    };
   }
 
   template <class F>
@@ -339,7 +408,15 @@ struct HttpServer::Impl {
                 {"max_samples", config.limits.maxSamples},
                 {"max_queue", config.maxQueue},
                 {"request_timeout_s", config.requestTimeoutS},
-                {"frame_ttl_s", config.frameTtlS}};
+                {"frame_ttl_s", config.frameTtlS},
+                {"max_json_depth", config.limits.maxJsonDepth},
+                {"max_decode_bytes", config.maxDecodeBytes},
+                {"max_frame_bytes", config.maxFrameBytes},
+                {"scene_cache_bytes", config.sceneCacheBytes},
+                {"read_timeout_s", config.readTimeoutS},
+                {"keep_alive_timeout_s", config.keepAliveTimeoutS},
+                {"shutdown_grace_s", config.shutdownGraceS},
+                {"max_connections", config.maxConnections}};
   }
 
   json techniquesJson() const {
@@ -374,15 +451,30 @@ struct HttpServer::Impl {
 
   // ---- routes ---------------------------------------------------------------------------------
   void routes() {
+    // Workers start as connections need them (slow clients must not queue health checks behind
+    // them), from --http-threads up to --max-connections.
     const int threads = config.httpThreads > 0 ? config.httpThreads : std::min(256, config.maxQueue + 8);
-    http.new_task_queue = [threads] { return new httplib::ThreadPool(static_cast<size_t>(threads)); };
+    const int maxThreads = std::max(threads, config.maxConnections);
+    http.new_task_queue = [threads, maxThreads] {
+      return new ElasticPool(static_cast<std::size_t>(threads), static_cast<std::size_t>(maxThreads));
+    };
     http.set_payload_max_length(config.maxBodyBytes);
-    http.set_read_timeout(30, 0);
-    http.set_write_timeout(30, 0);
-    http.set_keep_alive_timeout(2);  // idle keep-alive connections must not hold up a shutdown for long
+    http.setTimeouts({config.readTimeoutS, config.keepAliveTimeoutS, 30.0});
+    http.set_tcp_nodelay(true);
 
     http.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
       beginRequest(req, res);
+      // httplib reads the body of any other POST/PUT/PATCH/DELETE whole into memory before routing;
+      // with a Content-Length it is bounded by --max-body-bytes, a chunked or compressed one is not.
+      const bool bodyRoute = (req.method == "POST" || req.method == "PUT") &&
+                             (req.path == "/v1/renders" || req.path == "/v1/scenes" || req.path == "/v1/images");
+      if (!bodyRoute && (req.has_header("Transfer-Encoding") || req.has_header("Content-Encoding"))) {
+        markCloseConnection();
+        res.set_header("Connection", "close");
+        sendProblem(res, 400, "unexpected-body", "Unexpected body",
+                    "only POST/PUT /v1/renders, /v1/scenes and /v1/images take a chunked or encoded body");
+        return httplib::Server::HandlerResponse::Handled;
+      }
       if (!config.token.empty() && req.path != "/v1/health") {
         const std::string auth = req.get_header_value("Authorization");
         const std::string expected = "Bearer " + config.token;
@@ -406,7 +498,7 @@ struct HttpServer::Impl {
       if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;
       std::string detail = statusTitle(res.status);
       std::string type = "http-" + std::to_string(res.status);
-      if (res.status == 404) { type = "not-found"; detail = "no resource at " + req.method + " " + req.path; }
+      if (res.status == 404) { type = "not-found"; detail = "no resource at " + api::truncateUtf8(req.method, 16) + " " + api::truncateUtf8(req.path, 200); }
       if (res.status == 413) { type = "payload-too-large"; detail = "the body exceeds the limit of " + std::to_string(config.maxBodyBytes) + " bytes"; }
       sendProblem(res, res.status, type, statusTitle(res.status), detail);
       return httplib::Server::HandlerResponse::Handled;
@@ -438,7 +530,7 @@ struct HttpServer::Impl {
       line["render_ms"] = tRequest.renderMs >= 0 ? json(tRequest.renderMs) : json(nullptr);
       line["encode_ms"] = tRequest.encodeMs >= 0 ? json(tRequest.encodeMs) : json(nullptr);
       if (!tRequest.renderId.empty()) line["render_id"] = tRequest.renderId;
-      std::fprintf(stderr, "%s\n", line.dump().c_str());
+      std::fprintf(stderr, "%s\n", api::dumpSafe(line).c_str());
       tRequest = RequestContext{};
     });
 
@@ -479,13 +571,14 @@ struct HttpServer::Impl {
           {"radiant_jobs_active", {"Jobs rendering or encoding.", double(service.active())}},
           {"radiant_ready", {"1 once the render thread has a GL context.", service.ready() ? 1.0 : 0.0}},
           {"radiant_scene_store_bytes", {"Bytes of uploaded scenes stored.", double(scenes.totalBytes())}},
+          {"radiant_scene_cache_bytes", {"Bytes of decoded scenes kept in memory (--scene-cache-bytes).", double(decoded.totalBytes())}},
           {"radiant_image_store_bytes", {"Bytes of uploaded comparison images stored.", double(images.totalBytes())}},
           {"radiant_frame_store_bytes", {"Bytes of encoded frames stored.", double(frames.totalBytes())}}};
       res.status = 200;
       res.set_content(metrics.text(gauges), "text/plain; version=0.0.4; charset=utf-8");
     }));
 
-    auto upload = wrap([this](const httplib::Request& req, httplib::Response& res) {
+    auto upload = wrapBody([this](const httplib::Request& req, const std::string& body, httplib::Response& res) {
       static const std::set<std::string> kTypes{"model/gltf-binary", "model/gltf+json", "application/octet-stream",
                                                 "application/json"};
       const std::string type = mediaType(req);
@@ -493,17 +586,17 @@ struct HttpServer::Impl {
         throw api::ApiError(415, "unsupported-media-type", "Unsupported media type",
                             "scenes are uploaded as model/gltf-binary or model/gltf+json (also accepted: "
                             "application/octet-stream, application/json), got \"" + type + "\"");
-      checkBodySize(req);
-      if (req.body.empty()) throw api::ApiError(400, "empty-body", "Empty body", "the body holds no scene");
-      const std::string digest = api::sceneDigest(req.body);
+      if (body.empty()) throw api::ApiError(400, "empty-body", "Empty body", "the body holds no scene");
+      const std::string digest = api::sceneDigest(body);
       bool created = false;
-      if (!scenes.contains(digest)) {
-        decode(digest, req.body, "");  // reject what the loader cannot read before storing it
-        created = scenes.put(digest, req.body);
+      // get(), not contains(): a file in the cache dir that no longer matches its digest is dropped there.
+      if (!scenes.get(digest)) {
+        decode(digest, body, "");  // reject what the loader cannot read before storing it
+        created = scenes.put(digest, body);
       }
       res.set_header("Location", "/v1/scenes/" + digest);
       sendJson(res, created ? 201 : 200,
-               {{"digest", digest}, {"bytes", req.body.size()}, {"format", ContentStore::formatOf(req.body)},
+               {{"digest", digest}, {"bytes", body.size()}, {"format", ContentStore::formatOf(body)},
                 {"created", created}});
     });
     http.Put("/v1/scenes", upload);
@@ -540,7 +633,7 @@ struct HttpServer::Impl {
     }));
 
     // Comparison images: content-addressed like scenes; a render's compare.against names one by digest.
-    auto uploadImage = wrap([this](const httplib::Request& req, httplib::Response& res) {
+    auto uploadImage = wrapBody([this](const httplib::Request& req, const std::string& body, httplib::Response& res) {
       static const std::set<std::string> kTypes{"image/x-exr", "image/vnd.radiance", "image/png",
                                                 "application/octet-stream"};
       const std::string type = mediaType(req);
@@ -548,18 +641,17 @@ struct HttpServer::Impl {
         throw api::ApiError(415, "unsupported-media-type", "Unsupported media type",
                             "comparison images are uploaded as image/x-exr, image/vnd.radiance or image/png (also "
                             "accepted: application/octet-stream), got \"" + type + "\"");
-      checkBodySize(req);
-      if (req.body.empty()) throw api::ApiError(400, "empty-body", "Empty body", "the body holds no image");
-      const std::string digest = api::sceneDigest(req.body);
+      if (body.empty()) throw api::ApiError(400, "empty-body", "Empty body", "the body holds no image");
+      const std::string digest = api::sceneDigest(body);
       bool created = false;
-      if (!images.contains(digest)) {
+      if (!images.get(digest)) {
         if (!hooks.decodeImage) throw std::logic_error("no image decoder configured");
-        const Image decoded = hooks.decodeImage(req.body);  // refuse what cannot be read before storing it
-        created = images.put(digest, req.body);
+        const Image decoded = hooks.decodeImage(body);  // refuse what cannot be read before storing it
+        created = images.put(digest, body);
       }
       res.set_header("Location", "/v1/images/" + digest);
       sendJson(res, created ? 201 : 200,
-               {{"digest", digest}, {"bytes", req.body.size()}, {"format", ContentStore::formatOf(req.body)},
+               {{"digest", digest}, {"bytes", body.size()}, {"format", ContentStore::formatOf(body)},
                 {"created", created}});
     });
     http.Put("/v1/images", uploadImage);
@@ -576,14 +668,13 @@ struct HttpServer::Impl {
       res.set_content(*bytes, kMime.at(ContentStore::formatOf(*bytes)));
     }));
 
-    http.Post("/v1/renders", wrap([this](const httplib::Request& req, httplib::Response& res) {
+    http.Post("/v1/renders", wrapBody([this](const httplib::Request& req, const std::string& requestBody, httplib::Response& res) {
       if (mediaType(req) != "application/json")
         throw api::ApiError(415, "unsupported-media-type", "Unsupported media type",
                             "render requests are application/json, got \"" + mediaType(req) + "\"");
-      checkBodySize(req);
       if (shuttingDown)
         throw api::ApiError(503, "shutting-down", "Shutting down", "the daemon is shutting down and accepts no new renders");
-      api::RenderRequest request = api::parseRenderRequest(std::string_view(req.body), config.limits);
+      api::RenderRequest request = api::parseRenderRequest(std::string_view(requestBody), config.limits);
       if (!hooks.techniques.empty())
         for (const auto& [name, params] : request.passes) {
           bool known = false;
@@ -687,6 +778,12 @@ bool HttpServer::run() { return impl_->http.listen_after_bind(); }
 void HttpServer::shutdown() {
   impl_->shuttingDown = true;
   impl_->service.drain();
+  // Grace period: the renders just finished still have frames to download and jobs to poll
+  // (new renders get 503 meanwhile). It ends early once every stored frame has been fetched.
+  const auto end = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                      std::chrono::duration<double>(impl_->config.shutdownGraceS));
+  while (Clock::now() < end && impl_->frames.unfetched() > 0)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
   impl_->http.stop();
 }
 

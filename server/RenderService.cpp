@@ -1,5 +1,7 @@
 #include "server/RenderService.h"
 
+#include "api/JsonLimits.h"
+
 #include <algorithm>
 #include <cmath>
 #include <iostream>
@@ -230,7 +232,7 @@ void RenderService::renderLoop() {
         std::unique_lock lock(mutex_);
         ready_ = false;
         notReadyReason_ = std::string("creating the render backend failed: ") + e.what();
-        std::cerr << "{\"event\":\"backend_create_failed\",\"detail\":" << json(e.what()).dump() << "}\n";
+        std::cerr << "{\"event\":\"backend_create_failed\",\"detail\":" << api::dumpSafe(json(e.what())) << "}\n";
         changed_.wait_for(lock, std::chrono::duration<double>(backoff), [&] { return stopping_; });
         backoff = std::min(backoff * 2, 30.0);
         continue;
@@ -276,8 +278,8 @@ void RenderService::renderLoop() {
         metrics_.observePass(p.name, "cpu", p.cpuMs / 1000);
       }
     if (recreate) {
-      std::cerr << "{\"event\":\"backend_recreate\",\"render_id\":" << json(job->id).dump()
-                << ",\"detail\":" << json(problem->detail).dump() << "}\n";
+      std::cerr << "{\"event\":\"backend_recreate\",\"render_id\":" << api::dumpSafe(json(job->id))
+                << ",\"detail\":" << api::dumpSafe(json(problem->detail)) << "}\n";
       backend.reset();  // destroyed here, on the thread that owns its context
       std::lock_guard lock(mutex_);
       ready_ = false;

@@ -6,6 +6,7 @@
 #include "renderer/Renderer.h"
 #include "renderer/io/ImageIO.h"
 #include "renderer/scene/BuiltinScenes.h"
+#include "renderer/scene/GltfLimits.h"
 #include "renderer/scene/GltfLoader.h"
 #include "server/RenderService.h"
 
@@ -37,21 +38,34 @@ BackendHooks rendererHooks(const ServerConfig& config) {
   BackendHooks h;
   h.createBackend = [device] { return std::make_unique<RendererBackend>(device); };
   const std::size_t maxBytes = config.maxBodyBytes;
-  h.decodeScene = [maxBytes](std::string_view bytes) {
+  const std::size_t maxDecoded = config.maxDecodeBytes;
+  const std::size_t maxDepth = config.limits.maxJsonDepth;
+  h.decodeScene = [maxBytes, maxDecoded, maxDepth](std::string_view bytes) {
     LoadOptions options;  // empty asset root: uploads may not reference external files
     options.maxBytes = std::max<std::size_t>(maxBytes, std::size_t(256) << 20);
+    options.maxDecodedBytes = maxDecoded;
+    options.maxJsonDepth = maxDepth;
+    // The pointer is into the glTF document; for an upload that is the request body.
     try {
       return loadSceneFromMemory(bytes, options);
+    } catch (const SceneLimitError& e) {
+      throw api::ApiError(422, "limit-exceeded", "Server limit exceeded",
+                          std::string("the glTF file is over a limit") + (e.pointer.empty() ? "" : " at " + e.pointer) +
+                              ": " + e.what(),
+                          e.pointer);
     } catch (const SceneError& e) {
       throw api::ApiError(422, "invalid-scene", "Invalid scene",
                           std::string("the glTF file is invalid") +
-                              (e.pointer.empty() ? "" : " at " + e.pointer) + ": " + e.what());
+                              (e.pointer.empty() ? "" : " at " + e.pointer) + ": " + e.what(),
+                          e.pointer);
     }
   };
-  h.decodeImage = [](std::string_view bytes) {
+  h.decodeImage = [maxDecoded](std::string_view bytes) {
     Image image;
     try {
-      image = io::decodeImage(bytes);
+      image = io::decodeImage(bytes, "beauty", maxDecoded);
+    } catch (const io::DecodeLimitExceeded& e) {
+      throw api::ApiError(422, "limit-exceeded", "Server limit exceeded", e.what());
     } catch (const std::exception& e) {
       throw api::ApiError(422, "invalid-image", "Invalid image", e.what());
     }

@@ -47,6 +47,10 @@ json normaliseParam(const std::string& file, const std::string& name, const json
   if (!out.contains("description") || !out["description"].is_string())
     fail(file, "params." + name + " has no description");
   const std::string type = out["type"];
+  // Every number a request can carry is bounded, so none overflows the float it becomes (issue 13).
+  if ((type == "number" || type == "integer") && !out.contains("enum") &&
+      !(out.contains("minimum") && out.contains("maximum")))
+    fail(file, "params." + name + " is a " + type + " without both minimum and maximum (or an enum)");
   const json& d = out["default"];
   bool typeOk = (type == "integer" && d.is_number_integer()) || (type == "number" && d.is_number()) ||
                 (type == "boolean" && d.is_boolean()) || (type == "string" && d.is_string());
@@ -101,6 +105,7 @@ int main(int argc, char** argv) {
     for (const auto& a : aovs)
       if (a != "beauty") aovEnum.push_back(a);
     request["properties"]["outputs"]["items"]["properties"]["aovs"]["items"]["enum"] = aovEnum;
+    request["properties"]["compare"]["properties"]["aov"]["enum"] = aovEnum;
 
     std::ostringstream text;
     text << request.dump(2) << "\n";

@@ -131,10 +131,18 @@ void writeFile(const std::string& path, const std::string& bytes) {
 
 namespace {
 
-Image readFrom(OIIO::ImageInput* in, const std::string& what, const std::string& aov) {
+Image readFrom(OIIO::ImageInput* in, const std::string& what, const std::string& aov, std::size_t maxDecodedBytes = 0) {
   if (!in) throw std::runtime_error("io: cannot read " + what + ": " + OIIO::geterror());
   const OIIO::ImageSpec& spec = in->spec();
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0) throw std::runtime_error("io: " + what + " is empty");
+  // From the header, before allocating: the float copy of every channel plus the RGB image kept.
+  const std::uint64_t pixels = std::uint64_t(spec.width) * std::uint64_t(spec.height);
+  const std::uint64_t need = pixels * std::uint64_t(spec.nchannels) * 4 + pixels * 3 * 4;
+  if (maxDecodedBytes > 0 && need > maxDecodedBytes)
+    throw DecodeLimitExceeded("io: " + what + " is " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+                              " with " + std::to_string(spec.nchannels) + " channels: decoding needs " +
+                              std::to_string(need) + " bytes, above this server's decode budget of " +
+                              std::to_string(maxDecodedBytes) + " bytes (radiantd --max-decode-bytes)");
   Image img = Image::make(aov, spec.width, spec.height, spec.nchannels >= 3 ? 3 : 1);
   std::vector<float> all(static_cast<std::size_t>(spec.width) * spec.height * spec.nchannels);
   if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()))
@@ -151,7 +159,7 @@ Image readImage(const std::string& path, const std::string& aov) {
   return readFrom(in.get(), path, aov);
 }
 
-Image decodeImage(std::string_view bytes, const std::string& aov) {
+Image decodeImage(std::string_view bytes, const std::string& aov, std::size_t maxDecodedBytes) {
   auto starts = [&](std::string_view magic) { return bytes.substr(0, magic.size()) == magic; };
   const char* name = starts(std::string_view("\x76\x2f\x31\x01", 4)) ? "image.exr"
                      : starts("#?RADIANCE") || starts("#?RGBE") ? "image.hdr"
@@ -160,7 +168,7 @@ Image decodeImage(std::string_view bytes, const std::string& aov) {
   if (!name) throw std::runtime_error("io: not an EXR, Radiance HDR or PNG image");
   OIIO::Filesystem::IOMemReader reader(const_cast<char*>(bytes.data()), bytes.size());
   auto in = OIIO::ImageInput::open(name, nullptr, &reader);
-  return readFrom(in.get(), std::string("the uploaded ") + (name + 6) + " image", aov);
+  return readFrom(in.get(), std::string("the uploaded ") + (name + 6) + " image", aov, maxDecodedBytes);
 }
 
 }  // namespace radiant::io

@@ -2,6 +2,7 @@
 // Image encoding with OpenImageIO. Pure CPU: safe to call from any thread (the server runs it off the
 // render thread so the GPU keeps working while frames are written).
 
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -21,7 +22,12 @@ void writeFile(const std::string& path, const std::string& bytes);
 // compare-against-upload and tests. Throws std::runtime_error naming what failed.
 Image readImage(const std::string& path, const std::string& aov = "beauty");
 // The same from bytes in memory; the format comes from the magic bytes (EXR, Radiance HDR, PNG).
-Image decodeImage(std::string_view bytes, const std::string& aov = "beauty");
+// maxDecodedBytes > 0: the header's width x height x channels is checked against it before any
+// pixel is read (DecodeLimitExceeded).
+Image decodeImage(std::string_view bytes, const std::string& aov = "beauty", std::size_t maxDecodedBytes = 0);
+struct DecodeLimitExceeded : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
 
 // sRGB transfer of one linear value in [0,1] (IEC 61966-2-1).
 float linearToSrgb(float linear);

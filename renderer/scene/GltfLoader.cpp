@@ -18,6 +18,7 @@
 #include "renderer/scene/GltfCompression.h"
 #include "renderer/scene/GltfExtensions.h"
 #include "renderer/scene/GltfPackage.h"
+#include "renderer/scene/GltfLimits.h"
 
 namespace radiant {
 namespace {
@@ -148,49 +149,14 @@ bool fsWriteWholeFile(std::string* err, const std::string&, const std::vector<un
   return false;
 }
 
-// Width and height from a PNG IHDR or a JPEG SOFn marker, so an image bomb is refused before
-// stb_image allocates it. Unknown formats return nothing (stb then decides).
-std::optional<std::pair<std::uint32_t, std::uint32_t>> sniffImageSize(const unsigned char* b,
-                                                                        std::size_t n) {
-  auto be16 = [&](std::size_t i) { return std::uint32_t(b[i]) << 8 | b[i + 1]; };
-  auto be32 = [&](std::size_t i) { return be16(i) << 16 | be16(i + 2); };
-  if (n >= 24 && std::memcmp(b, "\x89PNG\r\n\x1a\n", 8) == 0) return std::pair{be32(16), be32(20)};
-  if (n >= 4 && b[0] == 0xFF && b[1] == 0xD8) {
-    std::size_t i = 2;
-    while (i + 9 < n) {
-      if (b[i] != 0xFF) return std::nullopt;
-      const unsigned char marker = b[i + 1];
-      if (marker == 0xFF) { ++i; continue; }
-      const bool sof = marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 &&
-                       marker != 0xCC;
-      if (sof) return std::pair{be16(i + 7), be16(i + 5)};
-      i += 2 + be16(i + 2);
-    }
-  }
-  return std::nullopt;
-}
-
-struct ImageContext {
-  std::size_t budget = 0;  // bytes of decoded RGBA left
-};
-
+// Every image's decoded size is charged against the scene's decode budget from its header, before
+// stb_image allocates it (GltfLimits.h).
 bool loadImageData(tinygltf::Image* image, const int index, std::string* err, std::string* warn,
                    int reqWidth, int reqHeight, const unsigned char* bytes, int size, void* user) {
-  auto& ctx = *static_cast<ImageContext*>(user);
-  if (const auto dims = sniffImageSize(bytes, std::size_t(size))) {
-    const std::uint64_t need = std::uint64_t(dims->first) * dims->second * 8;  // worst case 16 bit
-    if (need > ctx.budget) {
-      if (err)
-        *err += "image " + std::to_string(index) + " is " + std::to_string(dims->first) + "x" +
-                std::to_string(dims->second) + ", over the size limit\n";
-      return false;
-    }
-  }
+  auto& budget = *static_cast<DecodeBudget*>(user);
+  if (!budget.chargeImage(bytes, std::size_t(std::max(size, 0)), index, err)) return false;
   // nullptr options: expand every image to RGBA (8 or 16 bit per channel).
-  if (!tinygltf::LoadImageData(image, index, err, warn, reqWidth, reqHeight, bytes, size, nullptr))
-    return false;
-  ctx.budget -= std::min(ctx.budget, image->image.size());
-  return true;
+  return tinygltf::LoadImageData(image, index, err, warn, reqWidth, reqHeight, bytes, size, nullptr);
 }
 
 // ---- validation of the raw JSON, before tinygltf sees it -----------------------------------
@@ -1048,6 +1014,7 @@ Scene load(std::string_view bytes, const fs::path& baseDir, const fs::path& root
   digest.update(bytes);
   const bool glb = bytes.size() >= 4 && bytes.substr(0, 4) == "glTF";
   const std::string_view jsonText = glb ? glbJson(bytes) : bytes;
+  checkGltfText(jsonText, options);  // before any parser: nesting, UTF-8, overflowing numbers
   json doc;
   try {
     doc = json::parse(jsonText);
@@ -1057,6 +1024,7 @@ Scene load(std::string_view bytes, const fs::path& baseDir, const fs::path& root
   }
   std::vector<std::string> warnings;
   validateDocument(doc, baseDir, root, warnings);
+  DecodeBudget budget = checkGltfDocument(doc, options);  // finite transforms; accessor expansion charged
   // EXT_meshopt_compression is decoded into a plain GLB before tinygltf sees the file, KHR_draco_mesh_compression
   // into the model right after (GltfCompression.h).
   std::string decodedBytes;
@@ -1080,10 +1048,9 @@ Scene load(std::string_view bytes, const fs::path& baseDir, const fs::path& root
   fsContext.baseDir = baseDir;
   fsContext.budget = options.maxBytes - bytes.size();
   fsContext.digest = &digest;
-  ImageContext imageContext{options.maxBytes};
   tinygltf::TinyGLTF loader;
   loader.SetFsCallbacks({&fsFileExists, &fsExpandFilePath, &fsReadWholeFile, &fsWriteWholeFile, &fsContext});
-  loader.SetImageLoader(&loadImageData, &imageContext);
+  loader.SetImageLoader(&loadImageData, &budget);
   loader.SetStoreOriginalJSONForExtrasAndExtensions(true);
   tinygltf::Model model;
   std::string err, warn;
@@ -1100,6 +1067,7 @@ Scene load(std::string_view bytes, const fs::path& baseDir, const fs::path& root
     ok = false;
   }
   if (!ok) {
+    budget.rethrowImageError();
     while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
     for (auto& c : err)
       if (c == '\n') c = ';';
@@ -1108,6 +1076,7 @@ Scene load(std::string_view bytes, const fs::path& baseDir, const fs::path& root
   gltf::decodeDraco(model, options.maxBytes);
   Scene scene = Converter(model, options.maxBytes).run();
   scene.warnings.insert(scene.warnings.begin(), warnings.begin(), warnings.end());
+  checkSceneMagnitudes(scene, doc);  // world-space positions, camera and lights: finite, bounded
   scene.digest = "sha256:" + digest.finishHex();
   scene.features = computeFeatures(scene);
   return scene;

@@ -47,8 +47,13 @@ struct LoadOptions {
   // empty root means the file's own directory; for loadSceneFromMemory() it means no external
   // files at all.
   std::filesystem::path assetRoot;
-  // Upper bound on the bytes read (the file plus external files) and on decoded image memory.
+  // Upper bound on the bytes read (the file plus external files).
   std::size_t maxBytes = std::size_t(256) << 20;
+  // Upper bound on decoded memory: every image's pixels and every mesh instance's expanded
+  // accessors, charged before allocation (GltfLimits.h). radiantd --max-decode-bytes.
+  std::size_t maxDecodedBytes = std::size_t(512) << 20;
+  // Deepest nesting of the JSON (GltfLimits.h). radiantd --max-json-depth.
+  std::size_t maxJsonDepth = 64;
 };
 
 // Loads a .gltf or .glb file, which must lie inside options.assetRoot (when given).

@@ -82,6 +82,7 @@ public:
     if (out_ >= 0) close(out_);
   }
   int port() const { return port_; }
+  pid_t pid() const { return pid_; }
   const std::string& firstLine() const { return firstLine_; }
   std::string url() const { return "http://127.0.0.1:" + std::to_string(port_); }
   httplib::Client client() const {

@@ -614,3 +614,26 @@ TEST(ServerConfig, FlagsOverrideTheConfigFileAndTheTokenComesFromAFile) {
   EXPECT_THROW(radiant::server::parseCommandLine({"--port", "http"}), std::invalid_argument);
   std::filesystem::remove_all(dir);
 }
+
+TEST(ServerConfig, HardeningFlagsParseWithinTheirBounds) {
+  auto c = radiant::server::parseCommandLine({"--max-json-depth", "32", "--max-decode-bytes", "1048576",
+                                              "--scene-cache-bytes", "2097152", "--read-timeout", "2.5",
+                                              "--keep-alive-timeout", "0.5", "--shutdown-grace", "0",
+                                              "--max-connections", "64"});
+  ASSERT_TRUE(c);
+  EXPECT_EQ(c->limits.maxJsonDepth, 32u);
+  EXPECT_EQ(c->maxDecodeBytes, 1048576u);
+  EXPECT_EQ(c->sceneCacheBytes, 2097152u);
+  EXPECT_DOUBLE_EQ(c->readTimeoutS, 2.5);
+  EXPECT_DOUBLE_EQ(c->keepAliveTimeoutS, 0.5);
+  EXPECT_DOUBLE_EQ(c->shutdownGraceS, 0.0);
+  EXPECT_EQ(c->maxConnections, 64);
+  // radiantd's grace default is 10 s; servers embedded in tests get 0.
+  EXPECT_DOUBLE_EQ(radiant::server::parseCommandLine({})->shutdownGraceS, 10.0);
+  EXPECT_DOUBLE_EQ(ServerConfig{}.shutdownGraceS, 0.0);
+  EXPECT_THROW(radiant::server::parseCommandLine({"--max-json-depth", "7"}), std::invalid_argument);
+  EXPECT_THROW(radiant::server::parseCommandLine({"--max-json-depth", "1001"}), std::invalid_argument);
+  EXPECT_THROW(radiant::server::parseCommandLine({"--max-decode-bytes", "1000"}), std::invalid_argument);
+  EXPECT_THROW(radiant::server::parseCommandLine({"--read-timeout", "-1"}), std::invalid_argument);
+  EXPECT_THROW(radiant::server::parseCommandLine({"--max-connections", "2"}), std::invalid_argument);
+}
