@@ -6,12 +6,19 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(std430, binding = 6) readonly buffer Cells { uint cellStart[]; };
-layout(rgba32f, binding = 0) uniform writeonly image2D i_accum;
+layout(rgba32f, binding = 0) uniform image2D i_accum;
 
 uniform vec3 u_gridOrigin;
 uniform float u_cellSize;
 uniform ivec3 u_gridDims;
 uniform ivec2 u_size;
+// This dispatch's slice of every cell: entries [u_sliceBegin, u_sliceBegin + u_sliceLength) of it.
+// llvmpipe ends an invocation's loops after 65535 iterations in total (its loop limiter), so the CPU
+// splits the cells into slices of at most 27 * u_sliceLength candidates per pixel and dispatches once
+// per slice, accumulating (docs/DEVELOPMENT.md).
+uniform uint u_sliceBegin;
+uniform uint u_sliceLength;
+uniform int u_accumulate;
 
 void main() {
   ivec2 px = ivec2(gl_GlobalInvocationID.xy);
@@ -26,12 +33,14 @@ void main() {
           ivec3 q = c + ivec3(dx, dy, dz);
           if (any(lessThan(q, ivec3(0))) || any(greaterThanEqual(q, u_gridDims))) continue;
           int cell = (q.z * u_gridDims.y + q.y) * u_gridDims.x + q.x;
-          for (uint i = cellStart[cell]; i < cellStart[cell + 1]; ++i) {
+          uint begin = cellStart[cell] + u_sliceBegin, end = min(cellStart[cell + 1], begin + u_sliceLength);
+          for (uint i = begin; i < end; ++i) {
             GpuPhoton p = photons[i];
             if (p.power.a > 0.0) acc.a += coverageContribution(p, s);
             else acc.rgb += photonContribution(p, s);
           }
         }
   }
+  if (u_accumulate != 0) acc += imageLoad(i_accum, px);
   imageStore(i_accum, px, acc);
 }

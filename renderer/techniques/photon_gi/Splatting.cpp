@@ -13,6 +13,9 @@ namespace {
 
 constexpr GLuint kSplatBinding = 5, kCellBinding = 6;
 constexpr int kMaxCellsPerAxis = 128;
+// Candidates per cell and dispatch of the gather: 27 cells x 2000 = 54000 loop iterations per pixel,
+// under llvmpipe's limit of 65535 per invocation.
+constexpr std::uint32_t kGatherSlice = 2000;
 // The surface test (shaders/photon_gi/photon.glsl): a pixel's surface must lie within this fraction of
 // h of the photon's plane (a curved surface deviates from its tangent plane by r^2 / 2R) and its
 // geometric normal within acos(0.7) = 45.6 degrees of the photon's (creases between walls are 90).
@@ -91,6 +94,7 @@ SplatGrid buildSplatGrid(std::vector<GpuSplat> splats) {
   // Counting sort by cell: O(N), stable (photon order is kept within a cell).
   g.cellStart.assign(cells + 1, 0);
   for (const GpuSplat& s : splats) ++g.cellStart[cellOf(s) + 1];
+  for (std::size_t c = 0; c < cells; ++c) g.maxPerCell = std::max(g.maxPerCell, g.cellStart[c + 1]);
   for (std::size_t c = 0; c < cells; ++c) g.cellStart[c + 1] += g.cellStart[c];
   std::vector<std::uint32_t> next(g.cellStart.begin(), g.cellStart.end() - 1);
   g.splats.resize(splats.size());
@@ -174,8 +178,15 @@ void splatAndResolve(FrameResources& res, gl::ShaderLibrary& shaders, const Fram
     glUniform3iv(glGetUniformLocation(prog.id(), "u_gridDims"), 1, dims);
     const int size[2] = {view.width, view.height};
     glUniform2iv(glGetUniformLocation(prog.id(), "u_size"), 1, size);
-    accum.bindImage(0, GL_WRITE_ONLY);
-    glDispatchCompute((view.width + 7) / 8, (view.height + 7) / 8, 1);
+    accum.bindImage(0, GL_READ_WRITE);
+    const std::uint32_t slices = std::max<std::uint32_t>(1, (grid.maxPerCell + kGatherSlice - 1) / kGatherSlice);
+    for (std::uint32_t k = 0; k < slices; ++k) {
+      glUniform1ui(glGetUniformLocation(prog.id(), "u_sliceBegin"), k * kGatherSlice);
+      glUniform1ui(glGetUniformLocation(prog.id(), "u_sliceLength"), kGatherSlice);
+      prog.set("u_accumulate", k > 0 ? 1 : 0);
+      glDispatchCompute((view.width + 7) / 8, (view.height + 7) / 8, 1);
+      glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    }
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
   }
 

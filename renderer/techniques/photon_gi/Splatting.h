@@ -56,6 +56,7 @@ struct SplatGrid {
   glm::vec3 origin{0.f};
   float cellSize = 1.f;
   glm::ivec3 dims{1};
+  std::uint32_t maxPerCell = 0;  // the fullest cell's splats (the gather's dispatch count follows it)
 };
 // Cells are at least the largest kernel radius (a gather visits the 27 cells around a pixel), and at
 // most 128 per axis.
