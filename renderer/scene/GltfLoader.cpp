@@ -37,37 +37,6 @@ std::string primitivePointer(int mesh, int prim) {
 // ---- paths ---------------------------------------------------------------------------------
 
 // True when `p` equals `root` or lies below it; both must be canonical.
-bool isInside(const fs::path& root, const fs::path& p) {
-  auto r = root.begin();
-  auto q = p.begin();
-  for (; r != root.end(); ++r, ++q) {
-    if (r->empty()) continue;  // trailing separator
-    if (q == p.end() || *r != *q) return false;
-  }
-  return true;
-}
-
-// RFC 3986 percent-decoding, as tinygltf applies to external URIs before opening them.
-std::string percentDecode(std::string_view s) {
-  auto hex = [](char c) -> int {
-    if (c >= '0' && c <= '9') return c - '0';
-    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
-    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
-    return -1;
-  };
-  std::string out;
-  out.reserve(s.size());
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    if (s[i] == '%' && i + 2 < s.size() && hex(s[i + 1]) >= 0 &&
-        hex(s[i + 2]) >= 0) {
-      out.push_back(char(hex(s[i + 1]) * 16 + hex(s[i + 2])));
-      i += 2;
-    } else {
-      out.push_back(s[i]);
-    }
-  }
-  return out;
-}
 
 bool isDataUri(std::string_view uri) { return uri.substr(0, 5) == "data:"; }
 
@@ -89,7 +58,7 @@ std::optional<fs::path> resolveInside(FsContext& ctx, const std::string& path) {
   }
   std::error_code ec;
   const fs::path canon = fs::weakly_canonical(fs::absolute(fs::path(path), ec), ec);
-  if (ec || !isInside(ctx.root, canon)) {
+  if (ec || !pathIsInside(ctx.root, canon)) {
     ctx.refused = "\"" + path + "\" is outside the asset root";
     return std::nullopt;
   }
@@ -168,31 +137,12 @@ void checkExternalUri(const std::string& uri, const std::string& ptr, const fs::
                               "\" refused: no asset root is configured (upload one GLB: `radiant render "
                               "FILE.gltf` packs a .gltf and its files; or put the files under radiantd "
                               "--asset-root DIR and name the scene with scene.asset)");
-  // A scheme is letters, digits, + - . followed by ':' (RFC 3986 section 3.1).
-  const auto colon = uri.find(':');
-  if (colon != std::string::npos && colon > 0 && std::isalpha(static_cast<unsigned char>(uri[0])) &&
-      std::all_of(uri.begin(), uri.begin() + long(colon), [](char c) {
-        return std::isalnum(static_cast<unsigned char>(c)) || c == '+' || c == '-' || c == '.';
-      }))
-    throw SceneError(ptr, "URI \"" + uri + "\" refused: only data: URIs and relative file paths "
-                          "are supported");
-  const std::string path = percentDecode(uri);
-  if (path.find('\0') != std::string::npos)
-    throw SceneError(ptr, "URI \"" + uri + "\" refused: it contains a NUL byte");
-  if (path.empty() || path[0] == '/' || path[0] == '\\' || fs::path(path).is_absolute())
-    throw SceneError(ptr, "URI \"" + uri + "\" refused: absolute paths are not allowed");
-  std::size_t start = 0;
-  while (start <= path.size()) {
-    const std::size_t end = std::min(path.find_first_of("/\\", start), path.size());
-    if (path.compare(start, end - start, "..") == 0)
-      throw SceneError(ptr, "URI \"" + uri + "\" refused: \"..\" is not allowed in paths");
-    start = end + 1;
+  // The packer's check (GltfPackage.h): one definition of what a safe relative URI is.
+  try {
+    resolveRelativeUri(uri, ptr, baseDir, root);
+  } catch (const PackError& e) {
+    throw SceneError(e.pointer, e.what());
   }
-  std::error_code ec;
-  const fs::path resolved = fs::weakly_canonical(baseDir / path, ec);
-  if (ec || !isInside(root, resolved))
-    throw SceneError(ptr, "URI \"" + uri + "\" refused: it resolves to " + resolved.string() +
-                              ", outside the asset root " + root.string());
 }
 
 std::uint64_t jsonUnsigned(const json& o, const char* key, std::uint64_t fallback) {
@@ -1099,7 +1049,7 @@ Scene loadScene(const fs::path& file, const LoadOptions& options) {
   if (ec || !fs::is_regular_file(canon))
     throw SceneError("", "scene file " + file.string() + " does not exist or is not a regular file");
   const fs::path root = options.assetRoot.empty() ? canon.parent_path() : canonicalRoot(options.assetRoot);
-  if (!isInside(root, canon))
+  if (!pathIsInside(root, canon))
     throw SceneError("", "scene file " + file.string() + " is outside the asset root " + root.string());
   const auto size = fs::file_size(canon, ec);
   if (ec) throw SceneError("", "cannot read " + file.string() + ": " + ec.message());

@@ -14,16 +14,6 @@ namespace {
 namespace fs = std::filesystem;
 using json = nlohmann::json;
 
-bool isInside(const fs::path& root, const fs::path& p) {
-  auto r = root.begin();
-  auto q = p.begin();
-  for (; r != root.end(); ++r, ++q) {
-    if (r->empty()) continue;
-    if (q == p.end() || *r != *q) return false;
-  }
-  return true;
-}
-
 std::string percentDecode(std::string_view s) {
   auto hex = [](char c) -> int {
     if (c >= '0' && c <= '9') return c - '0';
@@ -128,6 +118,16 @@ bool hasExternalUri(const json& doc) {
 
 }  // namespace
 
+bool pathIsInside(const fs::path& root, const fs::path& p) {
+  auto r = root.begin();
+  auto q = p.begin();
+  for (; r != root.end(); ++r, ++q) {
+    if (r->empty()) continue;  // trailing separator
+    if (q == p.end() || *r != *q) return false;
+  }
+  return true;
+}
+
 fs::path resolveRelativeUri(const std::string& uri, const std::string& ptr, const fs::path& baseDir,
                             const fs::path& root) {
   // A scheme is letters, digits, + - . followed by ':' (RFC 3986 section 3.1).
@@ -152,8 +152,9 @@ fs::path resolveRelativeUri(const std::string& uri, const std::string& ptr, cons
   }
   std::error_code ec;
   const fs::path resolved = fs::weakly_canonical(baseDir / path, ec);
-  if (ec || !isInside(root, resolved))
-    throw PackError(ptr, "URI \"" + uri + "\" refused: it resolves to " + resolved.string() + ", outside " + root.string());
+  if (ec || !pathIsInside(root, resolved))
+    throw PackError(ptr, "URI \"" + uri + "\" refused: it resolves to " + resolved.string() + ", outside the asset root " +
+                             root.string());
   return resolved;
 }
 
@@ -285,7 +286,7 @@ PackResult packGltfFile(const fs::path& file, const fs::path& rootIn, std::size_
     throw PackError("", file.string() + " does not exist or is not a regular file");
   fs::path root = rootIn.empty() ? canon.parent_path() : fs::canonical(rootIn, ec);
   if (ec) throw PackError("", "the root " + rootIn.string() + " does not exist");
-  if (!isInside(root, canon)) throw PackError("", file.string() + " is outside " + root.string());
+  if (!pathIsInside(root, canon)) throw PackError("", file.string() + " is outside " + root.string());
   const auto size = fs::file_size(canon, ec);
   if (ec || size > maxBytes)
     throw PackError("", file.string() + (ec ? ": " + ec.message() : " is over the size limit of " + std::to_string(maxBytes) + " bytes"));

@@ -36,6 +36,9 @@ struct PackResult {
   bool packed = false;           // true when `bytes` is a newly written GLB
 };
 
+// True when the (canonical) path p lies inside the (canonical) directory root.
+bool pathIsInside(const std::filesystem::path& root, const std::filesystem::path& p);
+
 // True for a URI naming a file (not data:), after the checks above; throws PackError otherwise.
 // Returns the canonical path of the file.
 std::filesystem::path resolveRelativeUri(const std::string& uri, const std::string& pointer,
