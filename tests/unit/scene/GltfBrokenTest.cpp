@@ -14,14 +14,8 @@ using test::GltfBuilder;
 using test::json;
 using test::trianglePrimitive;
 
-const std::vector<glm::vec3> kTri = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
-
-GltfBuilder triangle() {
-  GltfBuilder b;
-  const int m = b.mesh(json::array({trianglePrimitive<std::uint8_t>(b, kTri, {0, 1, 2})}));
-  b.scene({b.node({{"mesh", m}})});
-  return b;
-}
+using test::triangle;
+const std::vector<glm::vec3>& kTri = test::kTriangle;
 
 // Runs `load`, expecting a SceneError with `pointer` and a message containing `text`.
 template <class F>

@@ -204,4 +204,13 @@ struct TempDir {
   ~TempDir() { std::error_code ec; std::filesystem::remove_all(path, ec); }
 };
 
+// The unit right triangle in z = 0 and a scene with one node showing it: the smallest valid file.
+inline const std::vector<glm::vec3> kTriangle = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+inline GltfBuilder triangle() {
+  GltfBuilder b;
+  const int m = b.mesh(json::array({trianglePrimitive<std::uint8_t>(b, kTriangle, {0, 1, 2})}));
+  b.scene({b.node({{"mesh", m}})});
+  return b;
+}
+
 }  // namespace radiant::test
