@@ -1,6 +1,7 @@
 #include "renderer/Renderer.h"
 
 #include <algorithm>
+#include <mutex>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -128,6 +129,30 @@ void compare(FrameResources& resources, const Scene& scene, const FrameView& vie
 }
 
 }  // namespace
+
+// A beauty whose brightest pixel is below 1e-6 (of any colour): no light reached the camera. Names the
+// likely cause so that a user does not mistake it for a finished render.
+std::string blackFrameWarning(const RenderOutput& out, const api::FrameStats& stats, const Scene& scene,
+                              const api::RenderRequest& request) {
+  auto it = std::find_if(out.aovs.begin(), out.aovs.end(), [](const Image& i) { return i.aov == "beauty"; });
+  if (it == out.aovs.end()) return "";
+  float brightest = 0.f;
+  for (float v : it->pixels) brightest = std::max(brightest, v);
+  if (brightest >= 1e-6f) return "";
+  std::string cause;
+  if (stats.lighting == "none")
+    cause = "the scene has no lights or emissive surfaces, and the request names no ambient or environment "
+            "(and turned the default lighting off)";
+  else if (scene.meshes.empty())
+    cause = "the scene has no geometry and the sky is black";
+  else if (!stats.skipped.empty()) {
+    cause = "passes were skipped:";
+    for (const auto& [name, why] : stats.skipped) cause += " " + name + " (" + why + ")";
+  } else {
+    cause = "no light reaches the camera (every light is occluded, outside the view, or of zero intensity)";
+  }
+  return "black frame: the beauty's brightest pixel is below 1e-6; " + cause;
+}
 
 struct Renderer::Impl {
   std::unique_ptr<EglDevice> device;
@@ -277,13 +302,27 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
       t->prepare(scene, params[i], im.resources);
       gl::checkError(("prepare " + t->info().name).c_str());
     }
+    // Frame progress: monotone, and reported in order although a pass's callback may come from several
+    // threads at once (hence the lock around the comparison and the call).
+    std::mutex progressMutex;
+    double progressSoFar = 0.0;
+    const double passCount = static_cast<double>(std::max<std::size_t>(1, plan.passes.size()));
+    auto report = [&](double value) {
+      if (!inputs.progress) return;
+      std::lock_guard lock(progressMutex);
+      if (!(value > progressSoFar)) return;
+      progressSoFar = value;
+      inputs.progress(value);
+    };
     for (std::size_t i = 0; i < plan.passes.size(); ++i) {
+      report(0.95 * static_cast<double>(i) / passCount);
       if (cancel && cancel->load())
         throw api::ApiError(409, "cancelled", "Render cancelled", "the render was cancelled before pass " +
                                                                   plan.passes[i]->info().name);
       Technique* t = plan.passes[i];
       gl::DebugGroup group(t->info().name);
       PassContext ctx{scene, gpu, view, params[i], im.resources, im.shaders, stats.passes[i]};
+      ctx.progress = [&, i](double f) { report(0.95 * (static_cast<double>(i) + std::clamp(f, 0.0, 1.0)) / passCount); };
       im.resources.beginPass();
       {
         GpuProfiler::Scope scope(im.profiler, stats.passes[i]);
@@ -327,8 +366,11 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     }
     stats.readbackMs = msSince(readStart);
     im.profiler.resolve();
+    report(0.95);
+    if (const std::string w = blackFrameWarning(out, stats, scene, request); !w.empty()) stats.warnings.push_back(w);
     if (request.compare) compare(im.resources, scene, view, request, inputs.compareTarget, out);
     stats.renderMs = msSince(frameStart);
+    report(1.0);
     if (nonFinite) stats.passes.back().counters["non_finite_pixels_zeroed"] = static_cast<double>(nonFinite);
     return out;
   } catch (const api::ApiError&) {

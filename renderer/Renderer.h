@@ -1,4 +1,5 @@
 #pragma once
+#include <functional>
 // The renderer library's one entry point. It owns the EGL context, so create it on the thread that
 // will render, and call render() only from that thread. It knows nothing about HTTP.
 
@@ -22,6 +23,10 @@ struct RenderOutput {
 struct FrameInputs {
   const Image* compareTarget = nullptr;  // compare.against when it names an image
   const Image* environment = nullptr;    // request.environment
+  // Progress of the frame in [0, 1]: passes done plus the running pass's own fraction (reference tiles,
+  // light-tracer waves, photon tracing), in pass-count units, then 1 after readback. Never decreases.
+  // May be called from the renderer's worker threads: keep it cheap and thread-safe (store an atomic).
+  std::function<void(double)> progress;
 };
 
 struct TechniqueDescription {

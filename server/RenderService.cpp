@@ -128,7 +128,9 @@ json RenderService::describe(const Job& job) {
       j["queue_position"] = pos;
       break;
     }
-    case JobState::Running: progress = 0.1; break;  // the renderer reports no finer progress yet
+    // Rendering spans 0.05..0.9 of the job, following the renderer's progress (passes done, the running
+    // pass's tiles or waves); encoding 0.9..1.
+    case JobState::Running: progress = 0.05 + 0.85 * std::clamp(job.renderProgress.load(), 0.0, 1.0); break;
     case JobState::Encoding: progress = 0.9; j["state"] = "running"; j["phase"] = "encoding"; break;
     default: progress = 1; break;
   }
@@ -258,8 +260,10 @@ void RenderService::renderLoop() {
     RenderOutput output;
     bool recreate = false;
     try {
-      output = backend->render(*job->scene, job->request, &job->cancel,
-                               FrameInputs{job->compareTarget.get(), job->environment.get()});
+      FrameInputs inputs{job->compareTarget.get(), job->environment.get()};
+      Job* raw = job.get();
+      inputs.progress = [raw](double f) { raw->renderProgress.store(f); };
+      output = backend->render(*job->scene, job->request, &job->cancel, inputs);
     } catch (const api::ApiError& e) {
       problem = Problem{e.status, e.type, e.title, e.detail(), e.pointer};
     } catch (const std::exception& e) {

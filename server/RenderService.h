@@ -54,6 +54,7 @@ struct Job {
   std::shared_ptr<const Image> environment;    // environment
   double sceneLoadMs = 0;                      // decoding the scene for this request (0: it was cached)
   std::atomic<bool> cancel{false};
+  std::atomic<double> renderProgress{0.0};  // the renderer's own progress, 0..1 (FrameInputs::progress)
   // Everything below is guarded by RenderService's mutex.
   JobState state = JobState::Queued;
   bool timedOut = false;

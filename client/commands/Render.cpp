@@ -1,4 +1,5 @@
 // radiant render: upload the scene if the server lacks it, render, download the frame.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <optional>
@@ -275,10 +276,19 @@ int cmdRender(const GlobalOptions& g, const std::vector<std::string>& args) {
         problem["render_id"] = result.value("id", "");
         throw ServerError(problem.value("status", 500), problem);
       }
-      if (tty)
+      if (tty) {
+        // A bar and, once rendering has visibly started, the time left at the rate so far.
+        const double progress = std::clamp(result.value("progress", 0.0), 0.0, 1.0);
+        const double elapsedS = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        const int filled = static_cast<int>(20 * progress);
+        std::string eta;
+        if (progress > 0.06 && elapsedS > 1.0)
+          eta = " ETA " + std::to_string(static_cast<int>(elapsedS * (1.0 - progress) / progress + 0.5)) + " s";
         std::cerr << "\r" << result.value("id", "") << ": " << state
                   << (result.contains("queue_position") ? " (position " + result["queue_position"].dump() + ")" : "")
-                  << " " << static_cast<int>(100 * result.value("progress", 0.0)) << "%   " << std::flush;
+                  << " [" << std::string(filled, '#') << std::string(20 - filled, '.') << "] "
+                  << static_cast<int>(100 * progress) << "%" << eta << "      " << std::flush;
+      }
       std::this_thread::sleep_for(std::chrono::milliseconds(200));
       result = HttpClient::expectOk(http.get(location)).json();
     }
@@ -295,6 +305,9 @@ int cmdRender(const GlobalOptions& g, const std::vector<std::string>& args) {
                          {"timings", result.value("timings", nlohmann::json::object())}, {"frames", result["frames"]}};
     writeFile(statsFile, stats.dump(2) + "\n");
   }
+  if (!quiet && result.contains("stats") && result["stats"].contains("warnings") && result["stats"]["warnings"].is_array())
+    for (const auto& w : result["stats"]["warnings"])
+      if (w.is_string()) std::cerr << "warning: " << w.get<std::string>() << "\n";
   if (!quiet && result.contains("stats") && result["stats"].value("lighting", "") == "default")
     std::cerr << "note: the scene has no lights, ambient or environment; it was lit by the default studio "
                  "environment (see docs/API.md; --ambient, --environment or --no-default-lighting change that)\n";

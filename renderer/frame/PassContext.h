@@ -1,4 +1,6 @@
 #pragma once
+#include <functional>
+
 #include "api/Types.h"
 #include "renderer/frame/FrameResources.h"
 #include "renderer/frame/FrameView.h"
@@ -17,6 +19,8 @@ struct PassContext {
   FrameResources& resources;
   gl::ShaderLibrary& shaders;
   api::PassStats& stats;
+  // The pass's own progress in [0, 1] (optional to call; thread-safe; the Renderer maps it onto the frame).
+  std::function<void(double)> progress = [](double) {};
 };
 
 }  // namespace radiant

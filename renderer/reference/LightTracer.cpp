@@ -143,6 +143,7 @@ Image LightTracer::render(const Camera& camera, int width, int height, const Lig
       });
       for (std::uint64_t b = 0; b < count; ++b)  // block order: independent of the thread count
         for (std::size_t i = 0; i < sum.size(); ++i) sum[i] += wave[b][i];
+      if (options.progress) options.progress(static_cast<double>(first + count) / static_cast<double>(blocks));
     }
   };
   if (options.threads > 0) {

@@ -23,6 +23,7 @@
 // Deterministic and parallel: light path i uses Sampler(i, 0, seed); paths run in fixed blocks whose
 // images are summed in block order, so the result does not depend on the number of threads.
 #include <climits>
+#include <functional>
 #include <cstdint>
 #include <memory>
 
@@ -45,6 +46,7 @@ struct LightTracerOptions {
   glm::vec3 skyRadiance{0.f};
   const Image* environment = nullptr;
   int threads = 0;  // 0 = TBB default
+  std::function<void(double)> progress;  // fraction of paths traced, after each wave of blocks
 };
 
 class LightTracer {

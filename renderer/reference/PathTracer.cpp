@@ -264,6 +264,7 @@ Image PathTracer::render(const Camera& camera, int width, int height, const Refe
   Image image = Image::make(aov, width, height, 3);
   const int tilesX = (width + kTileSize - 1) / kTileSize, tilesY = (height + kTileSize - 1) / kTileSize;
   std::atomic<std::uint64_t> rays{0};
+  std::atomic<int> tilesDone{0};
   const Impl& impl = *impl_;
   const CameraRays cameraRays(camera, width, height);
 
@@ -296,6 +297,7 @@ Image PathTracer::render(const Camera& camera, int width, int height, const Refe
             out[1] = static_cast<float>(mean.y);
             out[2] = static_cast<float>(mean.z);
           }
+        if (options.progress) options.progress(static_cast<double>(++tilesDone) / (tilesX * tilesY));
       }
       rays += counter.rays;
     });

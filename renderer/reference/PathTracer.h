@@ -56,6 +56,7 @@
 // centre is -Z), v = acos(dir.y) / pi, nearest texel (piecewise constant, importance sampled exactly).
 // When ReferenceOptions::environment is set it replaces skyRadiance.
 #include <climits>
+#include <functional>
 #include <cstdint>
 #include <memory>
 
@@ -79,6 +80,8 @@ struct ReferenceOptions {
   glm::vec3 skyRadiance{0.f};          // uniform environment radiance
   const Image* environment = nullptr;  // equirect RGB(A) linear radiance, optional; overrides skyRadiance
   int threads = 0;                     // 0 = TBB default
+  // Called with the fraction of tiles done, from worker threads (keep it cheap and thread-safe).
+  std::function<void(double)> progress;
   // Drop exactly the caustic paths L S+ D E (the camera's first vertex scatters through a non-delta
   // lobe, every later vertex through a Dirac delta, then an emitter or the sky), which the light tracer
   // renders (renderer/reference/LightTracer.h): path tracer with this + light tracer's caustics = the

@@ -12,7 +12,8 @@
 namespace radiant {
 
 const Image& referenceImage(FrameResources& res, const Scene& scene, const FrameView& view,
-                            const ReferenceRequest& r, bool* cacheHit, std::uint64_t* rays, bool* lightTraced) {
+                            const ReferenceRequest& r, bool* cacheHit, std::uint64_t* rays, bool* lightTraced,
+                            const std::function<void(double)>& progress) {
   const rt::RayScene& rayScene = sharedRayScene(res, scene);
   const reference::PathTracer tracer(rayScene);
   reference::ReferenceOptions o;
@@ -36,6 +37,9 @@ const Image& referenceImage(FrameResources& res, const Scene& scene, const Frame
   const bool lightTrace = causticsOnly || (r.caustics && o.mode == reference::ReferenceOptions::Mode::Radiance &&
                                            o.maxPathBounce >= 2 && reference::sceneHasDeltaLobes(scene));
   reference::LightTracerOptions lo;
+  // Progress: the path tracer's tiles, then the light tracer's waves, in proportion to their samples.
+  const double ptShare = causticsOnly ? 0.0 : lightTrace ? 0.5 : 1.0;
+  if (progress) o.progress = [&progress, ptShare](double f) { progress(ptShare * f); };
   if (lightTrace) {
     o.excludeCaustics = true;
     lo.paths = reference::LightTracerOptions::Paths::Caustics;
@@ -47,6 +51,7 @@ const Image& referenceImage(FrameResources& res, const Scene& scene, const Frame
     lo.maxPathBounce = o.maxPathBounce;
     lo.skyRadiance = o.skyRadiance;
     lo.environment = o.environment;
+    if (progress) lo.progress = [&progress, ptShare](double f) { progress(ptShare + (1.0 - ptShare) * f); };
   }
   const glm::mat4& w = view.camera.world;
   nlohmann::json key = {{"scene", res.sceneKey()},
@@ -120,7 +125,8 @@ void ReferencePass::execute(PassContext& ctx) {
   bool hit = false;
   std::uint64_t rays = 0;
   bool lightTraced = false;
-  const Image& img = referenceImage(ctx.resources, ctx.scene, ctx.view, request_, &hit, &rays, &lightTraced);
+  const Image& img =
+      referenceImage(ctx.resources, ctx.scene, ctx.view, request_, &hit, &rays, &lightTraced, ctx.progress);
   // Upload as RGBA with GL's bottom-up rows so readback treats it like every other AOV.
   std::vector<float> rgba(static_cast<std::size_t>(img.width) * img.height * 4, 0.f);
   for (int y = 0; y < img.height; ++y)

@@ -30,7 +30,8 @@ struct ReferenceRequest {
 };
 const Image& referenceImage(FrameResources& resources, const Scene& scene, const FrameView& view,
                             const ReferenceRequest& request, bool* cacheHit = nullptr,
-                            std::uint64_t* rays = nullptr, bool* lightTraced = nullptr);
+                            std::uint64_t* rays = nullptr, bool* lightTraced = nullptr,
+                            const std::function<void(double)>& progress = {});
 
 class ReferencePass final : public Technique {
 public:

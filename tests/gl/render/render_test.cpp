@@ -1,7 +1,9 @@
 // Render-core tests on the real GL device (llvmpipe in CI). Every expected value is fixed by the
 // physics of the scene: glTF light units, the Lambertian BRDF, the KHR_lights_punctual falloffs.
+#include <algorithm>
 #include <cmath>
 #include <memory>
+#include <mutex>
 #include <set>
 #include <string>
 #include <vector>
@@ -374,6 +376,54 @@ TEST(ImageIO, PngQuantisationIsTheRoundedSrgbTransfer) {
       }
     }
   EXPECT_LE(mismatches, 2);
+}
+
+}  // namespace
+}  // namespace radiant
+
+namespace radiant {
+namespace {
+
+// Real progress: the frame's progress follows the passes and, inside the reference pass, its tiles;
+// it never decreases and ends at 1.
+TEST(RenderCore, ProgressFollowsPassesAndReferenceTiles) {
+  std::mutex m;
+  std::vector<double> seen;
+  FrameInputs in;
+  in.progress = [&](double f) {
+    std::lock_guard lock(m);
+    seen.push_back(f);
+  };
+  api::RenderRequest req = request(64, {"beauty", "reference"});
+  req.passes["reference"] = {{"spp", 4}};  // 64x64 = 16 tiles of 16x16
+  renderer().render(umbraScene(1.f, "progress"), req, nullptr, in);
+  ASSERT_FALSE(seen.empty());
+  for (std::size_t i = 1; i < seen.size(); ++i) EXPECT_GE(seen[i], seen[i - 1]) << i;
+  EXPECT_EQ(seen.back(), 1.0);
+  // The reference pass alone reports 16 tile fractions: many distinct values inside (0, 0.95).
+  std::set<double> inner;
+  for (double v : seen)
+    if (v > 0.0 && v < 0.95) inner.insert(v);
+  EXPECT_GE(inner.size(), 12u);
+}
+
+// A frame no light reaches is flagged, with the cause; a lit one is not.
+TEST(RenderCore, BlackFrameIsWarnedWithItsCause) {
+  SceneBuilder b = planeScene(1.f);
+  api::RenderRequest req = request(16);
+  req.defaultLighting = false;
+  RenderOutput dark = renderer().render(b.build("unlit-plane"), req);
+  ASSERT_EQ(dark.stats.lighting, "none");
+  const auto hasBlack = [](const RenderOutput& o) {
+    return std::any_of(o.stats.warnings.begin(), o.stats.warnings.end(),
+                       [](const std::string& w) { return w.rfind("black frame", 0) == 0; });
+  };
+  EXPECT_TRUE(hasBlack(dark));
+  bool named = false;
+  for (const auto& w : dark.stats.warnings) named = named || w.find("no lights") != std::string::npos;
+  EXPECT_TRUE(named);
+  RenderOutput lit = renderer().render(umbraScene(1.f, "umbra-lit"), request(16));
+  EXPECT_FALSE(hasBlack(lit));
 }
 
 }  // namespace

@@ -256,6 +256,15 @@ TEST_F(Content, ClientLightingCameraAndRequestOptions) {
     auto [f, all] = run("dark", "--size 32x32 --no-default-lighting");
     EXPECT_EQ(f.stats["lighting"], "none");
     EXPECT_EQ(objectMean(f).first, 0.0);
+    // A frame no light reaches is not a silent success: the stats and the client say why.
+    bool warned = false;
+    for (const auto& w : f.stats["warnings"]) warned = warned || w.get<std::string>().rfind("black frame", 0) == 0;
+    EXPECT_TRUE(warned) << f.stats.dump();
+    const ProcessRun r = client(daemon_->url(), "render '" + box.string() + "' -o '" + (*dir_ / "dark.png").string() +
+                                                    "' --size 16x16 --no-default-lighting", *dir_);
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("warning: black frame"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("no lights"), std::string::npos) << r.err;
   }
   {
     // --request: a whole request from a file, with -o's outputs and the camera option on top.

@@ -55,8 +55,9 @@ public:
     return d;
   }
   RenderOutput render(const Scene& scene, const api::RenderRequest& r, const std::atomic<bool>* cancel,
-                      const FrameInputs& /*inputs*/) override {
+                      const FrameInputs& inputs) override {
     ++c_.started;
+    if (inputs.progress) inputs.progress(0.5);  // half the frame, then wait at the gate
     {
       std::unique_lock l(c_.m);
       while (!c_.gateOpen && !(cancel && *cancel)) c_.cv.wait_for(l, std::chrono::milliseconds(5));

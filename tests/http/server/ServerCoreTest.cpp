@@ -305,6 +305,33 @@ TEST(ServerCore, EightConcurrentClientsGetTheirOwnFrames) {
   EXPECT_EQ(s.control.finished, 8);
 }
 
+TEST(ServerCore, AsyncProgressFollowsTheRenderer) {
+  // The fake renderer reports half its frame done, then waits: the job shows 0.05 + 0.85 x 0.5.
+  TestServer s;
+  s.waitReady();
+  s.control.close();
+  auto c = s.client();
+  json b = renderBody(6);
+  b["async"] = true;
+  auto r = post(c, "/v1/renders", b);
+  ASSERT_EQ(r->status, 202);
+  const std::string location = r->get_header_value("Location");
+  json state;
+  for (int i = 0; i < 500; ++i) {
+    state = body(c.Get(location.c_str()));
+    if (state["state"] == "running" && state["progress"].get<double>() > 0.05) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  EXPECT_EQ(state["phase"], "rendering");
+  EXPECT_NEAR(state["progress"].get<double>(), 0.475, 1e-9);
+  s.control.open();
+  for (int i = 0; i < 500 && state["state"] != "done"; ++i) {
+    state = body(c.Get(location.c_str()));
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  EXPECT_EQ(state["progress"], 1.0);
+}
+
 TEST(ServerCore, AsyncRenderPollsToDone) {
   TestServer s;
   s.waitReady();
