@@ -20,6 +20,7 @@ int cmdScenes(const GlobalOptions& g, const std::vector<std::string>& args);
 int cmdSweep(const GlobalOptions& g, const std::vector<std::string>& args);
 int cmdReport(const GlobalOptions& g, const std::vector<std::string>& args);
 int cmdBench(const GlobalOptions& g, const std::vector<std::string>& args);
+int cmdCompare(const GlobalOptions& g, const std::vector<std::string>& args);  // no server needed
 
 // Helpers shared by commands.
 std::string readFile(const std::string& path);            // throws UsageError

@@ -19,6 +19,7 @@ commands:
   sweep    run a parameter sweep spec into a JSON Lines results file (radiant sweep --help)
   report   HTML + Markdown report of sweep results (radiant report --help)
   bench    the standard benchmark suite, or --service for the service's own overhead (radiant bench --help)
+  compare  metrics and a false-colour error image of two images from anywhere (radiant compare --help)
 The server is --server, else $RADIANT_SERVER, else http://127.0.0.1:8080. A bearer token is read from
 --token-file or $RADIANT_TOKEN_FILE.
 exit codes: 0 ok, 2 usage, 3 error reported by the server, 4 server unreachable, 130 interrupted
@@ -40,7 +41,7 @@ void printProblem(const ServerError& e) {
 int main(int argc, char** argv) {
   const std::map<std::string, std::function<int(const GlobalOptions&, const std::vector<std::string>&)>> commands{
       {"render", cmdRender}, {"info", cmdInfo}, {"scenes", cmdScenes},
-      {"sweep", cmdSweep},   {"report", cmdReport}, {"bench", cmdBench}};
+      {"sweep", cmdSweep},   {"report", cmdReport}, {"bench", cmdBench}, {"compare", cmdCompare}};
   GlobalOptions g;
   const char* env = std::getenv("RADIANT_SERVER");
   g.server = env && *env ? env : "http://127.0.0.1:8080";

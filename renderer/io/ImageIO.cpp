@@ -143,12 +143,48 @@ Image readFrom(OIIO::ImageInput* in, const std::string& what, const std::string&
                               " with " + std::to_string(spec.nchannels) + " channels: decoding needs " +
                               std::to_string(need) + " bytes, above this server's decode budget of " +
                               std::to_string(maxDecodedBytes) + " bytes (radiantd --max-decode-bytes)");
-  Image img = Image::make(aov, spec.width, spec.height, spec.nchannels >= 3 ? 3 : 1);
+  // Which channels: the layer `aov` by name (aov.R/G/B, or aov.Y); for "beauty" also unprefixed R/G/B
+  // (or Y), a file's only layer, and at last the first three channels or the first one. EXR stores channels
+  // in alphabetical order (B before G before R), so names, not positions, decide.
+  auto find = [&](const std::string& name) {
+    for (int c = 0; c < spec.nchannels; ++c)
+      if (c < static_cast<int>(spec.channelnames.size()) && spec.channelnames[c] == name) return c;
+    return -1;
+  };
+  std::vector<int> pick;
+  // Unprefixed channels are the beauty (encodeExr writes it so, and PNG/HDR have nothing else).
+  for (const std::string& prefix : aov == "beauty" ? std::vector<std::string>{"beauty.", ""} : std::vector<std::string>{aov + "."}) {
+    const int r = find(prefix + "R"), g = find(prefix + "G"), b = find(prefix + "B"), yy = find(prefix + "Y");
+    if (r >= 0 && g >= 0 && b >= 0) pick = {r, g, b};
+    else if (yy >= 0) pick = {yy};
+    if (!pick.empty()) break;
+  }
+  std::vector<std::string> layers;  // the prefixes of the file's layered channels
+  for (const auto& n : spec.channelnames)
+    if (const auto dot = n.rfind('.'); dot != std::string::npos &&
+        std::find(layers.begin(), layers.end(), n.substr(0, dot)) == layers.end())
+      layers.push_back(n.substr(0, dot));
+  if (pick.empty() && layers.size() == 1 && aov == "beauty") {  // one layer, whatever its name
+    const std::string& l = layers[0];
+    const int r = find(l + ".R"), g = find(l + ".G"), b = find(l + ".B"), yy = find(l + ".Y");
+    if (r >= 0 && g >= 0 && b >= 0) pick = {r, g, b};
+    else if (yy >= 0) pick = {yy};
+  }
+  if (pick.empty()) {
+    const bool layered = !layers.empty();
+    if (layered && aov != "beauty") {
+      std::string names;
+      for (const auto& n : spec.channelnames) names += (names.empty() ? "" : ", ") + n;
+      throw std::runtime_error("io: " + what + " has no layer '" + aov + "' (channels: " + names + ")");
+    }
+    pick = spec.nchannels >= 3 ? std::vector<int>{0, 1, 2} : std::vector<int>{0};
+  }
+  Image img = Image::make(aov, spec.width, spec.height, static_cast<int>(pick.size()));
   std::vector<float> all(static_cast<std::size_t>(spec.width) * spec.height * spec.nchannels);
   if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()))
     throw std::runtime_error("io: read " + what + ": " + in->geterror());
   for (std::size_t p = 0; p < static_cast<std::size_t>(spec.width) * spec.height; ++p)
-    for (int c = 0; c < img.channels; ++c) img.pixels[p * img.channels + c] = all[p * spec.nchannels + c];
+    for (int c = 0; c < img.channels; ++c) img.pixels[p * img.channels + c] = all[p * spec.nchannels + pick[c]];
   return img;
 }
 

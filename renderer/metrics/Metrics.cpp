@@ -134,6 +134,30 @@ ImageMetrics compareImages(const Image& test, const Image& reference, float expo
   return m;
 }
 
+Image falseColour(const Image& error, double maxError, double* usedMax) {
+  static constexpr float kViridis[5][3] = {{0.267f, 0.005f, 0.329f}, {0.229f, 0.322f, 0.546f},
+                                           {0.128f, 0.567f, 0.551f}, {0.369f, 0.789f, 0.383f},
+                                           {0.993f, 0.906f, 0.144f}};
+  if (!(maxError > 0.0) || !std::isfinite(maxError)) {
+    maxError = 0.0;
+    for (std::size_t i = 0; i < error.pixels.size(); i += std::max(1, error.channels))
+      if (std::isfinite(error.pixels[i])) maxError = std::max(maxError, static_cast<double>(error.pixels[i]));
+  }
+  if (usedMax) *usedMax = maxError;
+  Image out = Image::make("error_colour", error.width, error.height, 3);
+  for (int y = 0; y < error.height; ++y)
+    for (int x = 0; x < error.width; ++x) {
+      const double e = error.at(x, y)[0];
+      const double t = maxError > 0.0 && std::isfinite(e) ? std::clamp(e / maxError, 0.0, 1.0) : (std::isfinite(e) ? 0.0 : 1.0);
+      const double s = t * 4.0;
+      const int i = std::min(3, static_cast<int>(s));
+      const float f = static_cast<float>(s - i);
+      float* o = out.at(x, y);
+      for (int c = 0; c < 3; ++c) o[c] = kViridis[i][c] + f * (kViridis[i + 1][c] - kViridis[i][c]);
+    }
+  return out;
+}
+
 Image errorMap(const Image& test, const Image& reference) {
   checkCompatible(test, reference, "errorMap()");
   Image out = Image::make("error", test.width, test.height, 1);

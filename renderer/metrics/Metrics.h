@@ -44,6 +44,12 @@ ImageMetrics compareImages(const Image& test, const Image& reference, float expo
 // one channel, aov "error". Same argument checks as compareImages.
 Image errorMap(const Image& test, const Image& reference);
 
+// A false-colour picture of a one-channel error image: viridis (matplotlib's perceptually uniform map,
+// five stops interpolated linearly in display sRGB) of clamp(error / maxError, 0, 1); RGB values are
+// display-referred sRGB in [0, 1] (decode them before writing a linear image). maxError <= 0 or
+// non-finite picks the image's largest finite error (all black-purple when that is 0).
+Image falseColour(const Image& error, double maxError = 0.0, double* usedMax = nullptr);
+
 // The tone map used by psnr and ssim: sRGB transfer (IEC 61966-2-1) of clamp(v * 2^exposureEV, 0, 1).
 double toneMap(double linear, float exposureEV);
 
