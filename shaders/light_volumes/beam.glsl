@@ -41,6 +41,18 @@ struct BeamCone {
   vec4 axisSlope;     // xyz unit mean direction N, w radius slope per unit s
 };
 
+// The culled traversal (renderer/techniques/light_volumes/BeamBvh.h): a BVH over segments of the
+// beams' cones, one BVH per group of beams. A node's box holds its subtree; meta.x is the index of
+// its second child (the first is the next node) or -1 for a leaf, whose primitives are
+// [meta.y, meta.y + meta.z). A primitive is the part s0 <= s < s1 of one beam's cone: x s0, y s1,
+// z the beam index (exact in float below 2^24), w unused; a fragment is gathered from the beam by the
+// one segment whose s-range holds it, so no beam counts twice.
+struct BeamBvhNode {
+  vec4 lo;
+  vec4 hi;
+  ivec4 meta;
+};
+
 // The normalised 2-D Gaussian over the angular deviation x (rad): exp(-|x|^2 / 2 sigma^2) / (2 pi sigma^2).
 LV_FN float lvGaussian(vec2 x, float sigma) {
   float s2 = sigma * sigma;

@@ -17,6 +17,7 @@ namespace glsl {
 using glm::vec2;
 using glm::vec3;
 using glm::vec4;
+using glm::ivec4;
 using glm::abs;
 using glm::atan;
 using glm::clamp;
@@ -34,6 +35,8 @@ using Beam = glsl::Beam;
 using BeamCone = glsl::BeamCone;
 static_assert(sizeof(Beam) == 128, "std430 Beam is 8 x vec4");
 static_assert(sizeof(BeamCone) == 32, "std430 BeamCone is 2 x vec4");
+using BeamBvhNode = glsl::BeamBvhNode;
+static_assert(sizeof(BeamBvhNode) == 48, "std430 BeamBvhNode is 3 x vec4");
 
 enum class Split { Paper = glsl::kLvSplitPaper, TwoD = glsl::kLvSplit2d };
 
