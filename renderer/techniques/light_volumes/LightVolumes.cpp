@@ -47,7 +47,10 @@ const TechniqueInfo& LightVolumesPass::info() const {
                                {"direct"},  // runs after direct, which initialises beauty
                                {"light_volumes"},
                                true,
-                               true,
+                               // Not on by default: on coarse glossy meshes (the Glosbox's block) the
+                               // tessellation fallback gives sharp specular beams where photon_gi,
+                               // which owns LG+DE paths otherwise, gets the blur right.
+                               false,
                                {"LS+DE", "LG+DE"},
                                true};
   return i;
