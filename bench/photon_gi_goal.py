@@ -3,7 +3,8 @@
 machine: on the built-in Cornell box at SIZE x SIZE, how long does the default GI take to reach the RMSE
 of the reference path tracer at 256 spp, with photons cached and the camera changed?
 
-    bench/photon_gi_goal.py [--server URL] [--size 256] [--truth-spp 2048] [--truth FILE.exr] [--scene cornell_box]
+    bench/photon_gi_goal.py [--server URL] [--size 256] [--truth-spp 2048] [--truth FILE.exr] [--save-truth FILE.exr]
+                            [--scene cornell_box] [--quick]
 
 Start radiantd with a long --request-timeout (the ground truth takes minutes on a CPU); --truth reuses
 a ground-truth EXR rendered before (the reference's `reference` AOV of the same scene, size and camera).
@@ -13,7 +14,8 @@ Steps (every image scored against the same converged ground truth, uploaded as a
   2. the reference at 256 spp (seed 5): its render time and RMSE;
   3. photon_gi with default settings: one render from another camera (traces the photons), then the
      measured render from the scene camera (photons cached, camera changed): time and RMSE;
-  4. the same at a few cheaper and dearer settings, to show where the RMSE of step 2 is reached.
+  4. the default with gather_step 1 and 3;
+  5. unless --quick, the same at a few cheaper and dearer settings, to show where the RMSE of step 2 is reached.
 Prints a Markdown table for docs/PERFORMANCE.md. Python standard library only.
 """
 import argparse
@@ -50,6 +52,8 @@ def main():
     ap.add_argument("--truth-spp", type=int, default=2048)
     ap.add_argument("--scene", default="cornell_box")
     ap.add_argument("--truth", help="a ground-truth EXR to reuse instead of rendering one")
+    ap.add_argument("--save-truth", help="write the ground-truth EXR here (to reuse with --truth)")
+    ap.add_argument("--quick", action="store_true", help="only the default and its gather_step variants")
     a = ap.parse_args()
     S = a.server
     info = call(S, "/v1/info")
@@ -64,6 +68,9 @@ def main():
         truth, ms = render(S, dict(base, seed=99, passes={"reference": {"spp": a.truth_spp}, "photon_gi": False},
                                    outputs=[{"format": "exr", "half": False, "aovs": ["reference"]}]))
         exr = call(S, truth["frames"][0]["url"], ctype="image/x-exr")
+        if a.save_truth:
+            with open(a.save_truth, "wb") as f:
+                f.write(exr)
     digest = call(S, "/v1/images", exr, method="PUT", ctype="image/x-exr")
     digest = json.loads(digest)["digest"] if isinstance(digest, bytes) else digest["digest"]
     print(f"ground truth: reference {a.truth_spp} spp, {ms / 1000:.1f} s", file=sys.stderr)
@@ -77,8 +84,9 @@ def main():
     rows.append(("reference, 256 spp", ref_ms, ref["stats"]["render_ms"], ref_rmse, ref["stats"]["metrics"]["rel_mse"]))
 
     other_camera = {"position": [0.25, 0.55, 1.7], "target": [0.0, 0.45, 0.0], "up": [0, 1, 0], "yfov_deg": 42}
-    settings = [("photon_gi default", {})]
-    for method in ("splat", "gather"):
+    settings = [("photon_gi default (gather_step 2)", {}), ("photon_gi gather_step 1", {"gather_step": 1}),
+                ("photon_gi gather_step 3", {"gather_step": 3})]
+    for method in () if a.quick else ("splat", "gather"):
         for C in (5, 10, 20):
             for photons in (250000, 1000000):
                 settings.append((f"photon_gi {method}, C {C}, {photons // 1000}k photons",

@@ -9,6 +9,7 @@ packages=(
   libopenimageio-dev openimageio-tools libembree-dev libtbb-dev libdraco-dev libmeshoptimizer-dev
   libegl-dev libegl-mesa0 libgl1-mesa-dri libgbm1 mesa-utils
   libgtest-dev libgmock-dev googletest libbenchmark-dev
+  clang libclang-rt-14-dev  # the libFuzzer harnesses (scripts/fuzz.sh); the runtime is only recommended by clang
   curl gnuplot-nox
 )
 
