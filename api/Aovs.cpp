@@ -24,6 +24,10 @@ const std::vector<AovInfo>& aovTable() {
         // seen through specular surfaces only (needs a per-pixel mask: Technique::groundTruth, #20).
         {0, "specular", F::Rgba32F, "specular", 0, 3, {"specular.R", "specular.G", "specular.B"}, B::Overwrite,
          "specular", true, ""},
+        // light_volumes: first-order light through specular and glossy scatterers (LS+DE, LG+DE) from
+        // punctual lights; added to beauty.
+        {0, "light_volumes", F::Rgba32F, "light_volumes", 0, 3,
+         {"light_volumes.R", "light_volumes.G", "light_volumes.B"}, B::Overwrite, "light_volumes", true, ""},
         {0, "ao", F::R32F, "ao", 0, 1, {"ao.Y"}, B::Overwrite, "ambient_occlusion", true, "ao"},
         {0, "depth", F::Rgba32F, "gbuffer_position", 3, 1, {"depth.Z"}, B::Overwrite, "gbuffer", true, ""},
         {0, "gbuffer_position", F::Rgba32F, "gbuffer_position", 0, 3,

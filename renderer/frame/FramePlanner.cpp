@@ -105,7 +105,12 @@ FramePlan planFrame(const std::vector<Technique*>& techniques, const Scene& scen
   }
   for (Technique* t : techniques)
     if (keep.count(t)) plan.passes.push_back(t);
-  // Every light path is counted once: each class goes to the first planned technique claiming it.
+  // Every light path is counted once: each class goes to the first planned technique claiming it, in
+  // registry order, except that a technique with claimsWhenNamed takes its classes first when the
+  // request names it.
+  for (Technique* t : plan.passes)
+    if (t->info().claimsWhenNamed && request.passes.count(t->info().name))
+      for (const auto& cls : t->info().lightPaths) plan.lightPaths.emplace(cls, t->info().name);
   for (Technique* t : plan.passes)
     for (const auto& cls : t->info().lightPaths) plan.lightPaths.emplace(cls, t->info().name);
   return plan;

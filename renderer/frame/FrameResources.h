@@ -52,6 +52,11 @@ public:
     auto it = lightPaths_.find(cls);
     return it != lightPaths_.end() && it->second == technique;
   }
+  // The technique that owns `cls` this frame ("" when none claims it).
+  std::string lightPathOwner(const std::string& cls) const {
+    auto it = lightPaths_.find(cls);
+    return it == lightPaths_.end() ? std::string() : it->second;
+  }
 
   // Outputs written this frame (the planner and readback consult it).
   void markWritten(const std::string& name) {

@@ -28,6 +28,9 @@ struct TechniqueInfo {
   // "LD+DE". The planner gives each class to the first planned technique that claims it, in
   // registry order; a technique adds a class to beauty only when it owns it (FrameResources).
   std::vector<std::string> lightPaths = {};
+  // When the request names this technique, it owns its classes ahead of registry order (a request
+  // that asks for light_volumes gets them even when caustics, earlier in the registry, also runs).
+  bool claimsWhenNamed = false;
 };
 
 // Run or skip, and the reason if skipped. The planner records the reason in the frame stats.

@@ -25,6 +25,7 @@ void tracePhoton(const RayScene& rays, const SceneLights& lights, const PhotonOp
   glm::vec3 flux = e.flux;
   Ray ray = e.ray;
   const int lastBounce = o.maxBounces - 1;
+  bool narrowLobePath = true;  // every scattering so far off a metal or glass by a non-diffuse lobe
   for (int bounce = 0; bounce <= lastBounce; ++bounce) {
     SurfaceHit hit;
     if (!rays.intersect(ray, hit, sampler, counter)) return;
@@ -41,7 +42,8 @@ void tracePhoton(const RayScene& rays, const SceneLights& lights, const PhotonOp
       r.normal = sh.ngFacing;
       r.photon = static_cast<std::uint32_t>(index);
       r.wi = wo;
-      r.bounce = static_cast<std::uint32_t>(bounce);
+      r.bounce = static_cast<std::uint16_t>(bounce);
+      r.narrowLobePath = bounce >= 1 && narrowLobePath ? 1 : 0;
       r.flux = flux;
       r.light = static_cast<std::uint32_t>(e.light);
       out.push_back(r);
@@ -51,6 +53,8 @@ void tracePhoton(const RayScene& rays, const SceneLights& lights, const PhotonOp
     const glm::vec2 uDir = sampler.next2();
     GltfBsdf::Sample s;
     if (!sh.bsdf.sample(woL, uLobe, uFresnel, uDir, s) || s.delta) return;
+    narrowLobePath = narrowLobePath && (s.flags & (kLobeGlossy | kLobeSpecular)) != 0 &&
+                     rays.materialOf(hit.mesh).scattersNarrowLobe();
     const glm::vec3 wi = sh.frame.toWorld(s.wi);
     const float gi = glm::dot(wi, sh.ngFacing);
     if (s.wi.z > 0.f ? gi <= 0.f : gi >= 0.f) return;  // leaked through the geometric surface

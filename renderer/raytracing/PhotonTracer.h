@@ -28,7 +28,11 @@ struct PhotonRecord {
   glm::vec3 normal{0.f};        // unit geometric normal on the side the photon arrived from
   std::uint32_t photon = 0;     // index of the emitted photon; records are sorted by it
   glm::vec3 wi{0.f};            // unit direction towards where the photon came from
-  std::uint32_t bounce = 0;     // scattering events before this hit (0 = straight from the emitter)
+  std::uint16_t bounce = 0;     // scattering events before this hit (0 = straight from the emitter)
+  // 1 when every scattering event before this hit was a glossy or specular lobe of a metal or glass
+  // (Material::scattersNarrowLobe()) and bounce >= 1: the path so far is L(S|G)+, which light_volumes
+  // supplies (classes LS+DE, LG+DE) when it owns them.
+  std::uint16_t narrowLobePath = 0;
   glm::vec3 flux{0.f};          // Phi_total * rho_j (W); divide by the photons used
   std::uint32_t light = 0;      // index into SceneLights::emitters()
 };

@@ -86,6 +86,16 @@ struct Material {
     if (unlit) return false;
     return (metallicFactor > 0.5f && roughnessFactor < kSpecularRoughness) || isTransmissive();
   }
+  // Up to this roughness a metal's or glass's lobe is narrow enough to be traced as a beam.
+  static constexpr float kNarrowLobeRoughness = 0.5f;
+  // Metal or glass whose reflection or refraction is a Dirac or narrow glossy lobe: the S or G vertex
+  // of the light-path classes LS+DE and LG+DE. light_volumes builds beams from these surfaces and
+  // photon_gi leaves the paths scattered by them to it when it owns those classes (docs/TECHNIQUES.md).
+  // Factors only: a metallic-roughness texture does not change the classification.
+  bool scattersNarrowLobe() const {
+    if (unlit) return false;
+    return (metallicFactor >= 0.5f || isTransmissive()) && roughnessFactor <= kNarrowLobeRoughness;
+  }
 };
 
 // One glTF primitive instanced by one node, flattened to world space. Always an indexed triangle list.

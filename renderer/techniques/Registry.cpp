@@ -4,6 +4,7 @@
 #include "renderer/techniques/direct/Direct.h"
 #include "renderer/techniques/env_diffuse/EnvDiffuse.h"
 #include "renderer/techniques/gbuffer/GBuffer.h"
+#include "renderer/techniques/light_volumes/LightVolumes.h"
 #include "renderer/techniques/photon_gi/PhotonGi.h"
 #include "renderer/techniques/reference/ReferencePass.h"
 #include "renderer/techniques/shadow_maps/ShadowMaps.h"
@@ -18,6 +19,9 @@ std::vector<std::unique_ptr<Technique>> createTechniques() {
   t.push_back(std::make_unique<DirectPass>());
   t.push_back(std::make_unique<EnvDiffusePass>());
   t.push_back(std::make_unique<PhotonGiPass>());
+  // Claims LS+DE and LG+DE: a caustics technique that also claims them goes before it (so that it owns
+  // them by default), and the planner gives them to light_volumes when the request names it.
+  t.push_back(std::make_unique<LightVolumesPass>());
   t.push_back(std::make_unique<SpecularPass>());
   t.push_back(std::make_unique<AmbientOcclusionPass>());
   t.push_back(std::make_unique<ReferencePass>());

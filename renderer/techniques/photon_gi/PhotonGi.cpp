@@ -122,8 +122,13 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   // `direct`, which comes first in the registry: then sky photons at their first hit are splatted with
   // the diffuse lobe only.
   const bool ownsSkyGlossy = res.ownsLightPath("photon_gi", "L(sky)GE");
+  // Light from a punctual light through metal or glass only (L(S|G)+) onto a diffuse surface is
+  // LS+DE / LG+DE: when another technique owns those classes (light_volumes), such photons are not
+  // splatted on surfaces that are not themselves metal or glass (docs/TECHNIQUES.md).
+  const std::string narrowOwner = res.lightPathOwner("LG+DE");
+  const bool leaveNarrowLobePaths = !narrowOwner.empty() && narrowOwner != "photon_gi";
   const nlohmann::json splatKey = {{"photons", photonKey}, {"count", s.photons}, {"C", s.C}, {"sky", ownsSky},
-                                   {"sky_glossy", ownsSkyGlossy},
+                                   {"sky_glossy", ownsSkyGlossy}, {"leave_narrow_lobe_paths", leaveNarrowLobePaths},
                                    {"ppm", s.ppm}, {"alpha", s.ppmAlpha}, {"base", s.ppmBase},
                                    {"renormalize", splat_.renormalize}};
   upload_ = false;
@@ -137,6 +142,10 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
     // pass computes, and the sky's direct light when this pass owns it (the planner gives it to
     // photon_gi ahead of ambient_occlusion, whose visibility ends at its radius).
     auto splatted = [&](const rt::PhotonRecord& r) {
+      if (r.bounce >= 1 && r.narrowLobePath && leaveNarrowLobePaths &&
+          lights.emitters()[r.light].kind == rt::SceneLights::Kind::Punctual &&
+          !rays.materialOf(r.mesh).scattersNarrowLobe())
+        return false;
       if (r.bounce >= 1) return true;
       const auto kind = lights.emitters()[r.light].kind;
       return kind == rt::SceneLights::Kind::Triangle || (kind == rt::SceneLights::Kind::Environment && ownsSky);

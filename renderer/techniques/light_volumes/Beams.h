@@ -1,0 +1,100 @@
+#pragma once
+// Light volumes, the CPU side: beam set-up from every scatterer triangle facing a punctual light
+// (Duvenhage et al. §3.1, §4.3), the beams' culling bounds, and a CPU reading of the per-fragment
+// gathering (the same code as the shader: shaders/light_volumes/beam.glsl) for the tests.
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "renderer/scene/Scene.h"
+
+namespace radiant::light_volumes {
+
+namespace glsl {
+using glm::vec2;
+using glm::vec3;
+using glm::vec4;
+using glm::ivec4;
+using glm::abs;
+using glm::atan;
+using glm::clamp;
+using glm::cross;
+using glm::dot;
+using glm::exp;
+using glm::length;
+using glm::max;
+using glm::min;
+using glm::normalize;
+#include "shaders/light_volumes/beam.glsl"
+}  // namespace glsl
+
+using Beam = glsl::Beam;
+using BeamCone = glsl::BeamCone;
+static_assert(sizeof(Beam) == 128, "std430 Beam is 8 x vec4");
+static_assert(sizeof(BeamCone) == 32, "std430 BeamCone is 2 x vec4");
+using BeamBvhNode = glsl::BeamBvhNode;
+static_assert(sizeof(BeamBvhNode) == 48, "std430 BeamBvhNode is 3 x vec4");
+
+enum class Split { Paper = glsl::kLvSplitPaper, TwoD = glsl::kLvSplit2d };
+
+struct BeamOptions {
+  float sigmaScale = 1.1f;        // sigma = sigmaScale * alpha * sqrt(cos theta_i), alpha = roughness^2 (notes A8)
+  bool negativeBeams = false;     // build a shadow beam of -Phi per scatterer triangle (§3.1)
+  float maxConcentration = 1e4f;  // irradiance clamp: Phi / A_perp <= maxConcentration * Phi / A_0
+  float maxTriangleSigma = 0.5f;  // tessellation condition: triangle edge / receiver distance <= this * sigma
+  bool specularFallback = true;   // a scatterer failing the condition gets specular beams
+  float cullSigmas = 4.f;         // glossy culling bounds are padded by this many sigma
+};
+
+// Distance from `origin` along the unit `dir` to the first receiver (negative: none). The technique
+// traces it with Embree; tests may pass none (the tessellation condition is then not checked).
+using ReceiverDistance = std::function<float(const glm::vec3& origin, const glm::vec3& dir)>;
+
+struct BeamSet {
+  std::vector<Beam> beams;
+  std::vector<BeamCone> cones;  // one per beam
+  std::size_t scattered = 0, shadow = 0, glossy = 0;
+  std::size_t backfacing = 0;   // triangles facing away from a light (not scattering)
+  std::size_t tirDropped = 0;   // refracted beams dropped for total internal reflection at a vertex
+  std::size_t degenerate = 0;   // zero-area triangles or zero solid angle
+  // The tessellation condition (notes A5: a glossy beam conserves energy when its triangle subtends
+  // at most about sigma / 2 from the receiver): glossy beams checked, those that fail it, the worst
+  // (edge / distance) / sigma, and the scatterers (mesh x light) that fell back to specular beams.
+  std::size_t tessellationChecked = 0, tessellationFailed = 0, specularFallbacks = 0;
+  float worstTriangleSigma = 0.f;
+  glm::dvec3 flux{0.0};  // sum of the scattered beams' flux (W)
+};
+
+// Van Oosterom & Strackee 1983: the solid angle of the triangle (a, b, c) seen from the origin,
+// tan(Omega / 2) = |a.(b x c)| / (|a||b||c| + (a.b)|c| + (a.c)|b| + (b.c)|a|).
+float solidAngle(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c);
+
+// The Gaussian's sigma (rad, scattered-angle standard deviation) for glTF roughness at incidence
+// cos theta_i (notes A8): sigma = scale * alpha * sqrt(cos theta_i), alpha = roughness^2; 0 for
+// roughness 0 (a Dirac lobe).
+float sigmaFromRoughness(float roughness, float cosIncidence, float scale);
+
+// Beams of every scatterer (Material::scattersNarrowLobe()) for every light of the scene.
+BeamSet buildBeams(const Scene& scene, const BeamOptions& options, const ReceiverDistance& receiverDistance = {});
+
+// One beam from a triangle and a light, for tests and for buildBeams: the scattered beam (reflected
+// or, when `refract`, refracted with the material's ior) and optionally the shadow beam. Appends to
+// `out`; returns false when the triangle does not scatter (back-facing, degenerate, TIR).
+struct TriangleInput {
+  glm::vec3 p[3];
+  glm::vec3 n[3];
+  Material material;
+  bool refract = false;
+};
+bool appendTriangleBeams(const Light& light, const TriangleInput& t, const BeamOptions& options, BeamSet& out);
+
+// The culling bound of a beam (see BeamCone), padded by cullSigmas * sigma for glossy beams.
+BeamCone beamCone(const Beam& beam, float cullSigmas);
+
+// The irradiance at F (receiver normal n) summed over every beam: the shader's gathering, on the CPU.
+glm::vec3 gatherIrradiance(const std::vector<Beam>& beams, const glm::vec3& F, const glm::vec3& n, Split split);
+
+}  // namespace radiant::light_volumes

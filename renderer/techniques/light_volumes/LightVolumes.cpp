@@ -1,0 +1,209 @@
+#include "renderer/techniques/light_volumes/LightVolumes.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include <glm/gtc/type_ptr.hpp>
+#include <nlohmann/json.hpp>
+
+#include "renderer/frame/PassContext.h"
+#include "renderer/frame/RayScenes.h"
+
+namespace radiant {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+// Beams per dispatch of the linear traversal (llvmpipe's loop limit is 65535 iterations).
+constexpr int kLinearSlice = 16384;
+constexpr GLuint kBindingBeams = 8, kBindingCones = 9, kBindingNodes = 10, kBindingPrims = 11;
+
+bool hasScatterer(const Scene& scene) {
+  for (const MeshInstance& m : scene.meshes)
+    if (scene.material(m.material).scattersNarrowLobe() && m.triangleCount() > 0) return true;
+  return false;
+}
+
+nlohmann::json lightsKey(const Scene& scene) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const Light& l : scene.lights)
+    j.push_back({static_cast<int>(l.type), l.position.x, l.position.y, l.position.z, l.direction.x, l.direction.y,
+                 l.direction.z, l.color.x, l.color.y, l.color.z, l.intensity, l.range, l.innerConeAngle,
+                 l.outerConeAngle});
+  return j;
+}
+
+template <class T>
+std::size_t bytesOf(const std::vector<T>& v) { return std::max<std::size_t>(1, v.size()) * sizeof(T); }
+
+}  // namespace
+
+const TechniqueInfo& LightVolumesPass::info() const {
+  static const TechniqueInfo i{"light_volumes",
+                               "Glossy light volumes (Duvenhage et al.): backward polygon beams from specular and "
+                               "glossy scatterers to diffuse receivers (LS+DE, LG+DE, first order)",
+                               {"gbuffer_position", "normal", "albedo", "material", "emission"},
+                               {"direct"},  // runs after direct, which initialises beauty
+                               {"light_volumes"},
+                               true,
+                               // Not on by default: on coarse glossy meshes (the Glosbox's block) the
+                               // tessellation fallback gives sharp specular beams where photon_gi,
+                               // which owns LG+DE paths otherwise, gets the blur right.
+                               false,
+                               {"LS+DE", "LG+DE"},
+                               true};
+  return i;
+}
+
+Requirements LightVolumesPass::requirements(const Scene& scene, const api::RenderRequest&) const {
+  if (scene.lights.empty()) return Requirements::skip("the scene has no point, spot or directional light");
+  if (!hasScatterer(scene))
+    return Requirements::skip("no specular or glossy scatterer (metal or glass with roughness <= 0.5)");
+  return Requirements::ok();
+}
+
+void LightVolumesPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
+  light_volumes::BeamOptions o;
+  o.sigmaScale = params.get<float>("sigma_scale", 1.1f);
+  o.negativeBeams = params.get<std::string>("shadows", "shadow_map") == "negative_beams";
+  // Negative beams need the scatterers removed as shadow-map casters, or their shadows double (notes
+  // A7); the shadow maps cannot exclude meshes yet, so the GPU path refuses rather than double them.
+  if (o.negativeBeams)
+    throw api::ApiError(422, "invalid-value", "Invalid light_volumes parameter",
+                        "shadows = negative_beams needs the shadow maps to skip the scatterers, which they cannot yet; "
+                        "use shadow_map",
+                        "/passes/light_volumes/shadows");
+  o.maxConcentration = params.get<float>("max_concentration", 1e4f);
+  o.maxTriangleSigma = params.get<float>("max_triangle_sigma", 0.5f);
+  o.specularFallback = params.get<std::string>("tessellation_fallback", "specular") == "specular";
+  o.cullSigmas = params.get<float>("cull_sigmas", 4.f);
+  split_ = params.get<std::string>("split", "2d") == "paper" ? light_volumes::Split::Paper : light_volumes::Split::TwoD;
+  bvh_ = params.get<std::string>("traversal", "bvh") == "bvh";
+  // Every light path is counted once: without LS+DE and LG+DE (another technique owns them) the pass
+  // gathers nothing and adds nothing to beauty.
+  owns_ = res.ownsLightPath("light_volumes", "LS+DE") || res.ownsLightPath("light_volumes", "LG+DE");
+
+  const nlohmann::json key = {{"scene", res.sceneKey()},
+                              {"lights", lightsKey(scene)},
+                              {"params", nlohmann::json::parse(params.subsetKey(
+                                             {"sigma_scale", "shadows", "max_concentration", "max_triangle_sigma",
+                                              "tessellation_fallback", "cull_sigmas"}))}};
+  built_ = false;
+  const Cache& cache = res.cached<Cache>("light_volumes_beams", key.dump(), [&] {
+    built_ = true;
+    auto c = std::make_unique<Cache>();
+    auto t0 = Clock::now();
+    const rt::RayScene& rays = sharedRayScene(res, scene);
+    const float eps = 1e-4f * std::max(scene.features.bounds.radius(), 1e-6f);
+    auto receiverDistance = [&](const glm::vec3& origin, const glm::vec3& dir) {
+      rt::Sampler sampler(0, 0, 0);
+      rt::RayCounter counter;
+      rt::SurfaceHit hit;
+      const rt::Ray ray{origin + eps * dir, dir, 0.f, rt::kInf};
+      return rays.intersect(ray, hit, sampler, counter) ? hit.distance + eps : -1.f;
+    };
+    c->beams = light_volumes::buildBeams(scene, o, receiverDistance);
+    c->setupMs = msSince(t0);
+    t0 = Clock::now();
+    c->bvh = light_volumes::buildBeamBvh(c->beams.cones, scene.features.bounds);
+    c->bvhMs = msSince(t0);
+    return c;
+  });
+  cache_ = &cache;
+  upload_ = built_ || !res.hasBuffer("light_volumes_beams");
+  res.buffer("light_volumes_beams", bytesOf(cache.beams.beams));
+  res.buffer("light_volumes_cones", bytesOf(cache.beams.cones));
+  res.buffer("light_volumes_nodes", bytesOf(cache.bvh.nodes));
+  res.buffer("light_volumes_prims", bytesOf(cache.bvh.primitives));
+  const int w = res.view().width, h = res.view().height;
+  res.texture("light_volumes", GL_TEXTURE_2D, GL_RGBA32F, w, h).setFilter(GL_NEAREST, GL_NEAREST);
+  res.texture("beauty", GL_TEXTURE_2D, GL_RGBA32F, w, h);
+}
+
+void LightVolumesPass::execute(PassContext& ctx) {
+  FrameResources& res = ctx.resources;
+  const Cache& c = *cache_;
+  gl::Buffer& beams = res.buffer("light_volumes_beams");
+  gl::Buffer& cones = res.buffer("light_volumes_cones");
+  gl::Buffer& nodes = res.buffer("light_volumes_nodes");
+  gl::Buffer& prims = res.buffer("light_volumes_prims");
+  if (upload_) {
+    if (!c.beams.beams.empty()) beams.upload(c.beams.beams.data(), c.beams.beams.size() * sizeof(light_volumes::Beam));
+    if (!c.beams.cones.empty()) cones.upload(c.beams.cones.data(), c.beams.cones.size() * sizeof(light_volumes::BeamCone));
+    if (!c.bvh.nodes.empty()) nodes.upload(c.bvh.nodes.data(), c.bvh.nodes.size() * sizeof(light_volumes::BeamBvhNode));
+    if (!c.bvh.primitives.empty()) prims.upload(c.bvh.primitives.data(), c.bvh.primitives.size() * sizeof(glm::vec4));
+  }
+  const char* inputs[] = {"gbuffer_position", "normal", "albedo", "material", "emission"};
+  for (GLuint i = 0; i < std::size(inputs); ++i) res.texture(inputs[i]).bindUnit(i);
+  beams.bindBase(GL_SHADER_STORAGE_BUFFER, kBindingBeams);
+  cones.bindBase(GL_SHADER_STORAGE_BUFFER, kBindingCones);
+  nodes.bindBase(GL_SHADER_STORAGE_BUFFER, kBindingNodes);
+  prims.bindBase(GL_SHADER_STORAGE_BUFFER, kBindingPrims);
+  gl::Texture& out = res.texture("light_volumes");
+  out.bindImage(0, GL_READ_WRITE);
+  res.texture("beauty").bindImage(1, GL_READ_WRITE);
+
+  const FrameView& view = ctx.view;
+  const gl::Program& prog = ctx.shaders.program({"light_volumes/gather.comp"});
+  prog.use();
+  const int size[2] = {view.width, view.height};
+  glUniform2iv(glGetUniformLocation(prog.id(), "u_size"), 1, size);
+  prog.set("u_split", static_cast<int>(split_));
+  prog.set("u_eye", glm::value_ptr(view.eye), 3);
+  const glm::vec3 forward = -glm::normalize(glm::vec3(view.camera.world[2]));
+  prog.set("u_viewForward", glm::value_ptr(forward), 3);
+  prog.set("u_orthographic", view.camera.projection == ProjectionType::Orthographic ? 1 : 0);
+  prog.set("u_narrowLobeRoughness", Material::kNarrowLobeRoughness);
+  prog.set("u_traversal", bvh_ ? 1 : 0);
+  // One dispatch per slice (linear) or group (bvh); at least one, which clears the AOV.
+  std::vector<std::pair<int, int>> work;  // linear: [begin, end); bvh: (root, 0)
+  const int count = owns_ ? static_cast<int>(c.beams.beams.size()) : 0;
+  if (bvh_ && owns_) {
+    for (int root : c.bvh.roots)
+      if (root >= 0) work.push_back({root, 0});
+  } else {
+    for (int b = 0; b < count; b += kLinearSlice) work.push_back({b, std::min(count, b + kLinearSlice)});
+  }
+  if (work.empty()) work.push_back(bvh_ ? std::pair{-1, 0} : std::pair{0, 0});
+  for (std::size_t k = 0; k < work.size(); ++k) {
+    if (bvh_) prog.set("u_root", work[k].first);
+    else {
+      prog.set("u_begin", work[k].first);
+      prog.set("u_end", work[k].second);
+    }
+    prog.set("u_accumulate", k > 0 ? 1 : 0);
+    prog.set("u_addToBeauty", owns_ && k + 1 == work.size() ? 1 : 0);
+    glDispatchCompute((view.width + 7) / 8, (view.height + 7) / 8, 1);
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+  }
+  glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
+  res.markWritten("light_volumes");
+  if (owns_) res.markWritten("beauty");
+
+  auto& s = ctx.stats.counters;
+  const auto& b = c.beams;
+  s["beams"] = static_cast<double>(b.beams.size());
+  s["beams_scattered"] = static_cast<double>(b.scattered);
+  s["beams_shadow"] = static_cast<double>(b.shadow);
+  s["beams_glossy"] = static_cast<double>(b.glossy);
+  s["triangles_backfacing"] = static_cast<double>(b.backfacing);
+  s["beams_tir_dropped"] = static_cast<double>(b.tirDropped);
+  s["triangles_degenerate"] = static_cast<double>(b.degenerate);
+  s["tessellation_checked"] = static_cast<double>(b.tessellationChecked);
+  s["tessellation_failed"] = static_cast<double>(b.tessellationFailed);
+  s["tessellation_worst_triangle_sigma"] = b.worstTriangleSigma;
+  s["tessellation_specular_fallbacks"] = static_cast<double>(b.specularFallbacks);
+  s["beam_flux"] = b.flux.x + b.flux.y + b.flux.z;
+  s["setup_ms"] = built_ ? c.setupMs : 0.0;
+  s["bvh_ms"] = built_ ? c.bvhMs : 0.0;
+  s["beams_cached"] = built_ ? 0.0 : 1.0;
+  s["bvh_nodes"] = static_cast<double>(c.bvh.nodes.size());
+  s["bvh_segments"] = static_cast<double>(c.bvh.primitives.size());
+  s["bvh_depth"] = c.bvh.depth;
+  s["traversal_bvh"] = bvh_ ? 1.0 : 0.0;
+  s["dispatches"] = static_cast<double>(work.size());
+  s["owns_light_paths"] = owns_ ? 1.0 : 0.0;
+}
+
+}  // namespace radiant

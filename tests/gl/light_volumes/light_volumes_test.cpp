@@ -1,0 +1,213 @@
+// light_volumes on llvmpipe (Duvenhage et al.). Each test asserts a number fixed by a closed form or
+// by another technique's estimate of the same light:
+// - a flat mirror above a Lambertian floor is the image of the light: L = rho/pi R I cos / |F - L'|^2
+//   inside the reflected footprint, 0 outside, with both traversals (they agree to float rounding);
+// - a glossy plate: the culled (bvh) and linear traversals give the same image;
+// - light paths are counted once with photon_gi: when light_volumes owns LG+DE, photon_gi stops
+//   splatting photons that reached a diffuse surface through the glossy plate only, and the energy
+//   it drops is the energy light_volumes adds (within the two estimators' agreement);
+// - the planner's ownership rule, the tessellation report, the cache, and bad parameters.
+#include <cmath>
+#include <cstdio>
+
+#include <gtest/gtest.h>
+
+#include "tests/support/RenderTestSupport.h"
+#include "tests/support/SceneBuilder.h"
+
+namespace radiant {
+namespace {
+
+using testing::aov;
+using testing::pass;
+using testing::renderer;
+
+// An n x n grid mesh in the plane y = y0 spanning [-half, half]^2 around (cx, cz), facing -y.
+void gridFacingDown(testing::SceneBuilder& b, int n, float cx, float cz, float half, float y0, int mat,
+                    const std::string& name) {
+  MeshInstance m;
+  m.name = name;
+  m.material = mat;
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j <= n; ++j) {
+      m.positions.push_back({cx - half + 2.f * half * i / n, y0, cz - half + 2.f * half * j / n});
+      m.normals.push_back({0.f, -1.f, 0.f});
+    }
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const std::uint32_t a = i * (n + 1) + j, c = a + n + 1;
+      // Counter-clockwise seen from below (-y).
+      m.indices.insert(m.indices.end(), {a, c, a + 1, a + 1, c, c + 1});
+    }
+  for (auto& p : m.positions) m.bounds.extend(p);
+  b.scene().meshes.push_back(std::move(m));
+}
+
+Material metal(float roughness, float base) {
+  Material m = testing::lambertian(glm::vec3(base));
+  m.metallicFactor = 1.f;
+  m.roughnessFactor = roughness;
+  m.ior = 1.5f;
+  return m;
+}
+
+constexpr float kRho = 0.5f;
+constexpr float kHalf = 1.f;  // the camera sees [-1, 1]^2 of the floor
+
+api::RenderRequest request(int size, nlohmann::json lv = nlohmann::json::object()) {
+  api::RenderRequest r;
+  r.width = r.height = size;
+  r.passes["light_volumes"] = std::move(lv);
+  r.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty", "light_volumes"}, false}};
+  return r;
+}
+
+// Floor y = 0 (Lambertian kRho), a 0.3 m mirror at y = 1 facing down (32 x 32 x 2 facets, R = 1), a
+// point light between them; the camera looks down from y = 0.9 (under the mirror).
+const glm::vec3 kLight(0.2f, 0.5f, 0.1f);
+constexpr float kMirrorX = 0.0123f, kMirrorZ = -0.0071f;
+Scene mirrorScene() {
+  testing::SceneBuilder b;
+  const int floor = b.material(testing::lambertian(glm::vec3(kRho)));
+  b.quad(glm::vec3(0.f), {1.5f, 0, 0}, {0, 0, -1.5f}, floor, "floor");
+  // Off the pixel grid: a pixel centre exactly on a facet edge's plane would be counted by both
+  // facets' beams (the in-beam test is inclusive; docs/TECHNIQUES.md, limits).
+  gridFacingDown(b, 32, kMirrorX, kMirrorZ, 0.15f, 1.f, b.material(metal(0.f, 1.f)), "mirror");
+  b.pointLight(kLight, 1.f);
+  b.topDownOrtho(0.9f, kHalf);
+  return b.build("test:light_volumes:mirror");
+}
+
+TEST(LightVolumes, FlatMirrorIsTheImageOfTheLight) {
+  const Scene scene = mirrorScene();
+  const int size = 96;
+  const glm::vec3 image(kLight.x, 2.f - kLight.y, kLight.z);  // L' mirrored through y = 1
+  Image images[2];
+  for (int t = 0; t < 2; ++t) {
+    const RenderOutput out = renderer().render(scene, request(size, {{"traversal", t == 0 ? "linear" : "bvh"}}));
+    ASSERT_TRUE(testing::allFinite(out));
+    ASSERT_NE(pass(out, "light_volumes"), nullptr);
+    EXPECT_EQ(pass(out, "light_volumes")->counters.at("beams"), 2048.0);
+    images[t] = aov(out, "light_volumes");
+    EXPECT_EQ(out.stats.lightPaths.at("LS+DE"), "light_volumes");
+  }
+  int inside = 0, outside = 0;
+  double worst = 0.0, maxDiff = 0.0, peak = 0.0;
+  for (int py = 0; py < size; ++py)
+    for (int px = 0; px < size; ++px) {
+      const glm::vec2 xz = testing::topDownPixelToWorld(px, py, size, kHalf);
+      const glm::vec3 F(xz.x, 0.f, xz.y);
+      const glm::vec3 d = F - image;
+      const glm::vec3 hit = image + d * ((1.f - image.y) / d.y);  // where the ray from L' crosses the mirror
+      const float m = std::max(std::abs(hit.x - kMirrorX), std::abs(hit.z - kMirrorZ));
+      const float L = images[0].at(px, py)[0];
+      peak = std::max(peak, double(L));
+      maxDiff = std::max(maxDiff, double(std::abs(L - images[1].at(px, py)[0])));
+      if (m < 0.14f) {  // inside, a pixel away from the footprint's edge
+        const float r = glm::length(d);
+        const float exact = kRho / 3.14159265f * (-d.y / r) / (r * r);
+        worst = std::max(worst, std::abs(L / exact - 1.0));
+        ++inside;
+      } else if (m > 0.16f) {
+        EXPECT_EQ(L, 0.f) << px << ", " << py;
+        ++outside;
+      }
+    }
+  EXPECT_GT(inside, 300);
+  EXPECT_GT(outside, 3000);
+  EXPECT_LT(worst, 0.01) << "largest relative error inside the footprint";
+  EXPECT_LE(maxDiff, 1e-5 * peak) << "linear and bvh traversals differ";
+}
+
+// A glossy plate (roughness 0.3) above the floor.
+Scene glossyScene(int n, float roughness = 0.3f) {
+  testing::SceneBuilder b;
+  const int floor = b.material(testing::lambertian(glm::vec3(kRho)));
+  b.quad(glm::vec3(0.f), {1.5f, 0, 0}, {0, 0, -1.5f}, floor, "floor");
+  gridFacingDown(b, n, 0.f, 0.f, 0.3f, 1.2f, b.material(metal(roughness, 0.9f)), "plate");
+  b.pointLight({-0.5f, 0.6f, 0.f}, 2.f);
+  b.topDownOrtho(1.f, kHalf);
+  return b.build("test:light_volumes:glossy:" + std::to_string(n) + ":" + std::to_string(roughness));
+}
+
+double sum(const Image& img) {
+  double s = 0.0;
+  for (std::size_t i = 0; i < img.pixels.size(); i += img.channels) s += img.pixels[i];
+  return s;
+}
+
+TEST(LightVolumes, CulledAndLinearTraversalsGiveTheSameGlossyImage) {
+  const Scene scene = glossyScene(16);
+  const RenderOutput lin = renderer().render(scene, request(64, {{"traversal", "linear"}}));
+  const RenderOutput bvh = renderer().render(scene, request(64, {{"traversal", "bvh"}}));
+  const Image& a = aov(lin, "light_volumes");
+  const Image& b = aov(bvh, "light_volumes");
+  double l1 = 0.0;
+  for (std::size_t i = 0; i < a.pixels.size(); ++i) l1 += std::abs(a.pixels[i] - b.pixels[i]);
+  const double total = sum(a) * 3.0;
+  ASSERT_GT(total, 0.0);
+  EXPECT_LT(l1 / total, 1e-3) << "relative L1 between the traversals (cull_sigmas 4)";
+  // The beams were cached: the second request only changed the traversal.
+  EXPECT_EQ(testing::cacheEvent(bvh, "light_volumes_beams"), 1);
+  const auto& c = pass(bvh, "light_volumes")->counters;
+  EXPECT_EQ(c.at("beams_glossy"), 512.0);
+  EXPECT_EQ(c.at("tessellation_failed"), 0.0) << "0.0375 m facets 1.2 m from the floor, sigma ~0.1";
+  EXPECT_EQ(c.at("tessellation_specular_fallbacks"), 0.0);
+}
+
+TEST(LightVolumes, CoarseGlossyScattererFallsBackToSpecularBeams) {
+  // 2 x 2 x 2 facets of 0.3 m at 1.2 m (0.25 rad against sigma ~0.1): the condition fails and the
+  // scatterer gets specular beams (stats say so).
+  const RenderOutput out = renderer().render(glossyScene(2), request(32));
+  const auto& c = pass(out, "light_volumes")->counters;
+  EXPECT_GE(c.at("tessellation_failed"), 6.0) << "of 8 (two centroid rays reach the floor far out)";
+  EXPECT_GT(c.at("tessellation_worst_triangle_sigma"), 2.0);
+  EXPECT_EQ(c.at("tessellation_specular_fallbacks"), 1.0);
+  EXPECT_EQ(c.at("beams_glossy"), 0.0);
+}
+
+TEST(LightVolumes, PathsThroughTheGlossyPlateAreCountedOnceWithPhotonGi) {
+  // photon_gi alone splats the light the plate reflects onto the floor (its LD+DE estimate holds
+  // L G D). With light_volumes owning LG+DE, photon_gi leaves those photons out and light_volumes
+  // adds the beams: the indirect light photon_gi drops equals, within the estimators' agreement
+  // (GGX against the Gaussian fit, photon noise), what light_volumes adds, and the total is kept.
+  const Scene scene = glossyScene(16);
+  api::RenderRequest both = request(48);
+  both.passes["photon_gi"] = {{"photons", 200000}};
+  both.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty", "indirect", "light_volumes"}, false}};
+  api::RenderRequest photonsOnly = both;
+  photonsOnly.passes.erase("light_volumes");
+  photonsOnly.disabledPasses.insert("light_volumes");
+  photonsOnly.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty", "indirect"}, false}};
+  const RenderOutput a = renderer().render(scene, photonsOnly);
+  const RenderOutput b = renderer().render(scene, both);
+  EXPECT_EQ(a.stats.lightPaths.count("LG+DE"), 0u);
+  EXPECT_EQ(b.stats.lightPaths.at("LG+DE"), "light_volumes");
+  const double indirectA = sum(aov(a, "indirect")), indirectB = sum(aov(b, "indirect"));
+  const double lv = sum(aov(b, "light_volumes"));
+  std::printf("photon_gi alone %.4f; with light_volumes: photon_gi %.4f + light_volumes %.4f\n", indirectA, indirectB,
+              lv);
+  EXPECT_GT(lv, 0.5 * indirectA) << "the plate's light should dominate the indirect light";
+  EXPECT_NEAR((indirectA - indirectB) / lv, 1.0, 0.15) << "what photon_gi drops against what light_volumes adds";
+  EXPECT_NEAR((indirectB + lv) / indirectA, 1.0, 0.12) << "the total indirect light (a double count gives ~1.9)";
+  EXPECT_NEAR(sum(aov(b, "beauty")) / sum(aov(a, "beauty")), 1.0, 0.1);
+}
+
+TEST(LightVolumes, RefusesNegativeBeamsOnTheGpuAndReportsWhySkipped) {
+  try {
+    renderer().render(mirrorScene(), request(32, {{"shadows", "negative_beams"}}));
+    ADD_FAILURE() << "expected a 422";
+  } catch (const api::ApiError& e) {
+    EXPECT_EQ(e.status, 422);
+    EXPECT_EQ(e.pointer, "/passes/light_volumes/shadows");
+  }
+  testing::SceneBuilder b;
+  b.quad(glm::vec3(0.f), {1, 0, 0}, {0, 0, -1}, b.material(testing::lambertian()), "floor");
+  b.pointLight({0, 1, 0}, 1.f);
+  b.topDownOrtho(2.f, 1.f);
+  const RenderOutput out = renderer().render(b.build("test:light_volumes:none"), request(16));
+  EXPECT_NE(out.stats.skipped.at("light_volumes").find("no specular or glossy scatterer"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace radiant

@@ -1,0 +1,73 @@
+// Who owns LS+DE and LG+DE (docs/TECHNIQUES.md, light_volumes): the planner gives a light-path class
+// to the first planned technique claiming it in registry order, except that light_volumes
+// (TechniqueInfo::claimsWhenNamed) takes its classes first when the request names it. A stand-in for
+// the caustics technique (branch `caustics`), registered before light_volumes as the rule expects.
+#include <gtest/gtest.h>
+
+#include "renderer/frame/FramePlanner.h"
+#include "renderer/techniques/gbuffer/GBuffer.h"
+#include "renderer/techniques/light_volumes/LightVolumes.h"
+#include "tests/support/SceneBuilder.h"
+
+namespace radiant {
+namespace {
+
+class CausticsStandIn final : public Technique {
+public:
+  const TechniqueInfo& info() const override {
+    static const TechniqueInfo i{"caustics", "stand-in", {}, {}, {"caustics"}, true, true, {"LS+DE", "LG+DE"}};
+    return i;
+  }
+  Requirements requirements(const Scene&, const api::RenderRequest&) const override { return Requirements::ok(); }
+  void prepare(const Scene&, const Params&, FrameResources&) override {}
+  void execute(PassContext&) override {}
+};
+
+Scene mirrorScene() {
+  testing::SceneBuilder b;
+  Material m;
+  m.metallicFactor = 1.f;
+  m.roughnessFactor = 0.f;
+  b.quad(glm::vec3(0.f), {1, 0, 0}, {0, 0, -1}, b.material(m), "mirror");
+  b.pointLight({0, 1, 0}, 1.f);
+  return b.build();
+}
+
+api::RenderRequest asking(bool nameLightVolumes) {
+  api::RenderRequest r;
+  if (nameLightVolumes) r.passes["light_volumes"] = nlohmann::json::object();
+  r.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty", "light_volumes"}, false}};
+  return r;
+}
+
+TEST(LightPathOwnership, CausticsOwnsByDefaultLightVolumesWhenNamed) {
+  GBufferPass gbuffer;
+  CausticsStandIn caustics;
+  LightVolumesPass volumes;
+  const std::vector<Technique*> registry{&gbuffer, &caustics, &volumes};
+  const Scene scene = mirrorScene();
+  // light_volumes planned for its AOV only: caustics, first in the registry, owns both classes.
+  FramePlan p = planFrame(registry, scene, asking(false));
+  ASSERT_EQ(p.passes.size(), 3u);
+  EXPECT_EQ(p.lightPaths.at("LS+DE"), "caustics");
+  EXPECT_EQ(p.lightPaths.at("LG+DE"), "caustics");
+  // Named in the request: light_volumes owns them although caustics runs too.
+  p = planFrame(registry, scene, asking(true));
+  EXPECT_EQ(p.lightPaths.at("LS+DE"), "light_volumes");
+  EXPECT_EQ(p.lightPaths.at("LG+DE"), "light_volumes");
+  // caustics turned off (not planned): light_volumes owns them, named or not.
+  api::RenderRequest off = asking(false);
+  off.disabledPasses.insert("caustics");
+  p = planFrame(registry, scene, off);
+  EXPECT_EQ(p.lightPaths.at("LS+DE"), "light_volumes");
+  EXPECT_EQ(p.lightPaths.at("LG+DE"), "light_volumes");
+  // light_volumes is not on by default: a request that neither names it nor asks for its AOV leaves
+  // the classes to caustics.
+  api::RenderRequest plain;
+  p = planFrame(registry, scene, plain);
+  EXPECT_EQ(p.lightPaths.at("LG+DE"), "caustics");
+  EXPECT_EQ(p.passes.size(), 1u);  // caustics alone (its stand-in reads no G-buffer)
+}
+
+}  // namespace
+}  // namespace radiant
