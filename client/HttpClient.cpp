@@ -32,13 +32,14 @@ HttpClient::HttpClient(std::string baseUrl, std::string token, int timeoutSecond
 }
 
 HttpResponse HttpClient::send(const std::string& method, const std::string& path, const std::string* body,
-                              const std::string& contentType) const {
+                              const std::string& contentType, const Headers& extra) const {
   httplib::Client cli(base_);
   cli.set_connection_timeout(5, 0);
   cli.set_read_timeout(timeout_, 0);
   cli.set_write_timeout(timeout_, 0);
   httplib::Headers headers;
   if (!token_.empty()) headers.emplace("Authorization", "Bearer " + token_);
+  for (const auto& [k, v] : extra) headers.emplace(k, v);
   httplib::Result r = method == "GET"    ? cli.Get(path.c_str(), headers)
                       : method == "HEAD" ? cli.Head(path.c_str(), headers)
                       : method == "DELETE" ? cli.Delete(path.c_str(), headers)
@@ -58,13 +59,17 @@ HttpResponse HttpClient::send(const std::string& method, const std::string& path
 }
 
 HttpResponse HttpClient::get(const std::string& path) const { return send("GET", path, nullptr, ""); }
-HttpResponse HttpClient::head(const std::string& path) const { return send("HEAD", path, nullptr, ""); }
-HttpResponse HttpClient::del(const std::string& path) const { return send("DELETE", path, nullptr, ""); }
-HttpResponse HttpClient::post(const std::string& path, const std::string& body, const std::string& ct) const {
-  return send("POST", path, &body, ct);
+HttpResponse HttpClient::head(const std::string& path, const Headers& extra) const {
+  return send("HEAD", path, nullptr, "", extra);
 }
-HttpResponse HttpClient::put(const std::string& path, const std::string& body, const std::string& ct) const {
-  return send("PUT", path, &body, ct);
+HttpResponse HttpClient::del(const std::string& path) const { return send("DELETE", path, nullptr, ""); }
+HttpResponse HttpClient::post(const std::string& path, const std::string& body, const std::string& ct,
+                              const Headers& extra) const {
+  return send("POST", path, &body, ct, extra);
+}
+HttpResponse HttpClient::put(const std::string& path, const std::string& body, const std::string& ct,
+                             const Headers& extra) const {
+  return send("PUT", path, &body, ct, extra);
 }
 
 const HttpResponse& HttpClient::expectOk(const HttpResponse& r) {

@@ -34,15 +34,25 @@ struct HttpResponse {
   nlohmann::json json() const;  // throws ServerError when the body is not JSON
 };
 
+// Extra request headers, by name.
+using Headers = std::map<std::string, std::string>;
+
+// The header a proxy in front of several daemons routes uploads, HEADs and renders on
+// (docs/DEPLOYMENT.md): the scene's "sha256:..." digest, which the daemon checks against the scene.
+inline constexpr const char* kSceneHeader = "X-Radiant-Scene";
+inline Headers sceneHeader(const std::string& digest) { return digest.empty() ? Headers{} : Headers{{kSceneHeader, digest}}; }
+
 class HttpClient {
 public:
   // baseUrl: "http://host:port" (no TLS: put a proxy in front). token: "" = no Authorization header.
   explicit HttpClient(std::string baseUrl, std::string token = "", int timeoutSeconds = 600);
   HttpResponse get(const std::string& path) const;
-  HttpResponse head(const std::string& path) const;
+  HttpResponse head(const std::string& path, const Headers& extra = {}) const;
   HttpResponse del(const std::string& path) const;
-  HttpResponse post(const std::string& path, const std::string& body, const std::string& contentType) const;
-  HttpResponse put(const std::string& path, const std::string& body, const std::string& contentType) const;
+  HttpResponse post(const std::string& path, const std::string& body, const std::string& contentType,
+                    const Headers& extra = {}) const;
+  HttpResponse put(const std::string& path, const std::string& body, const std::string& contentType,
+                   const Headers& extra = {}) const;
   const std::string& baseUrl() const { return base_; }
 
   // Throws ServerError unless 200 <= status < 300.
@@ -50,7 +60,7 @@ public:
 
 private:
   HttpResponse send(const std::string& method, const std::string& path, const std::string* body,
-                    const std::string& contentType) const;
+                    const std::string& contentType, const Headers& extra = {}) const;
   std::string base_, token_;
   int timeout_;
 };

@@ -1,5 +1,6 @@
 #include "server/Config.h"
 
+#include <algorithm>
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -32,6 +33,7 @@ std::string usage() {
   --http-threads N          HTTP worker threads (default max-queue + 8)
   --device-index N          EGL device index
   --device NAME             EGL device whose GL_RENDERER or GL_VENDOR contains NAME
+  --cuda-device N           EGL device of CUDA device N (NVIDIA, EGL_NV_device_cuda): one daemon per GPU
   --gl-debug                GL debug context, messages to stderr
   --max-json-depth N        deepest nesting of a request or a glTF document (default 64)
   --max-decode-bytes N      memory one scene or image may decode into: pixels of every image,
@@ -41,6 +43,8 @@ std::string usage() {
   --keep-alive-timeout S    seconds an idle keep-alive connection stays open (default 2)
   --shutdown-grace S        after SIGTERM, seconds frame and job GETs are still served (default 10)
   --max-connections N       connections served at once, one worker thread each (default 256)
+  --daemon-id ID            this daemon's name behind a proxy, [a-z0-9]{1,32}: render ids (and so the
+                            job and frame URLs) start with "ID-" for the proxy to route on (docs/DEPLOYMENT.md)
 )";
 }
 
@@ -103,6 +107,7 @@ void apply(ServerConfig& c, const std::string& name, const std::string& v, std::
   else if (name == "http-threads") c.httpThreads = static_cast<int>(toInt(flag, v, 1, 1024));
   else if (name == "device-index") c.deviceIndex = static_cast<int>(toInt(flag, v, 0, 1024));
   else if (name == "device") c.deviceName = v;
+  else if (name == "cuda-device") c.cudaDevice = static_cast<int>(toInt(flag, v, 0, 1024));
   else if (name == "gl-debug") c.glDebug = v != "false" && v != "0";
   else if (name == "max-json-depth") c.limits.maxJsonDepth = static_cast<std::size_t>(toInt(flag, v, 8, 1000));
   else if (name == "max-decode-bytes") c.maxDecodeBytes = static_cast<std::size_t>(toInt(flag, v, 1 << 20, 1ll << 40));
@@ -111,6 +116,12 @@ void apply(ServerConfig& c, const std::string& name, const std::string& v, std::
   else if (name == "keep-alive-timeout") c.keepAliveTimeoutS = toDouble(flag, v);
   else if (name == "shutdown-grace") c.shutdownGraceS = v == "0" ? 0.0 : toDouble(flag, v);
   else if (name == "max-connections") c.maxConnections = static_cast<int>(toInt(flag, v, 4, 4096));
+  else if (name == "daemon-id") {
+    const bool ok = !v.empty() && v.size() <= 32 &&
+                    std::all_of(v.begin(), v.end(), [](char ch) { return (ch >= 'a' && ch <= 'z') || (ch >= '0' && ch <= '9'); });
+    if (!ok) throw std::invalid_argument(flag + ": expected 1 to 32 of [a-z0-9], got \"" + v + "\"");
+    c.daemonId = v;
+  }
   else throw std::invalid_argument("unknown option " + flag);
 }
 

@@ -28,6 +28,7 @@ struct ServerConfig {
   int encoderThreads = 2;
   int httpThreads = 0;                 // 0 = maxQueue + 8
   std::optional<int> deviceIndex;      // EGL device index (radiantd only)
+  std::optional<int> cudaDevice;       // the EGL device of this CUDA device id (EGL_NV_device_cuda)
   std::string deviceName;              // substring of GL_RENDERER/GL_VENDOR
   bool glDebug = false;
   // Hardening (docs/API.md, "Limits"): every budget a hostile input could exhaust is a flag.
@@ -39,6 +40,10 @@ struct ServerConfig {
   // fetched). 0 here, for servers embedded in tests; radiantd's command line defaults it to 10.
   double shutdownGraceS = 0;
   int maxConnections = 256;            // connections served at once (one HTTP worker thread each)
+  // Behind a proxy (docs/DEPLOYMENT.md): this daemon's name in the fleet, [a-z0-9]{1,32}. Render ids
+  // become "<id>-r-<hex>", so the job and frame URLs it hands out route back to it; every response
+  // carries X-Radiant-Daemon. "" = a lone daemon, ids "r-<hex>".
+  std::string daemonId;
 };
 
 // Parses argv (argv[0] skipped). Throws std::invalid_argument with a usage message on bad flags.

@@ -88,6 +88,24 @@ void sendProblem(httplib::Response& res, const api::ApiError& e, const std::stri
   sendProblem(res, e.status, e.type, e.title, e.detail(), e.pointer, renderId);
 }
 
+// The proxy routes uploads, HEADs and renders on X-Radiant-Scene (docs/DEPLOYMENT.md). A header that
+// names another scene than the request's own would park the scene on a daemon the proxy never sends
+// its renders to, so it is refused rather than ignored.
+void checkSceneHeader(const httplib::Request& req, const std::string& digest, const std::string& pointer = "") {
+  if (!req.has_header("X-Radiant-Scene")) return;
+  const std::string given = req.get_header_value("X-Radiant-Scene");
+  if (!api::isSceneDigest(given))
+    throw api::ApiError(400, "invalid-scene-header", "Invalid X-Radiant-Scene header",
+                        "the X-Radiant-Scene header must be the sha256:<64 lowercase hex> digest of the request's scene, got \"" +
+                            api::truncateUtf8(given, 100) + "\"",
+                        pointer);
+  if (!digest.empty() && given != digest)
+    throw api::ApiError(400, "scene-header-mismatch", "X-Radiant-Scene does not match the scene",
+                        "the X-Radiant-Scene header names " + given + " but the request's scene is " + digest +
+                            " (the proxy routes on this header: send the digest of the scene itself)",
+                        pointer);
+}
+
 std::string mediaType(const httplib::Request& req) {
   std::string ct = req.get_header_value("Content-Type");
   if (auto semi = ct.find(';'); semi != std::string::npos) ct.resize(semi);
@@ -464,6 +482,7 @@ struct HttpServer::Impl {
 
     http.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
       beginRequest(req, res);
+      if (!config.daemonId.empty()) res.set_header("X-Radiant-Daemon", config.daemonId);
       // httplib reads the body of any other POST/PUT/PATCH/DELETE whole into memory before routing;
       // with a Content-Length it is bounded by --max-body-bytes, a chunked or compressed one is not.
       const bool bodyRoute = (req.method == "POST" || req.method == "PUT") &&
@@ -557,6 +576,7 @@ struct HttpServer::Impl {
                {{"name", "radiantd"},
                 {"version", kVersion},
                 {"api", "v1"},
+                {"daemon_id", config.daemonId.empty() ? json(nullptr) : json(config.daemonId)},
                 {"ready", service.ready()},
                 {"device", device ? deviceJson(*device) : json(nullptr)},
                 {"limits", limitsJson()},
@@ -588,6 +608,7 @@ struct HttpServer::Impl {
                             "application/octet-stream, application/json), got \"" + type + "\"");
       if (body.empty()) throw api::ApiError(400, "empty-body", "Empty body", "the body holds no scene");
       const std::string digest = api::sceneDigest(body);
+      checkSceneHeader(req, digest);
       bool created = false;
       // get(), not contains(): a file in the cache dir that no longer matches its digest is dropped there.
       if (!scenes.get(digest)) {
@@ -617,6 +638,7 @@ struct HttpServer::Impl {
     // GET and HEAD (httplib routes HEAD to GET handlers and sends no body).
     http.Get(R"(/v1/scenes/([^/]+))", wrap([this](const httplib::Request& req, httplib::Response& res) {
       const std::string ref = req.matches[1];
+      checkSceneHeader(req, api::isSceneDigest(ref) ? ref : builtinDigest(ref).value_or(""));
       std::optional<std::string> bytes;
       if (api::isSceneDigest(ref)) {
         if (req.method == "HEAD" && scenes.contains(ref)) bytes = std::string();
@@ -684,7 +706,15 @@ struct HttpServer::Impl {
                                 "/passes/" + name + ": this daemon does not implement \"" + name + "\"",
                                 api::pointerAppend("/passes", name));
         }
+      // The header is checked before the scene is looked up where the request names its digest (a
+      // forged header routes the render to a daemon that may lack the scene: the header is at fault).
+      const bool named = request.scene.kind == api::SceneRef::Kind::Digest || request.scene.kind == api::SceneRef::Kind::Builtin;
+      if (named)
+        checkSceneHeader(req, request.scene.kind == api::SceneRef::Kind::Digest ? request.scene.value
+                                                                                : builtinDigest(request.scene.value).value_or(""),
+                         "/scene");
       auto scene = resolveScene(request.scene);
+      if (!named) checkSceneHeader(req, scene->digest, "/scene");
       std::shared_ptr<const Image> compareTarget, environment;
       if (request.compare && request.compare->against != "reference")
         compareTarget = resolveImage(request.compare->against, "/compare/against");

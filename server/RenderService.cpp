@@ -17,13 +17,14 @@ double msBetween(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double, std::milli>(b - a).count();
 }
 
-std::string newRenderId() {
+// "r-<hex>", or "<daemon id>-r-<hex>" behind a proxy, which routes the job's URLs on the prefix.
+std::string newRenderId(const std::string& daemonId) {
   static std::mutex m;
   static std::mt19937_64 rng{std::random_device{}()};
   std::lock_guard lock(m);
   char buf[32];
   std::snprintf(buf, sizeof buf, "r-%016llx", static_cast<unsigned long long>(rng()));
-  return buf;
+  return daemonId.empty() ? std::string(buf) : daemonId + "-" + buf;
 }
 
 }  // namespace
@@ -80,7 +81,7 @@ std::shared_ptr<Job> RenderService::submit(api::RenderRequest request, std::shar
                                            std::shared_ptr<const Image> compareTarget,
                                            std::shared_ptr<const Image> environment, double sceneLoadMs) {
   auto job = std::make_shared<Job>();
-  job->id = newRenderId();
+  job->id = newRenderId(config_.daemonId);
   request.id = job->id;
   job->request = std::move(request);
   job->scene = std::move(scene);

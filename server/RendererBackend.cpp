@@ -33,6 +33,7 @@ BackendHooks rendererHooks(const ServerConfig& config) {
   DeviceOptions device;
   device.index = config.deviceIndex;
   device.nameContains = config.deviceName;
+  device.cudaDevice = config.cudaDevice;
   device.debug = config.glDebug;
 
   BackendHooks h;

@@ -34,14 +34,14 @@ std::string sceneFileBytes(const std::string& path, std::string* note) {
 std::string ensureSceneUploaded(const HttpClient& http, const std::string& bytes, const std::string& fileName,
                                 bool verbose) {
   const std::string digest = api::sceneDigest(bytes);
-  const HttpResponse head = http.head("/v1/scenes/" + digest);
+  const HttpResponse head = http.head("/v1/scenes/" + digest, sceneHeader(digest));
   if (head.status == 200) {
     if (verbose) std::cerr << "scene " << digest << " already on the server\n";
     return digest;
   }
   if (head.status != 404) HttpClient::expectOk(head);
   const bool glb = bytes.size() >= 4 && bytes.compare(0, 4, "glTF") == 0;
-  const HttpResponse r = http.put("/v1/scenes", bytes, glb ? "model/gltf-binary" : "model/gltf+json");
+  const HttpResponse r = http.put("/v1/scenes", bytes, glb ? "model/gltf-binary" : "model/gltf+json", sceneHeader(digest));
   HttpClient::expectOk(r);
   const std::string stored = r.json().value("digest", "");
   if (stored != digest)

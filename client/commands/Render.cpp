@@ -261,7 +261,11 @@ int cmdRender(const GlobalOptions& g, const std::vector<std::string>& args) {
   if (requestFile.empty() || async) request["async"] = async;
 
   const auto t0 = std::chrono::steady_clock::now();
-  HttpResponse r = http.post("/v1/renders", request.dump(), "application/json");
+  // A scene by digest routes to the daemon holding it when a proxy is in front (docs/DEPLOYMENT.md).
+  std::string digest = request["scene"].is_object() && request["scene"].contains("digest") && request["scene"]["digest"].is_string()
+                           ? request["scene"]["digest"].get<std::string>() : "";
+  if (!api::isSceneDigest(digest)) digest.clear();  // the daemon names a bad digest at /scene/digest
+  HttpResponse r = http.post("/v1/renders", request.dump(), "application/json", sceneHeader(digest));
   HttpClient::expectOk(r);
   nlohmann::json result = r.json();
   if (async) {

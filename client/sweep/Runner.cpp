@@ -34,7 +34,28 @@ struct Server {
   std::mutex uploadMutex;
   std::set<std::string> uploaded;
   bool dead = false;  // guarded by Shared::m
+  // A daemon with --daemon-id, or a proxy in front of several (docs/DEPLOYMENT.md): renders carry the
+  // scene digest header, and a render the proxy could not complete (502/504, a draining daemon's 503)
+  // is sent again, after re-uploading the scene when it landed on a daemon without it.
+  bool fleet = false;
+  std::map<std::string, std::string> builtinDigests;  // name -> digest, from GET /v1/scenes
 };
+
+// One render as the runner saw it.
+struct Rendered {
+  json result;
+  double latencyMs = 0;
+  std::string daemon;  // X-Radiant-Daemon of the answer ("" for a daemon without --daemon-id)
+};
+
+// Renders through a proxy are retried this often (a second apart) before the server counts as gone.
+constexpr int kFleetRetries = 60;
+
+std::string problemType(const HttpResponse& r) {
+  const json problem = json::parse(r.body, nullptr, false);
+  const std::string type = problem.is_object() ? problem.value("type", "") : "";
+  return type.substr(type.rfind('/') == std::string::npos ? 0 : type.rfind('/') + 1);
+}
 
 std::string isoNow() {
   const std::time_t t = std::time(nullptr);
@@ -123,6 +144,12 @@ public:
       s->http = std::make_unique<HttpClient>(url, o_.token);
       try {
         s->info = HttpClient::expectOk(s->http->get("/v1/info")).json();
+        s->fleet = s->info.contains("daemon_id") && s->info["daemon_id"].is_string();
+        if (s->fleet) {
+          const json scenes = HttpClient::expectOk(s->http->get("/v1/scenes")).json();
+          for (const auto& b : scenes.value("builtins", json::array()))
+            s->builtinDigests[b.value("name", "")] = b.value("digest", "");
+        }
       } catch (const UnreachableError& e) {
         dropServer(*s, e.what());
       } catch (const ServerError& e) {
@@ -265,37 +292,96 @@ private:
     sh_.cv.notify_all();
   }
 
-  // One render, with the frames downloaded: returns the result and the end-to-end latency.
-  std::pair<json, double> renderOnce(Server& s, const json& body) {
+  // The scene digest a proxy routes a render on: the uploaded file's, or the built-in's.
+  static std::string routingDigest(const Server& s, const json& request) {
+    const json scene = request.value("scene", json::object());
+    if (!scene.is_object()) return "";
+    if (scene.contains("digest") && scene["digest"].is_string()) return scene["digest"];
+    if (scene.contains("builtin") && scene["builtin"].is_string())
+      if (auto it = s.builtinDigests.find(scene["builtin"].get<std::string>()); it != s.builtinDigests.end()) return it->second;
+    return "";
+  }
+
+  // Uploads the point's scene file unless this server has it; `again` after a render found it missing
+  // (a proxy moved the scene to another daemon). HEAD first, so workers that race here upload once.
+  void upload(Server& s, const Point& p, bool again) {
+    std::lock_guard lock(s.uploadMutex);
+    if (!again && s.uploaded.count(p.sceneFile)) return;
+    try {
+      ensureSceneUploaded(*s.http, sceneFileBytes(p.sceneFile), p.sceneFile, false);
+    } catch (const UnreachableError& e) {
+      throw ServerGone(e.what());
+    }
+    s.uploaded.insert(p.sceneFile);
+    if (again && !o_.quiet) {
+      std::lock_guard shared(sh_.m);
+      sh_.lines.push_back("sweep: " + p.sceneFile + " was missing behind " + s.url + " (a daemon was lost); re-uploaded it");
+    }
+  }
+
+  void pause(int seconds) {
+    for (int i = 0; i < seconds * 10 && !stopping(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+
+  // One render, with the frames downloaded.
+  Rendered renderOnce(Server& s, const Point& p, const json& body) {
     const std::string text = body.dump();
+    const Headers headers = sceneHeader(routingDigest(s, body));
+    int retries = 0;
     for (;;) {
       if (stopping()) throw Interrupted{};
       const auto t0 = Clock::now();
       HttpResponse r;
       try {
-        r = s.http->post("/v1/renders", text, "application/json");
-        if (r.status == 503 || r.status == 401) {
-          const json problem = json::parse(r.body, nullptr, false);
-          const std::string type = problem.is_object() ? problem.value("type", "") : "";
-          if (type.size() >= 10 && type.compare(type.size() - 10, 10, "queue-full") == 0) {
-            // Another client fills the queue: wait as told, then retry the same render.
-            const int wait = std::clamp(std::atoi(r.header("retry-after").c_str()), 1, 10);
-            for (int i = 0; i < wait * 10 && !stopping(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        r = s.http->post("/v1/renders", text, "application/json", headers);
+        const std::string type = r.status >= 400 ? problemType(r) : "";
+        if (r.status == 503 && type == "queue-full") {
+          // Another client fills the queue: wait as told, then retry the same render.
+          pause(std::clamp(std::atoi(r.header("retry-after").c_str()), 1, 10));
+          continue;
+        }
+        if (s.fleet && retries < kFleetRetries) {
+          // The proxy lost the daemon on the way (502/504), or the render reached a draining one: the
+          // proxy marks it down and the next try lands on another.
+          if (r.status == 502 || r.status == 504 || (r.status == 503 && type == "shutting-down")) {
+            ++retries;
+            pause(1);
             continue;
           }
+          if (r.status == 404 && type == "unknown-scene" && !p.sceneFile.empty()) {
+            ++retries;
+            upload(s, p, true);
+            continue;
+          }
+        }
+        if (r.status == 503 || r.status == 401) {
+          const json problem = json::parse(r.body, nullptr, false);
           throw ServerGone("POST /v1/renders answered " + std::to_string(r.status) + " (" +
                            (problem.is_object() ? problem.value("detail", r.body) : r.body) + ")");
         }
         HttpClient::expectOk(r);
         json result = r.json();
-        for (const auto& f : result.value("frames", json::array()))
-          HttpClient::expectOk(s.http->get(f.value("url", "")));
+        bool frameLost = false;
+        for (const auto& f : result.value("frames", json::array())) {
+          const HttpResponse frame = s.http->get(f.value("url", ""));
+          // The daemon holding the frames died after rendering: render again elsewhere.
+          if (s.fleet && (frame.status == 502 || frame.status == 504) && retries < kFleetRetries) {
+            frameLost = true;
+            break;
+          }
+          HttpClient::expectOk(frame);
+        }
+        if (frameLost) {
+          ++retries;
+          pause(1);
+          continue;
+        }
         const double latency = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
         try {
           s.http->del("/v1/renders/" + result.value("id", ""));  // free the frame store; not timed
         } catch (const std::exception&) {
         }
-        return {std::move(result), latency};
+        return {std::move(result), latency, r.header("x-radiant-daemon")};
       } catch (const UnreachableError& e) {
         throw ServerGone(e.what());
       }
@@ -309,17 +395,7 @@ private:
     if (!p.compare.is_null()) record["request"]["compare"] = p.compare;
     classify(p, s.info, record);
     try {
-      if (!p.sceneFile.empty()) {
-        std::lock_guard lock(s.uploadMutex);
-        if (!s.uploaded.count(p.sceneFile)) {
-          try {
-            ensureSceneUploaded(*s.http, sceneFileBytes(p.sceneFile), p.sceneFile, false);
-          } catch (const UnreachableError& e) {
-            throw ServerGone(e.what());
-          }
-          s.uploaded.insert(p.sceneFile);
-        }
-      }
+      if (!p.sceneFile.empty()) upload(s, p, false);
       json request = p.request;
       request["async"] = false;
       const int untimed = std::max(p.warmup, p.compare.is_null() ? 0 : 1);
@@ -327,10 +403,12 @@ private:
       std::vector<std::string> order;
       std::map<std::string, std::pair<std::vector<double>, std::vector<double>>> perPass;
       json last;
+      std::set<std::string> daemons;  // behind a proxy: which daemons rendered this point
       for (int k = 0; k < untimed + p.repeats; ++k) {
         json body = request;
         if (k == 0 && !p.compare.is_null()) body["compare"] = p.compare;
-        auto [result, ms] = renderOnce(s, body);
+        auto [result, ms, daemon] = renderOnce(s, p, body);
+        if (!daemon.empty()) daemons.insert(daemon);
         const json stats = result.value("stats", json::object());
         if (k == 0 && !p.compare.is_null()) record["metrics"] = stats.value("metrics", json());
         if (k < untimed) continue;
@@ -370,6 +448,7 @@ private:
       record["skipped"] = last.value("skipped", json::object());
       record["cache"] = last.value("cache", json::array());
       record["device"] = last.value("device", s.info.value("device", json()));
+      if (!daemons.empty()) record["daemons"] = daemons;
     } catch (const ServerError& e) {
       json error{{"status", e.status}, {"detail", e.what()}};
       for (const char* k : {"type", "title", "pointer", "request_id", "render_id"})
