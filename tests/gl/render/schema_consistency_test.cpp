@@ -95,7 +95,7 @@ TEST(SchemaConsistency, AovTableIsWellFormed) {
     const api::AovInfo& a = api::aovTable()[i];
     EXPECT_EQ(a.id, static_cast<int>(i)) << a.name;
     EXPECT_TRUE(names.insert(a.name).second) << "duplicate AOV " << a.name;
-    EXPECT_TRUE(a.channels == 1 || a.channels == 3) << a.name;
+    EXPECT_TRUE(a.channels == 1 || a.channels == 3 || a.channels == 4) << a.name;
     EXPECT_EQ(a.exr.size(), static_cast<std::size_t>(a.channels)) << a.name;
     for (const auto& c : a.exr) EXPECT_TRUE(exrChannels.insert(c).second) << "EXR channel " << c << " used twice";
     EXPECT_LE(a.firstChannel + a.channels, a.format == api::AovFormat::R32F ? 1 : 4) << a.name;
@@ -111,6 +111,9 @@ TEST(SchemaConsistency, AovTableIsWellFormed) {
   EXPECT_EQ(accumulate, 1);  // beauty
   EXPECT_EQ(api::findAov("beauty")->exr, (std::vector<std::string>{"R", "G", "B"}));
   EXPECT_EQ(api::findAov("depth")->exr, std::vector<std::string>{"depth.Z"});
+  // The material AOV carries all four G-buffer channels: metallic, roughness, occlusion, transmission.
+  EXPECT_EQ(api::findAov("material")->exr,
+            (std::vector<std::string>{"material.R", "material.G", "material.B", "material.A"}));
   EXPECT_EQ(api::findAov("specular")->groundTruth, "");  // scored against nothing rather than full beauty
   EXPECT_EQ(api::findAov("no_such_aov"), nullptr);
 }
