@@ -64,7 +64,10 @@
 #include "renderer/Image.h"
 #include "renderer/scene/Scene.h"
 
-namespace radiant::rt { class RayScene; }
+namespace radiant::rt {
+class RayScene;
+struct EnvironmentDistribution;
+}  // namespace radiant::rt
 
 namespace radiant::reference {
 
@@ -78,6 +81,8 @@ struct ReferenceOptions {
   float aoRadius = 1.f;
   glm::vec3 skyRadiance{0.f};          // uniform environment radiance
   const Image* environment = nullptr;  // equirect RGB(A) linear radiance, optional; overrides skyRadiance
+  // environment's importance-sampling distribution when the caller has it cached (built per render otherwise)
+  std::shared_ptr<const rt::EnvironmentDistribution> environmentDistribution;
   int threads = 0;                     // 0 = TBB default
 };
 

@@ -20,6 +20,7 @@ const Image& referenceImage(FrameResources& res, const Scene& scene, const Frame
   o.seed = view.seed;
   o.skyRadiance = view.ambient;
   o.environment = view.environment;  // when set, it replaces skyRadiance
+  o.environmentDistribution = environmentDistribution(res, view);
   if (r.aov == "direct") {
     o.minPathBounce = 0, o.maxPathBounce = 1;  // what the raster `direct` AOV holds: emission, sky, direct
   } else if (r.aov == "indirect" || r.aov == "indirect_diffuse") {

@@ -446,6 +446,34 @@ TEST(ImageBasedLighting, SplitSumAgainstTheReferenceOnAMetalSphereUnderASunSky) 
   }
 }
 
+// The environment's importance-sampling distribution is derived data of the map: built once per
+// environment digest and size, reused by every later render (the reference and photon_gi both read it).
+TEST(ImageBasedLighting, EnvironmentDistributionIsBuiltOncePerEnvironmentDigest) {
+  const Image env = sunSky();
+  testing::SceneBuilder b;
+  b.sphere({0, 0, 0}, 1.f, b.material(testing::lambertian()), 32, 16);
+  const Scene scene = b.build("env-distribution");
+  auto render = [&](const std::string& digest, int spp) {
+    api::RenderRequest req = exrRequest(32);
+    req.environment = "sha256:" + digest;
+    req.camera = api::CameraOverride{{0, 0, 4}, {0, 0, 0}, {0, 1, 0}, 35.f};
+    req.compare = api::CompareSpec{"reference", "beauty", spp, 1};  // a new spp: the reference re-renders
+    const RenderOutput out = renderer().render(scene, req, nullptr, FrameInputs{nullptr, &env});
+    int hits = 0, misses = 0;
+    for (const api::CacheEvent& e : out.stats.cache)
+      if (e.what == "environment_distribution") (e.hit ? hits : misses)++;
+    return std::pair<int, int>{hits, misses};
+  };
+  const std::string a(64, 'c'), other(64, 'd');
+  const auto first = render(a, 1);
+  EXPECT_EQ(first.second, 1);  // built once in the first frame...
+  EXPECT_GE(first.first, 1);   // ... and already shared by the second user within it (photon_gi, reference)
+  const auto second = render(a, 2);
+  EXPECT_EQ(second.second, 0);  // the same environment: every lookup is a hit
+  EXPECT_GE(second.first, 2);
+  EXPECT_EQ(render(other, 2).second, 1);  // another digest: built again
+}
+
 // ---- KHR_materials_clearcoat, _sheen, _specular: raster against the reference ---------------------
 
 // A sphere lit by one point light and nothing else (no sky, no ambient): a convex object has no
