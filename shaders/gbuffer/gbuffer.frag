@@ -23,6 +23,9 @@ layout(location = 7) out vec4 o_specular;  // rgb specular colour, a specular we
 void main() {
   Material m = materials[u_material];
   if (materialMasked(m, decodeBaseColor(m, v_uv0, v_uv1).a)) discard;
+  // alphaMode BLEND: composited over the lit opaque frame by the transparency pass; the passes that
+  // read the G-buffer light what lies behind it.
+  if (materialAlphaMode(m) == 2) discard;
   // glTF: back faces of single-sided materials are not rendered.
   if (!gl_FrontFacing && !materialDoubleSided(m)) discard;
   MaterialParams p = decodeMaterial(m, v_uv0, v_uv1);
