@@ -38,9 +38,9 @@ const std::vector<AovInfo>& aovTable() {
          {"geometric_normal.R", "geometric_normal.G", "geometric_normal.B"}, B::Overwrite, "gbuffer", true, ""},
         {0, "albedo", F::Rgba16F, "albedo", 0, 3, {"albedo.R", "albedo.G", "albedo.B"}, B::Overwrite, "gbuffer", true,
          ""},
-        // metallic, roughness, occlusion (transmission, the fourth channel, is not read back).
-        {0, "material", F::Rgba16F, "material", 0, 3, {"material.R", "material.G", "material.B"}, B::Overwrite,
-         "gbuffer", true, ""},
+        // metallic, roughness, occlusion, transmission (KHR_materials_transmission) in R, G, B, A.
+        {0, "material", F::Rgba16F, "material", 0, 4, {"material.R", "material.G", "material.B", "material.A"},
+         B::Overwrite, "gbuffer", true, ""},
         {0, "emission", F::Rgba16F, "emission", 0, 3, {"emission.R", "emission.G", "emission.B"}, B::Overwrite,
          "gbuffer", true, ""},
         {0, "reference", F::Rgba32F, "reference", 0, 3, {"reference.R", "reference.G", "reference.B"}, B::Overwrite,

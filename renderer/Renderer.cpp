@@ -50,7 +50,7 @@ std::size_t sanitize(std::vector<float>& v) {
 // Scores the compared AOV against the ground truth; adds stats.metrics and the "error" and
 // "reference" AOVs.
 void compare(FrameResources& resources, const Scene& scene, const FrameView& view, const api::RenderRequest& request,
-             const Image* target, RenderOutput& out) {
+             const Image* target, const std::vector<std::unique_ptr<Technique>>& techniques, RenderOutput& out) {
   const api::CompareSpec& c = *request.compare;
   auto test = std::find_if(out.aovs.begin(), out.aovs.end(), [&](const Image& i) { return i.aov == c.aov; });
   if (test == out.aovs.end())
@@ -64,10 +64,25 @@ void compare(FrameResources& resources, const Scene& scene, const FrameView& vie
   if (target) {
     reference = *target;
   } else {
-    // The ground truth of the AOV (the AOV table): a reference mode, or none, which is an error rather
-    // than a score against something else (the specular AOV used to be scored against full beauty).
+    // The ground truth of the AOV, as the technique that produced it declares it (Technique::
+    // groundTruth, with the frame's parameters of that technique): a reference mode and its
+    // parameters, or none, which is an error rather than a score against something else (the specular
+    // AOV used to be scored against full beauty).
     const api::AovInfo* info = api::findAov(c.aov);
-    if (!info || info->groundTruth.empty()) {
+    GroundTruth truth;
+    if (info && !info->producer.empty()) {
+      auto t = std::find_if(techniques.begin(), techniques.end(),
+                            [&](const auto& tech) { return tech->info().name == info->producer; });
+      if (t != techniques.end()) {
+        auto given = request.passes.find(info->producer);
+        const Params params(api::techniqueParams(info->producer,
+                                                 given == request.passes.end() ? nlohmann::json() : given->second));
+        truth = (*t)->groundTruth(params, c.aov);
+      }
+    } else if (info) {
+      truth = GroundTruth::fromAovTable(c.aov);  // beauty: the sum of every pass
+    }
+    if (!truth.exists()) {
       std::string have;
       for (const api::AovInfo& a : api::aovTable())
         if (!a.groundTruth.empty()) have += (have.empty() ? "" : ", ") + a.name;
@@ -76,20 +91,13 @@ void compare(FrameResources& resources, const Scene& scene, const FrameView& vie
                               "' (AOVs with one: " + have + "); compare it against an uploaded image instead",
                           "/compare/aov");
     }
-    ReferenceRequest r;
-    r.aov = info->groundTruth;
+    ReferenceRequest r = referenceRequestFrom(Params(api::techniqueParams("reference", truth.reference)));
     m["reference_mode"] = r.aov;
+    // The mode's own parameters (ao: radius and definition) go into the metrics as the technique gave them.
+    for (const auto& [key, value] : truth.reference.items())
+      if (key != "aov") m[key] = value;
     r.spp = c.spp;
     r.maxBounces = c.maxBounces;
-    if (c.aov == "ao") {
-      // The ground truth of the AO the frame used: same radius, and the definition its method estimates
-      // (volumetric: thesis eq. 4.6; the others: the cosine-weighted step).
-      auto given = request.passes.find("ambient_occlusion");
-      const nlohmann::json ao = api::techniqueParams(
-          "ambient_occlusion", given == request.passes.end() ? nlohmann::json() : given->second);
-      r.aoRadius = ao.at("radius").get<float>();
-      r.aoDefinition = ao.at("method").get<std::string>() == "volumetric" ? "volumetric" : "cosine";
-    }
     bool hit = false;
     const auto t0 = Clock::now();
     reference = referenceImage(resources, scene, view, r, &hit);
@@ -97,7 +105,6 @@ void compare(FrameResources& resources, const Scene& scene, const FrameView& vie
     m["max_bounces"] = c.maxBounces;
     m["reference_cached"] = hit;
     m["reference_ms"] = msSince(t0);
-    if (c.aov == "ao") m["ao_definition"] = r.aoDefinition;
   }
   if (reference.width != test->width || reference.height != test->height)
     throw api::ApiError(422, "invalid-compare", "Size mismatch",
@@ -368,7 +375,7 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     im.profiler.resolve();
     report(0.95);
     if (const std::string w = blackFrameWarning(out, stats, scene, request); !w.empty()) stats.warnings.push_back(w);
-    if (request.compare) compare(im.resources, scene, view, request, inputs.compareTarget, out);
+    if (request.compare) compare(im.resources, scene, view, request, inputs.compareTarget, im.techniques, out);
     stats.renderMs = msSince(frameStart);
     report(1.0);
     if (nonFinite) stats.passes.back().counters["non_finite_pixels_zeroed"] = static_cast<double>(nonFinite);

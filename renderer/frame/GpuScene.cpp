@@ -1,5 +1,7 @@
 #include "renderer/frame/GpuScene.h"
 
+#include "renderer/raytracing/Bsdf.h"
+
 #include <atomic>
 #include <cmath>
 #include <string>
@@ -43,6 +45,9 @@ gpu::Material toGpuMaterial(const Material& m) {
     g.uvTransform[2 * s] = glm::vec4(slots[s]->uvRow0, 0.f);
     g.uvTransform[2 * s + 1] = glm::vec4(slots[s]->uvRow1, 0.f);
   }
+  g.clearcoat = glm::vec4(m.clearcoatFactor, m.clearcoatRoughnessFactor, 0.f, 0.f);
+  g.sheen = glm::vec4(m.sheenColorFactor, m.sheenRoughnessFactor);
+  g.specular = glm::vec4(m.specularColorFactor, m.specularFactor);
   return g;
 }
 
@@ -136,7 +141,15 @@ GpuScene::GpuScene(const Scene& scene) : sceneKey(nextSceneKey(scene)) {
   for (const Light& l : scene.lights) lightData.push_back(toGpuLight(l));
   if (lightData.empty()) lightData.push_back(gpu::Light{});  // a zero-size SSBO is not bindable
   lights = gl::Buffer("lights", lightData.size() * sizeof(gpu::Light), lightData.data(), 0);
+  sheenAlbedo = gl::Buffer("sheen albedo", sizeof(float) * gpu::kSheenAlbedoSize * gpu::kSheenAlbedoSize,
+                           rt::sheenAlbedoTable(), 0);
   gl::checkError("GpuScene upload");
+}
+
+void GpuScene::bindSceneBuffers() const {
+  materials.bindBase(GL_SHADER_STORAGE_BUFFER, kMaterialBinding);
+  lights.bindBase(GL_SHADER_STORAGE_BUFFER, kLightBinding);
+  sheenAlbedo.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingSheenAlbedo);
 }
 
 void GpuScene::bindMaterialTextures(std::size_t meshIndex) const {
@@ -151,7 +164,7 @@ void GpuScene::draw(const gl::Program& program, bool withTextures) const {
 
 void GpuScene::drawMeshes(const gl::Program& program, bool withTextures,
                           const std::function<bool(std::size_t meshIndex)>& select) const {
-  materials.bindBase(GL_SHADER_STORAGE_BUFFER, kMaterialBinding);
+  bindSceneBuffers();
   const GLint materialLoc = program.uniformLocation("u_material");
   for (std::size_t i = 0; i < meshes.size(); ++i) {
     if (!select(i)) continue;

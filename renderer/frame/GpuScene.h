@@ -42,12 +42,15 @@ public:
   std::vector<gl::Texture> textures;  // one per (scene texture, colour space) actually used
   gl::Buffer materials;               // gpu::Material[], binding kMaterialBinding
   gl::Buffer lights;                  // gpu::Light[], binding kLightBinding
+  gl::Buffer sheenAlbedo;             // rt::sheenAlbedoTable(), binding gpu::kBindingSheenAlbedo
   std::vector<gpu::Light> lightData;  // CPU copy of `lights` (at least one entry: zero-size SSBOs are invalid)
   std::size_t triangles = 0;
 
   static constexpr GLuint kMaterialBinding = gpu::kBindingMaterials;
   static constexpr GLuint kLightBinding = gpu::kBindingLights;
 
+  // Binds the materials, lights and sheen-albedo buffers at their shared.h bindings.
+  void bindSceneBuffers() const;
   // Binds mesh `meshIndex`'s material textures to units kUnitMaterial0 + slot (what draw() does per mesh).
   void bindMaterialTextures(std::size_t meshIndex) const;
 

@@ -15,12 +15,15 @@ using mat4 = glm::mat4;
 
 static_assert(sizeof(Light) == 64, "std430 Light must be 64 bytes");
 static_assert(sizeof(ShadowInfo) == 96, "std430 ShadowInfo must be 96 bytes");
-static_assert(sizeof(Material) == 112 + 32 * kSlotCount, "std430 Material must be 304 bytes");
+static_assert(sizeof(Material) == 112 + 32 * kSlotCount + 48, "std430 Material must be 352 bytes");
+static_assert(offsetof(Material, clearcoat) == 112 + 32 * kSlotCount, "std430 Material: layer factors follow the uv rows");
 static_assert(offsetof(Material, texturesA) == 64 && offsetof(Material, texturesB) == 80,
               "std430 Material: texture slots follow the four factor vec4s");
 static_assert(offsetof(Material, flags) == 96 && offsetof(Material, uvTransform) == 112,
               "std430 Material: flags, then two uv-transform rows per slot");
-static_assert(sizeof(MaterialParams) == 48, "std430 MaterialParams must be 48 bytes");
+static_assert(sizeof(MaterialParams) == 96, "std430 MaterialParams must be 96 bytes");
+static_assert(offsetof(MaterialParams, clearcoat) == 48 && offsetof(MaterialParams, specular) == 80,
+              "std430 MaterialParams: the layers follow surface");
 static_assert(offsetof(MaterialParams, emission) == 16 && offsetof(MaterialParams, surface) == 32,
               "std430 MaterialParams: baseColor, emission, surface");
 static_assert(kUnitMaterial0 + kSlotCount <= kUnitEnvironment, "material texture units overlap the environment");

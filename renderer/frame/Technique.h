@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "api/Aovs.h"
 #include "api/Types.h"
 #include "renderer/scene/Scene.h"
 
@@ -64,9 +65,31 @@ private:
   nlohmann::json json_;
 };
 
+// What scores one of a technique's AOVs (ARCHITECTURE.md, "A technique owns its knowledge"): the
+// parameters of the reference pass (api/schema/techniques/reference.json) that render its ground truth,
+// e.g. {"aov": "ao", "ao_radius": 0.5, "ao_definition": "volumetric"}; null when the reference renderer
+// has none (the compare block then refuses instead of scoring the AOV against something else).
+struct GroundTruth {
+  nlohmann::json reference;
+  bool exists() const { return reference.is_object(); }
+  // The AOV table's reference mode for `aov` (api/Aovs.cpp), with the reference's defaults otherwise.
+  static GroundTruth fromAovTable(const std::string& aov) {
+    const api::AovInfo* a = api::findAov(aov);
+    if (!a || a->groundTruth.empty()) return {};
+    return {nlohmann::json{{"aov", a->groundTruth}}};
+  }
+};
+
 class Technique {
 public:
   virtual ~Technique() = default;
+  // The ground truth of `aov` (one of info().outputs) for a frame run with `params` (the technique's
+  // own, validated, defaults filled in). Techniques whose ground truth depends on their parameters
+  // override it; the default is the AOV table's reference mode.
+  virtual GroundTruth groundTruth(const Params& params, const std::string& aov) const {
+    (void)params;
+    return GroundTruth::fromAovTable(aov);
+  }
   virtual const TechniqueInfo& info() const = 0;
   // Run or skip for this scene and request (scene.features summarises what it contains; the whole
   // scene is there for rules that need more, such as which nodes receive indirect light). Called by

@@ -23,6 +23,22 @@
 // unpolarised Fresnel equations (Schlick cannot express total internal reflection and does not balance
 // reflection and refraction exactly). Rough transmission is Walter et al. 2007's microfacet BTDF.
 //
+// The layered extensions, as the KHR texts write them (glTF's layering by "mix" weights, not a
+// physical multiple-scattering model):
+//   KHR_materials_specular:  fresnel_mix gets f0 = min(f0_ior specularColor, 1) (rgb), F90 = 1, and the
+//                            layer weight w = specularFactor: the dielectric is
+//                            (1 - w max3(F)) diffuse + w F specular_brdf.
+//   KHR_materials_sheen:     sheen_material = sheen_brdf + base * min(1 - max3(c) E(n.v), 1 - max3(c) E(n.l)),
+//                            sheen_brdf = c D_charlie(alpha = r^2) V_ashikhmin (Estevez and Kulla 2017;
+//                            Neubelt and Pettineo 2013), E the sheen's directional albedo (a table).
+//   KHR_materials_clearcoat: coated = mix(sheen_material, coat_brdf, clearcoat Fc(|n_c.v|)),
+//                            Fc the Schlick Fresnel of index 1.5 (F0 0.04), coat_brdf = D V of
+//                            alpha = clearcoatRoughness^2 around the coat normal n_c.
+// The coat's mix weight depends on v alone, so a coated BSDF is not reciprocal: f(wo, wi) / f(wi, wo)
+// = (1 - Fc(wo) c) / (1 - Fc(wi) c) for its base, Fc(wo) / Fc(wi) for the coat (the unit tests state it).
+// Without the layers (clearcoat 0, sheen colour 0, specular (1, 1)) every formula reduces to the one
+// above. The transmissive part keeps its exact Fresnel (KHR_materials_specular does not tint it).
+//
 // Roughness: roughness == 0 makes the specular lobes Dirac deltas (perfect mirror / smooth dielectric,
 // the alpha -> 0 limit of the microfacet lobes, whose albedo tends to F(n.v)). Any roughness > 0 uses
 // alpha = max(roughness^2, kMinAlpha) with kMinAlpha = 1e-3, so D stays finite in float
@@ -210,6 +226,69 @@ inline float fresnelDielectric(float cosThetaI, float eta) {
 
 inline glm::vec3 reflect(const glm::vec3& wo, const glm::vec3& n) { return 2.f * glm::dot(wo, n) * n - wo; }
 
+// ---------------------------------------------------------------------------------------------------
+// KHR_materials_sheen: the Charlie distribution and Ashikhmin's visibility.
+
+// Estevez and Kulla 2017, eq. 2: D(h) = (2 + 1 / alpha) sin(theta_h)^(1 / alpha) / (2 pi).
+inline float charlieD(float cosThetaH, float alpha) {
+  if (cosThetaH <= 0.f) return 0.f;
+  const float invA = 1.f / alpha;
+  const float sin2 = std::max(0.f, 1.f - cosThetaH * cosThetaH);
+  return (2.f + invA) * std::pow(sin2, 0.5f * invA) / (2.f * kPi);
+}
+// Neubelt and Pettineo 2013: V = 1 / (4 (n.l + n.v - n.l n.v)), which includes 1 / (4 n.l n.v).
+inline float sheenVisibility(float NdotL, float NdotV) {
+  if (NdotL <= 0.f || NdotV <= 0.f) return 0.f;
+  return 1.f / (4.f * (NdotL + NdotV - NdotL * NdotV));
+}
+inline float sheenAlphaFromRoughness(float r) { return sqr(std::clamp(r, gpu::kMinSheenRoughness, 1.f)); }
+
+// E(mu, r) = integral of D_charlie V cos(theta_i) over the hemisphere for a white sheen, on the grid of
+// shared.h (mu_i = i / (N - 1), r_j = kMinSheenRoughness + (1 - kMinSheenRoughness) j / (N - 1)), by
+// midpoint quadrature in (cos theta_i, phi) with 128 x 64 cells (phi over [0, pi], doubled by symmetry).
+// Built once per process; GpuScene uploads the same numbers, so both languages read one table.
+inline const float* sheenAlbedoTable() {
+  static const auto table = [] {
+    constexpr int N = gpu::kSheenAlbedoSize, kCos = 128, kPhi = 64;
+    static float t[N * N];
+    for (int j = 0; j < N; ++j) {
+      const float r = gpu::kMinSheenRoughness + (1.f - gpu::kMinSheenRoughness) * float(j) / float(N - 1);
+      const float alpha = sheenAlphaFromRoughness(r);
+      for (int i = 0; i < N; ++i) {
+        const float mu = std::max(float(i) / float(N - 1), 1e-4f);
+        const glm::vec3 wo(std::sqrt(1.f - mu * mu), 0.f, mu);
+        double sum = 0.0;
+        for (int a = 0; a < kCos; ++a) {
+          const float ci = (float(a) + 0.5f) / float(kCos);
+          const float si = std::sqrt(1.f - ci * ci);
+          for (int b = 0; b < kPhi; ++b) {
+            const float phi = kPi * (float(b) + 0.5f) / float(kPhi);
+            const glm::vec3 wi(si * std::cos(phi), si * std::sin(phi), ci);
+            const glm::vec3 h = glm::normalize(wo + wi);
+            sum += double(charlieD(h.z, alpha) * sheenVisibility(ci, mu) * ci);
+          }
+        }
+        t[j * N + i] = float(sum * (2.0 * kPi / kPhi) / kCos);
+      }
+    }
+    return t;
+  }();
+  return table;
+}
+// Bilinear lookup of the table (the GLSL twin, sheenAlbedo() of brdf.glsl, does the same arithmetic).
+inline float sheenAlbedo(const float* table, float mu, float roughness) {
+  constexpr int N = gpu::kSheenAlbedoSize;
+  const float x = std::clamp(mu, 0.f, 1.f) * float(N - 1);
+  const float y = std::clamp((roughness - gpu::kMinSheenRoughness) / (1.f - gpu::kMinSheenRoughness), 0.f, 1.f) *
+                  float(N - 1);
+  const int x0 = std::min(int(x), N - 2), y0 = std::min(int(y), N - 2);
+  const float fx = x - float(x0), fy = y - float(y0);
+  const float a = table[y0 * N + x0] + (table[y0 * N + x0 + 1] - table[y0 * N + x0]) * fx;
+  const float b = table[(y0 + 1) * N + x0] + (table[(y0 + 1) * N + x0 + 1] - table[(y0 + 1) * N + x0]) * fx;
+  return a + (b - a) * fy;
+}
+inline float sheenAlbedo(float mu, float roughness) { return sheenAlbedo(sheenAlbedoTable(), mu, roughness); }
+
 // Refraction of wo (wo.n > 0, pointing away) through an interface with normal n, eta = n_t / n_i.
 // Returns false on total internal reflection.
 inline bool refract(const glm::vec3& wo, const glm::vec3& n, float eta, glm::vec3& wi) {
@@ -245,53 +324,100 @@ struct GltfBsdf {
   // ior when wo is outside a transmissive solid, 1 / ior inside. Only transmission uses it.
   float eta = 1.5f;
   TransportMode mode = TransportMode::Radiance;
+  // KHR_materials_specular: F0 tint and layer weight of the (opaque) dielectric.
+  glm::vec3 specularColor{1.f};
+  float specularWeight = 1.f;
+  // KHR_materials_sheen: colour 0 = no sheen.
+  glm::vec3 sheenColor{0.f};
+  float sheenRoughness = gpu::kMinSheenRoughness;
+  // KHR_materials_clearcoat: weight 0 = no coat. coatNormal in the local frame (the interpolated vertex
+  // normal: the coat ignores the base's normal map); it faces wo's side like +z.
+  float clearcoat = 0.f;
+  float clearcoatRoughness = 0.f;
+  glm::vec3 coatNormal{0.f, 0.f, 1.f};
 
   // 1 / eta^2 on refraction for radiance, 1 for importance.
   float refractionScale() const { return mode == TransportMode::Radiance ? 1.f / (eta * eta) : 1.f; }
 
   bool isDelta() const { return roughness <= 0.f; }
+  bool coatIsDelta() const { return clearcoatRoughness <= 0.f; }
   float alpha() const { return alphaFromRoughness(roughness); }
   float f0Dielectric() const { return f0FromIor(ior); }
+  bool hasSheen() const { return maxComponent(sheenColor) > 0.f; }
+  bool hasCoat() const { return clearcoat > 0.f; }
+  // KHR_materials_specular: the dielectric's Fresnel at cos(theta) = v.h, rgb, F90 = 1.
+  glm::vec3 specularF0() const { return glm::min(f0Dielectric() * specularColor, glm::vec3(1.f)); }
+  glm::vec3 dielectricFresnel(float cosTheta) const { return schlickFresnel(specularF0(), cosTheta); }
 
-  // Lobe selection probabilities at wo: reflection (metal + opaque dielectric specular), diffuse, and
-  // the transmissive dielectric (its reflection and refraction). Proportional to each lobe's albedo
-  // estimated with the Fresnel factor at n.wo.
-  struct LobeProbabilities { float reflect = 0.f, diffuse = 0.f, dielectric = 0.f; };
+  // The coat's mix weight clearcoat Fc(|n_c.w|) (KHR_materials_clearcoat, fresnel_coat).
+  float coatWeight(const glm::vec3& w) const {
+    return hasCoat() ? clearcoat * schlickFresnel(gpu::kClearcoatF0, std::abs(glm::dot(coatNormal, w))) : 0.f;
+  }
+  // The base's sheen albedo scaling min(1 - max3(c) E(|n.wo|), 1 - max3(c) E(|n.wi|)) (KHR_materials_sheen).
+  float sheenScaling(float cosO, float cosI) const {
+    if (!hasSheen()) return 1.f;
+    const float c = maxComponent(sheenColor);
+    return std::max(0.f, std::min(1.f - c * sheenAlbedo(std::abs(cosO), sheenRoughness),
+                                  1.f - c * sheenAlbedo(std::abs(cosI), sheenRoughness)));
+  }
+  // What the layers above leave of the base for the pair (wo, wi): (1 - coat weight) x sheen scaling.
+  float baseAttenuation(const glm::vec3& wo, const glm::vec3& wi) const {
+    return (1.f - coatWeight(wo)) * sheenScaling(wo.z, wi.z);
+  }
+
+  // Lobe selection probabilities at wo: the coat, the sheen, reflection (metal + opaque dielectric
+  // specular), diffuse, and the transmissive dielectric (its reflection and refraction). Proportional
+  // to each lobe's albedo estimated with the Fresnel factor at n.wo.
+  struct LobeProbabilities { float reflect = 0.f, diffuse = 0.f, dielectric = 0.f, coat = 0.f, sheen = 0.f; };
   LobeProbabilities lobeProbabilities(const glm::vec3& wo) const {
     const float m = metallic, t = transmission;
-    const float fd = schlickFresnel(f0Dielectric(), wo.z);
+    const glm::vec3 fd = dielectricFresnel(wo.z);
     const float fe = fresnelDielectric(wo.z, eta);
     const float lumBase = std::max(luminance(baseColor), 0.f);
+    const float cw = coatWeight(wo);
+    const float sheenE = hasSheen() ? maxComponent(sheenColor) * sheenAlbedo(wo.z, sheenRoughness) : 0.f;
+    const float below = (1.f - cw) * std::max(0.f, 1.f - sheenE);
     LobeProbabilities p;
-    p.reflect = m * luminance(schlickFresnel(baseColor, wo.z)) + (1.f - m) * (1.f - t) * fd;
-    p.diffuse = (1.f - m) * (1.f - t) * (1.f - fd) * lumBase;
-    p.dielectric = (1.f - m) * t * (fe + (1.f - fe) * lumBase);
-    const float sum = p.reflect + p.diffuse + p.dielectric;
-    if (!(sum > 0.f)) return {1.f, 0.f, 0.f};
-    p.reflect /= sum; p.diffuse /= sum; p.dielectric /= sum;
+    p.reflect = below * (m * luminance(schlickFresnel(baseColor, wo.z)) +
+                         (1.f - m) * (1.f - t) * specularWeight * luminance(fd));
+    p.diffuse = below * (1.f - m) * (1.f - t) * (1.f - specularWeight * maxComponent(fd)) * lumBase;
+    p.dielectric = below * (1.f - m) * t * (fe + (1.f - fe) * lumBase);
+    p.coat = cw;
+    p.sheen = (1.f - cw) * sheenE;
+    const float sum = p.reflect + p.diffuse + p.dielectric + p.coat + p.sheen;
+    if (!(sum > 0.f)) return {1.f, 0.f, 0.f, 0.f, 0.f};
+    p.reflect /= sum; p.diffuse /= sum; p.dielectric /= sum; p.coat /= sum; p.sheen /= sum;
     return p;
   }
   // True when some lobe is not a Dirac delta (so light sampling can contribute).
   bool hasNonDeltaLobe(const glm::vec3& wo) const {
-    if (!isDelta()) return true;
+    if (!isDelta() || hasSheen() || (hasCoat() && !coatIsDelta())) return true;
     return lobeProbabilities(wo).diffuse > 0.f;
   }
 
-  // f(wo, wi) of the non-delta lobes (the deltas have no value off their direction). Not multiplied by
-  // the cosine. wi below the horizon is transmission.
-  glm::vec3 eval(const glm::vec3& wo, const glm::vec3& wi) const {
-    if (wo.z <= 0.f || wi.z == 0.f) return glm::vec3(0.f);
+  // The coat's D V around coatNormal (0 for a Dirac coat or wi below it).
+  float coatLobe(const glm::vec3& wo, const glm::vec3& wi) const {
+    if (coatIsDelta()) return 0.f;
+    const float cO = glm::dot(coatNormal, wo), cI = glm::dot(coatNormal, wi);
+    if (cO <= 0.f || cI <= 0.f) return 0.f;
+    const glm::vec3 h = glm::normalize(wo + wi);
+    const float a = alphaFromRoughness(clearcoatRoughness);
+    return ggxD(glm::dot(coatNormal, h), a) * ggxVisibility(cI, cO, a);
+  }
+
+  // f(wo, wi) of the base material alone (metal, dielectric, transmission), without the layers.
+  glm::vec3 evalBase(const glm::vec3& wo, const glm::vec3& wi) const {
     const float m = metallic, t = transmission;
     if (wi.z > 0.f) {
       const glm::vec3 h = glm::normalize(wo + wi);
       const float voh = glm::dot(wo, h);
-      const float fd = schlickFresnel(f0Dielectric(), voh);
-      // fresnel_mix: diffuse weighted by (1 - F_dielectric), Lambert c_diff / pi.
-      glm::vec3 f = (1.f - m) * (1.f - t) * (1.f - fd) * baseColor * kInvPi;
+      const glm::vec3 fd = dielectricFresnel(voh);
+      // fresnel_mix: diffuse weighted by (1 - w max3(F_dielectric)), Lambert c_diff / pi.
+      glm::vec3 f = (1.f - m) * (1.f - t) * (1.f - specularWeight * maxComponent(fd)) * baseColor * kInvPi;
       if (!isDelta()) {
         const float a = alpha();
         const float dv = ggxD(h.z, a) * ggxVisibility(wi.z, wo.z, a);
-        const glm::vec3 fresnel = m * schlickFresnel(baseColor, voh) + glm::vec3((1.f - m) * (1.f - t) * fd) +
+        const glm::vec3 fresnel = m * schlickFresnel(baseColor, voh) + (1.f - m) * (1.f - t) * specularWeight * fd +
                                   glm::vec3((1.f - m) * t * fresnelDielectric(voh, eta));
         f += fresnel * dv;
       }
@@ -314,12 +440,38 @@ struct GltfBsdf {
     return (1.f - m) * t * ft * baseColor;
   }
 
+  // f(wo, wi) of the non-delta lobes (the deltas have no value off their direction). Not multiplied by
+  // the cosine. wi below the horizon is transmission.
+  glm::vec3 eval(const glm::vec3& wo, const glm::vec3& wi) const {
+    if (wo.z <= 0.f || wi.z == 0.f) return glm::vec3(0.f);
+    glm::vec3 f = evalBase(wo, wi);
+    if (!hasSheen() && !hasCoat()) return f;
+    f *= sheenScaling(wo.z, wi.z);
+    if (hasSheen() && wi.z > 0.f) {
+      const glm::vec3 h = glm::normalize(wo + wi);
+      f += sheenColor * (charlieD(h.z, sheenAlphaFromRoughness(sheenRoughness)) * sheenVisibility(wi.z, wo.z));
+    }
+    if (hasCoat()) {
+      const float cw = coatWeight(wo);
+      f = f * (1.f - cw) + glm::vec3(cw * coatLobe(wo, wi));
+    }
+    return f;
+  }
+
+  // Solid-angle pdf of wi = reflect(-wo, h) with h from the coat's visible normals.
+  float coatPdf(const glm::vec3& wo, const glm::vec3& wi) const {
+    if (coatIsDelta()) return 0.f;
+    const ShadingFrame cf = ShadingFrame::fromNormal(coatNormal);
+    return ggxReflectionPdf(cf.toLocal(wo), cf.toLocal(wi), alphaFromRoughness(clearcoatRoughness));
+  }
+
   // Solid-angle pdf with which sample() produces wi from its non-delta lobes.
   float pdf(const glm::vec3& wo, const glm::vec3& wi) const {
     if (wo.z <= 0.f || wi.z == 0.f) return 0.f;
     const LobeProbabilities p = lobeProbabilities(wo);
     if (wi.z > 0.f) {
-      float pdf = p.diffuse * cosineHemispherePdf(wi.z);
+      float pdf = (p.diffuse + p.sheen) * cosineHemispherePdf(wi.z);
+      if (p.coat > 0.f) pdf += p.coat * coatPdf(wo, wi);
       if (!isDelta()) {
         const float a = alpha();
         const float pr = ggxReflectionPdf(wo, wi, a);
@@ -354,12 +506,33 @@ struct GltfBsdf {
     if (wo.z <= 0.f) return false;
     const LobeProbabilities p = lobeProbabilities(wo);
     const float m = metallic, t = transmission;
-    if (uLobe < p.reflect) {
+    if (uLobe < p.coat) {
+      if (coatIsDelta()) {
+        s.wi = reflect(wo, coatNormal);
+        if (s.wi.z <= 0.f) return false;
+        s.weight = glm::vec3(coatWeight(wo) / p.coat);
+        s.pdf = 0.f;
+        s.delta = true;
+        s.flags = kLobeReflection | kLobeSpecular;
+        return true;
+      }
+      const ShadingFrame cf = ShadingFrame::fromNormal(coatNormal);
+      const glm::vec3 woC = cf.toLocal(wo);
+      if (woC.z <= 0.f) return false;
+      const glm::vec3 h = sampleGgxVndf(woC, alphaFromRoughness(clearcoatRoughness), u);
+      s.wi = cf.toWorld(reflect(woC, h));
+      if (s.wi.z <= 0.f) return false;
+      s.flags = kLobeReflection | kLobeGlossy;
+    } else if (uLobe < p.coat + p.sheen) {
+      s.wi = sampleCosineHemisphere(u);
+      if (s.wi.z <= 0.f) return false;
+      s.flags = kLobeReflection | kLobeGlossy;
+    } else if ((uLobe -= p.coat + p.sheen) < p.reflect) {
       if (isDelta()) {
         s.wi = {-wo.x, -wo.y, wo.z};
-        const glm::vec3 fr = m * schlickFresnel(baseColor, wo.z) +
-                             glm::vec3((1.f - m) * (1.f - t) * schlickFresnel(f0Dielectric(), wo.z));
-        s.weight = fr / p.reflect;
+        const glm::vec3 fr = m * schlickFresnel(baseColor, wo.z) + (1.f - m) * (1.f - t) * specularWeight *
+                                                                        dielectricFresnel(wo.z);
+        s.weight = fr * baseAttenuation(wo, s.wi) / p.reflect;
         s.pdf = 0.f;
         s.delta = true;
         s.flags = kLobeReflection | kLobeSpecular;
@@ -389,9 +562,11 @@ struct GltfBsdf {
         s.pdf = 0.f;
         s.flags = side | kLobeSpecular;
         // Lobe value (1-m) t F (reflection) or (1-m) t (1-F) base / eta^2 (refraction, radiance only),
-        // over its selection probability p.dielectric * F or p.dielectric * (1 - F).
-        s.weight = reflected ? glm::vec3((1.f - m) * t / p.dielectric)
-                             : (1.f - m) * t * baseColor * refractionScale() / p.dielectric;
+        // over its selection probability p.dielectric * F or p.dielectric * (1 - F); times what the
+        // layers above leave of it.
+        s.weight = (reflected ? glm::vec3((1.f - m) * t / p.dielectric)
+                              : (1.f - m) * t * baseColor * refractionScale() / p.dielectric) *
+                   baseAttenuation(wo, wi);
         return true;
       }
       if (reflected ? wi.z <= 0.f : wi.z >= 0.f) return false;

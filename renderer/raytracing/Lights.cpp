@@ -57,8 +57,9 @@ bool punctualLi(const Light& light, const glm::vec3& p, glm::vec3& wi, float& di
   return maxComponent(Li) > 0.f;
 }
 
-SceneLights::SceneLights(const RayScene& rays, const Image* environmentMap, glm::vec3 skyRadiance)
-    : rays_(rays), environment_(environmentMap, skyRadiance) {
+SceneLights::SceneLights(const RayScene& rays, const Image* environmentMap, glm::vec3 skyRadiance,
+                         std::shared_ptr<const EnvironmentDistribution> environmentDistribution)
+    : rays_(rays), environment_(environmentMap, skyRadiance, std::move(environmentDistribution)) {
   const Scene& scene = rays.scene();
   Bounds bounds;
   for (const MeshInstance& m : scene.meshes) bounds.extend(m.bounds);

@@ -8,6 +8,7 @@
 // doubleSided), and the environment (an equirect map or a uniform sky).
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 #include <vector>
 
@@ -59,27 +60,35 @@ inline int findInterval(const float* cdf, int n, float value) {
   return i;
 }
 
-// The environment: uniform sky or an equirectangular map importance sampled by a piecewise-constant 2D
-// distribution over texels weighted by luminance * sin(theta) (pbrt-v3 14.2.4).
+// The importance-sampling distribution of an equirectangular map: a piecewise-constant 2D distribution
+// over texels weighted by luminance * sin(theta) (pbrt-v3 14.2.4), and the map's integral over the
+// sphere. O(texels) to build, so it is derived data of the environment: FrameResources caches it per
+// environment digest and size ("environment_distribution", renderer/frame/RayScenes.h), and every
+// render with the same map reuses it.
+struct EnvironmentDistribution {
+  int width = 0, height = 0;
+  std::vector<float> conditional, marginal;  // h rows of (w + 1) CDF entries; h + 1 row sums
+  float total = 0.f;
+  glm::vec3 integral{0.f};  // \int L(w) dw, per channel
+  static std::shared_ptr<const EnvironmentDistribution> build(const Image& map);
+};
+
+// The environment: uniform sky or an equirectangular map importance sampled by its
+// EnvironmentDistribution.
 class EnvironmentLight {
 public:
   // `map` (equirect RGB(A) linear radiance) replaces `sky` when set; it must outlive the light.
-  EnvironmentLight(const Image* map, glm::vec3 sky) : map_(map), sky_(sky) {
+  // `distribution` is map's (EnvironmentDistribution::build, usually cached); built here when null.
+  EnvironmentLight(const Image* map, glm::vec3 sky, std::shared_ptr<const EnvironmentDistribution> distribution = nullptr)
+      : map_(map), sky_(sky), dist_(std::move(distribution)) {
     if (map_) {
       if (map_->width <= 0 || map_->height <= 0 || map_->channels <= 0 ||
           map_->pixels.size() < static_cast<size_t>(map_->width) * map_->height * map_->channels)
         throw std::invalid_argument("EnvironmentLight: environment image has no pixels");
-      const int w = map_->width, h = map_->height;
-      conditional_.assign(static_cast<size_t>(h) * (w + 1), 0.f);
-      marginal_.assign(h + 1, 0.f);
-      for (int y = 0; y < h; ++y) {
-        const float sinTheta = std::sin(kPi * (y + 0.5f) / h);
-        float* cdf = &conditional_[static_cast<size_t>(y) * (w + 1)];
-        for (int x = 0; x < w; ++x) cdf[x + 1] = cdf[x] + std::max(0.f, luminance(texelAt(x, y))) * sinTheta;
-        marginal_[y + 1] = marginal_[y] + cdf[w];
-      }
-      total_ = marginal_[h];
-      active_ = total_ > 0.f;
+      if (!dist_) dist_ = EnvironmentDistribution::build(*map_);
+      if (dist_->width != map_->width || dist_->height != map_->height)
+        throw std::invalid_argument("EnvironmentLight: the distribution is of another map");
+      active_ = dist_->total > 0.f;
     } else {
       active_ = maxComponent(sky_) > 0.f;
     }
@@ -87,16 +96,7 @@ public:
   bool active() const { return active_; }
 
   // \int L(w) dw over the sphere, per channel (4 pi sky for a uniform sky).
-  glm::vec3 integral() const {
-    if (!map_) return 4.f * kPi * sky_;
-    const int w = map_->width, h = map_->height;
-    glm::dvec3 sum(0.0);
-    for (int y = 0; y < h; ++y) {
-      const double dOmega = 2.0 * kPi * kPi * std::sin(kPi * (y + 0.5) / h) / (double(w) * h);
-      for (int x = 0; x < w; ++x) sum += dOmega * glm::dvec3(texelAt(x, y));
-    }
-    return glm::vec3(sum);
-  }
+  glm::vec3 integral() const { return map_ ? dist_->integral : 4.f * kPi * sky_; }
 
   glm::vec3 radiance(const glm::vec3& dir) const {
     if (!map_) return sky_;
@@ -113,8 +113,8 @@ public:
     int x, y;
     texelOf(dir, x, y);
     const int w = map_->width, h = map_->height;
-    const float* cdf = &conditional_[static_cast<size_t>(y) * (w + 1)];
-    const float p = (cdf[x + 1] - cdf[x]) / total_;  // discrete texel probability
+    const float* cdf = &dist_->conditional[static_cast<size_t>(y) * (w + 1)];
+    const float p = (cdf[x + 1] - cdf[x]) / dist_->total;  // discrete texel probability
     return p * w * h / (2.f * kPi * kPi * sinTheta);  // uv density -> solid angle: dw = 2 pi^2 sin(theta) du dv
   }
 
@@ -124,10 +124,11 @@ public:
       return sampleUniformSphere(u);
     }
     const int w = map_->width, h = map_->height;
-    const int y = findInterval(marginal_.data(), h, u.y * total_);
-    const float rowLo = marginal_[y], rowHi = marginal_[y + 1];
-    const float fy = rowHi > rowLo ? std::clamp((u.y * total_ - rowLo) / (rowHi - rowLo), 0.f, 1.f) : 0.5f;
-    const float* cdf = &conditional_[static_cast<size_t>(y) * (w + 1)];
+    const float total = dist_->total;
+    const int y = findInterval(dist_->marginal.data(), h, u.y * total);
+    const float rowLo = dist_->marginal[y], rowHi = dist_->marginal[y + 1];
+    const float fy = rowHi > rowLo ? std::clamp((u.y * total - rowLo) / (rowHi - rowLo), 0.f, 1.f) : 0.5f;
+    const float* cdf = &dist_->conditional[static_cast<size_t>(y) * (w + 1)];
     const int x = findInterval(cdf, w, u.x * cdf[w]);
     const float colLo = cdf[x], colHi = cdf[x + 1];
     const float fx = colHi > colLo ? std::clamp((u.x * cdf[w] - colLo) / (colHi - colLo), 0.f, 1.f) : 0.5f;
@@ -136,7 +137,7 @@ public:
     const float sinTheta = std::sin(theta);
     const glm::vec3 dir(sinTheta * std::sin(phi), std::cos(theta), -sinTheta * std::cos(phi));
     if (sinTheta <= 0.f) { pdfOut = 0.f; return dir; }
-    pdfOut = (colHi - colLo) / total_ * w * h / (2.f * kPi * kPi * sinTheta);
+    pdfOut = (colHi - colLo) / total * w * h / (2.f * kPi * kPi * sinTheta);
     return dir;
   }
 
@@ -148,10 +149,34 @@ private:
   void texelOf(const glm::vec3& dir, int& x, int& y) const { equirectTexel(*map_, dir, x, y); }
   const Image* map_;
   glm::vec3 sky_;
-  std::vector<float> conditional_, marginal_;
-  float total_ = 0.f;
+  std::shared_ptr<const EnvironmentDistribution> dist_;
   bool active_ = false;
 };
+
+inline std::shared_ptr<const EnvironmentDistribution> EnvironmentDistribution::build(const Image& map) {
+  auto d = std::make_shared<EnvironmentDistribution>();
+  const int w = map.width, h = map.height;
+  d->width = w;
+  d->height = h;
+  d->conditional.assign(static_cast<size_t>(h) * (w + 1), 0.f);
+  d->marginal.assign(h + 1, 0.f);
+  glm::dvec3 sum(0.0);
+  for (int y = 0; y < h; ++y) {
+    const float sinTheta = std::sin(kPi * (y + 0.5f) / h);
+    const double dOmega = 2.0 * kPi * kPi * std::sin(kPi * (y + 0.5) / h) / (double(w) * h);
+    float* cdf = &d->conditional[static_cast<size_t>(y) * (w + 1)];
+    for (int x = 0; x < w; ++x) {
+      const float* p = map.at(x, y);
+      const glm::vec3 L = map.channels >= 3 ? glm::vec3(p[0], p[1], p[2]) : glm::vec3(p[0]);
+      cdf[x + 1] = cdf[x] + std::max(0.f, luminance(L)) * sinTheta;
+      sum += dOmega * glm::dvec3(L);
+    }
+    d->marginal[y + 1] = d->marginal[y] + cdf[w];
+  }
+  d->total = d->marginal[h];
+  d->integral = glm::vec3(sum);
+  return d;
+}
 
 
 // A photon (or light-tracing particle) leaving an emitter: the ray and its flux, already divided by
@@ -175,7 +200,9 @@ public:
 
   // The environment (map or sky) and the emitters of `rays`' scene. Directional lights and the
   // environment emit through a disk around the scene's bounding sphere.
-  SceneLights(const RayScene& rays, const Image* environmentMap, glm::vec3 skyRadiance);
+  // `environmentDistribution`: environmentMap's, when the caller has it cached (built here otherwise).
+  SceneLights(const RayScene& rays, const Image* environmentMap, glm::vec3 skyRadiance,
+              std::shared_ptr<const EnvironmentDistribution> environmentDistribution = nullptr);
 
   const EnvironmentLight& environment() const { return environment_; }
   const std::vector<Emitter>& emitters() const { return emitters_; }

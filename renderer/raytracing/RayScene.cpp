@@ -274,16 +274,24 @@ Shading RayScene::shade(const SurfaceHit& hit, const glm::vec3& wo, TransportMod
   s.bsdf.transmission = params.surface.z;
   s.bsdf.mode = mode;
   s.bsdf.ior = params.surface.w;
+  s.bsdf.clearcoat = params.clearcoat.x;
+  s.bsdf.clearcoatRoughness = params.clearcoat.y;
+  s.bsdf.sheenColor = glm::vec3(params.sheen);
+  s.bsdf.sheenRoughness = params.sheen.w;
+  s.bsdf.specularColor = glm::vec3(params.specular);
+  s.bsdf.specularWeight = params.specular.w;
   const bool front = glm::dot(wo, hit.ng) >= 0.f;
   s.bsdf.eta = front ? s.bsdf.ior : 1.f / s.bsdf.ior;
   s.ngFacing = front ? hit.ng : -hit.ng;
 
   // Shading normal: interpolated vertex normal, normal-mapped when a tangent frame exists.
   glm::vec3 ns = hit.ng;
+  glm::vec3 coat = s.ngFacing;  // KHR_materials_clearcoat: the interpolated normal, not normal-mapped
   const std::uint32_t* i = &m.indices[static_cast<size_t>(hit.prim) * 3];
   if (m.normals.size() == m.positions.size()) {
     const glm::vec3 n = hit.b0 * m.normals[i[0]] + hit.b1 * m.normals[i[1]] + hit.b2 * m.normals[i[2]];
     if (glm::dot(n, n) > 0.f) ns = glm::normalize(n);
+    coat = ns;
     if (mat.normalTexture.valid() && m.tangents.size() == m.positions.size()) {
       const glm::vec4 t4 = hit.b0 * m.tangents[i[0]] + hit.b1 * m.tangents[i[1]] + hit.b2 * m.tangents[i[2]];
       glm::vec3 t = glm::vec3(t4) - ns * glm::dot(ns, glm::vec3(t4));
@@ -300,10 +308,14 @@ Shading RayScene::shade(const SurfaceHit& hit, const glm::vec3& wo, TransportMod
     if (glm::dot(ns, hit.ng) < 0.f) ns = -ns;  // normals inconsistent with the winding
     if (!front) ns = -ns;
     if (glm::dot(ns, wo) <= 1e-4f) ns = s.ngFacing;  // wo under the shading hemisphere
+    if (glm::dot(coat, hit.ng) < 0.f) coat = -coat;
+    if (!front) coat = -coat;
+    if (glm::dot(coat, wo) <= 1e-4f) coat = s.ngFacing;
   } else {
     ns = s.ngFacing;
   }
   s.frame = ShadingFrame::fromNormal(ns);
+  s.bsdf.coatNormal = s.frame.toLocal(coat);
   return s;
 }
 

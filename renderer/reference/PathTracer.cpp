@@ -259,7 +259,7 @@ Image PathTracer::render(const Camera& camera, int width, int height, const Refe
     throw std::invalid_argument("PathTracer::render(): aoRadius must be > 0");
   if (options.maxBounces < 0) throw std::invalid_argument("PathTracer::render(): maxBounces must be >= 0");
 
-  const SceneLights lights(*impl_->rays, options.environment, options.skyRadiance);
+  const SceneLights lights(*impl_->rays, options.environment, options.skyRadiance, options.environmentDistribution);
   const char* aov = options.mode == ReferenceOptions::Mode::Radiance ? "beauty" : "ao";
   Image image = Image::make(aov, width, height, 3);
   const int tilesX = (width + kTileSize - 1) / kTileSize, tilesY = (height + kTileSize - 1) / kTileSize;

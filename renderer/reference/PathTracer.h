@@ -65,7 +65,10 @@
 #include "renderer/Image.h"
 #include "renderer/scene/Scene.h"
 
-namespace radiant::rt { class RayScene; }
+namespace radiant::rt {
+class RayScene;
+struct EnvironmentDistribution;
+}  // namespace radiant::rt
 
 namespace radiant::reference {
 
@@ -79,6 +82,8 @@ struct ReferenceOptions {
   float aoRadius = 1.f;
   glm::vec3 skyRadiance{0.f};          // uniform environment radiance
   const Image* environment = nullptr;  // equirect RGB(A) linear radiance, optional; overrides skyRadiance
+  // environment's importance-sampling distribution when the caller has it cached (built per render otherwise)
+  std::shared_ptr<const rt::EnvironmentDistribution> environmentDistribution;
   int threads = 0;                     // 0 = TBB default
   // Called with the fraction of tiles done, from worker threads (keep it cheap and thread-safe).
   std::function<void(double)> progress;

@@ -15,6 +15,9 @@ const std::vector<std::string>& supportedExtensions() {
       "KHR_materials_transmission",
       "KHR_materials_ior",
       "KHR_materials_emissive_strength",
+      "KHR_materials_clearcoat",  // factors; its textures are listed in stats.warnings
+      "KHR_materials_sheen",      // factors; its textures are listed in stats.warnings
+      "KHR_materials_specular",   // factors; its textures are listed in stats.warnings
       "KHR_mesh_quantization",  // any component type is read and normalised
       "KHR_texture_transform",
       "KHR_materials_unlit",
@@ -69,10 +72,6 @@ void checkExtensions(const nlohmann::json& doc, std::vector<std::string>& warnin
                            "were absent");
     }
   }
-  if (const auto it = doc.find("materials"); it != doc.end() && it->is_array())
-    for (std::size_t i = 0; i < it->size(); ++i)
-      if ((*it)[i].is_object() && (*it)[i].value("alphaMode", "") == "BLEND")
-        warnings.push_back("/materials/" + std::to_string(i) + ": alphaMode BLEND is rendered opaque");
 }
 
 void textureTransformRows(glm::vec2 offset, float rotation, glm::vec2 scale, glm::vec3& row0, glm::vec3& row1) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <initializer_list>
 #include <limits>
 #include <numeric>
 #include <optional>
@@ -649,6 +650,38 @@ private:
       if (const auto* e = extension(g.extensions, "KHR_materials_ior")) mat.ior = number(*e, "ior", 1.5f);
       if (const auto* e = extension(g.extensions, "KHR_materials_emissive_strength"))
         mat.emissiveStrength = number(*e, "emissiveStrength", 1.f);
+      // The layered extensions: their factors are rendered; their textures are not read yet, and a
+      // material that has one says so in stats.warnings rather than losing it silently.
+      auto ignoredTextures = [&](const tinygltf::Value& e, const char* ext,
+                                 std::initializer_list<const char*> names) {
+        for (const char* t : names)
+          if (e.Has(t)) scene_.warnings.push_back(ep + ext + "/" + t + ": ignored (textures of " + ext +
+                                                  " are not supported yet; its factor is used)");
+      };
+      auto color3 = [](const tinygltf::Value& e, const char* key, glm::vec3 fallback) {
+        if (!e.Has(key)) return fallback;
+        const tinygltf::Value& a = e.Get(key);
+        if (!a.IsArray() || a.ArrayLen() != 3) return fallback;
+        glm::vec3 c;
+        for (int k = 0; k < 3; ++k) c[k] = a.Get(k).IsNumber() ? float(a.Get(k).GetNumberAsDouble()) : fallback[k];
+        return c;
+      };
+      if (const auto* e = extension(g.extensions, "KHR_materials_clearcoat")) {
+        mat.clearcoatFactor = std::clamp(number(*e, "clearcoatFactor", 0.f), 0.f, 1.f);
+        mat.clearcoatRoughnessFactor = std::clamp(number(*e, "clearcoatRoughnessFactor", 0.f), 0.f, 1.f);
+        ignoredTextures(*e, "KHR_materials_clearcoat",
+                        {"clearcoatTexture", "clearcoatRoughnessTexture", "clearcoatNormalTexture"});
+      }
+      if (const auto* e = extension(g.extensions, "KHR_materials_sheen")) {
+        mat.sheenColorFactor = glm::clamp(color3(*e, "sheenColorFactor", glm::vec3(0.f)), 0.f, 1.f);
+        mat.sheenRoughnessFactor = std::clamp(number(*e, "sheenRoughnessFactor", 0.f), 0.f, 1.f);
+        ignoredTextures(*e, "KHR_materials_sheen", {"sheenColorTexture", "sheenRoughnessTexture"});
+      }
+      if (const auto* e = extension(g.extensions, "KHR_materials_specular")) {
+        mat.specularFactor = std::clamp(number(*e, "specularFactor", 1.f), 0.f, 1.f);
+        mat.specularColorFactor = glm::max(color3(*e, "specularColorFactor", glm::vec3(1.f)), 0.f);
+        ignoredTextures(*e, "KHR_materials_specular", {"specularTexture", "specularColorTexture"});
+      }
       scene_.materials.push_back(std::move(mat));
     }
   }

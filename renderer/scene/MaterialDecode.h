@@ -40,6 +40,16 @@ glm::vec3 decodeEmission(const Material& m, Texel&& texel) {
   return e;
 }
 
+// The layered extensions (factors only): KHR_materials_clearcoat, _sheen, _specular, clamped to their
+// ranges (decodeLayers() of material.glsl).
+inline void decodeLayers(const Material& m, gpu::MaterialParams& p) {
+  p.clearcoat = glm::vec4(std::clamp(m.clearcoatFactor, 0.f, 1.f), std::clamp(m.clearcoatRoughnessFactor, 0.f, 1.f),
+                          0.f, 0.f);
+  p.sheen = glm::vec4(glm::clamp(m.sheenColorFactor, 0.f, 1.f),
+                      std::clamp(m.sheenRoughnessFactor, gpu::kMinSheenRoughness, 1.f));
+  p.specular = glm::vec4(glm::max(m.specularColorFactor, 0.f), std::clamp(m.specularFactor, 0.f, 1.f));
+}
+
 // What the BSDF reads (baseColor, surface), without the emission and occlusion lookups: the ray
 // tracer's shade() needs only these. emission is (0, 0, 0, 1). glTF 3.9.2: metallic = blue, roughness
 // = green of metallicRoughnessTexture; KHR_materials_transmission: red channel of transmissionTexture.
@@ -60,6 +70,7 @@ gpu::MaterialParams decodeBsdfInputs(const Material& m, Texel&& texel) {
   p.emission = glm::vec4(0.f, 0.f, 0.f, 1.f);
   p.surface = glm::vec4(std::clamp(metallic, 0.f, 1.f), std::clamp(roughness, 0.f, 1.f),
                         std::clamp(transmission, 0.f, 1.f), ior);
+  decodeLayers(m, p);
   return p;
 }
 

@@ -70,6 +70,12 @@ struct Material {
   float emissiveStrength = 1.f;  // KHR_materials_emissive_strength
   float transmissionFactor = 0.f;  // KHR_materials_transmission
   float ior = 1.5f;                // KHR_materials_ior
+  float clearcoatFactor = 0.f;           // KHR_materials_clearcoat
+  float clearcoatRoughnessFactor = 0.f;
+  glm::vec3 sheenColorFactor{0.f};       // KHR_materials_sheen
+  float sheenRoughnessFactor = 0.f;
+  float specularFactor = 1.f;            // KHR_materials_specular
+  glm::vec3 specularColorFactor{1.f};
   TextureRef baseColorTexture, metallicRoughnessTexture, normalTexture, occlusionTexture,
       emissiveTexture, transmissionTexture;
   bool doubleSided = false;

@@ -9,6 +9,7 @@
 #include "renderer/techniques/reference/ReferencePass.h"
 #include "renderer/techniques/shadow_maps/ShadowMaps.h"
 #include "renderer/techniques/specular/Specular.h"
+#include "renderer/techniques/transparency/Transparency.h"
 
 namespace radiant {
 
@@ -24,6 +25,7 @@ std::vector<std::unique_ptr<Technique>> createTechniques() {
   t.push_back(std::make_unique<LightVolumesPass>());
   t.push_back(std::make_unique<SpecularPass>());
   t.push_back(std::make_unique<AmbientOcclusionPass>());
+  t.push_back(std::make_unique<TransparencyPass>());  // last of the beauty passes: composites over them
   t.push_back(std::make_unique<ReferencePass>());
   return t;
 }

@@ -68,25 +68,63 @@ float fresnelDielectric(float cosThetaI, float eta) {
   return 0.5 * (rs * rs + rp * rp);
 }
 
-// f(wo, wi) |n.wi| for the decoded material p. n, wo, wi unit vectors, wo on n's side; wi below the
-// surface is transmission. eta = n_(far side) / n_(wo side): ior seen from outside, 1 / ior inside.
-vec3 gltfBsdfCos(vec3 n, vec3 wo, vec3 wi, MaterialParams p, float eta) {
+// KHR_materials_sheen: Charlie D (Estevez and Kulla 2017, eq. 2) and Ashikhmin's visibility (Neubelt and
+// Pettineo 2013), and the directional albedo E(mu, r) from the table rt::sheenAlbedoTable() builds
+// (GpuScene uploads it at kBindingSheenAlbedo), interpolated as rt::sheenAlbedo does.
+layout(std430, binding = kBindingSheenAlbedo) readonly buffer SheenAlbedoTable { float sheenAlbedoTable[]; };
+float charlieD(float NdotH, float alpha) {
+  if (NdotH <= 0.0) return 0.0;
+  float invA = 1.0 / alpha;
+  float sin2 = max(0.0, 1.0 - NdotH * NdotH);
+  return (2.0 + invA) * pow(sin2, 0.5 * invA) / (2.0 * PI);
+}
+float sheenVisibility(float NdotL, float NdotV) {
+  if (NdotL <= 0.0 || NdotV <= 0.0) return 0.0;
+  return 1.0 / (4.0 * (NdotL + NdotV - NdotL * NdotV));
+}
+float sheenAlbedo(float mu, float roughness) {
+  const int N = kSheenAlbedoSize;
+  float x = clamp(mu, 0.0, 1.0) * float(N - 1);
+  float y = clamp((roughness - kMinSheenRoughness) / (1.0 - kMinSheenRoughness), 0.0, 1.0) * float(N - 1);
+  int x0 = min(int(x), N - 2), y0 = min(int(y), N - 2);
+  float fx = x - float(x0), fy = y - float(y0);
+  float a = sheenAlbedoTable[y0 * N + x0] + (sheenAlbedoTable[y0 * N + x0 + 1] - sheenAlbedoTable[y0 * N + x0]) * fx;
+  float b = sheenAlbedoTable[(y0 + 1) * N + x0] +
+            (sheenAlbedoTable[(y0 + 1) * N + x0 + 1] - sheenAlbedoTable[(y0 + 1) * N + x0]) * fx;
+  return a + (b - a) * fy;
+}
+float maxComponent(vec3 c) { return max(c.r, max(c.g, c.b)); }
+bool materialHasSheen(MaterialParams p) { return maxComponent(p.sheen.rgb) > 0.0; }
+// min(1 - max3(c) E(|n.v|), 1 - max3(c) E(|n.l|)), 1 without sheen.
+float sheenScaling(MaterialParams p, float cosO, float cosI) {
+  if (!materialHasSheen(p)) return 1.0;
+  float c = maxComponent(p.sheen.rgb);
+  return max(0.0, min(1.0 - c * sheenAlbedo(abs(cosO), p.sheen.a), 1.0 - c * sheenAlbedo(abs(cosI), p.sheen.a)));
+}
+// KHR_materials_clearcoat: the coat's mix weight clearcoat Fc(|n_c.v|), F0 0.04.
+float coatWeight(MaterialParams p, vec3 nc, vec3 wo) {
+  return p.clearcoat.x > 0.0 ? p.clearcoat.x * schlickFresnel(kClearcoatF0, abs(dot(nc, wo))) : 0.0;
+}
+// KHR_materials_specular: the opaque dielectric's F0 = min(F0(ior) specularColor, 1).
+vec3 specularF0(MaterialParams p) { return min(f0FromIor(p.surface.w) * p.specular.rgb, vec3(1.0)); }
+
+// f(wo, wi) |n.wi| of the base material (metal, dielectric, transmission), without the layers.
+vec3 gltfBaseBsdfCos(vec3 n, vec3 wo, vec3 wi, MaterialParams p, float eta) {
   float NdotV = dot(n, wo);
   float NdotL = dot(n, wi);
-  if (NdotV <= 0.0 || NdotL == 0.0) return vec3(0.0);
   vec3 base = p.baseColor.rgb;
-  float m = p.surface.x, roughness = p.surface.y, t = p.surface.z, ior = p.surface.w;
+  float m = p.surface.x, roughness = p.surface.y, t = p.surface.z, w = p.specular.a;
   bool delta = roughness <= 0.0;
   float alpha = max(roughness * roughness, kMinGgxAlpha);
   if (NdotL > 0.0) {
     vec3 h = normalize(wo + wi);
     float VdotH = dot(wo, h);
-    float fd = schlickFresnel(f0FromIor(ior), VdotH);
-    // fresnel_mix: the diffuse lobe weighted by (1 - F_dielectric), Lambert c_diff / pi.
-    vec3 f = (1.0 - m) * (1.0 - t) * (1.0 - fd) * base * INV_PI;
+    vec3 fd = schlickFresnel(specularF0(p), VdotH);
+    // fresnel_mix: the diffuse lobe weighted by (1 - w max3(F_dielectric)), Lambert c_diff / pi.
+    vec3 f = (1.0 - m) * (1.0 - t) * (1.0 - w * maxComponent(fd)) * base * INV_PI;
     if (!delta) {
       float dv = ggxD(dot(n, h), alpha) * smithVisibility(NdotL, NdotV, alpha);
-      vec3 fresnel = m * schlickFresnel(base, VdotH) + vec3((1.0 - m) * (1.0 - t) * fd) +
+      vec3 fresnel = m * schlickFresnel(base, VdotH) + (1.0 - m) * (1.0 - t) * w * fd +
                      vec3((1.0 - m) * t * fresnelDielectric(VdotH, eta));
       f += fresnel * dv;
     }
@@ -109,6 +147,37 @@ vec3 gltfBsdfCos(vec3 n, vec3 wo, vec3 wi, MaterialParams p, float eta) {
   return (1.0 - m) * t * ft * base * abs(NdotL);
 }
 
+// f(wo, wi) |n.wi| for the decoded material p with its layers (sheen over the base, the clear coat over
+// both; rt::GltfBsdf::eval). n the shading normal, nc the coat's normal (the interpolated normal, not
+// normal-mapped), wo, wi unit vectors, wo on n's side; wi below the surface is transmission.
+// eta = n_(far side) / n_(wo side): ior seen from outside, 1 / ior inside.
+vec3 gltfBsdfCos(vec3 n, vec3 nc, vec3 wo, vec3 wi, MaterialParams p, float eta) {
+  float NdotV = dot(n, wo);
+  float NdotL = dot(n, wi);
+  if (NdotV <= 0.0 || NdotL == 0.0) return vec3(0.0);
+  vec3 f = gltfBaseBsdfCos(n, wo, wi, p, eta);
+  bool sheen = materialHasSheen(p);
+  if (!sheen && p.clearcoat.x <= 0.0) return f;
+  f *= sheenScaling(p, NdotV, NdotL);
+  if (sheen && NdotL > 0.0) {
+    vec3 h = normalize(wo + wi);
+    float as = p.sheen.a * p.sheen.a;
+    f += p.sheen.rgb * (charlieD(dot(n, h), as) * sheenVisibility(NdotL, NdotV) * NdotL);
+  }
+  if (p.clearcoat.x > 0.0) {
+    float cw = coatWeight(p, nc, wo);
+    float coat = 0.0;
+    float cO = dot(nc, wo), cI = dot(nc, wi);
+    if (p.clearcoat.y > 0.0 && cO > 0.0 && cI > 0.0) {
+      float a = max(p.clearcoat.y * p.clearcoat.y, kMinGgxAlpha);
+      coat = ggxD(dot(nc, normalize(wo + wi)), a) * smithVisibility(cI, cO, a);
+    }
+    f = f * (1.0 - cw) + vec3(cw * coat * abs(NdotL));
+  }
+  return f;
+}
+vec3 gltfBsdfCos(vec3 n, vec3 wo, vec3 wi, MaterialParams p, float eta) { return gltfBsdfCos(n, n, wo, wi, p, eta); }
+
 // The surface seen from outside (eta = ior), as every raster pass sees it.
 vec3 gltfBrdfCos(vec3 n, vec3 wo, vec3 wi, MaterialParams p) { return gltfBsdfCos(n, wo, wi, p, p.surface.w); }
 
@@ -117,6 +186,9 @@ MaterialParams materialParams(vec3 baseColor, float metallic, float roughness, f
   p.baseColor = vec4(baseColor, 1.0);
   p.emission = vec4(0.0, 0.0, 0.0, 1.0);
   p.surface = vec4(metallic, roughness, transmission, ior);
+  p.clearcoat = vec4(0.0);
+  p.sheen = vec4(0.0, 0.0, 0.0, kMinSheenRoughness);
+  p.specular = vec4(1.0);
   return p;
 }
 

@@ -62,15 +62,19 @@ float shadowVisibility(int li, vec3 p, vec3 ng, float lightDist) {
 
 // Sum over lights of f(wi, wo) cos(theta_i) E_light V_shadow (no emission). n is the shading normal
 // (facing wo), ng the geometric normal on the same side (used for the shadow normal offset).
-vec3 directLighting(vec3 p, vec3 n, vec3 ng, vec3 wo, MaterialParams material) {
+// nc is the clear coat's normal (KHR_materials_clearcoat; n when there is no coat).
+vec3 directLighting(vec3 p, vec3 n, vec3 nc, vec3 ng, vec3 wo, MaterialParams material) {
   vec3 L = vec3(0.0);
   for (int i = 0; i < u_lightCount; ++i) {
     LightSample s = sampleLight(lights[i], p);
-    vec3 f = gltfBrdfCos(n, wo, s.wi, material);
+    vec3 f = gltfBsdfCos(n, nc, wo, s.wi, material, material.surface.w);
     if (all(equal(f, vec3(0.0)))) continue;
     L += f * s.intensity * shadowVisibility(i, p, ng, s.dist);
   }
   return L;
+}
+vec3 directLighting(vec3 p, vec3 n, vec3 ng, vec3 wo, MaterialParams material) {
+  return directLighting(p, n, n, ng, wo, material);
 }
 // The former positional signature, kept for callers not yet on MaterialParams.
 vec3 directLighting(vec3 p, vec3 n, vec3 ng, vec3 wo, vec3 albedo, float metallic, float roughness,

@@ -56,6 +56,32 @@ vec3 iblSpecular(sampler2D dfg, sampler2DArray map, vec3 n, vec3 wo, vec3 baseCo
   return iblPrefiltered(map, r, roughness) * scale;
 }
 
+#ifdef RADIANT_COMMON_BRDF
+// The split-sum of the whole layered material (common/brdf.glsl's gltfBsdfCos): the base's specular
+// with KHR_materials_specular's F0 = min(F0(ior) specularColor, 1) and weight w, under the sheen and the
+// clear coat; the sheen's reflection of the irradiance, c E(mu) E(n) / pi (exact for a uniform sky); the
+// coat's own lobe, Lpre(R_c, r_c) cw (A_c + B_c) (its layer is D V with the Fresnel in the mix weight cw).
+// The base's attenuation by the layers is taken at mu: (1 - cw(wo)) (1 - max3(c) E(mu)).
+vec3 iblSpecular(sampler2D dfg, sampler2DArray map, vec3 n, vec3 nc, vec3 wo, MaterialParams p) {
+  float mu = max(dot(n, wo), 0.0);
+  float m = p.surface.x, roughness = p.surface.y;
+  vec3 ab = iblDfg(dfg, mu, roughness);
+  vec3 r = reflect(-wo, n);
+  vec3 scale = (1.0 - m) * p.specular.a * (specularF0(p) * ab.x + ab.y) + m * (p.baseColor.rgb * ab.x + ab.y);
+  vec3 L = iblPrefiltered(map, r, roughness) * scale;
+  if (materialHasSheen(p)) {
+    float e = sheenAlbedo(mu, p.sheen.a);
+    L = L * max(0.0, 1.0 - maxComponent(p.sheen.rgb) * e) + p.sheen.rgb * e * iblIrradiance(n) * INV_PI;
+  }
+  if (p.clearcoat.x > 0.0) {
+    float cw = coatWeight(p, nc, wo);
+    vec3 abc = iblDfg(dfg, max(dot(nc, wo), 0.0), p.clearcoat.y);
+    L = L * (1.0 - cw) + cw * (abc.x + abc.y) * iblPrefiltered(map, reflect(-wo, nc), p.clearcoat.y);
+  }
+  return L;
+}
+#endif
+
 // The diffuse weight glTF's fresnel_mix leaves the base: (1 - f0)(1 - Dp(mu)).
 float iblDiffuseWeight(sampler2D dfg, float mu, float ior) {
   return (1.0 - iblF0Dielectric(ior)) * (1.0 - iblDfg(dfg, mu, 1.0).z);

@@ -8,6 +8,7 @@
 // it before the include, e.g. as textureLod(sampler, uv, 0.0).
 #ifndef RADIANT_COMMON_MATERIAL
 #define RADIANT_COMMON_MATERIAL
+#include "common/octahedral.glsl"
 #include "common/scene.glsl"
 
 #ifndef MATERIAL_SAMPLE
@@ -76,12 +77,30 @@ MaterialParams decodeMaterial(Material m, vec2 uv0, vec2 uv1) {
   p.baseColor = vec4(clamp(base.rgb, 0.0, 1.0), base.a);
   p.emission = vec4(decodeEmission(m, uv0, uv1), occlusion);
   p.surface = vec4(clamp(metallic, 0.0, 1.0), clamp(roughness, 0.0, 1.0), clamp(transmission, 0.0, 1.0), ior);
+  // KHR_materials_clearcoat, _sheen, _specular (factors only), clamped to their ranges.
+  p.clearcoat = vec4(clamp(m.clearcoat.x, 0.0, 1.0), clamp(m.clearcoat.y, 0.0, 1.0), 0.0, 0.0);
+  p.sheen = vec4(clamp(m.sheen.rgb, 0.0, 1.0), clamp(m.sheen.a, kMinSheenRoughness, 1.0));
+  p.specular = vec4(max(m.specular.rgb, vec3(0.0)), clamp(m.specular.a, 0.0, 1.0));
   return p;
 }
 
 vec3 materialSafeNormalize(vec3 v, vec3 fallback) {
   float l2 = dot(v, v);
   return l2 > 1e-30 ? v * inversesqrt(l2) : fallback;
+}
+
+// The G-buffer's `gbuffer_layers` target (docs/GBUFFER.md): x = halves (clear coat, coat roughness),
+// y = the coat normal octahedron-encoded in two snorm16 (Cigolle et al. 2014), z = halves (sheen r, g),
+// w = halves (sheen b, sheen roughness). decodeLayers() is its inverse.
+uvec4 encodeLayers(MaterialParams p, vec3 coatNormal) {
+  return uvec4(packHalf2x16(p.clearcoat.xy), packSnorm2x16(octEncode(coatNormal)), packHalf2x16(p.sheen.rg),
+               packHalf2x16(p.sheen.ba));
+}
+// Fills p.clearcoat and p.sheen from the target and returns the coat normal.
+vec3 decodeLayers(uvec4 layers, inout MaterialParams p) {
+  p.clearcoat = vec4(unpackHalf2x16(layers.x), 0.0, 0.0);
+  p.sheen = vec4(unpackHalf2x16(layers.z), unpackHalf2x16(layers.w));
+  return octDecode(unpackSnorm2x16(layers.y));
 }
 
 // The normal-mapped shading normal (glTF 3.9.3): n is the interpolated vertex normal (on the front

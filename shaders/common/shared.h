@@ -24,6 +24,15 @@
 RADIANT_CONST float kMinGgxAlpha = 1e-3;
 // Index of refraction when a material gives none (glTF default, KHR_materials_ior).
 RADIANT_CONST float kDefaultIor = 1.5;
+// KHR_materials_clearcoat: the coat is a dielectric of index 1.5, F0 = ((1 - 1.5) / (1 + 1.5))^2.
+RADIANT_CONST float kClearcoatF0 = 0.04;
+// KHR_materials_sheen: sheen roughness is clamped to [kMinSheenRoughness, 1] (Charlie alpha = r^2), so the
+// exponent 1 / alpha of sin(theta_h) stays below ~204 and the directional-albedo table resolves it.
+RADIANT_CONST float kMinSheenRoughness = 0.07;
+// The sheen directional-albedo table E(mu, r) (Bsdf.h rt::sheenAlbedoTable, read by both languages with
+// the same bilinear interpolation): kSheenAlbedoSize^2 floats, row r_j = j / (size - 1) over the
+// clamped roughness, column mu_i = i / (size - 1).
+RADIANT_CONST int kSheenAlbedoSize = 32;
 
 // ---------------------------------------------------------------------------------------------------
 // Texture units. Every sampler of every program has its own unit, so a pass can bind anything it
@@ -47,12 +56,15 @@ RADIANT_CONST int kUnitLdmDistance = 18;
 RADIANT_CONST int kUnitIblDfg = 19;       // image-based lighting: split-sum DFG table (direct, ambient_occlusion)
 RADIANT_CONST int kUnitIblPrefiltered = 20;  // image-based lighting: GGX-prefiltered environment (direct)
 RADIANT_CONST int kUnitAoEmission = 21;   // ambient_occlusion resolve: the emission target (a = ior)
-RADIANT_CONST int kUnitCount = 22;        // units used; GL 4.5 guarantees 16, every driver we run has 32
+RADIANT_CONST int kUnitGbufferLayers = 22;    // direct: the G-buffer's gbuffer_layers (KHR_materials_clearcoat, sheen)
+RADIANT_CONST int kUnitGbufferSpecular = 23;  // direct: the G-buffer's gbuffer_specular (KHR_materials_specular)
+RADIANT_CONST int kUnitCount = 24;        // units used; GL 4.5 guarantees 16, every driver we run has 32
 
 // Shader storage bindings of the scene buffers.
 RADIANT_CONST int kBindingMaterials = 0;
 RADIANT_CONST int kBindingLights = 1;
 RADIANT_CONST int kBindingShadows = 2;
+RADIANT_CONST int kBindingSheenAlbedo = 7;  // float[kSheenAlbedoSize^2] (GpuScene::sheenAlbedo)
 
 // ---------------------------------------------------------------------------------------------------
 // Lights.
@@ -97,6 +109,10 @@ struct Material {
   // KHR_texture_transform per slot: rows 2 slot and 2 slot + 1 of uv' = M (u, v, 1) (xyz used, w 0);
   // identity rows for a slot without the extension.
   vec4 uvTransform[2 * kSlotCount];
+  // Layered extensions (factors; their textures are not read yet and are listed in stats.warnings).
+  vec4 clearcoat;  // KHR_materials_clearcoat: x clearcoatFactor, y clearcoatRoughnessFactor, zw unused
+  vec4 sheen;      // KHR_materials_sheen: rgb sheenColorFactor, a sheenRoughnessFactor
+  vec4 specular;   // KHR_materials_specular: rgb specularColorFactor, a specularFactor
 };
 
 // The material decoded at a surface point (factors x textures): what the BRDF reads. gltfBrdfCos
@@ -105,6 +121,10 @@ struct MaterialParams {
   vec4 baseColor;  // rgb linear base colour clamped to [0,1], a alpha (coverage)
   vec4 emission;   // rgb emitted radiance, a ambient occlusion (1 = none)
   vec4 surface;    // x metallic, y roughness (both clamped to [0,1]), z transmission in [0,1], w ior
+  vec4 clearcoat;  // x coat weight in [0,1], y coat roughness in [0,1], zw 0 (KHR_materials_clearcoat)
+  vec4 sheen;      // rgb sheen colour in [0,1], a sheen roughness in [kMinSheenRoughness,1] (KHR_materials_sheen)
+  vec4 specular;   // rgb specular colour (>= 0), a specular weight in [0,1] (KHR_materials_specular):
+                   // dielectric F0 = min(F0(ior) rgb, 1), F90 = 1, scaled by a; (1, 1, 1, 1) without it
 };
 
 #endif

@@ -3,6 +3,7 @@
 #include "common/direct_lighting.glsl"
 #include "common/environment.glsl"
 #include "common/ibl.glsl"
+#include "common/material.glsl"
 
 in vec2 v_uv;
 
@@ -12,6 +13,8 @@ layout(binding = 2) uniform sampler2D t_albedo;
 layout(binding = 3) uniform sampler2D t_material;
 layout(binding = 4) uniform sampler2D t_emission;
 layout(binding = 5) uniform sampler2D t_geoNormal;
+layout(binding = kUnitGbufferLayers) uniform usampler2D t_layers;    // common/material.glsl encodeLayers
+layout(binding = kUnitGbufferSpecular) uniform sampler2D t_specular;  // gbuffer_specular
 
 uniform vec3 u_eye;
 uniform vec3 u_viewForward;
@@ -62,14 +65,19 @@ void main() {
   float nv = dot(n, wo);
   if (nv < 1e-3) n = normalize(n + wo * (1e-3 - nv));
 
-  vec3 L = emission + directLighting(p, n, ng, wo, materialParams(albedo, mat.x, mat.y, mat.w, emissionIor.a));
+  MaterialParams params = materialParams(albedo, mat.x, mat.y, mat.w, emissionIor.a);
+  params.specular = texelFetch(t_specular, px, 0);
+  vec3 nc = decodeLayers(texelFetch(t_layers, px, 0), params);
+  float ncv = dot(nc, wo);
+  if (ncv < 1e-3) nc = normalize(nc + wo * (1e-3 - ncv));
+  vec3 L = emission + directLighting(p, n, nc, ng, wo, params);
   // The environment's specular reflection (split-sum), times the material's baked occlusion: light
   // path L(sky)GE, which this pass owns (u_iblMode is IBL_NONE otherwise). Mirror-like metals and
   // transmissive materials belong to the specular pass (Material::isSpecular(), the same per-material
   // rule the planner and that pass use; the G-buffer carries it in ng.w).
   bool specularOwned = ngOwned.w > 0.5;
   if (u_iblMode != IBL_NONE && !specularOwned)
-    L += mat.z * iblSpecular(t_dfg, t_prefiltered, n, wo, albedo, mat.x, mat.y, emissionIor.a);
+    L += mat.z * iblSpecular(t_dfg, t_prefiltered, n, nc, wo, params);
   o_direct = vec4(L, 1.0);
   o_beauty = o_direct;
 }

@@ -17,16 +17,22 @@ layout(location = 3) out vec4 o_material;  // metallic, roughness, occlusion, tr
 layout(location = 4) out vec4 o_emission;  // rgb emitted radiance, a = ior (KHR_materials_ior)
 layout(location = 5) out vec4 o_geoNormal; // xyz geometric normal facing the viewer side, w = 1 when the
                                            // specular pass owns the surface's reflections (isSpecular())
+layout(location = 6) out uvec4 o_layers;   // encodeLayers (common/material.glsl): clear coat, coat normal, sheen
+layout(location = 7) out vec4 o_specular;  // rgb specular colour, a specular weight (KHR_materials_specular)
 
 void main() {
   Material m = materials[u_material];
   if (materialMasked(m, decodeBaseColor(m, v_uv0, v_uv1).a)) discard;
+  // alphaMode BLEND: composited over the lit opaque frame by the transparency pass; the passes that
+  // read the G-buffer light what lies behind it.
+  if (materialAlphaMode(m) == 2) discard;
   // glTF: back faces of single-sided materials are not rendered.
   if (!gl_FrontFacing && !materialDoubleSided(m)) discard;
   MaterialParams p = decodeMaterial(m, v_uv0, v_uv1);
 
   vec3 faceNormal = materialSafeNormalize(cross(dFdx(v_position), dFdy(v_position)), vec3(0, 1, 0));
   vec3 n = materialSafeNormalize(v_normal, faceNormal);
+  vec3 coatNormal = gl_FrontFacing ? n : -n;  // KHR_materials_clearcoat: not normal-mapped
   n = decodeShadingNormal(m, n, v_tangent, v_uv0, v_uv1, gl_FrontFacing);
 
   // Geometric normal on the side the viewer sees: used for shadow normal-offset bias.
@@ -39,6 +45,8 @@ void main() {
   o_material = vec4(p.surface.x, p.surface.y, p.emission.a, p.surface.z);
   o_emission = vec4(p.emission.rgb, p.surface.w);
   o_geoNormal = vec4(geo, materialSpecularOwned(m) ? 1.0 : 0.0);
+  o_layers = encodeLayers(p, coatNormal);
+  o_specular = p.specular;
   if (materialUnlit(m)) {
     // KHR_materials_unlit: the base colour is the radiance leaving the surface and nothing lights it;
     // normal.w = 0 tells the shading passes, and a black non-metal albedo keeps ambient terms out.
@@ -46,5 +54,7 @@ void main() {
     o_albedo = vec4(0.0, 0.0, 0.0, p.baseColor.a);
     o_material = vec4(0.0, 1.0, 1.0, 0.0);
     o_emission = vec4(p.baseColor.rgb, kDefaultIor);
+    o_layers = uvec4(0u);
+    o_specular = vec4(1.0);
   }
 }

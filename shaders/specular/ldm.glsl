@@ -19,6 +19,7 @@
 //                  read with nearest texels: filtering normals or object indices is meaningless).
 #ifndef RADIANT_SPECULAR_LDM
 #define RADIANT_SPECULAR_LDM
+#include "common/octahedral.glsl"
 #include "common/shared.h"
 
 // Reflection/refraction data of a specular surface in the thesis' representation (5.2). Mixtures are
@@ -29,19 +30,6 @@ vec4 specularTexel(vec3 baseColor, float metallic, float transmission, float ior
   if (transmission > 0.0) return vec4(baseColor * transmission, max(ior, 1.0));
   float r = (ior - 1.0) / (ior + 1.0);
   return vec4(mix(vec3(r * r), baseColor, metallic), -1.0);
-}
-
-// Octahedral normal encoding (Cigolle et al. 2014): unit vector <-> [-1,1]^2.
-vec2 octEncode(vec3 n) {
-  n /= abs(n.x) + abs(n.y) + abs(n.z);
-  vec2 p = n.xy;
-  if (n.z < 0.0) p = (1.0 - abs(n.yx)) * vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);
-  return p;
-}
-vec3 octDecode(vec2 p) {
-  vec3 n = vec3(p, 1.0 - abs(p.x) - abs(p.y));
-  if (n.z < 0.0) n.xy = (1.0 - abs(n.yx)) * vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);
-  return normalize(n);
 }
 
 const float kEmptyDistance = 3.0e38;

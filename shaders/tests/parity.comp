@@ -11,15 +11,15 @@ layout(local_size_x = 64) in;
 uniform int u_count;
 
 #if defined(PARITY_BRDF)
-// n, wo, wi (w = eta), the decoded material.
-struct BrdfCase { vec4 n; vec4 wo; vec4 wi; MaterialParams p; };
+// n, wo, wi (w = eta), the decoded material, the clear coat's normal.
+struct BrdfCase { vec4 n; vec4 wo; vec4 wi; MaterialParams p; vec4 nc; };
 layout(std430, binding = 3) readonly buffer Cases { BrdfCase cases[]; };
 layout(std430, binding = 4) writeonly buffer Results { vec4 results[]; };
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= uint(u_count)) return;
   BrdfCase c = cases[i];
-  results[i] = vec4(gltfBsdfCos(c.n.xyz, c.wo.xyz, c.wi.xyz, c.p, c.wi.w), 0.0);
+  results[i] = vec4(gltfBsdfCos(c.n.xyz, c.nc.xyz, c.wo.xyz, c.wi.xyz, c.p, c.wi.w), 0.0);
 }
 
 #elif defined(PARITY_LIGHT)

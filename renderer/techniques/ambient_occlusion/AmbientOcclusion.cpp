@@ -372,4 +372,12 @@ void AmbientOcclusionPass::execute(PassContext& ctx) {
   ctx.stats.counters["filter_taps"] = blur_ ? 16.0 : (scale_ == 2 ? 4.0 : 1.0);
 }
 
+GroundTruth AmbientOcclusionPass::groundTruth(const Params& params, const std::string& aov) const {
+  if (aov != "ao") return GroundTruth::fromAovTable(aov);
+  return {nlohmann::json{{"aov", "ao"},
+                         {"ao_radius", params.get<double>("radius", 0.5)},
+                         {"ao_definition", params.get<std::string>("method", "volumetric") == "volumetric" ? "volumetric"
+                                                                                                           : "cosine"}}};
+}
+
 }  // namespace radiant

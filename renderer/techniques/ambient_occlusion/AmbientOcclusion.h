@@ -70,6 +70,9 @@ Falloff parseFalloff(const std::string& s);
 class AmbientOcclusionPass final : public Technique {
 public:
   const TechniqueInfo& info() const override;
+  // The AO the frame estimated: same radius, and the definition its method estimates (volumetric:
+  // the tangent-sphere fraction, thesis eq. 4.6; the others: the cosine-weighted step).
+  GroundTruth groundTruth(const Params& params, const std::string& aov) const override;
   Requirements requirements(const Scene&, const api::RenderRequest&) const override;
   void prepare(const Scene&, const Params&, FrameResources&) override;
   void execute(PassContext&) override;

@@ -16,7 +16,8 @@ struct EnvironmentMapEntry {};  // marks the environment_map texture as holding 
 const TechniqueInfo& DirectPass::info() const {
   static const TechniqueInfo i{"direct",
                                "Direct lighting from punctual lights (glTF BRDF, PCF shadow maps) plus emission",
-                               {"gbuffer_position", "normal", "albedo", "material", "emission", "geometric_normal"},
+                               {"gbuffer_position", "normal", "albedo", "material", "emission", "geometric_normal",
+                                "gbuffer_layers", "gbuffer_specular"},
                                {"shadow_maps"},
                                // environment_map: the request's environment, uploaded here for every pass
                                // that shows it (a frame resource, not an AOV).
@@ -76,6 +77,8 @@ void DirectPass::execute(PassContext& ctx) {
 
   const char* inputs[] = {"gbuffer_position", "normal", "albedo", "material", "emission", "geometric_normal"};
   for (GLuint i = 0; i < std::size(inputs); ++i) res.texture(inputs[i]).bindUnit(i);
+  res.texture("gbuffer_layers").bindUnit(gpu::kUnitGbufferLayers);
+  res.texture("gbuffer_specular").bindUnit(gpu::kUnitGbufferSpecular);
   const gl::Program& prog = ctx.shaders.program({"common/fullscreen.vert", "direct/direct.frag"});
   prog.use();
   bindDirectLighting(prog, res, ctx.gpu, static_cast<int>(ctx.scene.lights.size()), pcfRadius_);

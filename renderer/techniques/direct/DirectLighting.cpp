@@ -14,8 +14,7 @@ void bindDirectLighting(const gl::Program& program, FrameResources& res, const G
                         int pcfRadius) {
   res.texture("shadow_cube").bindUnit(gpu::kUnitShadowCube);
   res.texture("shadow_2d").bindUnit(gpu::kUnitShadow2D);
-  gpu.materials.bindBase(GL_SHADER_STORAGE_BUFFER, GpuScene::kMaterialBinding);
-  gpu.lights.bindBase(GL_SHADER_STORAGE_BUFFER, GpuScene::kLightBinding);
+  gpu.bindSceneBuffers();
   res.buffer("shadow_info").bindBase(GL_SHADER_STORAGE_BUFFER, 2);
   program.set("u_lightCount", lightCount);
   program.set("u_hasShadows", res.written("shadow_maps") ? 1 : 0);

@@ -8,7 +8,11 @@ namespace {
 constexpr std::pair<const char*, GLenum> kTargets[] = {
     {"gbuffer_position", GL_RGBA32F}, {"normal", GL_RGBA16F},   {"albedo", GL_RGBA16F},
     {"material", GL_RGBA16F},         {"emission", GL_RGBA16F}, {"geometric_normal", GL_RGBA16F},
+    // The layered extensions (docs/GBUFFER.md): clear coat, coat normal and sheen packed as halves/snorm
+    // in an integer target (cleared with the integer clear), and the specular colour and weight.
+    {"gbuffer_layers", GL_RGBA32UI}, {"gbuffer_specular", GL_RGBA16F},
 };
+constexpr int kLayersTarget = 6;
 }  // namespace
 
 const TechniqueInfo& GBufferPass::info() const {
@@ -17,7 +21,7 @@ const TechniqueInfo& GBufferPass::info() const {
                                {},
                                {},
                                {"depth_buffer", "gbuffer_position", "depth", "normal", "albedo", "material",
-                                "emission", "geometric_normal"},
+                                "emission", "geometric_normal", "gbuffer_layers", "gbuffer_specular"},
                                false,
                                false};
   return i;
@@ -38,7 +42,7 @@ void GBufferPass::prepare(const Scene&, const Params&, FrameResources& res) {
     fb.attach(GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(i), t);
   }
   fb.setDrawBuffers({GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2, GL_COLOR_ATTACHMENT3,
-                     GL_COLOR_ATTACHMENT4, GL_COLOR_ATTACHMENT5});
+                     GL_COLOR_ATTACHMENT4, GL_COLOR_ATTACHMENT5, GL_COLOR_ATTACHMENT6, GL_COLOR_ATTACHMENT7});
   fb.checkComplete("GBufferPass::prepare");
 }
 
@@ -48,7 +52,11 @@ void GBufferPass::execute(PassContext& ctx) {
   fb.bind();
   glViewport(0, 0, view.width, view.height);
   const float zero[4] = {0.f, 0.f, 0.f, 0.f};
-  for (int i = 0; i < static_cast<int>(std::size(kTargets)); ++i) glClearNamedFramebufferfv(fb.id(), GL_COLOR, i, zero);
+  const GLuint zeroU[4] = {0u, 0u, 0u, 0u};
+  for (int i = 0; i < static_cast<int>(std::size(kTargets)); ++i) {
+    if (i == kLayersTarget) glClearNamedFramebufferuiv(fb.id(), GL_COLOR, i, zeroU);
+    else glClearNamedFramebufferfv(fb.id(), GL_COLOR, i, zero);
+  }
   const float depthClear = 0.f;  // reversed-Z: 0 is infinitely far
   glClearNamedFramebufferfv(fb.id(), GL_DEPTH, 0, &depthClear);
   glEnable(GL_DEPTH_TEST);

@@ -102,7 +102,7 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
                                     {"max_bounces", s.maxBounces}};
   PhotonCache& cache = res.cached<PhotonCache>("photon_gi_photons", photonKey.dump(),
                                                [] { return std::make_unique<PhotonCache>(); });
-  const rt::SceneLights lights(rays, view.environment, view.ambient);
+  const rt::SceneLights lights(rays, view.environment, view.ambient, environmentDistribution(res, view));
   traced_ = 0;
   traceMs_ = 0.0;
   if (cache.set.emitted < s.photons) {

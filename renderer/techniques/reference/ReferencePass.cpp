@@ -23,6 +23,7 @@ const Image& referenceImage(FrameResources& res, const Scene& scene, const Frame
   o.seed = view.seed;
   o.skyRadiance = view.ambient;
   o.environment = view.environment;  // when set, it replaces skyRadiance
+  o.environmentDistribution = environmentDistribution(res, view);
   if (r.aov == "direct") {
     o.minPathBounce = 0, o.maxPathBounce = 1;  // what the raster `direct` AOV holds: emission, sky, direct
   } else if (r.aov == "indirect" || r.aov == "indirect_diffuse") {
@@ -109,15 +110,21 @@ Requirements ReferencePass::requirements(const Scene& scene, const api::RenderRe
   return f.triangles > 0 ? Requirements::ok() : Requirements::skip("the scene has no triangles");
 }
 
+ReferenceRequest referenceRequestFrom(const Params& params) {
+  ReferenceRequest r;
+  r.aov = params.get<std::string>("aov", "beauty");
+  r.spp = params.get<int>("spp", 64);
+  r.lightPathsPerPixel = params.get<int>("light_paths_per_pixel", 0);
+  r.caustics = params.get<bool>("caustics", true);
+  r.maxBounces = params.get<int>("max_bounces", 8);
+  r.russianRoulette = params.get<bool>("russian_roulette", true);
+  r.aoRadius = params.get<float>("ao_radius", 0.5f);
+  r.aoDefinition = params.get<std::string>("ao_definition", "cosine");
+  return r;
+}
+
 void ReferencePass::prepare(const Scene&, const Params& params, FrameResources& res) {
-  request_.aov = params.get<std::string>("aov", "beauty");
-  request_.spp = params.get<int>("spp", 64);
-  request_.lightPathsPerPixel = params.get<int>("light_paths_per_pixel", 0);
-  request_.caustics = params.get<bool>("caustics", true);
-  request_.maxBounces = params.get<int>("max_bounces", 8);
-  request_.russianRoulette = params.get<bool>("russian_roulette", true);
-  request_.aoRadius = params.get<float>("ao_radius", 0.5f);
-  request_.aoDefinition = params.get<std::string>("ao_definition", "cosine");
+  request_ = referenceRequestFrom(params);
   res.texture("reference", GL_TEXTURE_2D, GL_RGBA32F, res.view().width, res.view().height);
 }
 

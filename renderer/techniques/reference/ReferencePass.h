@@ -28,6 +28,8 @@ struct ReferenceRequest {
   float aoRadius = 0.5f;
   std::string aoDefinition = "cosine";
 };
+// The reference pass's parameters (its schema, defaults filled in) as a ReferenceRequest.
+ReferenceRequest referenceRequestFrom(const Params& params);
 const Image& referenceImage(FrameResources& resources, const Scene& scene, const FrameView& view,
                             const ReferenceRequest& request, bool* cacheHit = nullptr,
                             std::uint64_t* rays = nullptr, bool* lightTraced = nullptr,

@@ -110,8 +110,9 @@ float zeroOneOrBetween(std::mt19937& rng) {
 struct BrdfCase {
   glm::vec4 n, wo, wi;  // wi.w = eta
   gpu::MaterialParams p;
+  glm::vec4 nc;  // the clear coat's normal (KHR_materials_clearcoat)
 };
-static_assert(sizeof(BrdfCase) == 96, "matches parity.comp's std430 BrdfCase");
+static_assert(sizeof(BrdfCase) == 160, "matches parity.comp's std430 BrdfCase");
 
 rt::GltfBsdf cpuBsdf(const BrdfCase& c) {
   rt::GltfBsdf b;
@@ -122,6 +123,13 @@ rt::GltfBsdf cpuBsdf(const BrdfCase& c) {
   b.ior = c.p.surface.w;
   b.eta = c.wi.w;
   b.mode = rt::TransportMode::Radiance;
+  b.clearcoat = c.p.clearcoat.x;
+  b.clearcoatRoughness = c.p.clearcoat.y;
+  b.sheenColor = glm::vec3(c.p.sheen);
+  b.sheenRoughness = c.p.sheen.w;
+  b.specularColor = glm::vec3(c.p.specular);
+  b.specularWeight = c.p.specular.w;
+  b.coatNormal = rt::ShadingFrame::fromNormal(glm::vec3(c.n)).toLocal(glm::vec3(c.nc));
   return b;
 }
 glm::vec3 cpuBrdfCos(const BrdfCase& c, const glm::vec3& wiWorld) {
@@ -142,7 +150,14 @@ float ggxConditioning(const BrdfCase& c) {
   h = glm::normalize(h);
   const float cosH = std::min(1.f, std::abs(h.z)), a = b.alpha();
   const float d = rt::ggxD(cosH, a);
-  return d > 0.f ? std::abs(rt::ggxD(cosH - 2.4e-7f, a) - d) / d : 0.f;
+  float k = d > 0.f ? std::abs(rt::ggxD(cosH - 2.4e-7f, a) - d) / d : 0.f;
+  // The coat's lobe has its own peak (around the coat normal), conditioned the same way.
+  if (b.hasCoat() && !b.coatIsDelta() && wi.z > 0.f) {
+    const float cosC = std::min(1.f, std::abs(glm::dot(b.coatNormal, h)));
+    const float ac = rt::alphaFromRoughness(b.clearcoatRoughness), dc = rt::ggxD(cosC, ac);
+    if (dc > 0.f) k = std::max(k, std::abs(rt::ggxD(cosC - 2.4e-7f, ac) - dc) / dc);
+  }
+  return k;
 }
 
 TEST_F(ParityTest, BrdfMatchesCpuBsdfOnRandomInputs) {
@@ -150,7 +165,7 @@ TEST_F(ParityTest, BrdfMatchesCpuBsdfOnRandomInputs) {
   const int kCases = 12000;
   std::vector<BrdfCase> cases;
   int roughness0 = 0, roughness1 = 0, clampedAlpha = 0, metals = 0, transmissive = 0, grazing = 0, below = 0,
-      inside = 0;
+      inside = 0, coated = 0, sheened = 0, tinted = 0;
   for (int i = 0; i < kCases; ++i) {
     BrdfCase c{};
     const glm::vec3 n = unitVector(rng);
@@ -180,6 +195,23 @@ TEST_F(ParityTest, BrdfMatchesCpuBsdfOnRandomInputs) {
     c.p.baseColor = glm::vec4(uniform(rng), uniform(rng), uniform(rng), 1.f);
     c.p.emission = glm::vec4(0.f, 0.f, 0.f, 1.f);
     c.p.surface = glm::vec4(metallic, roughness, transmission, ior);
+    // The layers: a third of the cases each without clear coat, sheen or specular tint; the coat's
+    // normal tilted off n (a normal-mapped base under an unmapped coat) in half of the coated ones.
+    c.p.clearcoat = uniform(rng) < 0.35f ? glm::vec4(0.f) : glm::vec4(zeroOneOrBetween(rng), randomRoughness(rng), 0.f, 0.f);
+    c.p.sheen = uniform(rng) < 0.35f ? glm::vec4(0.f, 0.f, 0.f, gpu::kMinSheenRoughness)
+                                     : glm::vec4(uniform(rng), uniform(rng), uniform(rng),
+                                                 uniform(rng) < 0.2f ? gpu::kMinSheenRoughness
+                                                                     : uniform(rng, gpu::kMinSheenRoughness, 1.f));
+    c.p.specular = uniform(rng) < 0.35f ? glm::vec4(1.f)
+                                        : glm::vec4(uniform(rng, 0.f, 2.f), uniform(rng, 0.f, 2.f),
+                                                    uniform(rng, 0.f, 30.f), zeroOneOrBetween(rng));
+    glm::vec3 nc = n;
+    if (uniform(rng) < 0.5f) nc = glm::normalize(n + 0.3f * unitVector(rng));
+    if (glm::dot(nc, glm::vec3(c.wo)) <= 0.01f) nc = n;
+    c.nc = glm::vec4(nc, 0.f);
+    coated += c.p.clearcoat.x > 0.f;
+    sheened += c.p.sheen.r > 0.f;
+    tinted += c.p.specular != glm::vec4(1.f);
     roughness0 += roughness == 0.f;
     roughness1 += roughness == 1.f;
     clampedAlpha += roughness > 0.f && roughness * roughness < gpu::kMinGgxAlpha;
@@ -196,7 +228,14 @@ TEST_F(ParityTest, BrdfMatchesCpuBsdfOnRandomInputs) {
   EXPECT_GT(grazing, 3000);
   EXPECT_GT(below, 4000);
   EXPECT_GT(inside, 1500);
+  EXPECT_GT(coated, 4000);
+  EXPECT_GT(sheened, 6000);
+  EXPECT_GT(tinted, 6000);
 
+  // The sheen's directional-albedo table, as GpuScene uploads it.
+  const Buffer sheenTable("sheen albedo", sizeof(float) * gpu::kSheenAlbedoSize * gpu::kSheenAlbedoSize,
+                          rt::sheenAlbedoTable(), 0);
+  sheenTable.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingSheenAlbedo);
   const std::vector<glm::vec4> gpu = run<BrdfCase, glm::vec4>("PARITY_BRDF", cases, 1);
   int failures = 0, nonzero = 0;
   float worst = 0.f;
@@ -219,7 +258,9 @@ TEST_F(ParityTest, BrdfMatchesCpuBsdfOnRandomInputs) {
         if (++failures <= 10)
           ADD_FAILURE() << "case " << i << " channel " << ch << ": GPU " << g[ch] << " CPU " << cpu[ch]
                         << " (metallic " << c.p.surface.x << " roughness " << c.p.surface.y << " transmission "
-                        << c.p.surface.z << " ior " << c.p.surface.w << " eta " << c.wi.w << " n.wo "
+                        << c.p.surface.z << " ior " << c.p.surface.w << " eta " << c.wi.w << " coat "
+                        << c.p.clearcoat.x << "/" << c.p.clearcoat.y << " sheen " << c.p.sheen.r << "/"
+                        << c.p.sheen.w << " specular " << c.p.specular.w << " n.wo "
                         << glm::dot(c.n, c.wo) << " n.wi " << glm::dot(c.n, c.wi) << ")";
       }
       if (cpu[ch] > 0.f) worst = std::max(worst, err / cpu[ch]);
@@ -362,6 +403,13 @@ TEST_F(ParityTest, MaterialDecodingMatchesCpuOnRandomInputs) {
     m.ior = i % 7 == 0 ? 0.f : uniform(rng, 1.f, 2.5f);  // 0: the decoders fall back to kDefaultIor
     m.emissiveFactor = glm::vec3(uniform(rng), uniform(rng), uniform(rng));
     m.emissiveStrength = uniform(rng, 1.f, 5.f);
+    // The layers' factors, out of range in some materials (the decoders clamp).
+    m.clearcoatFactor = zeroOneOrBetween(rng);
+    m.clearcoatRoughnessFactor = i % 6 == 1 ? 1.4f : randomRoughness(rng);
+    m.sheenColorFactor = glm::vec3(uniform(rng), uniform(rng), i % 6 == 2 ? 1.7f : uniform(rng));
+    m.sheenRoughnessFactor = i % 4 == 3 ? 0.f : uniform(rng);  // 0: the decoders clamp to kMinSheenRoughness
+    m.specularFactor = zeroOneOrBetween(rng);
+    m.specularColorFactor = glm::vec3(uniform(rng, 0.f, 3.f), uniform(rng), i % 6 == 4 ? -1.f : uniform(rng));
     m.baseColorTexture = maybeTexture(0.7f);
     m.metallicRoughnessTexture = maybeTexture(0.7f);
     m.occlusionTexture = maybeTexture(0.6f);
@@ -524,6 +572,9 @@ TEST_F(ParityTest, MaterialDecodingMatchesCpuOnRandomInputs) {
       expectNear(i, ch < 3 ? "emission" : "occlusion", g.emission[ch], cpu.emission[ch],
                  ch < 3 ? srgbTol * emissionScale : linearTol);
       expectNear(i, "surface", g.surface[ch], cpu.surface[ch], linearTol);
+      expectNear(i, "clearcoat", g.clearcoat[ch], cpu.clearcoat[ch], 1e-6f);
+      expectNear(i, "sheen", g.sheen[ch], cpu.sheen[ch], 1e-6f);
+      expectNear(i, "specular", g.specular[ch], cpu.specular[ch], 1e-6f);
     }
     // The ray-tracing core's own reading of the material is the decoder's, and its normal-mapped
     // shading normal is GLSL's decodeShadingNormal (2 texel - 1, times a normal scale up to 1.5, then
@@ -545,6 +596,12 @@ TEST_F(ParityTest, MaterialDecodingMatchesCpuOnRandomInputs) {
     expectNear(i, "shade.roughness", sh.bsdf.roughness, cpu.surface.y, 0.f);
     expectNear(i, "shade.transmission", sh.bsdf.transmission, cpu.surface.z, 0.f);
     expectNear(i, "shade.ior", sh.bsdf.ior, cpu.surface.w, 0.f);
+    expectNear(i, "shade.clearcoat", sh.bsdf.clearcoat, cpu.clearcoat.x, 0.f);
+    expectNear(i, "shade.clearcoatRoughness", sh.bsdf.clearcoatRoughness, cpu.clearcoat.y, 0.f);
+    expectNear(i, "shade.sheen.b", sh.bsdf.sheenColor.b, cpu.sheen.b, 0.f);
+    expectNear(i, "shade.sheenRoughness", sh.bsdf.sheenRoughness, cpu.sheen.a, 0.f);
+    expectNear(i, "shade.specular.r", sh.bsdf.specularColor.r, cpu.specular.r, 0.f);
+    expectNear(i, "shade.specularWeight", sh.bsdf.specularWeight, cpu.specular.a, 0.f);
     const glm::vec3 e = rays.emissionAt(hit, -wo);
     expectNear(i, "emissionAt.g", e.g, cpu.emission.g, 0.f);
   }

@@ -310,6 +310,40 @@ TEST(AovTable, FrameResourcesRefuseAnAovInAnotherFormatOrRespecifiedWithinAFrame
   res.texture("scratch", GL_TEXTURE_2D, GL_RGBA16F, 8, 8);
 }
 
+TEST(AovTable, MaterialAovCarriesTransmission) {
+  // Two quads side by side: a rough dielectric with KHR_materials_transmission 0.75 and an opaque one.
+  // The material AOV is metallic, roughness, occlusion, transmission (material.R/G/B/A), read back per
+  // pixel exactly as the G-buffer stores it (RGBA16F: 0.75, 0.25, 0.5 are exact in half floats).
+  SceneBuilder b;
+  Material glass = lambertian();
+  glass.roughnessFactor = 0.5f;
+  glass.metallicFactor = 0.25f;
+  glass.transmissionFactor = 0.75f;
+  Material opaque = lambertian();
+  b.quad({-5, 0, 0}, {5, 0, 0}, {0, 0, -10}, b.material(glass), "glass");
+  b.quad({5, 0, 0}, {5, 0, 0}, {0, 0, -10}, b.material(opaque), "opaque");
+  b.directionalLight({0, -1, 0}, 1.f);
+  api::RenderRequest req = request(32, {"beauty", "material"});
+  req.camera = api::CameraOverride{{0, 10, 0}, {0, 0, 0}, {0, 0, -1}, 90.f};
+  const RenderOutput out = renderer().render(b.build("material-aov"), req);
+  const Image& m = aov(out, "material");
+  ASSERT_EQ(m.channels, 4);
+  EXPECT_EQ(m.at(8, 16)[0], 0.25f);   // metallic
+  EXPECT_EQ(m.at(8, 16)[1], 0.5f);    // roughness
+  EXPECT_EQ(m.at(8, 16)[2], 1.f);     // occlusion (none)
+  EXPECT_EQ(m.at(8, 16)[3], 0.75f);   // transmission
+  EXPECT_EQ(m.at(24, 16)[3], 0.f);
+  // And the EXR names it material.A.
+  const std::string exr = io::encodeExr({m}, false);
+  const std::string path = ::testing::TempDir() + "/material.exr";
+  io::writeFile(path, exr);
+  auto in = OIIO::ImageInput::open(path);
+  ASSERT_TRUE(in);
+  const auto& names = in->spec().channelnames;
+  EXPECT_EQ(std::set<std::string>(names.begin(), names.end()),
+            (std::set<std::string>{"material.R", "material.G", "material.B", "material.A"}));
+}
+
 TEST(ImageIO, ExrChannelNamesComeFromTheAovTable) {
   Image ao = Image::make("ao", 2, 1, 1), normal = Image::make("normal", 2, 1, 3), beauty = Image::make("beauty", 2, 1, 3);
   const std::string exrPath = ::testing::TempDir() + "/names.exr";

@@ -10,6 +10,7 @@
 #include "api/Validate.h"
 #include "renderer/Renderer.h"
 #include "renderer/frame/FramePlanner.h"
+#include "renderer/techniques/Registry.h"
 
 namespace radiant {
 namespace {
@@ -95,7 +96,7 @@ TEST(SchemaConsistency, AovTableIsWellFormed) {
     const api::AovInfo& a = api::aovTable()[i];
     EXPECT_EQ(a.id, static_cast<int>(i)) << a.name;
     EXPECT_TRUE(names.insert(a.name).second) << "duplicate AOV " << a.name;
-    EXPECT_TRUE(a.channels == 1 || a.channels == 3) << a.name;
+    EXPECT_TRUE(a.channels == 1 || a.channels == 3 || a.channels == 4) << a.name;
     EXPECT_EQ(a.exr.size(), static_cast<std::size_t>(a.channels)) << a.name;
     for (const auto& c : a.exr) EXPECT_TRUE(exrChannels.insert(c).second) << "EXR channel " << c << " used twice";
     EXPECT_LE(a.firstChannel + a.channels, a.format == api::AovFormat::R32F ? 1 : 4) << a.name;
@@ -111,6 +112,9 @@ TEST(SchemaConsistency, AovTableIsWellFormed) {
   EXPECT_EQ(accumulate, 1);  // beauty
   EXPECT_EQ(api::findAov("beauty")->exr, (std::vector<std::string>{"R", "G", "B"}));
   EXPECT_EQ(api::findAov("depth")->exr, std::vector<std::string>{"depth.Z"});
+  // The material AOV carries all four G-buffer channels: metallic, roughness, occlusion, transmission.
+  EXPECT_EQ(api::findAov("material")->exr,
+            (std::vector<std::string>{"material.R", "material.G", "material.B", "material.A"}));
   EXPECT_EQ(api::findAov("specular")->groundTruth, "");  // scored against nothing rather than full beauty
   EXPECT_EQ(api::findAov("no_such_aov"), nullptr);
 }
@@ -123,6 +127,34 @@ TEST(SchemaConsistency, UndeclaredWritesAreFound) {
   info.addsToBeauty = false;
   EXPECT_EQ(undeclaredWrite(info, {"specular", "beauty"}), "beauty");  // beauty needs addsToBeauty
   EXPECT_EQ(undeclaredWrite(info, {}), "");
+}
+
+// Each technique declares what scores its AOVs (Technique::groundTruth); the compare block only asks.
+TEST(SchemaConsistency, TechniquesDeclareTheirGroundTruth) {
+  std::map<std::string, std::unique_ptr<Technique>> byName;
+  for (auto& t : createTechniques()) byName[t->info().name] = std::move(t);
+  // Every AOV with a producer: the producer's answer agrees with the AOV table's reference mode, and
+  // every mode it names is one the reference pass has.
+  const auto& modes = api::findTechnique("reference")->params.at("aov").at("enum");
+  for (const api::AovInfo& a : api::aovTable()) {
+    if (a.producer.empty() || !byName.count(a.producer)) continue;
+    const GroundTruth g = byName.at(a.producer)->groundTruth(Params(api::techniqueParams(a.producer)), a.name);
+    EXPECT_EQ(g.exists(), !a.groundTruth.empty()) << a.name;
+    if (!g.exists()) continue;
+    EXPECT_EQ(g.reference.at("aov"), a.groundTruth) << a.name;
+    EXPECT_NE(std::find(modes.begin(), modes.end(), g.reference.at("aov")), modes.end()) << a.name;
+    // What it returns is a valid set of the reference pass's parameters.
+    EXPECT_NO_THROW(api::techniqueParams("reference", g.reference)) << a.name;
+  }
+  // AO's ground truth follows its parameters: the radius, and the definition its method estimates.
+  const Technique& ao = *byName.at("ambient_occlusion");
+  const GroundTruth vol = ao.groundTruth(Params(api::techniqueParams("ambient_occlusion", {{"radius", 2.0}})), "ao");
+  EXPECT_EQ(vol.reference, (nlohmann::json{{"aov", "ao"}, {"ao_radius", 2.0}, {"ao_definition", "volumetric"}}));
+  const GroundTruth gtao = ao.groundTruth(
+      Params(api::techniqueParams("ambient_occlusion", {{"radius", 0.25}, {"method", "gtao"}})), "ao");
+  EXPECT_EQ(gtao.reference, (nlohmann::json{{"aov", "ao"}, {"ao_radius", 0.25}, {"ao_definition", "cosine"}}));
+  // The specular AOV has none: it is refused, not scored against beauty.
+  EXPECT_FALSE(byName.at("specular")->groundTruth(Params(api::techniqueParams("specular")), "specular").exists());
 }
 
 TEST(SchemaConsistency, DefaultsComeFromTheSchema) {

@@ -170,10 +170,35 @@ TEST(GltfCompression, UnsupportedOptionalExtensionIsAWarningNotSilence) {
   GltfBuilder b;
   const int m = b.mesh(json::array({test::trianglePrimitive<std::uint8_t>(b, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {0, 1, 2})}));
   b.scene({b.node({{"mesh", m}})});
-  b.doc["extensionsUsed"] = {"KHR_materials_clearcoat", "KHR_texture_transform"};
+  b.doc["extensionsUsed"] = {"KHR_materials_volume", "KHR_texture_transform"};
   const Scene s = loadSceneFromMemory(b.gltf());
   ASSERT_EQ(s.warnings.size(), 1u);
-  EXPECT_NE(s.warnings[0].find("KHR_materials_clearcoat"), std::string::npos) << s.warnings[0];
+  EXPECT_NE(s.warnings[0].find("KHR_materials_volume"), std::string::npos) << s.warnings[0];
+}
+
+TEST(GltfExtensions, ClearcoatSheenAndSpecularFactorsAreReadAndTheirTexturesWarned) {
+  GltfBuilder b;
+  const int mat = b.material({{"extensions",
+                               {{"KHR_materials_clearcoat", {{"clearcoatFactor", 0.8}, {"clearcoatRoughnessFactor", 0.3},
+                                                             {"clearcoatNormalTexture", {{"index", 0}}}}},
+                                {"KHR_materials_sheen", {{"sheenColorFactor", {0.5, 0.25, 2.0}}, {"sheenRoughnessFactor", 0.4}}},
+                                {"KHR_materials_specular", {{"specularFactor", 0.5}, {"specularColorFactor", {2.0, 1.0, 0.5}}}}}}});
+  const int m = b.mesh(json::array({test::trianglePrimitive<std::uint8_t>(b, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {0, 1, 2}, {}, {}, mat)}));
+  b.scene({b.node({{"mesh", m}})});
+  b.doc["extensionsUsed"] = {"KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_specular"};
+  const Scene s = loadSceneFromMemory(b.gltf());
+  ASSERT_EQ(s.materials.size(), 1u);
+  const Material& x = s.materials[0];
+  EXPECT_FLOAT_EQ(x.clearcoatFactor, 0.8f);
+  EXPECT_FLOAT_EQ(x.clearcoatRoughnessFactor, 0.3f);
+  EXPECT_EQ(x.sheenColorFactor, glm::vec3(0.5f, 0.25f, 1.f));  // a colour factor is clamped to [0, 1]
+  EXPECT_FLOAT_EQ(x.sheenRoughnessFactor, 0.4f);
+  EXPECT_FLOAT_EQ(x.specularFactor, 0.5f);
+  EXPECT_EQ(x.specularColorFactor, glm::vec3(2.f, 1.f, 0.5f));  // may exceed 1 (F0 = min(F0 color, 1))
+  // The coat's normal texture is not read: said, at its JSON pointer.
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("/materials/0/extensions/KHR_materials_clearcoat/clearcoatNormalTexture"),
+            std::string::npos) << s.warnings[0];
 }
 
 // glTF-Validator accepts a texture without a source (an extension may hold its only image): the file
