@@ -47,7 +47,8 @@ RADIANT_CONST int kUnitLdmDistance = 18;
 RADIANT_CONST int kUnitIblDfg = 19;       // image-based lighting: split-sum DFG table (direct, ambient_occlusion)
 RADIANT_CONST int kUnitIblPrefiltered = 20;  // image-based lighting: GGX-prefiltered environment (direct)
 RADIANT_CONST int kUnitAoEmission = 21;   // ambient_occlusion resolve: the emission target (a = ior)
-RADIANT_CONST int kUnitCount = 22;        // units used; GL 4.5 guarantees 16, every driver we run has 32
+RADIANT_CONST int kUnitCausticCube = 22;  // caustics: the caustic cube maps (irradiance per receiver area)
+RADIANT_CONST int kUnitCount = 23;        // units used; GL 4.5 guarantees 16, every driver we run has 32
 
 // Shader storage bindings of the scene buffers.
 RADIANT_CONST int kBindingMaterials = 0;
