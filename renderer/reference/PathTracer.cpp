@@ -13,6 +13,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "renderer/raytracing/CameraRays.h"
 #include "renderer/raytracing/Lights.h"
 #include "renderer/raytracing/RayScene.h"
 
@@ -132,11 +133,14 @@ struct PathTracer::Impl {
     int k = 0;  // scattering events so far
     bool prevDelta = true;  // the camera "sampled" this direction: no MIS on directly seen emitters
     float prevPdf = 0.f;
+    // L S+ D E bookkeeping (ReferenceOptions::excludeCaustics): true while the first vertex scattered
+    // through a non-delta lobe and every later vertex through a delta lobe.
+    bool causticChain = false;
     const int lastVertex = std::min(o.maxBounces, o.maxPathBounce);
     for (;;) {
       SurfaceHit hit;
       if (!rays->intersect(ray, hit, sampler, counter)) {
-        if (env.active() && inRange(k, o)) {
+        if (env.active() && inRange(k, o) && !(o.excludeCaustics && causticChain && k >= 2)) {
           const float w = prevDelta ? 1.f : powerHeuristic(prevPdf, env.pdf(ray.dir));
           L += beta * env.radiance(ray.dir) * w;
         }
@@ -147,7 +151,7 @@ struct PathTracer::Impl {
         if (inRange(k, o)) L += beta * rays->unlitRadiance(hit);
         break;
       }
-      if (inRange(k, o)) {
+      if (inRange(k, o) && !(o.excludeCaustics && causticChain && k >= 2)) {
         const glm::vec3 Le = rays->emissionAt(hit, ray.dir);
         if (maxComponent(Le) > 0.f) {
           const float w = prevDelta ? 1.f : powerHeuristic(prevPdf, lights.trianglePdf(hit, ray.dir));
@@ -171,6 +175,7 @@ struct PathTracer::Impl {
       const float gs = glm::dot(wi, sh.ngFacing);
       if (bs.wi.z > 0.f ? gs <= 0.f : gs >= 0.f) break;  // leaked through the geometric surface
       beta *= bs.weight;
+      causticChain = k == 1 ? !bs.delta : causticChain && bs.delta;
       if (bs.wi.z < 0.f) etaScale *= sh.bsdf.eta * sh.bsdf.eta;
       prevDelta = bs.delta;
       prevPdf = bs.pdf;
@@ -232,29 +237,6 @@ struct PathTracer::Impl {
     }
   }
 
-  Ray cameraRay(const Camera& cam, int width, int height, float px, float py) const {
-    const float aspect = cam.aspectRatio > 0.f ? cam.aspectRatio : static_cast<float>(width) / height;
-    const float sx = 2.f * px / width - 1.f;
-    const float sy = 1.f - 2.f * py / height;
-    const glm::mat3 rot(cam.world);
-    Ray r;
-    if (cam.projection == ProjectionType::Orthographic) {
-      r.org = glm::vec3(cam.world * glm::vec4(sx * cam.xmag, sy * cam.ymag, 0.f, 1.f));
-      const glm::vec3 d = rot * glm::vec3(0.f, 0.f, -1.f);
-      const float len = glm::length(d);
-      r.dir = d / len;
-      r.tnear = std::max(0.f, cam.znear) * len;
-    } else {
-      const float tanY = std::tan(0.5f * cam.yfov);
-      const glm::vec3 d = rot * glm::vec3(sx * tanY * aspect, sy * tanY, -1.f);
-      const float len = glm::length(d);
-      r.org = glm::vec3(cam.world[3]);
-      r.dir = d / len;
-      r.tnear = std::max(0.f, cam.znear) * len;  // the point at view depth znear
-    }
-    r.tfar = kInf;
-    return r;
-  }
 };
 
 PathTracer::PathTracer(const Scene& scene) : impl_(std::make_unique<Impl>()) {
@@ -283,6 +265,7 @@ Image PathTracer::render(const Camera& camera, int width, int height, const Refe
   const int tilesX = (width + kTileSize - 1) / kTileSize, tilesY = (height + kTileSize - 1) / kTileSize;
   std::atomic<std::uint64_t> rays{0};
   const Impl& impl = *impl_;
+  const CameraRays cameraRays(camera, width, height);
 
   auto renderTiles = [&] {
     tbb::parallel_for(tbb::blocked_range<int>(0, tilesX * tilesY, 1), [&](const tbb::blocked_range<int>& range) {
@@ -297,7 +280,7 @@ Image PathTracer::render(const Camera& camera, int width, int height, const Refe
             for (int s = 0; s < options.spp; ++s) {
               Sampler sampler(pixel, static_cast<std::uint64_t>(s), options.seed);
               const glm::vec2 jitter = sampler.next2();
-              const Ray ray = impl.cameraRay(camera, width, height, x + jitter.x, y + jitter.y);
+              const Ray ray = cameraRays.ray(x + jitter.x, y + jitter.y);
               glm::vec3 value;
               if (options.mode == ReferenceOptions::Mode::Radiance)
                 value = impl.radiance(ray, options, lights, sampler, counter);

@@ -79,6 +79,11 @@ struct ReferenceOptions {
   glm::vec3 skyRadiance{0.f};          // uniform environment radiance
   const Image* environment = nullptr;  // equirect RGB(A) linear radiance, optional; overrides skyRadiance
   int threads = 0;                     // 0 = TBB default
+  // Drop exactly the caustic paths L S+ D E (the camera's first vertex scatters through a non-delta
+  // lobe, every later vertex through a Dirac delta, then an emitter or the sky), which the light tracer
+  // renders (renderer/reference/LightTracer.h): path tracer with this + light tracer's caustics = the
+  // whole image, each path counted once. Unlit surfaces do not scatter, so they start no chain.
+  bool excludeCaustics = false;
 };
 
 class PathTracer {

@@ -7,11 +7,17 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(std430, binding = 6) readonly buffer Cells { uint cellStart[]; };
 layout(rgba32f, binding = 0) uniform image2D i_accum;
+layout(r32f, binding = 1) uniform readonly image2D i_fixup;
 
 uniform vec3 u_gridOrigin;
 uniform float u_cellSize;
 uniform ivec3 u_gridDims;
-uniform ivec2 u_size;
+uniform ivec2 u_size;     // the G-buffer's (full) resolution
+// u_step > 1: one invocation per step x step block, at the block's centre pixel, written at the block's
+// index (upsample.comp spreads it). u_fixup = 1: full resolution, only the pixels upsample.comp marked.
+uniform int u_step;
+uniform ivec2 u_outSize;
+uniform int u_fixup;
 // This dispatch's slice of every cell: entries [u_sliceBegin, u_sliceBegin + u_sliceLength) of it.
 // llvmpipe ends an invocation's loops after 65535 iterations in total (its loop limiter), so the CPU
 // splits the cells into slices of at most 27 * u_sliceLength candidates per pixel and dispatches once
@@ -21,8 +27,10 @@ uniform uint u_sliceLength;
 uniform int u_accumulate;
 
 void main() {
-  ivec2 px = ivec2(gl_GlobalInvocationID.xy);
-  if (px.x >= u_size.x || px.y >= u_size.y) return;
+  ivec2 out_ = ivec2(gl_GlobalInvocationID.xy);
+  if (out_.x >= u_outSize.x || out_.y >= u_outSize.y) return;
+  if (u_fixup != 0 && imageLoad(i_fixup, out_).r == 0.0) return;
+  ivec2 px = min(out_ * u_step + u_step / 2, u_size - 1);
   SplatSurface s;
   vec4 acc = vec4(0.0);
   if (loadSurface(px, s)) {
@@ -41,6 +49,6 @@ void main() {
           }
         }
   }
-  if (u_accumulate != 0) acc += imageLoad(i_accum, px);
-  imageStore(i_accum, px, acc);
+  if (u_accumulate != 0) acc += imageLoad(i_accum, out_);
+  imageStore(i_accum, out_, acc);
 }

@@ -92,6 +92,7 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
                                                                                   : photon_gi::Kernel::Biweight;
   splat_.renormalize = params.get<bool>("renormalize", true);
   splat_.minGlossyRoughness = params.get<float>("min_glossy_roughness", 0.2f);
+  splat_.gatherStep = params.get<int>("gather_step", 2);
 
   const FrameView& view = res.view();
   // --- Photon records: derived data of the scene, its lights and environment, never of the camera.
@@ -192,7 +193,7 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   hMin_ = splats.hMin;
   hMax_ = splats.hMax;
   if (!res.hasBuffer("photon_gi_splats")) upload_ = true;  // resources were dropped after a failure
-  photon_gi::declareSplatResources(res, *grid_);
+  photon_gi::declareSplatResources(res, *grid_, splat_);
 }
 
 void PhotonGiPass::execute(PassContext& ctx) {
@@ -217,6 +218,7 @@ void PhotonGiPass::execute(PassContext& ctx) {
   c["h_max"] = hMax_;
   c["C"] = settings_.C;
   c["gather"] = splat_.method == photon_gi::Method::Gather ? 1.0 : 0.0;
+  c["gather_step"] = splat_.method == photon_gi::Method::Gather ? splat_.gatherStep : 1;
   upload_ = false;
 }
 

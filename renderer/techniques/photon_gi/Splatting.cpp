@@ -75,6 +75,7 @@ SplatGrid buildSplatGrid(std::vector<GpuSplat> splats) {
   for (const GpuSplat& s : splats) {
     b.extend(glm::vec3(s.positionRadius));
     hMax = std::max(hMax, s.positionRadius.w);
+    g.hMin = g.hMin > 0.f ? std::min(g.hMin, s.positionRadius.w) : s.positionRadius.w;
   }
   if (splats.empty()) {
     g.cellStart = {0, 0};
@@ -82,7 +83,10 @@ SplatGrid buildSplatGrid(std::vector<GpuSplat> splats) {
   }
   const glm::vec3 extent = b.extent();
   const float longest = std::max({extent.x, extent.y, extent.z});
-  g.cellSize = std::max({hMax, longest / kMaxCellsPerAxis, 1e-30f});
+  // Cells hold the reach of the largest kernel: the surface test accepts in-plane distances below h and
+  // plane distances below kPlaneTolerance h, so a splat reaches h sqrt(1 + tolerance^2) in 3-D.
+  const float reach = hMax * std::sqrt(1.f + kPlaneTolerance * kPlaneTolerance) * (1.f + 1e-5f);
+  g.cellSize = std::max({reach, longest / kMaxCellsPerAxis, 1e-30f});
   g.origin = b.min;
   g.dims = glm::clamp(glm::ivec3(glm::floor(extent / g.cellSize)) + 1, glm::ivec3(1), glm::ivec3(kMaxCellsPerAxis));
   const std::size_t cells = static_cast<std::size_t>(g.dims.x) * g.dims.y * g.dims.z;
@@ -103,7 +107,7 @@ SplatGrid buildSplatGrid(std::vector<GpuSplat> splats) {
   return g;
 }
 
-void declareSplatResources(FrameResources& res, const SplatGrid& grid) {
+void declareSplatResources(FrameResources& res, const SplatGrid& grid, const SplatSettings& settings) {
   const std::size_t splatBytes = std::max<std::size_t>(grid.count, 1) * sizeof(GpuSplat);
   if (!res.hasBuffer("photon_gi_splats") || res.buffer("photon_gi_splats").size() < splatBytes)
     res.buffer("photon_gi_splats", capacity(splatBytes));
@@ -113,6 +117,12 @@ void declareSplatResources(FrameResources& res, const SplatGrid& grid) {
   const int w = res.view().width, h = res.view().height;
   gl::Texture& accum = res.texture("photon_gi_accum", GL_TEXTURE_2D, GL_RGBA32F, w, h);
   accum.setFilter(GL_NEAREST, GL_NEAREST);
+  if (settings.method == Method::Gather && settings.gatherStep > 1) {
+    const int step = settings.gatherStep;
+    res.texture("photon_gi_accum_low", GL_TEXTURE_2D, GL_RGBA32F, (w + step - 1) / step, (h + step - 1) / step)
+        .setFilter(GL_NEAREST, GL_NEAREST);
+    res.texture("photon_gi_fixup", GL_TEXTURE_2D, GL_R32F, w, h).setFilter(GL_NEAREST, GL_NEAREST);
+  }
   gl::Framebuffer& splatFb = res.framebuffer("photon_gi_splat");
   splatFb.attach(GL_COLOR_ATTACHMENT0, accum);
   splatFb.setDrawBuffers({GL_COLOR_ATTACHMENT0});
@@ -178,14 +188,48 @@ void splatAndResolve(FrameResources& res, gl::ShaderLibrary& shaders, const Fram
     glUniform3iv(glGetUniformLocation(prog.id(), "u_gridDims"), 1, dims);
     const int size[2] = {view.width, view.height};
     glUniform2iv(glGetUniformLocation(prog.id(), "u_size"), 1, size);
-    accum.bindImage(0, GL_READ_WRITE);
     const std::uint32_t slices = std::max<std::uint32_t>(1, (grid.maxPerCell + kGatherSlice - 1) / kGatherSlice);
-    for (std::uint32_t k = 0; k < slices; ++k) {
-      glUniform1ui(glGetUniformLocation(prog.id(), "u_sliceBegin"), k * kGatherSlice);
-      glUniform1ui(glGetUniformLocation(prog.id(), "u_sliceLength"), kGatherSlice);
-      prog.set("u_accumulate", k > 0 ? 1 : 0);
+    // One gather over an output grid (full resolution, the block samples, or the marked pixels).
+    auto gather = [&](gl::Texture& target, int step, int outW, int outH, bool fixup) {
+      prog.use();
+      const int out[2] = {outW, outH};
+      glUniform2iv(glGetUniformLocation(prog.id(), "u_outSize"), 1, out);
+      prog.set("u_step", step);
+      prog.set("u_fixup", fixup ? 1 : 0);
+      target.bindImage(0, GL_READ_WRITE);
+      if (fixup) res.texture("photon_gi_fixup").bindImage(1, GL_READ_ONLY);
+      for (std::uint32_t k = 0; k < slices; ++k) {
+        glUniform1ui(glGetUniformLocation(prog.id(), "u_sliceBegin"), k * kGatherSlice);
+        glUniform1ui(glGetUniformLocation(prog.id(), "u_sliceLength"), kGatherSlice);
+        prog.set("u_accumulate", k > 0 ? 1 : 0);
+        glDispatchCompute((outW + 7) / 8, (outH + 7) / 8, 1);
+        glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+      }
+    };
+    const int step = settings.gatherStep;
+    if (step <= 1) {
+      gather(accum, 1, view.width, view.height, false);
+    } else {
+      gl::Texture& low = res.texture("photon_gi_accum_low");
+      const int lowW = (view.width + step - 1) / step, lowH = (view.height + step - 1) / step;
+      gather(low, step, lowW, lowH, false);
+      glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+      const gl::Program& up = shaders.program({"photon_gi/upsample.comp"});
+      common(up);
+      glUniform2iv(glGetUniformLocation(up.id(), "u_size"), 1, size);
+      const int lowSize[2] = {lowW, lowH};
+      glUniform2iv(glGetUniformLocation(up.id(), "u_lowSize"), 1, lowSize);
+      up.set("u_step", step);
+      up.set("u_hMin", grid.hMin);
+      up.set("u_renormalize", settings.renormalize ? 1 : 0);
+      up.set("u_minKernelMass", kMinKernelMass);
+      low.bindUnit(7);
+      accum.bindImage(0, GL_WRITE_ONLY);
+      res.texture("photon_gi_fixup").bindImage(1, GL_WRITE_ONLY);
       glDispatchCompute((view.width + 7) / 8, (view.height + 7) / 8, 1);
       glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+      common(prog);
+      gather(accum, 1, view.width, view.height, true);
     }
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
   }

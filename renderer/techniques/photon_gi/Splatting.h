@@ -46,6 +46,9 @@ struct SplatSettings {
   Kernel kernel = Kernel::Biweight;
   bool renormalize = true;
   float minGlossyRoughness = 0.2f;
+  // Gather only: one gather per gatherStep x gatherStep pixel block, spread to the block's pixels on
+  // the same surface by shaders/photon_gi/upsample.comp (the others get a full-resolution gather).
+  int gatherStep = 1;
 };
 
 // The splats sorted by grid cell, and the grid (cell c holds splats cellStart[c] .. cellStart[c+1]-1).
@@ -57,13 +60,14 @@ struct SplatGrid {
   float cellSize = 1.f;
   glm::ivec3 dims{1};
   std::uint32_t maxPerCell = 0;  // the fullest cell's splats (the gather's dispatch count follows it)
+  float hMin = 0.f;              // the smallest kernel radius
 };
-// Cells are at least the largest kernel radius (a gather visits the 27 cells around a pixel), and at
-// most 128 per axis.
+// Cells are at least the reach of the largest kernel, h sqrt(1 + planeTolerance^2) (a gather visits the
+// 27 cells around a pixel), and at most 128 per axis.
 SplatGrid buildSplatGrid(std::vector<GpuSplat> splats);
 
-// Declares the splat buffers (capacity in powers of two), the accumulation target and `indirect`.
-void declareSplatResources(FrameResources& res, const SplatGrid& grid);
+// Declares the splat buffers (capacity in powers of two), the accumulation targets and `indirect`.
+void declareSplatResources(FrameResources& res, const SplatGrid& grid, const SplatSettings& settings);
 // Uploads `grid` when `upload` (else the buffers hold it already), accumulates into the target and
 // resolves into `indirect`, adding it to `beauty` when addToBeauty. Reads the G-buffer resources.
 void splatAndResolve(FrameResources& res, gl::ShaderLibrary& shaders, const FrameView& view,

@@ -7,12 +7,14 @@
 
 #include "renderer/frame/PassContext.h"
 #include "renderer/frame/RayScenes.h"
+#include "renderer/reference/LightTracer.h"
 
 namespace radiant {
 
 const Image& referenceImage(FrameResources& res, const Scene& scene, const FrameView& view,
-                            const ReferenceRequest& r, bool* cacheHit, std::uint64_t* rays) {
-  const reference::PathTracer tracer(sharedRayScene(res, scene));
+                            const ReferenceRequest& r, bool* cacheHit, std::uint64_t* rays, bool* lightTraced) {
+  const rt::RayScene& rayScene = sharedRayScene(res, scene);
+  const reference::PathTracer tracer(rayScene);
   reference::ReferenceOptions o;
   o.spp = r.spp;
   o.maxBounces = r.maxBounces;
@@ -29,6 +31,23 @@ const Image& referenceImage(FrameResources& res, const Scene& scene, const Frame
                                             : reference::ReferenceOptions::Mode::AoCosineStep;
     o.aoRadius = r.aoRadius;
   }
+  // The light tracer's caustics join the image when caustic paths can exist and the range holds k >= 2.
+  const bool causticsOnly = r.aov == "caustics";
+  const bool lightTrace = causticsOnly || (r.caustics && o.mode == reference::ReferenceOptions::Mode::Radiance &&
+                                           o.maxPathBounce >= 2 && reference::sceneHasDeltaLobes(scene));
+  reference::LightTracerOptions lo;
+  if (lightTrace) {
+    o.excludeCaustics = true;
+    lo.paths = reference::LightTracerOptions::Paths::Caustics;
+    lo.pathsPerPixel = r.lightPathsPerPixel > 0 ? r.lightPathsPerPixel : r.spp;
+    lo.maxBounces = o.maxBounces;
+    lo.russianRoulette = o.russianRoulette;
+    lo.seed = o.seed;
+    lo.minPathBounce = std::max(2, o.minPathBounce);
+    lo.maxPathBounce = o.maxPathBounce;
+    lo.skyRadiance = o.skyRadiance;
+    lo.environment = o.environment;
+  }
   const glm::mat4& w = view.camera.world;
   nlohmann::json key = {{"scene", res.sceneKey()},
                         {"camera", std::vector<float>(&w[0][0], &w[0][0] + 16)},
@@ -38,11 +57,22 @@ const Image& referenceImage(FrameResources& res, const Scene& scene, const Frame
                         {"rr", o.russianRoulette}, {"seed", o.seed}, {"bounces", {o.minPathBounce, o.maxPathBounce}},
                         {"mode", static_cast<int>(o.mode)}, {"ao_radius", o.aoRadius},
                         {"sky", {o.skyRadiance.x, o.skyRadiance.y, o.skyRadiance.z}},
-                        {"environment", view.environmentKey}};
+                        {"environment", view.environmentKey},
+                        {"light_paths", lightTrace ? lo.pathsPerPixel : 0}, {"caustics_only", causticsOnly}};
   bool built = false;
+  std::uint64_t lightRays = 0;
   Image& img = res.cached<Image>("reference:" + r.aov, key.dump(), [&] {
     built = true;
-    auto image = std::make_unique<Image>(tracer.render(view.camera, view.width, view.height, o));
+    std::unique_ptr<Image> image;
+    if (!causticsOnly) image = std::make_unique<Image>(tracer.render(view.camera, view.width, view.height, o));
+    if (lightTrace) {
+      const reference::LightTracer lightTracer(rayScene);
+      const Image caustics = lightTracer.render(view.camera, view.width, view.height, lo);
+      lightRays = lightTracer.raysTraced();
+      if (!image) image = std::make_unique<Image>(caustics);
+      else
+        for (std::size_t i = 0; i < image->pixels.size(); ++i) image->pixels[i] += caustics.pixels[i];
+    }
     image->aov = "reference";
     if (o.mode != reference::ReferenceOptions::Mode::Radiance) {
       // AO is scalar: keep one channel, like the raster `ao` AOV.
@@ -53,7 +83,8 @@ const Image& referenceImage(FrameResources& res, const Scene& scene, const Frame
     return image;
   });
   if (cacheHit) *cacheHit = !built;
-  if (rays) *rays = built ? tracer.raysTraced() : 0;
+  if (rays) *rays = built ? (causticsOnly ? 0 : tracer.raysTraced()) + lightRays : 0;
+  if (lightTraced) *lightTraced = lightTrace;
   return img;
 }
 
@@ -76,6 +107,8 @@ Requirements ReferencePass::requirements(const Scene& scene, const api::RenderRe
 void ReferencePass::prepare(const Scene&, const Params& params, FrameResources& res) {
   request_.aov = params.get<std::string>("aov", "beauty");
   request_.spp = params.get<int>("spp", 64);
+  request_.lightPathsPerPixel = params.get<int>("light_paths_per_pixel", 0);
+  request_.caustics = params.get<bool>("caustics", true);
   request_.maxBounces = params.get<int>("max_bounces", 8);
   request_.russianRoulette = params.get<bool>("russian_roulette", true);
   request_.aoRadius = params.get<float>("ao_radius", 0.5f);
@@ -86,7 +119,8 @@ void ReferencePass::prepare(const Scene&, const Params& params, FrameResources& 
 void ReferencePass::execute(PassContext& ctx) {
   bool hit = false;
   std::uint64_t rays = 0;
-  const Image& img = referenceImage(ctx.resources, ctx.scene, ctx.view, request_, &hit, &rays);
+  bool lightTraced = false;
+  const Image& img = referenceImage(ctx.resources, ctx.scene, ctx.view, request_, &hit, &rays, &lightTraced);
   // Upload as RGBA with GL's bottom-up rows so readback treats it like every other AOV.
   std::vector<float> rgba(static_cast<std::size_t>(img.width) * img.height * 4, 0.f);
   for (int y = 0; y < img.height; ++y)
@@ -97,6 +131,8 @@ void ReferencePass::execute(PassContext& ctx) {
   ctx.stats.counters["spp"] = request_.spp;
   ctx.stats.counters["rays"] = static_cast<double>(rays);
   ctx.stats.counters["cached"] = hit ? 1.0 : 0.0;
+  // 1 when the light tracer added the caustic paths L S+ D E (the scene has a Dirac-delta lobe).
+  ctx.stats.counters["light_traced_caustics"] = lightTraced ? 1.0 : 0.0;
   ctx.resources.markWritten("reference");
 }
 

@@ -12,11 +12,17 @@
 
 namespace radiant {
 
-// Reference image of `aov` ("beauty", "direct", "indirect", "ao", "reference") for the frame's view.
-// For "ao", aoDefinition is "volumetric" (thesis eq. 4.6) or "cosine" (cosine-weighted step).
+// Reference image of `aov` ("beauty", "direct", "indirect", "caustics", "ao", "reference") for the
+// frame's view. For "ao", aoDefinition is "volumetric" (thesis eq. 4.6) or "cosine" (cosine-weighted step).
+// Caustics: when the scene has a material with a Dirac-delta lobe, "beauty" and "indirect" are the path
+// tracer without the caustic paths L S+ D E plus the light tracer's caustics (renderer/reference/
+// LightTracer.h), so that a point light's caustic through glass is in the ground truth, counted once;
+// "caustics" is the light tracer's caustics alone. `caustics = false` keeps the path tracer alone.
 struct ReferenceRequest {
   std::string aov = "beauty";
   int spp = 64;
+  int lightPathsPerPixel = 0;  // light tracer paths per pixel; 0 = spp
+  bool caustics = true;
   int maxBounces = 8;
   bool russianRoulette = true;
   float aoRadius = 0.5f;
@@ -24,7 +30,7 @@ struct ReferenceRequest {
 };
 const Image& referenceImage(FrameResources& resources, const Scene& scene, const FrameView& view,
                             const ReferenceRequest& request, bool* cacheHit = nullptr,
-                            std::uint64_t* rays = nullptr);
+                            std::uint64_t* rays = nullptr, bool* lightTraced = nullptr);
 
 class ReferencePass final : public Technique {
 public:

@@ -53,7 +53,7 @@ public:
   // The `indirect` image (RGB, row 0 = top) for these splats.
   Image run(std::vector<GpuSplat> splats, const SplatSettings& settings) {
     const photon_gi::SplatGrid grid = photon_gi::buildSplatGrid(std::move(splats));
-    photon_gi::declareSplatResources(res_, grid);
+    photon_gi::declareSplatResources(res_, grid, settings);
     photon_gi::splatAndResolve(res_, shaders_, view_, settings, grid, true, false);
     std::vector<float> rgba(static_cast<std::size_t>(view_.width) * view_.height * 4);
     res_.texture("indirect").download(0, GL_RGBA, GL_FLOAT, rgba.data(), rgba.size() * sizeof(float));
@@ -363,6 +363,36 @@ TEST(PhotonGi, CornellBoxIndirectAndBeautyAgainstTheReference) {
   EXPECT_NEAR(mean(aov(beauty, "beauty")) / mean(aov(beauty, "reference")), 1.0, 0.04);
   EXPECT_EQ(testing::cacheEvent(beauty, "photon_gi_photons"), 1);  // same photons, re-splatted
   for (const auto& pass : beauty.stats.passes) EXPECT_EQ(pass.counters.count("non_finite_pixels_zeroed"), 0u);
+}
+
+TEST(PhotonGi, GatherStepSpreadsBlockSamplesWithoutLosingLight) {
+  // gather_step 2 gathers one pixel per 2x2 block and spreads it over the block's pixels on the same
+  // surface; pixels with no such sample get their own gather. Against the full gather with the same
+  // (cached) photons: the frame's light within 1%, no pixel left dark where the full gather has
+  // light, and the error against the reference's indirect no more than 5% above the full gather's
+  // (what the knob trades; measured 0.2097 and 0.2092 at 64 px, where a block is 2/3 of the kernel radius).
+  const Scene scene = loadBuiltinScene("cornell_box");
+  api::RenderRequest full = cornellRequest(64, {{"photons", 200000}, {"gather_step", 1}});
+  full.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"indirect"}, false}};
+  full.compare = api::CompareSpec{"reference", "indirect", 256, 8};
+  api::RenderRequest blocks = full;
+  blocks.passes["photon_gi"]["gather_step"] = 2;
+  const RenderOutput a = renderer().render(scene, full);
+  const RenderOutput b = renderer().render(scene, blocks);
+  EXPECT_EQ(pass(b, "photon_gi")->counters.at("gather_step"), 2.0);
+  const Image& ia = aov(a, "indirect");
+  const Image& ib = aov(b, "indirect");
+  EXPECT_NEAR(mean(ib) / mean(ia), 1.0, 0.01);
+  const double m = mean(ia);
+  int dark = 0;
+  for (std::size_t i = 0; i < ia.pixels.size(); ++i) {
+    ASSERT_TRUE(std::isfinite(ib.pixels[i]));
+    if (ia.pixels[i] > 0.05 * m && ib.pixels[i] == 0.f) ++dark;
+  }
+  EXPECT_EQ(dark, 0);
+  const double ra = a.stats.metrics["rmse"].get<double>(), rb = b.stats.metrics["rmse"].get<double>();
+  std::printf("indirect rmse vs reference: gather_step 1 %.4f, 2 %.4f\n", ra, rb);
+  EXPECT_LT(rb, 1.05 * ra);
 }
 
 TEST(PhotonGi, GlossyBoxIndirectAgainstTheReference) {

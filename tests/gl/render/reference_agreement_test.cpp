@@ -105,3 +105,42 @@ TEST(ReferenceAgreement, IdenticalImagesGiveZeroError) {
 
 }  // namespace
 }  // namespace radiant
+
+namespace radiant {
+namespace {
+
+// The reference pass with caustics: the Cornell box's point light through the smooth glass sphere is
+// a caustic the path tracer cannot sample (a delta light behind a delta BSDF), so the pass adds the
+// light tracer's L S+ D E image. With a point light the path tracer finds no caustic path at all, so
+// beauty with caustics is exactly beauty without + the `caustics` mode, and the direct range holds none.
+TEST(ReferenceAgreement, ReferenceBeautyAddsTheLightTracedCausticsOnce) {
+  Scene scene = loadBuiltinScene("cornell_glass");
+  auto render = [&](const nlohmann::json& params, double* traced = nullptr) {
+    api::RenderRequest req;
+    req.width = req.height = 32;
+    req.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"reference"}, false}};
+    req.passes["reference"] = params;
+    RenderOutput out = testing::renderer().render(scene, req);
+    for (const auto& p : out.stats.passes)
+      if (p.name == "reference" && traced) *traced = p.counters.at("light_traced_caustics");
+    return testing::aov(out, "reference");
+  };
+  double traced = -1;
+  const Image with = render({{"spp", 4}, {"light_paths_per_pixel", 16}}, &traced);
+  EXPECT_EQ(traced, 1.0);
+  const Image without = render({{"spp", 4}, {"caustics", false}}, &traced);
+  EXPECT_EQ(traced, 0.0);
+  const Image caustics = render({{"spp", 4}, {"aov", "caustics"}, {"light_paths_per_pixel", 16}});
+  render({{"spp", 4}, {"aov", "direct"}}, &traced);
+  EXPECT_EQ(traced, 0.0);  // k <= 1 holds no caustic
+  double sum = 0;
+  for (std::size_t i = 0; i < with.pixels.size(); ++i) {
+    ASSERT_TRUE(std::isfinite(with.pixels[i]));
+    EXPECT_NEAR(with.pixels[i], without.pixels[i] + caustics.pixels[i], 1e-5f * (1.f + with.pixels[i]));
+    sum += caustics.pixels[i];
+  }
+  EXPECT_GT(sum, 0.0);
+}
+
+}  // namespace
+}  // namespace radiant

@@ -29,16 +29,7 @@ float renderPoint(const Scene& s, glm::vec3 target, glm::vec3 towardsEye, const 
   return render(s, pinpointCamera(target, towardsEye, distance), 1, 1, o).pixels[0];
 }
 
-// Unpolarised Fresnel reflectance written out from the Fresnel equations (independent of Brdf.h).
-double fresnelUnpolarised(double cosI, double n1, double n2) {
-  const double sinT = n1 / n2 * std::sqrt(1 - cosI * cosI);
-  if (sinT >= 1) return 1;
-  const double cosT = std::sqrt(1 - sinT * sinT);
-  const double rs = (n1 * cosI - n2 * cosT) / (n1 * cosI + n2 * cosT);
-  const double rp = (n2 * cosI - n1 * cosT) / (n2 * cosI + n1 * cosT);
-  return 0.5 * (rs * rs + rp * rp);
-}
-
+using testing::fresnelUnpolarised;
 using testing::bsdfOf;
 
 // E(mu) tabulated by quadrature on [mu0, 1] and interpolated.

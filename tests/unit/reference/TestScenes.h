@@ -13,6 +13,16 @@
 
 namespace radiant::testing {
 
+// Unpolarised Fresnel reflectance written out from the Fresnel equations (independent of Brdf.h).
+inline double fresnelUnpolarised(double cosI, double n1, double n2) {
+  const double sinT = n1 / n2 * std::sqrt(1 - cosI * cosI);
+  if (sinT >= 1) return 1;
+  const double cosT = std::sqrt(1 - sinT * sinT);
+  const double rs = (n1 * cosI - n2 * cosT) / (n1 * cosI + n2 * cosT);
+  const double rp = (n2 * cosI - n1 * cosT) / (n2 * cosI + n1 * cosT);
+  return 0.5 * (rs * rs + rp * rp);
+}
+
 inline Material lambert(glm::vec3 albedo) {
   // glTF has no pure Lambertian material: the dielectric always carries a Fresnel-weighted GGX layer.
   // ior = 1 makes f0 = 0, so Schlick's F = (1 - v.h)^5 vanishes for small angles between v and l

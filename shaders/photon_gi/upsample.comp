@@ -1,0 +1,64 @@
+// gather_step > 1: the gather ran on one pixel per step x step block (its centre pixel); this pass gives
+// every pixel the photon estimate of the nearby block samples that lie on its own surface, bilinear
+// weights times a surface test (the estimator's own: within planeTolerance h_min of the pixel's plane,
+// normals within acos(0.9), and closer than h_min / 2, so borrowing blurs less than half the smallest
+// kernel). The diffuse albedo is re-modulated per pixel, (albedo + 0.02) / (albedo_sample + 0.02), so
+// texture detail survives. Pixels without a matching sample are marked for a full-resolution gather
+// (i_fixup = 1), which the next dispatch of gather.comp does for them alone: no pixel is left dark.
+#include "photon_gi/photon.glsl"
+#include "photon_gi/surface.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(rgba32f, binding = 0) uniform writeonly image2D i_accum;
+layout(r32f, binding = 1) uniform writeonly image2D i_fixup;
+layout(binding = 7) uniform sampler2D t_low;
+
+uniform ivec2 u_size;     // full resolution
+uniform ivec2 u_lowSize;  // the block samples
+uniform int u_step;
+uniform float u_hMin;
+uniform int u_renormalize;
+uniform float u_minKernelMass;
+
+ivec2 samplePixel(ivec2 q) { return min(q * u_step + u_step / 2, u_size - 1); }
+
+void main() {
+  ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+  if (px.x >= u_size.x || px.y >= u_size.y) return;
+  SplatSurface s;
+  if (!loadSurface(px, s)) {
+    imageStore(i_accum, px, vec4(0.0));
+    imageStore(i_fixup, px, vec4(0.0));
+    return;
+  }
+  vec2 f = (vec2(px) + 0.5) / float(u_step) - 0.5;
+  ivec2 q0 = ivec2(floor(f));
+  vec2 t = f - vec2(q0);
+  vec3 sum = vec3(0.0);
+  float wsum = 0.0;
+  for (int j = 0; j <= 1; ++j)
+    for (int i = 0; i <= 1; ++i) {
+      ivec2 q = clamp(q0 + ivec2(i, j), ivec2(0), u_lowSize - 1);
+      float wb = (i == 0 ? 1.0 - t.x : t.x) * (j == 0 ? 1.0 - t.y : t.y);
+      if (wb <= 0.0) continue;
+      SplatSurface o;
+      if (!loadSurface(samplePixel(q), o)) continue;
+      vec3 d = s.x - o.x;
+      if (abs(dot(d, o.ng)) > u_planeTolerance * u_hMin) continue;
+      if (dot(s.ng, o.ng) < 0.9) continue;
+      if (dot(d, d) > 0.25 * u_hMin * u_hMin) continue;
+      vec4 a = texelFetch(t_low, q, 0);
+      vec3 L = a.rgb;
+      if (u_renormalize != 0 && a.a > 0.0) L /= max(a.a, u_minKernelMass);
+      sum += wb * L * (s.baseColor + 0.02) / (o.baseColor + 0.02);
+      wsum += wb;
+    }
+  if (wsum > 0.0) {
+    // a = 1: the resolve's renormalisation divides by max(1, minKernelMass) = 1.
+    imageStore(i_accum, px, vec4(sum / wsum, 1.0));
+    imageStore(i_fixup, px, vec4(0.0));
+  } else {
+    imageStore(i_accum, px, vec4(0.0));
+    imageStore(i_fixup, px, vec4(1.0));
+  }
+}
