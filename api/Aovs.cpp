@@ -26,7 +26,7 @@ const std::vector<AovInfo>& aovTable() {
          "specular", true, ""},
         // caustics: L S+ D E from punctual lights through mirrors and refractors (caustic triangles).
         {0, "caustics", F::Rgba32F, "caustics", 0, 3, {"caustics.R", "caustics.G", "caustics.B"}, B::Overwrite,
-         "caustics", true, ""},
+         "caustics", true, "caustics"},
         {0, "ao", F::R32F, "ao", 0, 1, {"ao.Y"}, B::Overwrite, "ambient_occlusion", true, "ao"},
         {0, "depth", F::Rgba32F, "gbuffer_position", 3, 1, {"depth.Z"}, B::Overwrite, "gbuffer", true, ""},
         {0, "gbuffer_position", F::Rgba32F, "gbuffer_position", 0, 3,
