@@ -24,6 +24,9 @@ const std::vector<AovInfo>& aovTable() {
         // seen through specular surfaces only (needs a per-pixel mask: Technique::groundTruth, #20).
         {0, "specular", F::Rgba32F, "specular", 0, 3, {"specular.R", "specular.G", "specular.B"}, B::Overwrite,
          "specular", true, ""},
+        // caustics: L S+ D E from punctual lights through mirrors and refractors (caustic triangles).
+        {0, "caustics", F::Rgba32F, "caustics", 0, 3, {"caustics.R", "caustics.G", "caustics.B"}, B::Overwrite,
+         "caustics", true, "caustics"},
         // light_volumes: first-order light through specular and glossy scatterers (LS+DE, LG+DE) from
         // punctual lights; added to beauty.
         {0, "light_volumes", F::Rgba32F, "light_volumes", 0, 3,

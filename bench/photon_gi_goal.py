@@ -45,6 +45,35 @@ def render(server, request):
     return r, wall
 
 
+def upload_ground_truth(server, base, truth_spp, truth_file=None, save_truth=None):
+    """Renders the reference at truth_spp (seed 99), or reads truth_file, uploads it; returns its digest."""
+    if truth_file:
+        with open(truth_file, "rb") as f:
+            exr = f.read()
+        ms = 0.0
+    else:
+        truth, ms = render(server, dict(base, seed=99, passes={"reference": {"spp": truth_spp}, "photon_gi": False},
+                                        outputs=[{"format": "exr", "half": False, "aovs": ["reference"]}]))
+        exr = call(server, truth["frames"][0]["url"], ctype="image/x-exr")
+        if save_truth:
+            with open(save_truth, "wb") as f:
+                f.write(exr)
+    digest = call(server, "/v1/images", exr, method="PUT", ctype="image/x-exr")
+    digest = json.loads(digest)["digest"] if isinstance(digest, bytes) else digest["digest"]
+    print(f"ground truth: reference {truth_spp} spp, {ms / 1000:.1f} s", file=sys.stderr)
+    return digest
+
+
+def reference_256(server, base, digest):
+    """The reference at 256 spp (seed 5) scored against the ground truth: (its pass ms, RMSE, table row)."""
+    ref, _ = render(server, dict(base, seed=5, passes={"reference": {"spp": 256}, "photon_gi": False},
+                                 compare={"against": digest, "aov": "reference"},
+                                 outputs=[{"format": "exr", "aovs": ["reference"]}]))
+    ref_ms = next(p["cpu_ms"] for p in ref["stats"]["passes"] if p["name"] == "reference")
+    m = ref["stats"]["metrics"]
+    return ref_ms, m["rmse"], ("reference, 256 spp", ref_ms, ref["stats"]["render_ms"], m["rmse"], m["rel_mse"])
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--server", default=os.environ.get("RADIANT_SERVER", "http://127.0.0.1:8080"))
@@ -60,28 +89,10 @@ def main():
     renderer = info.get("device", {}).get("renderer", "?")
     base = {"scene": {"builtin": a.scene}, "width": a.size, "height": a.size}
 
-    if a.truth:
-        with open(a.truth, "rb") as f:
-            exr = f.read()
-        ms = 0.0
-    else:
-        truth, ms = render(S, dict(base, seed=99, passes={"reference": {"spp": a.truth_spp}, "photon_gi": False},
-                                   outputs=[{"format": "exr", "half": False, "aovs": ["reference"]}]))
-        exr = call(S, truth["frames"][0]["url"], ctype="image/x-exr")
-        if a.save_truth:
-            with open(a.save_truth, "wb") as f:
-                f.write(exr)
-    digest = call(S, "/v1/images", exr, method="PUT", ctype="image/x-exr")
-    digest = json.loads(digest)["digest"] if isinstance(digest, bytes) else digest["digest"]
-    print(f"ground truth: reference {a.truth_spp} spp, {ms / 1000:.1f} s", file=sys.stderr)
-
+    digest = upload_ground_truth(S, base, a.truth_spp, a.truth, a.save_truth)
     rows = []
-    ref, ms = render(S, dict(base, seed=5, passes={"reference": {"spp": 256}, "photon_gi": False},
-                             compare={"against": digest, "aov": "reference"},
-                             outputs=[{"format": "exr", "aovs": ["reference"]}]))
-    ref_ms = next(p["cpu_ms"] for p in ref["stats"]["passes"] if p["name"] == "reference")
-    ref_rmse = ref["stats"]["metrics"]["rmse"]
-    rows.append(("reference, 256 spp", ref_ms, ref["stats"]["render_ms"], ref_rmse, ref["stats"]["metrics"]["rel_mse"]))
+    ref_ms, ref_rmse, ref_row = reference_256(S, base, digest)
+    rows.append(ref_row)
 
     other_camera = {"position": [0.25, 0.55, 1.7], "target": [0.0, 0.45, 0.0], "up": [0, 1, 0], "yfov_deg": 42}
     settings = [("photon_gi default (gather_step 2)", {}), ("photon_gi gather_step 1", {"gather_step": 1}),

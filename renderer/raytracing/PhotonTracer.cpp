@@ -26,6 +26,7 @@ void tracePhoton(const RayScene& rays, const SceneLights& lights, const PhotonOp
   Ray ray = e.ray;
   const int lastBounce = o.maxBounces - 1;
   bool narrowLobePath = true;  // every scattering so far off a metal or glass by a non-diffuse lobe
+  bool specularChain = true;  // every scattering vertex so far on a Material::isSpecular() surface
   for (int bounce = 0; bounce <= lastBounce; ++bounce) {
     SurfaceHit hit;
     if (!rays.intersect(ray, hit, sampler, counter)) return;
@@ -43,12 +44,14 @@ void tracePhoton(const RayScene& rays, const SceneLights& lights, const PhotonOp
       r.photon = static_cast<std::uint32_t>(index);
       r.wi = wo;
       r.bounce = static_cast<std::uint16_t>(bounce);
-      r.narrowLobePath = bounce >= 1 && narrowLobePath ? 1 : 0;
+      r.flags = static_cast<std::uint16_t>((bounce >= 1 && specularChain ? kPhotonSpecularChain : 0) |
+                                           (bounce >= 1 && narrowLobePath ? kPhotonNarrowLobePath : 0));
       r.flux = flux;
       r.light = static_cast<std::uint32_t>(e.light);
       out.push_back(r);
     }
     if (bounce == lastBounce) return;
+    specularChain = specularChain && rays.materialOf(hit.mesh).isSpecular();
     const float uLobe = sampler.next(), uFresnel = sampler.next();
     const glm::vec2 uDir = sampler.next2();
     GltfBsdf::Sample s;

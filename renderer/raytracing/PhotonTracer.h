@@ -11,7 +11,9 @@
 // photons with the same seed (photon i's random numbers depend only on (i, seed)).
 //
 // A delta (mirror, smooth glass) scattering ends a photon: what it would carry is LS+D light, caustics,
-// which this tracer does not own.
+// which this tracer does not own. Near-mirrors (Material::isSpecular() with roughness > 0) have a
+// glossy lobe and are scattered by it; a record whose earlier vertices all lie on such surfaces is
+// flagged kPhotonSpecularChain (class LS+D), so that a consumer can leave it to the caustics pass.
 #include <cstdint>
 #include <vector>
 
@@ -29,14 +31,18 @@ struct PhotonRecord {
   std::uint32_t photon = 0;     // index of the emitted photon; records are sorted by it
   glm::vec3 wi{0.f};            // unit direction towards where the photon came from
   std::uint16_t bounce = 0;     // scattering events before this hit (0 = straight from the emitter)
-  // 1 when every scattering event before this hit was a glossy or specular lobe of a metal or glass
-  // (Material::scattersNarrowLobe()) and bounce >= 1: the path so far is L(S|G)+, which light_volumes
-  // supplies (classes LS+DE, LG+DE) when it owns them.
-  std::uint16_t narrowLobePath = 0;
+  std::uint16_t flags = 0;      // kPhoton* bits
   glm::vec3 flux{0.f};          // Phi_total * rho_j (W); divide by the photons used
   std::uint32_t light = 0;      // index into SceneLights::emitters()
 };
 static_assert(sizeof(PhotonRecord) == 64, "PhotonRecord is 64 bytes");
+// bounce >= 1 and every scattering vertex before this hit was on a Material::isSpecular() surface:
+// the photon's path so far is L S+ D (what the caustics pass supplies for punctual lights).
+inline constexpr std::uint16_t kPhotonSpecularChain = 1u;
+// bounce >= 1 and every scattering event before this hit was a glossy or specular lobe of a metal or
+// glass (Material::scattersNarrowLobe()): the path so far is L(S|G)+, which light_volumes supplies
+// (classes LS+DE, LG+DE) when it owns them.
+inline constexpr std::uint16_t kPhotonNarrowLobePath = 2u;
 
 struct PhotonOptions {
   // Most scattering events a path may have counting the surface the photon lands on as seen by the

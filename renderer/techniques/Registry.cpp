@@ -1,6 +1,7 @@
 #include "renderer/techniques/Registry.h"
 
 #include "renderer/techniques/ambient_occlusion/AmbientOcclusion.h"
+#include "renderer/techniques/caustics/Caustics.h"
 #include "renderer/techniques/direct/Direct.h"
 #include "renderer/techniques/env_diffuse/EnvDiffuse.h"
 #include "renderer/techniques/gbuffer/GBuffer.h"
@@ -18,12 +19,15 @@ std::vector<std::unique_ptr<Technique>> createTechniques() {
   t.push_back(std::make_unique<GBufferPass>());
   t.push_back(std::make_unique<ShadowMapsPass>());
   t.push_back(std::make_unique<DirectPass>());
+  // specular before caustics (which reads its distance maps), and caustics before photon_gi: the
+  // first planned claimant of a light-path class owns it, and caustics owns LS+DE when it runs.
+  t.push_back(std::make_unique<SpecularPass>());
+  t.push_back(std::make_unique<CausticsPass>());
   t.push_back(std::make_unique<EnvDiffusePass>());
   t.push_back(std::make_unique<PhotonGiPass>());
-  // Claims LS+DE and LG+DE: a caustics technique that also claims them goes before it (so that it owns
-  // them by default), and the planner gives them to light_volumes when the request names it.
+  // Claims LS+DE and LG+DE: caustics, which also claims LS+DE, goes before it (so that it owns it by
+  // default), and the planner gives both classes to light_volumes when the request names it.
   t.push_back(std::make_unique<LightVolumesPass>());
-  t.push_back(std::make_unique<SpecularPass>());
   t.push_back(std::make_unique<AmbientOcclusionPass>());
   t.push_back(std::make_unique<TransparencyPass>());  // last of the beauty passes: composites over them
   t.push_back(std::make_unique<ReferencePass>());

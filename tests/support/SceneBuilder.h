@@ -53,6 +53,27 @@ public:
     return *this;
   }
 
+  // The same box as one mesh (one MeshInstance, outward normals): a solid the specular and caustics
+  // passes treat as one object with one reference point, as a glTF file's box primitive would be.
+  SceneBuilder& solidBox(glm::vec3 lo, glm::vec3 hi, int mat, const std::string& name = "solid") {
+    const std::size_t first = scene_.meshes.size();
+    box(lo, hi, mat, name);
+    MeshInstance merged = std::move(scene_.meshes[first]);
+    merged.name = name;
+    for (std::size_t i = first + 1; i < scene_.meshes.size(); ++i) {
+      const auto base = static_cast<std::uint32_t>(merged.positions.size());
+      const MeshInstance& q = scene_.meshes[i];
+      merged.positions.insert(merged.positions.end(), q.positions.begin(), q.positions.end());
+      merged.normals.insert(merged.normals.end(), q.normals.begin(), q.normals.end());
+      merged.uv0.insert(merged.uv0.end(), q.uv0.begin(), q.uv0.end());
+      for (std::uint32_t idx : q.indices) merged.indices.push_back(base + idx);
+      merged.bounds.extend(q.bounds);
+    }
+    scene_.meshes.resize(first);
+    scene_.meshes.push_back(std::move(merged));
+    return *this;
+  }
+
   // A UV sphere with outward normals.
   SceneBuilder& sphere(glm::vec3 c, float r, int mat, int segments = 48, int rings = 24, const std::string& name = "sphere") {
     MeshInstance m;

@@ -53,7 +53,9 @@ const TechniqueInfo& PhotonGiPass::info() const {
                                {"indirect"},
                                true,
                                true,
-                               {"LD+DE", "L(area)DE", "L(sky)DE", "L(sky)GE"}};
+                               // LS+DE: punctual light through near-mirrors (isSpecular() with a glossy
+                               // lobe), which the tracer scatters; the caustics pass owns it when it runs.
+                               {"LD+DE", "L(area)DE", "L(sky)DE", "L(sky)GE", "LS+DE"}};
   return i;
 }
 
@@ -127,8 +129,13 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   // splatted on surfaces that are not themselves metal or glass (docs/TECHNIQUES.md).
   const std::string narrowOwner = res.lightPathOwner("LG+DE");
   const bool leaveNarrowLobePaths = !narrowOwner.empty() && narrowOwner != "photon_gi";
+  // Light from a punctual light that reached the surface through near-mirrors only (LS+D): the
+  // caustics pass's when it owns LS+DE (its photons cover point, spot and directional lights; those
+  // of emissive triangles and the sky stay here).
+  const bool ownsCaustics = res.ownsLightPath("photon_gi", "LS+DE");
   const nlohmann::json splatKey = {{"photons", photonKey}, {"count", s.photons}, {"C", s.C}, {"sky", ownsSky},
                                    {"sky_glossy", ownsSkyGlossy}, {"leave_narrow_lobe_paths", leaveNarrowLobePaths},
+                                   {"caustics", ownsCaustics},
                                    {"ppm", s.ppm}, {"alpha", s.ppmAlpha}, {"base", s.ppmBase},
                                    {"renormalize", splat_.renormalize}};
   upload_ = false;
@@ -142,12 +149,13 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
     // pass computes, and the sky's direct light when this pass owns it (the planner gives it to
     // photon_gi ahead of ambient_occlusion, whose visibility ends at its radius).
     auto splatted = [&](const rt::PhotonRecord& r) {
-      if (r.bounce >= 1 && r.narrowLobePath && leaveNarrowLobePaths &&
-          lights.emitters()[r.light].kind == rt::SceneLights::Kind::Punctual &&
-          !rays.materialOf(r.mesh).scattersNarrowLobe())
-        return false;
-      if (r.bounce >= 1) return true;
       const auto kind = lights.emitters()[r.light].kind;
+      if (r.bounce >= 1 && (r.flags & rt::kPhotonNarrowLobePath) && leaveNarrowLobePaths &&
+          kind == rt::SceneLights::Kind::Punctual && !rays.materialOf(r.mesh).scattersNarrowLobe())
+        return false;
+      if (r.bounce >= 1)
+        return ownsCaustics || !(r.flags & rt::kPhotonSpecularChain) || kind == rt::SceneLights::Kind::Triangle ||
+               kind == rt::SceneLights::Kind::Environment;
       return kind == rt::SceneLights::Kind::Triangle || (kind == rt::SceneLights::Kind::Environment && ownsSky);
     };
     std::vector<double> count(scene.meshes.size(), 0.0), area(scene.meshes.size(), 0.0);

@@ -33,11 +33,18 @@ const TechniqueInfo& SpecularPass::info() const {
       "Multiple specular reflections and refractions traced in layered distance maps (thesis ch. 5)",
       {"gbuffer_position", "normal", "albedo", "material", "emission"},
       {"shadow_maps", "environment_map"},  // rays that leave the scene see the environment map
-      {"specular"},
+      {"specular", "specular_maps"},  // specular_maps: the layered distance maps (internal, read by caustics)
       true,
       true,
       {"LS+E", "LDS+E"}};
   return i;
+}
+
+std::vector<std::size_t> SpecularPass::specularMeshes(const Scene& scene) {
+  std::vector<std::size_t> out;
+  for (std::size_t i = 0; i < scene.meshes.size(); ++i)
+    if (scene.material(scene.meshes[i].material).isSpecular() && scene.meshes[i].triangleCount() > 0) out.push_back(i);
+  return out;
 }
 
 Requirements SpecularPass::requirements(const Scene& scene, const api::RenderRequest&) const {
@@ -59,9 +66,8 @@ void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResour
   const Bounds& sb = scene.features.bounds;
   objects_.clear();
   objectOfMesh_.assign(scene.meshes.size(), -1);
-  for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
+  for (std::size_t i : specularMeshes(scene)) {
     const MeshInstance& m = scene.meshes[i];
-    if (!scene.material(m.material).isSpecular() || m.triangleCount() == 0) continue;
     Object o;
     o.mesh = i;
     const glm::vec3 ref = referencePoint(m);
@@ -219,6 +225,7 @@ void SpecularPass::execute(PassContext& ctx) {
     glMemoryBarrier(GL_ALL_BARRIER_BITS);
     ctx.stats.counters["maps_rendered"] = draws;
   }
+  res.markWritten("specular_maps");
   ctx.stats.counters["cube_resolution"] = resolution_;
   ctx.stats.counters["layers"] = layers_;
 

@@ -629,6 +629,9 @@ TEST_F(ParityTest, SamplerUnitsAreUniqueAcrossTheFramesPrograms) {
       {"specular/map.vert", "specular/map.frag"},         {"specular/map.vert", "specular/specular.frag"},
       {"env_diffuse/cube.vert", "env_diffuse/cube.frag"}, {"env_diffuse/cube.vert", "env_diffuse/receiver.frag"},
       {"common/fullscreen.vert", "ambient_occlusion/ao_resolve.frag"},  // image-based lighting's DFG table
+      {"specular/map.vert", "caustics/photon.frag"},      {"common/fullscreen.vert", "caustics/camera.frag"},
+      {"caustics/grid.vert", "caustics/triangles.geom", "caustics/deposit.frag"},
+      {"caustics/grid.vert", "caustics/splat.geom", "caustics/deposit.frag"},
   };
   std::map<int, std::string> sharedUnitOwner;  // unit >= 6 -> sampler name
   int samplers = 0;

@@ -115,10 +115,10 @@ TEST(Validate, UnknownTopLevelKeyIs422WithPointer) {
 
 TEST(Validate, UnknownTechniqueAndUnknownParameterNamed) {
   json body = minimal();
-  body["passes"] = {{"caustics", json::object()}};
+  body["passes"] = {{"no_such_technique", json::object()}};
   ApiError e = errorOf(body);
   EXPECT_EQ(e.status, 422);
-  EXPECT_EQ(e.pointer, "/passes/caustics");
+  EXPECT_EQ(e.pointer, "/passes/no_such_technique");
 
   body["passes"] = {{"direct", {{"pcf_radiu", 2}}}};
   e = errorOf(body);

@@ -1,0 +1,64 @@
+#!/usr/bin/env python3
+"""The goal measurement of caustics (issue 14): on the built-in cornell_glass at SIZE x SIZE, does the
+default frame with caustics land within 1.5x the RMSE of the reference at 256 spp, in under a tenth of
+its time? Same procedure as bench/photon_gi_goal.py (whose helpers it uses), one run on one machine:
+
+    bench/caustics_goal.py [--server URL] [--size 128] [--truth-spp 2048] [--truth FILE.exr]
+
+  1. ground truth: the reference at --truth-spp (seed 99; path tracer + light-traced caustics);
+  2. the reference at 256 spp (seed 5): its time (the reference pass) and RMSE;
+  3. frames with photons cached (a first render from another camera traces them), scored on beauty:
+     the default frame (caustics on), the same with caustics off, and caustics at P 256 / C 512.
+Prints a Markdown table for docs/PERFORMANCE.md. Python standard library only.
+"""
+import argparse
+import os
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from photon_gi_goal import call, reference_256, render, upload_ground_truth  # noqa: E402
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--server", default=os.environ.get("RADIANT_SERVER", "http://127.0.0.1:8080"))
+    ap.add_argument("--size", type=int, default=128)
+    ap.add_argument("--truth-spp", type=int, default=2048)
+    ap.add_argument("--scene", default="cornell_glass")
+    ap.add_argument("--truth", help="a ground-truth EXR to reuse instead of rendering one")
+    a = ap.parse_args()
+    S = a.server
+    info = call(S, "/v1/info")
+    renderer = info.get("device", {}).get("renderer", "?")
+    base = {"scene": {"builtin": a.scene}, "width": a.size, "height": a.size}
+    digest = upload_ground_truth(S, base, a.truth_spp, a.truth)
+    ref_ms, ref_rmse, ref_row = reference_256(S, base, digest)
+    rows = [ref_row + (0.0,)]
+
+    other_camera = {"position": [0.25, 0.55, 1.7], "target": [0.0, 0.45, 0.0], "up": [0, 1, 0], "yfov_deg": 42}
+    settings = [("default frame (photon_gi + specular + caustics)", {}),
+                ("default frame, caustics off", False),
+                ("default frame, caustics P 256, C 512", {"photon_resolution": 256, "cube_resolution": 512}),
+                ("default frame, caustics splat r 0.02", {"method": "splat", "splat_radius": 0.02})]
+    for label, caustics in settings:
+        passes = {"photon_gi": {}, "caustics": caustics}
+        render(S, dict(base, camera=other_camera, passes=passes, outputs=[{"format": "exr", "aovs": ["beauty"]}]))
+        r, ms = render(S, dict(base, passes=passes, compare={"against": digest, "aov": "beauty"},
+                               outputs=[{"format": "exr", "aovs": ["beauty"]}]))
+        st = r["stats"]
+        passes_ms = sum(p["cpu_ms"] for p in st["passes"])
+        cms = next((p["cpu_ms"] for p in st["passes"] if p["name"] == "caustics"), 0.0)
+        rows.append((label, passes_ms, st["render_ms"], st["metrics"]["rmse"], st["metrics"]["rel_mse"], cms))
+
+    print(f"Scene `{a.scene}` at {a.size}x{a.size}, GL renderer `{renderer}`, {time.strftime('%Y-%m-%d %H:%M')}; "
+          f"ground truth: reference at {a.truth_spp} spp. Times are the frame's passes (CPU wall clock, the GPU "
+          f"work included) and the whole render; photons cached, camera changed.\n")
+    print("| frame | passes ms | caustics ms | render ms | RMSE | relMSE | time / reference-256 | RMSE / reference-256 |")
+    print("|---|---|---|---|---|---|---|---|")
+    for label, pm, rm, rmse, rel, cms in rows:
+        print(f"| {label} | {pm:.0f} | {cms:.0f} | {rm:.0f} | {rmse:.4f} | {rel:.4f} | {pm / ref_ms:.3f} | {rmse / ref_rmse:.2f} |")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,392 @@
+#include "renderer/techniques/caustics/Caustics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "renderer/frame/GpuTypes.h"
+#include "renderer/frame/PassContext.h"
+#include "renderer/techniques/direct/DirectLighting.h"
+#include "renderer/techniques/shadow_maps/ShadowMaps.h"
+#include "renderer/techniques/specular/Specular.h"
+
+namespace radiant {
+namespace {
+
+glm::vec3 anyPerpendicular(const glm::vec3& d) {
+  return std::abs(d.y) < 0.99f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
+}
+
+// Does the light reach the sphere (centre, radius) at all: inside its range and, for a spot, its cone?
+bool lightReaches(const Light& l, const glm::vec3& centre, float radius) {
+  if (l.type == LightType::Directional) return true;
+  const glm::vec3 toC = centre - l.position;
+  const float d = glm::length(toC);
+  if (d <= radius) return true;
+  if (l.range > 0.f && d - radius > l.range) return false;
+  if (l.type == LightType::Spot) {
+    const float angle = std::acos(std::clamp(glm::dot(glm::normalize(l.direction), toC / d), -1.f, 1.f));
+    if (angle - std::asin(std::min(1.f, radius / d)) > l.outerConeAngle) return false;
+  }
+  return true;
+}
+
+// Some corner of `b` lies inside the side planes of the camera's clip volume, or the box straddles
+// them (a conservative frustum test: false only when all eight corners are outside one plane).
+bool boundsMayBeVisible(const Bounds& b, const glm::mat4& viewProj) {
+  bool out[5] = {true, true, true, true, true};
+  for (int c = 0; c < 8; ++c) {
+    const glm::vec3 p((c & 1) ? b.max.x : b.min.x, (c & 2) ? b.max.y : b.min.y, (c & 4) ? b.max.z : b.min.z);
+    const glm::vec4 q = viewProj * glm::vec4(p, 1.f);
+    out[0] = out[0] && q.x < -q.w;
+    out[1] = out[1] && q.x > q.w;
+    out[2] = out[2] && q.y < -q.w;
+    out[3] = out[3] && q.y > q.w;
+    out[4] = out[4] && q.w <= 0.f;
+  }
+  return !(out[0] || out[1] || out[2] || out[3] || out[4]);
+}
+
+constexpr int kGroup = 8;
+constexpr float kMaxLightTan = 11.4f;  // tan(85 degrees)  // work-group side of area.comp and energy.comp
+
+}  // namespace
+
+const TechniqueInfo& CausticsPass::info() const {
+  static const TechniqueInfo i{
+      "caustics",
+      "Caustic triangles (thesis ch. 6): light through mirrors and refractors onto diffuse and glossy surfaces",
+      {"gbuffer_position", "normal", "albedo", "material", "emission", "geometric_normal", "specular_maps"},
+      {"shadow_maps"},
+      {"caustics"},
+      true,
+      true,
+      {"LS+DE"}};
+  return i;
+}
+
+bool CausticsPass::lightCamera(const Light& light, const Bounds& bounds, LightCamera& out) {
+  const glm::vec3 centre = bounds.center();
+  const float radius = std::max(bounds.radius(), 1e-6f);
+  if (light.type == LightType::Directional) {
+    const glm::vec3 dir = glm::normalize(light.direction);
+    const glm::vec3 eye = centre - dir * (2.f * radius);
+    out.orthographic = true;
+    out.halfExtent = radius;
+    out.viewProj = reversedZOrthographic(radius, radius, 0.f, 4.f * radius) * glm::lookAt(eye, centre, anyPerpendicular(dir));
+    return true;
+  }
+  // A square frustum from the light around the axis to the centre, wide enough for the eight corners
+  // of the generator's bounds (tighter than its bounding sphere for flat mirrors, and defined when the
+  // light is inside that sphere but in front of the mirror).
+  const glm::vec3 toC = centre - light.position;
+  const float d = glm::length(toC);
+  if (!(d > 1e-6f * radius)) return false;
+  const glm::vec3 axis = toC / d;
+  float maxTan = 0.f, minDepth = std::numeric_limits<float>::max();
+  for (int c = 0; c < 8; ++c) {
+    const glm::vec3 p((c & 1) ? bounds.max.x : bounds.min.x, (c & 2) ? bounds.max.y : bounds.min.y,
+                      (c & 4) ? bounds.max.z : bounds.min.z);
+    const glm::vec3 v = p - light.position;
+    const float depth = glm::dot(v, axis);
+    if (!(depth > 1e-4f * radius)) return false;  // a corner beside or behind the light
+    maxTan = std::max(maxTan, glm::length(v - depth * axis) / depth);
+    minDepth = std::min(minDepth, depth);
+  }
+  if (!(maxTan < kMaxLightTan)) return false;  // wider than ~170 degrees: the light is too close
+  maxTan = std::max(maxTan * 1.01f, 1e-6f);
+  out.orthographic = false;
+  out.halfExtent = maxTan;
+  out.viewProj = reversedZPerspective(2.f * std::atan(maxTan), 1.f, 0.5f * minDepth) *
+                 glm::lookAt(light.position, centre, anyPerpendicular(axis));
+  return true;
+}
+
+std::string CausticsPass::skipReason(const Scene& scene) {
+  if (scene.features.lightCount() == 0) return "no point, spot or directional light";
+  const std::vector<std::size_t> generators = SpecularPass::specularMeshes(scene);
+  if (generators.empty()) return "no specular material (mirror or refractor) in the scene";
+  bool seen = false;
+  for (const Light& l : scene.lights)
+    for (std::size_t g : generators)
+      seen = seen || lightReaches(l, SpecularPass::referencePoint(scene.meshes[g]), scene.meshes[g].bounds.radius());
+  if (!seen) return "no specular material in view of a light";
+  return "";
+}
+
+Requirements CausticsPass::requirements(const Scene& scene, const api::RenderRequest& request) const {
+  std::string why = skipReason(scene);
+  if (!why.empty()) return Requirements::skip(why);
+  // The camera must see a receiver: a mesh that is neither specular nor unlit inside the view frustum.
+  const FrameView view = makeFrameView(scene, request);
+  bool receiver = false;
+  for (const MeshInstance& m : scene.meshes) {
+    const Material& mat = scene.material(m.material);
+    if (mat.isSpecular() || mat.unlit || m.triangleCount() == 0) continue;
+    receiver = receiver || boundsMayBeVisible(m.bounds, view.viewProj);
+  }
+  if (!receiver) return Requirements::skip("the camera sees no diffuse or glossy receiver");
+  return Requirements::ok();
+}
+
+void CausticsPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
+  // Fallbacks are the schema defaults (api/schema/techniques/caustics.json).
+  method_ = params.get<std::string>("method", "triangles") == "splat" ? Method::Splat : Method::Triangles;
+  photonResolution_ = std::clamp(params.get<int>("photon_resolution", 128), 32, 256);
+  cubeResolution_ = std::clamp(params.get<int>("cube_resolution", 256), 16, 1024);
+  areaWeight_ = std::clamp(params.get<float>("area_weight", 1.f / 3.f), 0.1f, 1.f);
+  visibilityTolerance_ = std::clamp(params.get<float>("visibility_tolerance", 2.f), 0.f, 64.f);
+  maxDepth_ = std::clamp(params.get<int>("max_depth", 4), 1, 8);
+  linearSteps_ = std::clamp(params.get<int>("linear_steps", 32), 1, 256);
+  secantSteps_ = std::clamp(params.get<int>("secant_steps", 4), 0, 32);
+  splatRadius_ = std::clamp(params.get<float>("splat_radius", 0.02f), 1e-4f, 10.f);
+  energyCheck_ = params.get<bool>("energy_check", false);
+
+  generators_ = SpecularPass::specularMeshes(scene);
+  pairs_.clear();
+  skippedPairs_ = 0;
+  for (std::size_t li = 0; li < scene.lights.size(); ++li)
+    for (std::size_t g = 0; g < generators_.size(); ++g) {
+      const MeshInstance& m = scene.meshes[generators_[g]];
+      const glm::vec3 c = SpecularPass::referencePoint(m);
+      if (!lightReaches(scene.lights[li], c, m.bounds.radius())) continue;
+      Pair p{static_cast<int>(li), static_cast<int>(g), {}};
+      if (!lightCamera(scene.lights[li], m.bounds, p.camera)) {
+        ++skippedPairs_;
+        continue;
+      }
+      pairs_.push_back(p);
+    }
+
+  const int P = photonResolution_;
+  const char* hitTargets[] = {"caustics_hit", "caustics_power", "caustics_hit_normal"};
+  gl::Framebuffer& photonFb = res.framebuffer("caustics_photons");
+  for (int i = 0; i < 3; ++i) {
+    gl::Texture& t = res.texture(hitTargets[i], GL_TEXTURE_2D, GL_RGBA32F, P, P);
+    t.setFilter(GL_NEAREST, GL_NEAREST);
+    photonFb.attach(GL_COLOR_ATTACHMENT0 + i, t);
+  }
+  photonFb.attach(GL_DEPTH_ATTACHMENT, res.texture("caustics_photon_depth", GL_TEXTURE_2D, GL_DEPTH_COMPONENT32F, P, P));
+  photonFb.setDrawBuffers({GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2});
+  photonFb.checkComplete("CausticsPass::prepare (photons)");
+  res.texture("caustics_vertex", GL_TEXTURE_2D, GL_RGBA32F, P, P).setFilter(GL_NEAREST, GL_NEAREST);
+  const int groups = ((P + kGroup - 1) / kGroup) * ((P + kGroup - 1) / kGroup);
+  res.buffer("caustics_power_sums", static_cast<std::size_t>(groups) * 2 * sizeof(glm::vec4));
+
+  const int C = cubeResolution_;
+  const int cubes = std::max<int>(1, static_cast<int>(generators_.size()));
+  gl::Texture& cube = res.texture("caustics_cube", GL_TEXTURE_CUBE_MAP_ARRAY, GL_RGBA32F, C, C, 6 * cubes);
+  cube.setFilter(GL_LINEAR, GL_LINEAR);
+  gl::Framebuffer& cubeFb = res.framebuffer("caustics_cube");
+  cubeFb.attach(GL_COLOR_ATTACHMENT0, cube);  // layered: the geometry shaders pick gl_Layer
+  cubeFb.setDrawBuffers({GL_COLOR_ATTACHMENT0});
+  cubeFb.checkComplete("CausticsPass::prepare (cube)");
+  const int cubeGroups = ((C + kGroup - 1) / kGroup) * ((C + kGroup - 1) / kGroup) * 6;
+  res.buffer("caustics_deposit_sums", static_cast<std::size_t>(cubeGroups) * sizeof(glm::vec4));
+
+  const int w = res.view().width, h = res.view().height;
+  gl::Framebuffer& fb = res.framebuffer("caustics");
+  fb.attach(GL_COLOR_ATTACHMENT0, res.texture("caustics", GL_TEXTURE_2D, GL_RGBA32F, w, h));
+  fb.attach(GL_COLOR_ATTACHMENT1, res.texture("beauty", GL_TEXTURE_2D, GL_RGBA32F, w, h));
+  fb.setDrawBuffers({GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1});
+  fb.checkComplete("CausticsPass::prepare");
+  declareDirectLightingResources(res);
+}
+
+void CausticsPass::execute(PassContext& ctx) {
+  FrameResources& res = ctx.resources;
+  auto& counters = ctx.stats.counters;
+  const int P = photonResolution_, C = cubeResolution_;
+  const int G = static_cast<int>(generators_.size());
+  // The specular pass's maps (declared by it; this pass runs after it in the registry).
+  gl::Texture& ldmMaterial = res.texture("specular_ldm_material");
+  gl::Texture& ldmGeometry = res.texture("specular_ldm_geometry");
+  gl::Texture& ldmDistance = res.texture("specular_ldm_distance");
+  const int ldmResolution = ldmGeometry.width();
+  const int layers = G > 0 ? std::max(3, ldmGeometry.depth() / (6 * G)) : 3;
+  auto bindMaps = [&](const gl::Program& prog) {
+    ldmMaterial.bindUnit(gpu::kUnitLdmMaterial);
+    ldmGeometry.bindUnit(gpu::kUnitLdmGeometry);
+    ldmDistance.bindUnit(gpu::kUnitLdmDistance);
+    res.buffer("specular_objects").bindBase(GL_SHADER_STORAGE_BUFFER, 3);
+    res.buffer("specular_minmax").bindBase(GL_SHADER_STORAGE_BUFFER, 4);
+    prog.set("u_layers", layers);
+    prog.set("u_linearSteps", linearSteps_);
+    prog.set("u_secantSteps", secantSteps_);
+    prog.set("u_minmax", 1);
+    prog.set("u_cubeResolution", static_cast<float>(ldmResolution));
+  };
+
+  gl::Texture& cube = res.texture("caustics_cube");
+  gl::Framebuffer& cubeFb = res.framebuffer("caustics_cube");
+  const float zero[4] = {0.f, 0.f, 0.f, 0.f};
+  glClearNamedFramebufferfv(cubeFb.id(), GL_COLOR, 0, zero);
+
+  // Face transforms around the origin: hit positions are relative to the reference point.
+  std::vector<glm::mat4> faces(6);
+  const float sceneRadius = std::max(ctx.scene.features.bounds.radius(), 1e-6f);
+  for (int f = 0; f < 6; ++f) faces[f] = ShadowMapsPass::cubeFaceViewProj(glm::vec3(0.f), f, sceneRadius * 1e-6f);
+
+  gl::Framebuffer& photonFb = res.framebuffer("caustics_photons");
+  gl::Texture& hit = res.texture("caustics_hit");
+  gl::Texture& power = res.texture("caustics_power");
+  gl::Texture& hitNormal = res.texture("caustics_hit_normal");
+  gl::Texture& vertex = res.texture("caustics_vertex");
+  gl::Buffer& powerSums = res.buffer("caustics_power_sums");
+  const int groupsX = (P + kGroup - 1) / kGroup;
+  std::vector<glm::vec4> sums(static_cast<std::size_t>(groupsX) * groupsX * 2);
+  double photonPower = 0.0, lostPower = 0.0;
+  double validPhotons = 0.0;
+
+  const gl::Program& photonProg = ctx.shaders.program({"specular/map.vert", "caustics/photon.frag"});
+  const gl::Program& areaProg = ctx.shaders.program({"caustics/area.comp"});
+  const gl::Program& drawProg = method_ == Method::Triangles
+                                    ? ctx.shaders.program({"caustics/grid.vert", "caustics/triangles.geom", "caustics/deposit.frag"})
+                                    : ctx.shaders.program({"caustics/grid.vert", "caustics/splat.geom", "caustics/deposit.frag"});
+  for (const Pair& pair : pairs_) {
+    // (1) Photon tracing pass: the generator seen from the light, negative power where it is not.
+    photonFb.bind();
+    glViewport(0, 0, P, P);
+    const float invalid[4] = {0.f, 0.f, 0.f, -1.f};
+    const float depthClear = 0.f;
+    for (int i = 0; i < 3; ++i) glClearNamedFramebufferfv(photonFb.id(), GL_COLOR, i, i == 1 ? invalid : zero);
+    glClearNamedFramebufferfv(photonFb.id(), GL_DEPTH, 0, &depthClear);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_GREATER);  // reversed-Z: the surface nearest the light
+    glDepthMask(GL_TRUE);
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_BLEND);
+    photonProg.use();
+    bindDirectLighting(photonProg, res, ctx.gpu, static_cast<int>(ctx.scene.lights.size()), 0);
+    bindMaps(photonProg);
+    photonProg.setMat4("u_viewProj", &pair.camera.viewProj[0][0]);
+    photonProg.set("u_object", pair.generator);
+    photonProg.set("u_light", pair.light);
+    photonProg.set("u_orthographic", pair.camera.orthographic ? 1 : 0);
+    photonProg.set("u_halfExtent", pair.camera.halfExtent);
+    photonProg.set("u_maxDepth", maxDepth_);
+    photonProg.set("u_photonResolution", P);
+    const std::size_t mesh = generators_[pair.generator];
+    ctx.gpu.drawMeshes(photonProg, true, [&](std::size_t m) { return m == mesh; });
+    glDisable(GL_DEPTH_TEST);
+    glMemoryBarrier(GL_ALL_BARRIER_BITS);
+
+    // (2) Vertex areas and irradiance.
+    areaProg.use();
+    hit.bindUnit(0);
+    power.bindUnit(1);
+    hitNormal.bindUnit(2);
+    vertex.bindImage(0, GL_WRITE_ONLY);
+    powerSums.bindBase(GL_SHADER_STORAGE_BUFFER, 5);
+    areaProg.set("u_photonResolution", P);
+    areaProg.set("u_areaWeight", areaWeight_);
+    glDispatchCompute(groupsX, groupsX, 1);
+    glMemoryBarrier(GL_ALL_BARRIER_BITS);
+    if (energyCheck_) {
+      powerSums.download(sums.data(), sums.size() * sizeof(glm::vec4));
+      for (std::size_t g = 0; g < sums.size(); g += 2) {
+        photonPower += 0.2126 * sums[g].x + 0.7152 * sums[g].y + 0.0722 * sums[g].z;
+        validPhotons += sums[g].w;
+        lostPower += 0.2126 * sums[g + 1].x + 0.7152 * sums[g + 1].y + 0.0722 * sums[g + 1].z;
+      }
+    }
+
+    // (3) Reconstruction into the generator's caustic cube, additively.
+    cubeFb.bind();
+    glViewport(0, 0, C, C);
+    glEnable(GL_BLEND);
+    glBlendEquation(GL_FUNC_ADD);
+    glBlendFunc(GL_ONE, GL_ONE);
+    drawProg.use();
+    hit.bindUnit(0);
+    power.bindUnit(1);
+    hitNormal.bindUnit(2);
+    vertex.bindUnit(3);
+    drawProg.set("u_photonResolution", P);
+    drawProg.set("u_gridResolution", P);
+    drawProg.set("u_areaWeight", areaWeight_);
+    drawProg.set("u_cubeLayer", 6 * pair.generator);
+    drawProg.set("u_causticResolution", static_cast<float>(C));
+    drawProg.set("u_splatRadius", splatRadius_);
+    glProgramUniformMatrix4fv(drawProg.id(), drawProg.uniformLocation("u_faceViewProj"), 6, GL_FALSE, &faces[0][0][0]);
+    if (method_ == Method::Triangles) {
+      drawProg.set("u_gridMode", 0);
+      glDrawArrays(GL_TRIANGLES, 0, 6 * (P - 1) * (P - 1));
+    } else {
+      drawProg.set("u_gridMode", 1);
+      glDrawArrays(GL_POINTS, 0, P * P);
+    }
+    glDisable(GL_BLEND);
+    glMemoryBarrier(GL_ALL_BARRIER_BITS);
+  }
+
+  double deposited = 0.0;
+  if (energyCheck_ && !pairs_.empty()) {
+    const gl::Program& energyProg = ctx.shaders.program({"caustics/energy.comp"});
+    energyProg.use();
+    bindMaps(energyProg);
+    cube.bindImage(1, GL_READ_ONLY, 0, true, 0);
+    gl::Buffer& depositSums = res.buffer("caustics_deposit_sums");
+    depositSums.bindBase(GL_SHADER_STORAGE_BUFFER, 5);
+    energyProg.set("u_causticResolution", static_cast<float>(C));
+    const int cg = (C + kGroup - 1) / kGroup;
+    std::vector<glm::vec4> dep(static_cast<std::size_t>(cg) * cg * 6);
+    for (int g = 0; g < G; ++g) {
+      energyProg.set("u_generator", g);
+      glDispatchCompute(cg, cg, 6);
+      glMemoryBarrier(GL_ALL_BARRIER_BITS);
+      depositSums.download(dep.data(), dep.size() * sizeof(glm::vec4));
+      for (const glm::vec4& d : dep) deposited += 0.2126 * d.x + 0.7152 * d.y + 0.0722 * d.z;
+    }
+    counters["photon_power"] = photonPower;
+    counters["valid_photons"] = validPhotons;
+    counters["lost_power"] = lostPower;
+    counters["deposited_power"] = deposited;
+  }
+
+  // (4) Camera pass: caustics AOV, and beauty += caustics when this pass owns LS+DE (a request that
+  // names light_volumes gives the class to it: then the AOV is written but not added, counted once).
+  const bool owns = res.ownsLightPath("caustics", "LS+DE");
+  gl::Framebuffer& fb = res.framebuffer("caustics");
+  fb.bind();
+  glViewport(0, 0, ctx.view.width, ctx.view.height);
+  glClearNamedFramebufferfv(fb.id(), GL_COLOR, 0, zero);
+  glDisable(GL_DEPTH_TEST);
+  glEnablei(GL_BLEND, 1);
+  glBlendEquation(GL_FUNC_ADD);
+  glBlendFunc(GL_ONE, GL_ONE);
+  if (!owns) glColorMaski(1, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+  if (!pairs_.empty()) {
+    const char* inputs[] = {"gbuffer_position", "normal", "albedo", "material", "emission", "geometric_normal"};
+    for (GLuint i = 0; i < std::size(inputs); ++i) res.texture(inputs[i]).bindUnit(i);
+    cube.bindUnit(gpu::kUnitCausticCube);
+    const gl::Program& prog = ctx.shaders.program({"common/fullscreen.vert", "caustics/camera.frag"});
+    prog.use();
+    bindMaps(prog);
+    prog.set("u_generators", G);
+    prog.set("u_visibilityTolerance", visibilityTolerance_);
+    prog.set("u_eye", &ctx.view.eye[0], 3);
+    const glm::vec3 forward = -glm::normalize(glm::vec3(ctx.view.camera.world[2]));
+    prog.set("u_viewForward", &forward[0], 3);
+    prog.set("u_orthographic", ctx.view.camera.projection == ProjectionType::Orthographic ? 1 : 0);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+  }
+  glDisablei(GL_BLEND, 1);
+  glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  res.markWritten("caustics");
+  if (owns) res.markWritten("beauty");
+  counters["adds_to_beauty"] = owns ? 1.0 : 0.0;
+
+  counters["generators"] = G;
+  counters["pairs"] = static_cast<double>(pairs_.size());
+  counters["pairs_light_inside_generator"] = skippedPairs_;
+  counters["photon_resolution"] = P;
+  counters["cube_resolution"] = C;
+  counters["triangles"] = method_ == Method::Triangles ? 2.0 * (P - 1) * (P - 1) * pairs_.size() : 0.0;
+  counters["splats"] = method_ == Method::Splat ? double(P) * P * pairs_.size() : 0.0;
+  counters["area_weight"] = areaWeight_;
+}
+
+}  // namespace radiant

@@ -1,0 +1,67 @@
+#pragma once
+// Caustic triangles (thesis ch. 6, Algorithm 4): light from point, spot and directional lights that
+// reaches a diffuse or glossy surface through mirrors and refractors (the light-path class LS+DE).
+//
+// prepare(): finds the generators (the specular pass's objects: transmissive, or metallic with
+// roughness below Material::kSpecularRoughness; their layered distance maps are specular's, read
+// through its internal output "specular_maps", never rebuilt) and the (light, generator) pairs, and
+// declares the photon hit image (P x P, three RGBA32F targets), the vertex image and the caustic cube
+// array (C x C x 6 per generator, RGBA32F, additive).
+// execute(), per pair: (1) rasterise the generator from the light and trace each pixel's photon
+// through the distance maps to its first non-specular hit (shaders/caustics/photon.frag); (2) vertex
+// areas and irradiance I = dPhi / dA (area.comp); (3) 2 P^2 caustic triangles, or the splat
+// baseline's disks, added into the generator's cube (triangles.geom / splat.geom); then (4) one camera
+// pass over the G-buffer adds f_r E where the distance map says the receiver is visible from c_G
+// (camera.frag), into the `caustics` AOV and beauty.
+//
+// Generators stay opaque in the shadow maps: the direct pass leaves them black shadows and this pass
+// brings the transmitted light back, so no light is counted twice.
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "renderer/frame/Technique.h"
+
+namespace radiant {
+
+class CausticsPass final : public Technique {
+public:
+  const TechniqueInfo& info() const override;
+  Requirements requirements(const Scene&, const api::RenderRequest&) const override;
+  void prepare(const Scene&, const Params&, FrameResources&) override;
+  void execute(PassContext&) override;
+
+  // The light camera of one (light, generator) pair (thesis 6.1.1: "place camera in light source and
+  // orient to caster"): a square perspective frustum from the light holding the corners of the
+  // generator's bounds, or, for a directional light, an orthographic one fitted to its bounding
+  // sphere. false when the light is inside the bounds or so close that the frustum would be wider
+  // than 170 degrees.
+  struct LightCamera {
+    glm::mat4 viewProj{1.f};
+    bool orthographic = false;
+    float halfExtent = 0.f;  // tan(half angle) or half the side of the square
+  };
+  static bool lightCamera(const Light& light, const Bounds& bounds, LightCamera& out);
+
+  // Needed when a punctual light sees a generator and the camera can see a receiver: "" or the reason
+  // to skip (also used by the tests).
+  static std::string skipReason(const Scene& scene);
+
+private:
+  struct Pair {
+    int light;
+    int generator;
+    LightCamera camera;
+  };
+  enum class Method { Triangles, Splat };
+  Method method_ = Method::Triangles;
+  int photonResolution_ = 128, cubeResolution_ = 256, maxDepth_ = 4, linearSteps_ = 32, secantSteps_ = 4;
+  float areaWeight_ = 1.f / 3.f, visibilityTolerance_ = 2.f, splatRadius_ = 0.02f;
+  bool energyCheck_ = false;
+  std::vector<std::size_t> generators_;  // mesh index per generator (= specular object index)
+  std::vector<Pair> pairs_;
+  int skippedPairs_ = 0;  // lights inside (or too close to) a generator's bounds
+};
+
+}  // namespace radiant

@@ -1,0 +1,60 @@
+// Camera pass (thesis 6.1.3): every visible non-specular receiver x looks up, per generator, the
+// caustic cube map in the direction v = x - c_G. The distance map's environment layer is the shadow
+// map: only when |v| matches the stored distance (within visibility_tolerance texels) does x receive
+// the caustic. The cube holds irradiance per receiver area, so the radiance added is f_r(wi, wo) E
+// with no further cosine; wi points from x towards c_G (so glossy receivers get a direction).
+#define LDM_TRACING
+#include "common/brdf.glsl"
+#include "specular/ldm.glsl"
+
+layout(binding = 0) uniform sampler2D t_position;
+layout(binding = 1) uniform sampler2D t_normal;
+layout(binding = 2) uniform sampler2D t_albedo;
+layout(binding = 3) uniform sampler2D t_material;
+layout(binding = 4) uniform sampler2D t_emission;
+layout(binding = 5) uniform sampler2D t_geoNormal;
+layout(binding = kUnitCausticCube) uniform samplerCubeArray t_caustics;
+
+uniform int u_generators;
+uniform float u_visibilityTolerance;  // texels of the distance map
+uniform vec3 u_eye;
+uniform vec3 u_viewForward;
+uniform int u_orthographic;
+
+layout(location = 0) out vec4 o_caustics;
+layout(location = 1) out vec4 o_beauty;
+
+void main() {
+  ivec2 px = ivec2(gl_FragCoord.xy);
+  o_caustics = vec4(0.0);
+  o_beauty = vec4(0.0);
+  vec4 P = texelFetch(t_position, px, 0);
+  vec4 N = texelFetch(t_normal, px, 0);
+  if (P.w <= 0.0 || N.w == 0.0) return;               // background, or unlit
+  if (texelFetch(t_geoNormal, px, 0).w > 0.5) return;  // a specular surface: the specular pass's
+  vec3 x = P.xyz;
+  vec3 n = normalize(N.xyz);
+  vec3 wo = u_orthographic != 0 ? -u_viewForward : normalize(u_eye - x);
+  vec4 mat = texelFetch(t_material, px, 0);
+  MaterialParams mp = materialParams(texelFetch(t_albedo, px, 0).rgb, mat.x, mat.y, mat.w,
+                                     texelFetch(t_emission, px, 0).a);
+  vec3 L = vec3(0.0);
+  for (int k = 0; k < u_generators; ++k) {
+    vec3 v = x - objects[k].referenceRadius.xyz;
+    float dist = length(v);
+    if (!(dist > 0.0)) continue;
+    // Environment layer (l = 2) of generator k: the closest non-generator surface seen from c_G.
+    float stored = texture(t_ldmGeometry, vec4(v, float(k * u_layers + 2))).z;
+    if (stored <= 0.0) continue;
+    vec3 wi = -v / dist;
+    float NdotL = dot(n, wi);
+    if (NdotL <= 0.0) continue;
+    float tol = u_visibilityTolerance * 2.0 * dist / u_cubeResolution / max(NdotL, 0.2);
+    if (abs(dist - stored) > tol) continue;
+    vec3 E = texture(t_caustics, vec4(v, float(k))).rgb;
+    L += gltfBrdfCos(n, wo, wi, mp) / NdotL * E;
+  }
+  if (any(isnan(L)) || any(isinf(L))) L = vec3(0.0);
+  o_caustics = vec4(L, 1.0);
+  o_beauty = vec4(L, 0.0);
+}
