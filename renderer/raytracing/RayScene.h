@@ -27,6 +27,32 @@ struct Ray {
   float tnear = 0.f, tfar = kInf;
 };
 
+// The camera ray through image point (px, py) (pixels, row 0 = top), starting at the near plane
+// (view depth znear) and unbounded: the one definition of every CPU integrator's primary rays.
+inline Ray cameraRay(const Camera& cam, int width, int height, float px, float py) {
+  const float aspect = cam.aspectRatio > 0.f ? cam.aspectRatio : static_cast<float>(width) / height;
+  const float sx = 2.f * px / width - 1.f;
+  const float sy = 1.f - 2.f * py / height;
+  const glm::mat3 rot(cam.world);
+  Ray r;
+  if (cam.projection == ProjectionType::Orthographic) {
+    r.org = glm::vec3(cam.world * glm::vec4(sx * cam.xmag, sy * cam.ymag, 0.f, 1.f));
+    const glm::vec3 d = rot * glm::vec3(0.f, 0.f, -1.f);
+    const float len = glm::length(d);
+    r.dir = d / len;
+    r.tnear = std::max(0.f, cam.znear) * len;
+  } else {
+    const float tanY = std::tan(0.5f * cam.yfov);
+    const glm::vec3 d = rot * glm::vec3(sx * tanY * aspect, sy * tanY, -1.f);
+    const float len = glm::length(d);
+    r.org = glm::vec3(cam.world[3]);
+    r.dir = d / len;
+    r.tnear = std::max(0.f, cam.znear) * len;  // the point at view depth znear
+  }
+  r.tfar = kInf;
+  return r;
+}
+
 // What a closest hit tells the shader.
 struct SurfaceHit {
   int mesh = -1, prim = -1;

@@ -231,30 +231,6 @@ struct PathTracer::Impl {
       default: return 0.f;
     }
   }
-
-  Ray cameraRay(const Camera& cam, int width, int height, float px, float py) const {
-    const float aspect = cam.aspectRatio > 0.f ? cam.aspectRatio : static_cast<float>(width) / height;
-    const float sx = 2.f * px / width - 1.f;
-    const float sy = 1.f - 2.f * py / height;
-    const glm::mat3 rot(cam.world);
-    Ray r;
-    if (cam.projection == ProjectionType::Orthographic) {
-      r.org = glm::vec3(cam.world * glm::vec4(sx * cam.xmag, sy * cam.ymag, 0.f, 1.f));
-      const glm::vec3 d = rot * glm::vec3(0.f, 0.f, -1.f);
-      const float len = glm::length(d);
-      r.dir = d / len;
-      r.tnear = std::max(0.f, cam.znear) * len;
-    } else {
-      const float tanY = std::tan(0.5f * cam.yfov);
-      const glm::vec3 d = rot * glm::vec3(sx * tanY * aspect, sy * tanY, -1.f);
-      const float len = glm::length(d);
-      r.org = glm::vec3(cam.world[3]);
-      r.dir = d / len;
-      r.tnear = std::max(0.f, cam.znear) * len;  // the point at view depth znear
-    }
-    r.tfar = kInf;
-    return r;
-  }
 };
 
 PathTracer::PathTracer(const Scene& scene) : impl_(std::make_unique<Impl>()) {
@@ -297,7 +273,7 @@ Image PathTracer::render(const Camera& camera, int width, int height, const Refe
             for (int s = 0; s < options.spp; ++s) {
               Sampler sampler(pixel, static_cast<std::uint64_t>(s), options.seed);
               const glm::vec2 jitter = sampler.next2();
-              const Ray ray = impl.cameraRay(camera, width, height, x + jitter.x, y + jitter.y);
+              const Ray ray = cameraRay(camera, width, height, x + jitter.x, y + jitter.y);
               glm::vec3 value;
               if (options.mode == ReferenceOptions::Mode::Radiance)
                 value = impl.radiance(ray, options, lights, sampler, counter);

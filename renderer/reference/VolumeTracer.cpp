@@ -1,0 +1,213 @@
+#include "renderer/reference/VolumeTracer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "renderer/raytracing/Lights.h"
+#include "renderer/raytracing/Media.h"
+#include "renderer/raytracing/ParticleMedium.h"
+#include "renderer/raytracing/RayScene.h"
+
+namespace radiant::reference {
+
+using rt::Chord;
+using rt::MediumParticle;
+using rt::Ray;
+using rt::RayCounter;
+using rt::Sampler;
+
+const char* toString(MediaMode m) {
+  switch (m) {
+    case MediaMode::EmissionAbsorption: return "emission_absorption";
+    case MediaMode::SingleScatter: return "single_scatter";
+    case MediaMode::Full: return "full";
+    default: return "single_scatter_unshadowed";
+  }
+}
+
+MediaMode mediaModeFromString(const std::string& name) {
+  for (MediaMode m : {MediaMode::EmissionAbsorption, MediaMode::SingleScatterUnshadowed, MediaMode::SingleScatter,
+                      MediaMode::Full})
+    if (name == toString(m)) return m;
+  throw std::invalid_argument("unknown media mode '" + name + "'");
+}
+
+VolumeTracer::VolumeTracer(const rt::RayScene& surfaces, const rt::ParticleMedium& media)
+    : surfaces_(surfaces), media_(media) {}
+
+namespace {
+
+struct Context {
+  const rt::RayScene& surfaces;
+  const rt::ParticleMedium& media;
+  const VolumeOptions& o;
+  const std::vector<Light>& lights;
+};
+
+// Light arriving at x from every punctual light, weighted by particle p's phase for light leaving
+// along -dir (towards the previous vertex of a path traced along dir), with the shadowing of the mode.
+glm::vec3 inScattered(const Context& c, const MediumParticle& p, const glm::vec3& x, const glm::vec3& dir,
+                      bool shadowed, Sampler& sampler, RayCounter& counter) {
+  glm::vec3 sum(0.f);
+  for (const Light& light : c.lights) {
+    glm::vec3 wi, Li;
+    float dist;
+    if (!rt::punctualLi(light, x, wi, dist, Li)) continue;
+    if (shadowed) {
+      Ray shadow{x, wi, 0.f, dist == rt::kInf ? rt::kInf : dist * (1.f - 1e-5f)};
+      if (c.surfaces.occluded(shadow, sampler, counter)) continue;
+      Li *= c.media.transmittance(x, wi, 0.f, std::min(shadow.tfar, 3.0e38f));
+    }
+    // Light propagates along -wi into x and leaves along -dir: mu = dot(-wi, -dir).
+    sum += rt::phaseValue(p.phase, p.g, glm::dot(wi, dir)) * Li;
+  }
+  if (rt::maxComponent(c.o.sky) > 0.f) {
+    if (!shadowed) {
+      sum += c.o.sky;  // the phase function integrates to 1
+    } else {
+      const glm::vec3 wi = rt::sampleUniformSphere(sampler.next2());
+      Ray shadow{x, wi, 0.f, rt::kInf};
+      if (!c.surfaces.occluded(shadow, sampler, counter))
+        sum += c.o.sky * c.media.transmittance(x, wi, 0.f, 3.0e38f) *
+               rt::phaseValue(p.phase, p.g, glm::dot(wi, dir)) / rt::uniformSpherePdf();
+    }
+  }
+  return sum;
+}
+
+// Deterministic integration along [tmin, tmax] (EmissionAbsorption and the single-scatter modes).
+glm::vec3 integrate(const Context& c, const Ray& ray, float tmax, Sampler& sampler, RayCounter& counter,
+                    std::vector<Chord>& chords, float& transmittance) {
+  const MediaMode mode = c.o.mode;
+  c.media.chords(ray.org, ray.dir, ray.tnear, tmax, chords);
+  std::vector<float> ends;
+  for (const Chord& ch : chords) ends.push_back(ch.t0), ends.push_back(ch.t1);
+  std::sort(ends.begin(), ends.end());
+  glm::dvec3 L(0.0);
+  double T = 1.0;
+  std::vector<double> depth(chords.size());
+  for (std::size_t k = 0; k + 1 < ends.size(); ++k) {
+    const float a = ends[k], b = ends[k + 1];
+    if (!(b > a)) continue;
+    for (int piece = 0; piece < c.o.pieces; ++piece) {
+      const float p0 = a + (b - a) * piece / c.o.pieces, p1 = a + (b - a) * (piece + 1) / c.o.pieces;
+      double total = 0.0;
+      for (std::size_t j = 0; j < chords.size(); ++j) {
+        depth[j] = chords[j].t1 <= p0 || chords[j].t0 >= p1
+                       ? 0.0
+                       : c.media.opticalDepth(chords[j].particle, ray.org, ray.dir, p0, p1);
+        total += depth[j];
+      }
+      if (!(total > 0.0)) continue;
+      const glm::vec3 x = ray.org + 0.5f * (p0 + p1) * ray.dir;
+      glm::dvec3 source(0.0);
+      for (std::size_t j = 0; j < chords.size(); ++j) {
+        if (!(depth[j] > 0.0)) continue;
+        const MediumParticle& p = c.media.particles()[static_cast<std::size_t>(chords[j].particle)];
+        glm::vec3 s = (1.f - p.albedo) * p.emission;
+        if (mode != MediaMode::EmissionAbsorption && rt::maxComponent(p.albedo) > 0.f)
+          s += p.albedo * inScattered(c, p, x, ray.dir, mode == MediaMode::SingleScatter, sampler, counter);
+        source += depth[j] / total * glm::dvec3(s);
+      }
+      L += T * -std::expm1(-total) * source;
+      T *= std::exp(-total);
+    }
+  }
+  transmittance = static_cast<float>(T);
+  return glm::vec3(L);
+}
+
+// Every order of scattering (delta tracking); surfaces absorb.
+glm::vec3 pathTrace(const Context& c, Ray ray, float tmax, Sampler& sampler, RayCounter& counter,
+                    std::vector<Chord>& chords) {
+  glm::vec3 L(0.f), throughput(1.f);
+  for (int bounce = 0;; ++bounce) {
+    float t;
+    int j;
+    if (!c.media.sampleCollision(ray.org, ray.dir, ray.tnear, tmax, sampler, t, j, chords)) {
+      if (bounce > 0 && tmax == rt::kInf) L += throughput * c.o.sky;  // escaped; sky only after scattering
+      return L;
+    }
+    const MediumParticle& p = c.media.particles()[static_cast<std::size_t>(j)];
+    const glm::vec3 x = ray.org + t * ray.dir;
+    L += throughput * (1.f - p.albedo) * p.emission;
+    if (bounce >= c.o.maxScattering || rt::maxComponent(p.albedo) <= 0.f) return L;
+    throughput *= p.albedo;
+    // Punctual lights are deltas: next-event estimation only (the sky is found by escaping).
+    for (const Light& light : c.lights) {
+      glm::vec3 wi, Li;
+      float dist;
+      if (!rt::punctualLi(light, x, wi, dist, Li)) continue;
+      Ray shadow{x, wi, 0.f, dist == rt::kInf ? rt::kInf : dist * (1.f - 1e-5f)};
+      if (c.surfaces.occluded(shadow, sampler, counter)) continue;
+      L += throughput * Li * c.media.transmittance(x, wi, 0.f, std::min(shadow.tfar, 3.0e38f)) *
+           rt::phaseValue(p.phase, p.g, glm::dot(wi, ray.dir));  // mu = dot(-wi, -ray.dir)
+    }
+    // Russian roulette once the path is dim (unbiased).
+    const float q = std::min(1.f, rt::maxComponent(throughput));
+    if (q < 0.25f) {
+      if (sampler.next() >= q) return L;
+      throughput /= q;
+    }
+    float weight = 1.f;
+    const glm::vec3 dir = rt::samplePhase(p.phase, p.g, ray.dir, sampler.next2(), weight);
+    throughput *= weight;
+    ray = Ray{x, dir, 0.f, rt::kInf};
+    rt::SurfaceHit hit;
+    tmax = c.surfaces.intersect(ray, hit, sampler, counter) ? hit.distance : rt::kInf;
+  }
+}
+
+}  // namespace
+
+Image VolumeTracer::render(const Camera& camera, int width, int height, const VolumeOptions& o) const {
+  if (width <= 0 || height <= 0) throw std::invalid_argument("VolumeTracer::render(): image size is not positive");
+  if (o.spp < 1 || o.pieces < 1) throw std::invalid_argument("VolumeTracer::render(): spp and pieces must be >= 1");
+  Image image = Image::make("media", width, height, 4);
+  const Context c{surfaces_, media_, o, surfaces_.scene().lights};
+  auto rows = [&] {
+    tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& range) {
+      RayCounter counter;
+      std::vector<Chord> chords;
+      for (int y = range.begin(); y != range.end(); ++y)
+        for (int x = 0; x < width; ++x) {
+          glm::dvec4 sum(0.0);
+          for (int s = 0; s < o.spp; ++s) {
+            Sampler sampler(static_cast<std::uint64_t>(y) * width + x, static_cast<std::uint64_t>(s), o.seed);
+            const glm::vec2 jitter = o.spp == 1 ? glm::vec2(0.5f) : sampler.next2();
+            Ray ray = rt::cameraRay(camera, width, height, x + jitter.x, y + jitter.y);
+            rt::SurfaceHit hit;
+            const float tmax = surfaces_.intersect(ray, hit, sampler, counter) ? hit.distance : rt::kInf;
+            const float T = media_.transmittance(ray.org, ray.dir, ray.tnear, std::min(tmax, 3.0e38f));
+            glm::vec3 L;
+            if (o.mode == MediaMode::Full) {
+              L = pathTrace(c, ray, tmax, sampler, counter, chords);
+            } else {
+              float unused;
+              L = integrate(c, ray, std::min(tmax, 3.0e38f), sampler, counter, chords, unused);
+            }
+            if (std::isfinite(L.x) && std::isfinite(L.y) && std::isfinite(L.z)) sum += glm::dvec4(glm::dvec3(L), T);
+            else sum.w += T;
+          }
+          const glm::dvec4 mean = sum / static_cast<double>(o.spp);
+          float* out = image.at(x, y);
+          for (int k = 0; k < 4; ++k) out[k] = static_cast<float>(mean[k]);
+        }
+    });
+  };
+  if (o.threads > 0) {
+    tbb::task_arena arena(o.threads);
+    arena.execute(rows);
+  } else {
+    rows();
+  }
+  return image;
+}
+
+}  // namespace radiant::reference
