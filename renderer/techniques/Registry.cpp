@@ -8,6 +8,7 @@
 #include "renderer/techniques/reference/ReferencePass.h"
 #include "renderer/techniques/shadow_maps/ShadowMaps.h"
 #include "renderer/techniques/specular/Specular.h"
+#include "renderer/techniques/spherical_billboards/SphericalBillboards.h"
 
 namespace radiant {
 
@@ -20,6 +21,8 @@ std::vector<std::unique_ptr<Technique>> createTechniques() {
   t.push_back(std::make_unique<PhotonGiPass>());
   t.push_back(std::make_unique<SpecularPass>());
   t.push_back(std::make_unique<AmbientOcclusionPass>());
+  // Media compose over every opaque contribution (beauty = beauty * T + C): after all of them.
+  t.push_back(std::make_unique<SphericalBillboardsPass>());
   t.push_back(std::make_unique<ReferencePass>());
   return t;
 }

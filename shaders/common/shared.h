@@ -107,4 +107,18 @@ struct MaterialParams {
   vec4 surface;    // x metallic, y roughness (both clamped to [0,1]), z transmission in [0,1], w ior
 };
 
+// ---------------------------------------------------------------------------------------------------
+// Participating media (renderer/techniques/spherical_billboards, shaders/spherical_billboards).
+
+RADIANT_CONST int kProfileConstant = 0;
+RADIANT_CONST int kProfileThesis = 1;       // thesis eq. 7.4
+RADIANT_CONST int kProfileLinearExact = 2;  // tau (1 - |x - c| / r), integrated exactly
+
+// One particle as the billboard shaders read it, in draw order (back to front).
+struct MediaParticle {
+  vec4 centerRadius;  // xyz world centre, w radius
+  vec4 sourceTau;     // rgb the radiance the particle's medium sends (fire: (1 - a) L_e + a L_in), w tau
+  ivec4 profile;      // x density profile (kProfile*), yzw unused
+};
+
 #endif

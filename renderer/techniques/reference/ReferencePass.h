@@ -12,7 +12,9 @@
 
 namespace radiant {
 
-// Reference image of `aov` ("beauty", "direct", "indirect", "ao", "reference") for the frame's view.
+// Reference image of `aov` ("beauty", "direct", "indirect", "ao", "reference", "media",
+// "media_transmittance") for the frame's view. The media AOVs come from the volumetric reference
+// (renderer/reference/VolumeTracer.h) over the frame's particle systems (FrameView::media).
 // For "ao", aoDefinition is "volumetric" (thesis eq. 4.6) or "cosine" (cosine-weighted step).
 struct ReferenceRequest {
   std::string aov = "beauty";
@@ -21,6 +23,8 @@ struct ReferenceRequest {
   bool russianRoulette = true;
   float aoRadius = 0.5f;
   std::string aoDefinition = "cosine";
+  // aov "media" / "media_transmittance": the volumetric reference's light transport.
+  std::string mediaMode = "single_scatter_unshadowed";
 };
 const Image& referenceImage(FrameResources& resources, const Scene& scene, const FrameView& view,
                             const ReferenceRequest& request, bool* cacheHit = nullptr,
