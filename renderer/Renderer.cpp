@@ -97,6 +97,7 @@ void compare(FrameResources& resources, const Scene& scene, const FrameView& vie
     m["reference_cached"] = hit;
     m["reference_ms"] = msSince(t0);
     if (c.aov == "ao") m["ao_definition"] = r.aoDefinition;
+    if (r.aov == "media" || r.aov == "media_transmittance") m["media_mode"] = r.mediaMode;
   }
   if (reference.width != test->width || reference.height != test->height)
     throw api::ApiError(422, "invalid-compare", "Size mismatch",

@@ -114,11 +114,19 @@ RADIANT_CONST int kProfileConstant = 0;
 RADIANT_CONST int kProfileThesis = 1;       // thesis eq. 7.4
 RADIANT_CONST int kProfileLinearExact = 2;  // tau (1 - |x - c| / r), integrated exactly
 
+RADIANT_CONST int kPhaseIsotropic = 0;
+RADIANT_CONST int kPhaseHenyeyGreenstein = 1;
+RADIANT_CONST int kPhaseCornetteShanks = 2;  // thesis eq. 1.3
+
+// The particle buffer's binding (after the scene's materials, lights and shadows).
+RADIANT_CONST int kBindingMediaParticles = 3;
+
 // One particle as the billboard shaders read it, in draw order (back to front).
 struct MediaParticle {
   vec4 centerRadius;  // xyz world centre, w radius
-  vec4 sourceTau;     // rgb the radiance the particle's medium sends (fire: (1 - a) L_e + a L_in), w tau
-  ivec4 profile;      // x density profile (kProfile*), yzw unused
+  vec4 sourceTau;     // rgb the direction-independent source ((1 - a) L_e + a L_ambient), w tau
+  vec4 albedoG;       // rgb albedo (scales the punctual lights' in-scattering), w phase g
+  ivec4 models;       // x density profile (kProfile*), y phase model (kPhase*), zw unused
 };
 
 #endif

@@ -12,9 +12,13 @@
 //            billboard plane lies between the near plane and the scene (clipping and popping).
 //   method 2 soft: planar times saturate((Z_s - z_p) / D) saturate((z_p - f) / D), D = soft_scale r
 //            (soft particles, Lorach 2007).
-#include "common/shared.h"
+//   Colour: the particle's direction-independent source plus albedo x the punctual lights' light
+//   (unshadowed, thesis 7.2.1) scattered by the phase function at the middle of the ray's segment in
+//   the particle (the closest point to the centre for the screen-parallel and planar chords).
+#include "common/lights.glsl"
+#include "common/phase.glsl"
 
-layout(std430, binding = 0) readonly buffer Particles { MediaParticle particles[]; };
+layout(std430, binding = kBindingMediaParticles) readonly buffer Particles { MediaParticle particles[]; };
 layout(binding = 0) uniform sampler2D t_position;  // gbuffer_position: xyz world, w view depth (0 = none)
 
 uniform int u_hasDepth;
@@ -26,6 +30,7 @@ uniform float u_znear;
 uniform int u_method;
 uniform int u_chord;
 uniform float u_softScale;
+uniform int u_lightCount;
 
 flat in int v_particle;
 layout(location = 0) out vec4 o_color;
@@ -41,6 +46,18 @@ float segmentDepth(int profile, float tau, float r, float d, float a, float b) {
   return max(0.0, tau * ((b - a) - (falloffG(b, d) - falloffG(a, d)) / (2.0 * r)));
 }
 
+// The particle's radiance towards the camera at x for a ray along dir.
+vec3 source(MediaParticle q, vec3 x, vec3 dir) {
+  vec3 L = q.sourceTau.rgb;
+  if (max(q.albedoG.r, max(q.albedoG.g, q.albedoG.b)) <= 0.0) return L;
+  vec3 in_ = vec3(0.0);
+  for (int i = 0; i < u_lightCount; ++i) {
+    const LightSample s = sampleLight(lights[i], x);
+    in_ += phaseValue(q.models.y, q.albedoG.w, dot(s.wi, dir)) * s.intensity;  // mu = dot(-wi, -dir)
+  }
+  return L + q.albedoG.rgb * in_;
+}
+
 vec3 unproject(vec2 ndc, float depth) {
   const vec4 p = u_invViewProj * vec4(ndc, depth, 1.0);
   return p.xyz / p.w;
@@ -50,7 +67,7 @@ void main() {
   const MediaParticle q = particles[v_particle];
   const vec3 c = q.centerRadius.xyz;
   const float r = q.centerRadius.w, tau = q.sourceTau.w;
-  const int profile = q.profile.x;
+  const int profile = q.models.x;
 
   const vec2 uv = gl_FragCoord.xy / u_targetSize;
   const vec2 ndc = uv * 2.0 - 1.0;
@@ -64,6 +81,7 @@ void main() {
   }
 
   float depth = 0.0;
+  float tMid;  // where along the ray the particle's colour is evaluated
   if (u_method == 0 && u_chord == 0) {
     const vec3 oc = c - o;
     const float tc = dot(oc, dir);
@@ -74,6 +92,7 @@ void main() {
     const float w = sqrt(r * r - d2), d = sqrt(max(d2, 0.0));
     const float t0 = max(0.0, tc - w), t1 = min(tScene, tc + w);
     depth = segmentDepth(profile, tau, r, d, t0 - tc, t1 - tc);
+    tMid = 0.5 * (t0 + t1);
   } else {
     // View space: the ray meets the billboard plane z = z_p at Q (eq. 7.1's assumption z_q = z_p).
     const vec3 P = (u_view * vec4(c, 1.0)).xyz;
@@ -82,6 +101,7 @@ void main() {
     const vec3 Q = oV + dV * ((P.z - oV.z) / dV.z);
     const float d = length(Q.xy - P.xy);
     if (d >= r) discard;
+    tMid = dot(c - o, dir);
     const float w = sqrt(r * r - d * d);  // eq. 7.2
     if (u_method == 0) {
       const float front = max(u_znear, zp - w), back = min(zScene, zp + w);  // eqs. 7.1, 7.3
@@ -96,12 +116,12 @@ void main() {
         const float fade = clamp((zScene - zp) / D, 0.0, 1.0) * clamp((zp - u_znear) / D, 0.0, 1.0);
         const float alpha = (1.0 - exp(-chord)) * fade;
         if (!(alpha > 0.0)) discard;
-        o_color = vec4(q.sourceTau.rgb * alpha, alpha);
+        o_color = vec4(source(q, o + tMid * dir, dir) * alpha, alpha);
         return;
       }
     }
   }
   const float alpha = 1.0 - exp(-depth);
   if (!(alpha > 0.0)) discard;
-  o_color = vec4(q.sourceTau.rgb * alpha, alpha);
+  o_color = vec4(source(q, o + tMid * dir, dir) * alpha, alpha);
 }

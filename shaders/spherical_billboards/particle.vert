@@ -5,7 +5,7 @@
 // (depth test off, thesis 7.1).
 #include "common/shared.h"
 
-layout(std430, binding = 0) readonly buffer Particles { MediaParticle particles[]; };
+layout(std430, binding = kBindingMediaParticles) readonly buffer Particles { MediaParticle particles[]; };
 
 uniform mat4 u_view;  // world -> view (the camera looks down -z)
 uniform mat4 u_proj;

@@ -5,7 +5,6 @@
 #include <numeric>
 
 #include "renderer/frame/PassContext.h"
-#include "renderer/raytracing/Lights.h"
 #include "renderer/raytracing/Media.h"
 
 namespace radiant {
@@ -31,7 +30,6 @@ Requirements SphericalBillboardsPass::requirements(const Scene& scene, const api
 }
 
 std::vector<gpu::MediaParticle> SphericalBillboardsPass::gpuParticles(const std::vector<api::ParticleSystem>& media,
-                                                                     const std::vector<Light>& lights,
                                                                      glm::vec3 ambient, glm::vec3 eye,
                                                                      glm::vec3 forward, bool orthographic, bool sort) {
   std::vector<gpu::MediaParticle> out;
@@ -40,21 +38,16 @@ std::vector<gpu::MediaParticle> SphericalBillboardsPass::gpuParticles(const std:
     const int profile = s.profile == api::DensityProfile::Thesis        ? gpu::kProfileThesis
                         : s.profile == api::DensityProfile::LinearExact ? gpu::kProfileLinearExact
                                                                         : gpu::kProfileConstant;
+    const int phase = s.phase == api::PhaseModel::HenyeyGreenstein ? gpu::kPhaseHenyeyGreenstein
+                      : s.phase == api::PhaseModel::CornetteShanks ? gpu::kPhaseCornetteShanks
+                                                                   : gpu::kPhaseIsotropic;
     for (const api::Particle& p : s.particles) {
       if (!(p.tau > 0.f)) continue;
-      const glm::vec3 toEye = orthographic ? -forward : glm::normalize(eye - p.position);
-      glm::vec3 source = s.emits() ? (1.f - p.albedo) * s.emissionScale * rt::blackbodyRgb(p.temperature)
-                                   : glm::vec3(0.f);
-      if (rt::maxComponent(p.albedo) > 0.f) {
-        glm::vec3 in = ambient;  // a uniform sky: the phase function integrates to 1
-        for (const Light& l : lights) {
-          glm::vec3 wi, Li;
-          float dist;
-          if (rt::punctualLi(l, p.position, wi, dist, Li)) in += rt::phaseValue(s.phase, s.g, glm::dot(-wi, toEye)) * Li;
-        }
-        source += p.albedo * in;
-      }
-      out.push_back({glm::vec4(p.position, p.radius), glm::vec4(source, p.tau), glm::ivec4(profile, 0, 0, 0)});
+      // (1 - a) L_e + a L_ambient: a uniform sky integrates the phase function to 1.
+      const glm::vec3 emitted = s.emits() ? s.emissionScale * rt::blackbodyRgb(p.temperature) : glm::vec3(0.f);
+      const glm::vec3 source = (1.f - p.albedo) * emitted + p.albedo * ambient;
+      out.push_back({glm::vec4(p.position, p.radius), glm::vec4(source, p.tau), glm::vec4(p.albedo, s.g),
+                     glm::ivec4(profile, phase, 0, 0)});
       key.push_back(orthographic ? glm::dot(p.position - eye, forward) : glm::length(p.position - eye));
     }
   }
@@ -67,7 +60,7 @@ std::vector<gpu::MediaParticle> SphericalBillboardsPass::gpuParticles(const std:
   return sorted;
 }
 
-void SphericalBillboardsPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
+void SphericalBillboardsPass::prepare(const Scene&, const Params& params, FrameResources& res) {
   const FrameView& view = res.view();
   const std::string method = params.get<std::string>("method", "spherical");
   method_ = method == "planar" ? 1 : method == "soft" ? 2 : 0;
@@ -77,8 +70,7 @@ void SphericalBillboardsPass::prepare(const Scene& scene, const Params& params, 
   depthAware_ = params.get<std::string>("upsampling", "depth_aware") == "depth_aware";
   const glm::vec3 forward = -glm::normalize(glm::vec3(view.camera.world[2]));
   const bool ortho = view.camera.projection == ProjectionType::Orthographic;
-  particles_ = gpuParticles(view.media, scene.lights, view.ambient, view.eye, forward, ortho,
-                            params.get<bool>("sort", true));
+  particles_ = gpuParticles(view.media, view.ambient, view.eye, forward, ortho, params.get<bool>("sort", true));
 
   // Overdraw estimate: covered pixels of every particle's disc over the image (the cost driver, 7.3).
   const float pixelsPerUnit = ortho ? 0.5f * view.height / view.camera.ymag
@@ -144,7 +136,8 @@ void SphericalBillboardsPass::execute(PassContext& ctx) {
   // C = alpha L + (1 - alpha) C; T = (1 - alpha) T.
   glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE_MINUS_SRC_ALPHA);
   if (hasDepth) res.texture("gbuffer_position").bindUnit(0);
-  buffer.bindBase(GL_SHADER_STORAGE_BUFFER, 0);
+  buffer.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingMediaParticles);
+  ctx.gpu.lights.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingLights);
   const gl::Program& prog = ctx.shaders.program({"spherical_billboards/particle.vert", "spherical_billboards/particle.frag"});
   prog.use();
   prog.setMat4("u_view", &view.view[0][0]);
@@ -159,6 +152,7 @@ void SphericalBillboardsPass::execute(PassContext& ctx) {
   prog.set("u_method", method_);
   prog.set("u_chord", chord_);
   prog.set("u_softScale", softScale_);
+  prog.set("u_lightCount", static_cast<int>(ctx.scene.lights.size()));
   if (!particles_.empty()) glDrawArraysInstanced(GL_TRIANGLES, 0, 6, static_cast<GLsizei>(particles_.size()));
   glDisable(GL_BLEND);
 

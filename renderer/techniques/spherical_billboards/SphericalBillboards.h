@@ -7,11 +7,12 @@
 // composes beauty = beauty * T + C (layer composition, 7.2.3, at resolution ratio 1 to 1/8 with
 // depth-aware upsampling).
 //
-// The particles' source radiance is evaluated per particle on the CPU, at its centre: fire emits
-// (1 - albedo) emission_scale * blackbody(T) (Planck x CIE 1931 -> linear sRGB, renderer/raytracing/
-// Media.h, the reference's own function); scatterers add albedo * (sum over punctual lights of
-// phase(mu) * Li + ambient), unshadowed as in the thesis (7.2.1). Its ground truth is therefore the
-// volumetric reference's single_scatter_unshadowed mode (emission_absorption for fire alone).
+// The particles' source radiance: fire emits (1 - albedo) emission_scale * blackbody(T) (Planck x
+// CIE 1931 -> linear sRGB, renderer/raytracing/Media.h, the reference's own function, per particle on
+// the CPU); scatterers add albedo * ambient (per particle) and albedo * the punctual lights' phase(mu)
+// * Li per fragment at the middle of its ray's segment, unshadowed as in the thesis (7.2.1). Its
+// ground truth is the volumetric reference's single_scatter_unshadowed mode (emission_absorption for
+// fire alone).
 #include <vector>
 
 #include "renderer/frame/GpuTypes.h"
@@ -27,13 +28,12 @@ public:
   void prepare(const Scene&, const Params&, FrameResources&) override;
   void execute(PassContext&) override;
 
-  // The particles of `media` as the shaders read them, with their source radiance for the view from
-  // `eye` (forward: the view direction, used for orthographic cameras), sorted back to front when
-  // `sort` (else in the systems' order).
+  // The particles of `media` as the shaders read them, with their direction-independent source
+  // radiance, sorted back to front for the view from `eye` (forward: the view direction, the sort key
+  // of orthographic cameras) when `sort` (else in the systems' order).
   static std::vector<gpu::MediaParticle> gpuParticles(const std::vector<api::ParticleSystem>& media,
-                                                      const std::vector<Light>& lights, glm::vec3 ambient,
-                                                      glm::vec3 eye, glm::vec3 forward, bool orthographic,
-                                                      bool sort);
+                                                      glm::vec3 ambient, glm::vec3 eye, glm::vec3 forward,
+                                                      bool orthographic, bool sort);
 
 private:
   std::vector<gpu::MediaParticle> particles_;
