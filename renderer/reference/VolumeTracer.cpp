@@ -123,23 +123,74 @@ glm::vec3 integrate(const Context& c, const Ray& ray, float tmax, Sampler& sampl
   return glm::vec3(L);
 }
 
-// Every order of scattering (delta tracking); surfaces absorb.
+// Punctual lights at a surface vertex: BSDF x cosine x Li x visibility x the media's transmittance.
+glm::vec3 surfaceDirect(const Context& c, const rt::SurfaceHit& hit, const rt::Shading& sh, const glm::vec3& woL,
+                        Sampler& sampler, RayCounter& counter) {
+  glm::vec3 L(0.f);
+  for (const Light& light : c.lights) {
+    glm::vec3 wi, Li;
+    float dist;
+    if (!rt::punctualLi(light, hit.p, wi, dist, Li)) continue;
+    const glm::vec3 wiL = sh.frame.toLocal(wi);
+    const float gs = glm::dot(wi, sh.ngFacing);
+    if (wiL.z > 0.f ? gs <= 0.f : gs >= 0.f) continue;
+    const glm::vec3 f = sh.bsdf.eval(woL, wiL);
+    if (rt::maxComponent(f) <= 0.f) continue;
+    Ray shadow{rt::RayScene::offsetOrigin(hit.p, hit.ng, hit.offsetScale, wi), wi, 0.f, dist};
+    if (dist != rt::kInf) shadow.tfar = glm::length(light.position - shadow.org) * (1.f - 1e-5f);
+    if (c.surfaces.occluded(shadow, sampler, counter)) continue;
+    L += f * std::abs(wiL.z) * Li * c.media.transmittance(shadow.org, wi, 0.f, std::min(shadow.tfar, 3.0e38f));
+  }
+  return L;
+}
+
+// Every order of scattering by delta tracking, for light whose last scattering towards the camera
+// happened in the media (the camera ray itself stops at the first surface). Before that, the path
+// may scatter on surfaces too: their emission is found by hitting them, punctual lights by NEE at
+// every vertex (medium or surface), the sky by escaping.
 glm::vec3 pathTrace(const Context& c, Ray ray, float tmax, Sampler& sampler, RayCounter& counter,
                     std::vector<Chord>& chords) {
   glm::vec3 L(0.f), throughput(1.f);
-  for (int bounce = 0;; ++bounce) {
+  rt::SurfaceHit hit;
+  auto roulette = [&] {
+    const float q = std::min(1.f, rt::maxComponent(throughput));
+    if (q >= 0.25f) return true;
+    if (sampler.next() >= q) return false;
+    throughput /= q;
+    return true;
+  };
+  for (int bounce = 0; bounce <= c.o.maxScattering; ++bounce) {
     float t;
     int j;
     if (!c.media.sampleCollision(ray.org, ray.dir, ray.tnear, tmax, sampler, t, j, chords)) {
-      if (bounce > 0 && tmax == rt::kInf) L += throughput * c.o.sky;  // escaped; sky only after scattering
-      return L;
+      if (bounce == 0) return L;  // the camera ray reached its surface or the background
+      if (tmax == rt::kInf) return L + throughput * c.o.sky;
+      // A surface after scattering in the media: its emission, then it scatters in turn.
+      const Material& mat = c.surfaces.materialOf(hit.mesh);
+      if (mat.unlit) return L + throughput * c.surfaces.unlitRadiance(hit);
+      L += throughput * c.surfaces.emissionAt(hit, ray.dir);
+      const glm::vec3 wo = -ray.dir;
+      const rt::Shading sh = c.surfaces.shade(hit, wo);
+      const glm::vec3 woL = sh.frame.toLocal(wo);
+      if (sh.bsdf.hasNonDeltaLobe(woL)) L += throughput * surfaceDirect(c, hit, sh, woL, sampler, counter);
+      const float uLobe = sampler.next(), uFresnel = sampler.next();
+      rt::GltfBsdf::Sample bs;
+      if (!sh.bsdf.sample(woL, uLobe, uFresnel, sampler.next2(), bs)) return L;
+      const glm::vec3 wi = sh.frame.toWorld(bs.wi);
+      const float gs = glm::dot(wi, sh.ngFacing);
+      if (bs.wi.z > 0.f ? gs <= 0.f : gs >= 0.f) return L;
+      throughput *= bs.weight;
+      if (!(rt::maxComponent(throughput) > 0.f) || !roulette()) return L;
+      ray = Ray{rt::RayScene::offsetOrigin(hit.p, hit.ng, hit.offsetScale, wi), wi, 0.f, rt::kInf};
+      tmax = c.surfaces.intersect(ray, hit, sampler, counter) ? hit.distance : rt::kInf;
+      continue;
     }
     const MediumParticle& p = c.media.particles()[static_cast<std::size_t>(j)];
     const glm::vec3 x = ray.org + t * ray.dir;
     L += throughput * (1.f - p.albedo) * p.emission;
-    if (bounce >= c.o.maxScattering || rt::maxComponent(p.albedo) <= 0.f) return L;
+    if (rt::maxComponent(p.albedo) <= 0.f) return L;
     throughput *= p.albedo;
-    // Punctual lights are deltas: next-event estimation only (the sky is found by escaping).
+    // Punctual lights are deltas: next-event estimation only.
     for (const Light& light : c.lights) {
       glm::vec3 wi, Li;
       float dist;
@@ -149,19 +200,14 @@ glm::vec3 pathTrace(const Context& c, Ray ray, float tmax, Sampler& sampler, Ray
       L += throughput * Li * c.media.transmittance(x, wi, 0.f, std::min(shadow.tfar, 3.0e38f)) *
            rt::phaseValue(p.phase, p.g, glm::dot(wi, ray.dir));  // mu = dot(-wi, -ray.dir)
     }
-    // Russian roulette once the path is dim (unbiased).
-    const float q = std::min(1.f, rt::maxComponent(throughput));
-    if (q < 0.25f) {
-      if (sampler.next() >= q) return L;
-      throughput /= q;
-    }
+    if (!roulette()) return L;
     float weight = 1.f;
     const glm::vec3 dir = rt::samplePhase(p.phase, p.g, ray.dir, sampler.next2(), weight);
     throughput *= weight;
     ray = Ray{x, dir, 0.f, rt::kInf};
-    rt::SurfaceHit hit;
     tmax = c.surfaces.intersect(ray, hit, sampler, counter) ? hit.distance : rt::kInf;
   }
+  return L;
 }
 
 }  // namespace

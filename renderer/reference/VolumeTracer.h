@@ -11,9 +11,11 @@
 //   SingleScatterUnshadowed  + light scattered once, lights seen without any shadowing (neither media
 //                            nor surfaces): what spherical billboards compute (thesis 7.2.1);
 //   SingleScatter            + the light's transmittance through the media and surface visibility;
-//   Full                     every order of scattering inside the media by delta tracking, punctual
-//                            lights by next-event estimation; surfaces absorb (they reflect no light
-//                            into the media: not a full path tracer with media).
+//   Full                     every order of scattering by delta tracking, in the media and on the
+//                            surfaces (glTF BSDF) before the last medium vertex: surface emission is
+//                            found by hitting it, punctual lights by next-event estimation at every
+//                            vertex, the sky by escaping. Only light whose last scattering towards
+//                            the camera is in the media counts (the camera ray stops at its surface).
 // Lights: KHR_lights_punctual (glTF units) and a uniform sky `sky` (the map's average for an
 // environment), which in the single-scatter modes adds albedo * sky (unshadowed) or a sampled
 // direction with its visibility (shadowed). Emissive triangles do not light the media.

@@ -11,6 +11,7 @@
 #include "renderer/raytracing/ParticleMedium.h"
 #include "renderer/raytracing/RayScene.h"
 #include "renderer/reference/VolumeTracer.h"
+#include "tests/support/SceneBuilder.h"
 
 namespace radiant::reference {
 namespace {
@@ -123,6 +124,50 @@ TEST(VolumeTracer, AlbedoOneInAWhiteFurnaceReturnsTheFurnaceRadiance) {
       // Each sample adds sky exactly or nothing: the ratio between channels is the sky's.
       EXPECT_NEAR(img.at(x, y)[0] * sky[1], img.at(x, y)[1] * sky[0], 1e-5);
     }
+  EXPECT_NEAR(sum, expected, 4 * std::sqrt(variance) + 1e-6);
+}
+
+TEST(VolumeTracer, ANonAbsorbingMediumInAClosedBoxConservesItsRadiance) {
+  // A closed box whose walls show radiance Lw (KHR_materials_unlit: exactly Lw from both sides, no
+  // scattering) around a medium of albedo 1: the radiance is Lw everywhere, so every pixel's media
+  // light + Lw T is Lw. In the full model every path that collides leaves through the medium to a wall
+  // with throughput 1: a pixel's media light is Lw times the fraction of its samples that collided.
+  testing::SceneBuilder b;
+  Material wall;
+  wall.unlit = true;
+  wall.doubleSided = true;
+  wall.baseColorFactor = glm::vec4(0.25f, 0.5f, 1.f, 1.f);  // (base colours are clamped to [0, 1])
+  const glm::vec3 Lw(0.25f, 0.5f, 1.f);
+  b.box(glm::vec3(-1.f), glm::vec3(1.f), b.material(wall));
+  Scene scene = b.build();
+  const rt::RayScene rays(scene);
+  auto a = sphere(api::MediumKind::Cloud, 0.5f, 3.f, glm::vec3(1.f));
+  auto c = sphere(api::MediumKind::Cloud, 0.4f, 5.f, glm::vec3(1.f), api::DensityProfile::LinearExact);
+  c.particles[0].position = {0.3f, -0.2f, 0.1f};
+  c.phase = api::PhaseModel::HenyeyGreenstein;
+  c.g = -0.4f;
+  const rt::ParticleMedium medium({a, c});
+  Camera cam;
+  cam.yfov = 1.2f;
+  cam.znear = 0.01f;
+  cam.world = glm::mat4(1.f);
+  cam.world[3] = glm::vec4(0, 0, 0.9f, 1);
+  VolumeOptions o;
+  o.mode = MediaMode::Full;
+  o.spp = 32;
+  o.maxScattering = 1000;
+  const int n = 16;
+  const Image img = VolumeTracer(rays, medium).render(cam, n, n, o);
+  double sum = 0, expected = 0, variance = 0;
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      const double T = img.at(x, y)[3];
+      sum += img.at(x, y)[1] / Lw[1];
+      expected += 1 - T;
+      variance += T * (1 - T) / o.spp;
+      EXPECT_NEAR(img.at(x, y)[2], 2.f * img.at(x, y)[1], 1e-5);  // the walls' colour, exactly
+    }
+  ASSERT_GT(expected, 10.0);  // the medium covers a good part of the view
   EXPECT_NEAR(sum, expected, 4 * std::sqrt(variance) + 1e-6);
 }
 
