@@ -86,34 +86,41 @@ glm::vec3 integrate(const Context& c, const Ray& ray, float tmax, Sampler& sampl
                     std::vector<Chord>& chords, float& transmittance) {
   const MediaMode mode = c.o.mode;
   c.media.chords(ray.org, ray.dir, ray.tnear, tmax, chords);
-  std::vector<float> ends;
-  for (const Chord& ch : chords) ends.push_back(ch.t0), ends.push_back(ch.t1);
-  std::sort(ends.begin(), ends.end());
+  // Sweep the chord ends in order, keeping the chords that cover the current interval, so each piece
+  // evaluates only the particles it lies in.
+  std::vector<std::pair<float, int>> events;  // (t, chord + 1 when it starts, -(chord + 1) when it ends)
+  for (std::size_t j = 0; j < chords.size(); ++j) {
+    events.emplace_back(chords[j].t0, static_cast<int>(j) + 1);
+    events.emplace_back(chords[j].t1, -static_cast<int>(j) - 1);
+  }
+  std::sort(events.begin(), events.end());
+  std::vector<int> active;
+  std::vector<double> depth;
   glm::dvec3 L(0.0);
   double T = 1.0;
-  std::vector<double> depth(chords.size());
-  for (std::size_t k = 0; k + 1 < ends.size(); ++k) {
-    const float a = ends[k], b = ends[k + 1];
-    if (!(b > a)) continue;
+  for (std::size_t k = 0; k + 1 < events.size(); ++k) {
+    const int e = events[k].second;
+    if (e > 0) active.push_back(e - 1);
+    else active.erase(std::find(active.begin(), active.end(), -e - 1));
+    const float a = events[k].first, b = events[k + 1].first;
+    if (!(b > a) || active.empty()) continue;
+    depth.resize(active.size());
     for (int piece = 0; piece < c.o.pieces; ++piece) {
       const float p0 = a + (b - a) * piece / c.o.pieces, p1 = a + (b - a) * (piece + 1) / c.o.pieces;
       double total = 0.0;
-      for (std::size_t j = 0; j < chords.size(); ++j) {
-        depth[j] = chords[j].t1 <= p0 || chords[j].t0 >= p1
-                       ? 0.0
-                       : c.media.opticalDepth(chords[j].particle, ray.org, ray.dir, p0, p1);
-        total += depth[j];
-      }
+      for (std::size_t i = 0; i < active.size(); ++i)
+        total += depth[i] = c.media.opticalDepth(chords[static_cast<std::size_t>(active[i])].particle, ray.org,
+                                                 ray.dir, p0, p1);
       if (!(total > 0.0)) continue;
       const glm::vec3 x = ray.org + 0.5f * (p0 + p1) * ray.dir;
       glm::dvec3 source(0.0);
-      for (std::size_t j = 0; j < chords.size(); ++j) {
-        if (!(depth[j] > 0.0)) continue;
-        const MediumParticle& p = c.media.particles()[static_cast<std::size_t>(chords[j].particle)];
+      for (std::size_t i = 0; i < active.size(); ++i) {
+        if (!(depth[i] > 0.0)) continue;
+        const MediumParticle& p = c.media.particles()[static_cast<std::size_t>(chords[static_cast<std::size_t>(active[i])].particle)];
         glm::vec3 s = (1.f - p.albedo) * p.emission;
         if (mode != MediaMode::EmissionAbsorption && rt::maxComponent(p.albedo) > 0.f)
           s += p.albedo * inScattered(c, p, x, ray.dir, mode == MediaMode::SingleScatter, sampler, counter);
-        source += depth[j] / total * glm::dvec3(s);
+        source += depth[i] / total * glm::dvec3(s);
       }
       L += T * -std::expm1(-total) * source;
       T *= std::exp(-total);
