@@ -48,6 +48,13 @@ const std::vector<AovInfo>& aovTable() {
          "gbuffer", true, ""},
         {0, "reference", F::Rgba32F, "reference", 0, 3, {"reference.R", "reference.G", "reference.B"}, B::Overwrite,
          "reference", true, ""},
+        // Participating media (the media techniques; spherical_billboards first): RGB = the media's
+        // radiance in front of the first surface (premultiplied), A = the camera ray's transmittance to
+        // it; beauty = opaque * A + RGB. Scored against the volumetric reference (VolumeTracer.h).
+        {0, "media", F::Rgba32F, "media", 0, 3, {"media.R", "media.G", "media.B"}, B::Overwrite,
+         "spherical_billboards", true, "media"},
+        {0, "media_transmittance", F::Rgba32F, "media", 3, 1, {"media_transmittance.Y"}, B::Overwrite,
+         "spherical_billboards", true, "media_transmittance"},
         // compare() writes it (per-pixel luminance-weighted absolute error); never requested.
         {0, "error", F::R32F, "", 0, 1, {"error.Y"}, B::Overwrite, "compare", false, ""},
     };

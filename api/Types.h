@@ -13,6 +13,8 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
+#include "api/Media.h"
+
 namespace radiant::api {
 
 // A user-input error. Maps to a 4xx application/problem+json response whose "pointer" is a JSON
@@ -79,6 +81,8 @@ struct RenderRequest {
   bool defaultLighting = true;
   std::optional<CompareSpec> compare;
   bool async = false;
+  // Particle systems added to the scene's own for this frame (api/Media.h), generators expanded.
+  std::vector<ParticleSystem> media;
 };
 
 // Timing and counters for one pass that ran.

@@ -387,6 +387,12 @@ RenderRequest parseRenderRequest(const json& body, const RequestLimits& limits) 
     r.compare = CompareSpec{c["against"], c["aov"], c["spp"], c["max_bounces"]};
   }
   r.async = v["async"];
+  std::size_t particles = 0;
+  for (std::size_t i = 0; i < v["media"].size(); ++i) {
+    const std::string ptr = pointerAppend("/media", i);
+    r.media.push_back(particleSystemFromRequest(v["media"][i], ptr, limits.maxParticles - particles));
+    particles += r.media.back().particles.size();
+  }
   return r;
 }
 

@@ -37,6 +37,8 @@ struct RequestLimits {
   std::size_t maxJsonDepth = 64;  // nesting of the request text (radiantd --max-json-depth)
   // Uncompressed bytes of all requested output files (radiantd --max-frame-bytes); 0 = no limit.
   std::uint64_t maxOutputBytes = 0;
+  // Particles of all request media systems together (radiantd --max-particles).
+  std::size_t maxParticles = 65536;
 };
 
 // The merged request schema (technique parameter schemas included under properties.passes).

@@ -101,10 +101,14 @@ void compare(FrameResources& resources, const Scene& scene, const FrameView& vie
     bool hit = false;
     const auto t0 = Clock::now();
     reference = referenceImage(resources, scene, view, r, &hit);
+    if (!view.media.empty() && r.aov != "media" && r.aov != "media_transmittance")
+      out.stats.warnings.push_back("the reference path tracer renders no participating media: compare.aov " + c.aov +
+                                   " is scored without the frame's particle systems (compare.aov media scores them)");
     m["spp"] = c.spp;
     m["max_bounces"] = c.maxBounces;
     m["reference_cached"] = hit;
     m["reference_ms"] = msSince(t0);
+    if (r.aov == "media" || r.aov == "media_transmittance") m["media_mode"] = r.mediaMode;
   }
   if (reference.width != test->width || reference.height != test->height)
     throw api::ApiError(422, "invalid-compare", "Size mismatch",

@@ -17,6 +17,9 @@ Scenes
                   surfaces.
   ao_creases      objects on a floor and against two walls, with creases, contact points and a
                   90 degree groove, for ambient-occlusion work; one point light.
+  explosion       thesis ch. 7's explosion in a room: fire (115 particles), smoke (28) and dust (16)
+                  as RADIANT_particle_system generators (api/schema/media.json) around crates, a warm
+                  point light at the fire's heart and a cool fill light.
 """
 
 import base64
@@ -109,6 +112,15 @@ class Builder:
             n["scale"] = scale
         if extras:
             n["extras"] = extras
+        self.doc["nodes"].append(n)
+        self.doc["scenes"][0]["nodes"].append(len(self.doc["nodes"]) - 1)
+
+    def particle_system(self, name, system, translation=None):
+        """A node carrying RADIANT_particle_system (particles from a seeded generator)."""
+        n = {"name": name, "extensions": {"RADIANT_particle_system": system}}
+        if translation:
+            n["translation"] = translation
+        self.extensions_used.add("RADIANT_particle_system")
         self.doc["nodes"].append(n)
         self.doc["scenes"][0]["nodes"].append(len(self.doc["nodes"]) - 1)
 
@@ -295,10 +307,49 @@ def ao_creases():
     return b.finish("ao_creases")
 
 
+def explosion():
+    """A 6 x 3 x 6 m room (open towards the camera) with crates and an explosion at its centre."""
+    b = Builder()
+    wall = b.material("plaster", [0.7, 0.68, 0.64, 1.0], double_sided=True)
+    floor = b.material("concrete", [0.45, 0.45, 0.45, 1.0], double_sided=True)
+    wood = b.material("crate", [0.55, 0.38, 0.2, 1.0])
+    b.node("floor", b.mesh("floor", quad([-3, 0, 3], [6, 0, 0], [0, 0, -6]), floor))
+    b.node("ceiling", b.mesh("ceiling", quad([-3, 3, -3], [6, 0, 0], [0, 0, 6]), wall))
+    b.node("back_wall", b.mesh("back_wall", quad([-3, 0, -3], [6, 0, 0], [0, 3, 0]), wall))
+    b.node("left_wall", b.mesh("left_wall", quad([-3, 0, 3], [0, 0, -6], [0, 3, 0]), wall))
+    b.node("right_wall", b.mesh("right_wall", quad([3, 0, -3], [0, 0, 6], [0, 3, 0]), wall))
+    crate = b.mesh("crate", unit_box(), wood)
+    b.node("crate_left", crate, translation=[-1.3, 0.35, -0.4], rotation=y_rotation(20.0), scale=[0.7, 0.7, 0.7])
+    b.node("crate_right", crate, translation=[1.2, 0.3, 0.5], rotation=y_rotation(-35.0), scale=[0.6, 0.6, 0.6])
+    b.node("crate_back", crate, translation=[0.4, 0.5, -1.8], scale=[1.0, 1.0, 1.0])
+    # Thesis 7.3: 115 fire, 28 smoke and 16 dust particles. Fire: black body of 2500-3200 K
+    # (Fig. 7.10); smoke albedo 0.2, dust 0.9 (7.2.1); g = 0 everywhere (7.2.1).
+    b.particle_system("fire", {
+        "kind": "fire", "tau": 6.0, "profile": "linear_exact", "emission_scale": 1.5, "seed": 1,
+        "temperature": {"bias": 2500, "scale": 700},
+        "generator": {"shape": "sphere", "extent": [0.55, 0.45, 0.55], "count": 115, "radius": 0.22,
+                      "radius_jitter": 0.4}}, translation=[0.0, 0.75, 0.0])
+    b.particle_system("smoke", {
+        "kind": "smoke", "tau": 2.5, "profile": "linear_exact", "seed": 2,
+        "generator": {"shape": "sphere", "extent": [0.9, 0.5, 0.9], "count": 28, "radius": 0.45,
+                      "radius_jitter": 0.3}}, translation=[0.0, 1.6, 0.0])
+    b.particle_system("dust", {
+        "kind": "dust", "tau": 0.8, "profile": "linear_exact", "seed": 3,
+        "generator": {"shape": "box", "extent": [1.6, 0.2, 1.4], "count": 16, "radius": 0.5,
+                      "radius_jitter": 0.3}}, translation=[0.0, 0.3, 0.2])
+    b.node("fire_light", light=b.point_light("fire_glow", 6.0, (1.0, 0.55, 0.2)), translation=[0.0, 0.8, 0.0])
+    b.node("fill_light", light=b.point_light("fill", 3.0, (0.7, 0.8, 1.0)), translation=[-2.0, 2.6, 2.0])
+    eye, target = [0.0, 1.4, 5.2], [0.0, 1.0, 0.0]
+    b.node("camera", camera=b.perspective_camera("front", round(math.radians(50.0), 6), znear=0.05),
+           translation=eye, rotation=look_rotation(eye, target))
+    return b.finish("explosion")
+
+
 def main():
     out = sys.argv[1] if len(sys.argv) > 1 else os.path.dirname(os.path.abspath(__file__))
     scenes = {"cornell_box": cornell("box"), "cornell_mirror": cornell("mirror"),
-              "cornell_glass": cornell("glass"), "cornell_glossy": cornell("glossy"), "ao_creases": ao_creases()}
+              "cornell_glass": cornell("glass"), "cornell_glossy": cornell("glossy"), "ao_creases": ao_creases(),
+              "explosion": explosion()}
     for name, text in scenes.items():
         path = os.path.join(out, name + ".gltf")
         with open(path, "w", encoding="ascii", newline="\n") as f:

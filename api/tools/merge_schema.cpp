@@ -1,6 +1,8 @@
 // Build-time tool: completes api/schema/render_request.json with every technique's parameter schema
 // (api/schema/techniques/<name>.json) so the daemon, the client and the docs read one merged schema.
-//   merge_schema <out.json> <render_request.json> <technique.json>...
+//   merge_schema <out.json> <render_request.json> <media.json> <technique.json>...
+// media.json (the particle-system schema) becomes properties.media.items (particles given inline) and
+// the annotation "x-gltf-media" (the RADIANT_particle_system node extension: particles as accessors).
 // A technique file that breaks the rules below fails the build, naming the file and the key.
 #include <algorithm>
 #include <cstdio>
@@ -67,8 +69,8 @@ json normaliseParam(const std::string& file, const std::string& name, const json
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 3) {
-    std::cerr << "usage: merge_schema <out.json> <render_request.json> <technique.json>...\n";
+  if (argc < 4) {
+    std::cerr << "usage: merge_schema <out.json> <render_request.json> <media.json> <technique.json>...\n";
     return 2;
   }
   try {
@@ -76,7 +78,19 @@ int main(int argc, char** argv) {
     json& passes = request.at("properties").at("passes");
     passes["properties"] = json::object();
     std::set<std::string> aovs;
-    for (int i = 3; i < argc; ++i) {
+    {
+      const std::string file = argv[3];
+      const json media = readJson(file);
+      for (const char* k : {"system", "request_particles", "gltf_particles"})
+        if (!media.contains(k) || !media[k].is_object()) fail(file, std::string("missing object \"") + k + "\"");
+      json inRequest = media["system"], inGltf = media["system"];
+      inRequest["properties"]["particles"] = media["request_particles"];
+      inGltf["properties"]["particles"] = media["gltf_particles"];
+      json& m = request.at("properties").at("media");
+      m["items"] = inRequest;
+      request["x-gltf-media"] = inGltf;
+    }
+    for (int i = 4; i < argc; ++i) {
       const std::string file = argv[i];
       json t = readJson(file);
       static const std::set<std::string> kAllowed{"name", "description", "outputs", "params"};

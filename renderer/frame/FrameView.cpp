@@ -38,6 +38,9 @@ FrameView makeFrameView(const Scene& scene, const api::RenderRequest& request, c
   v.exposure = request.exposure;
   v.seed = request.seed;
   v.ambient = request.ambient;
+  v.media = scene.media;
+  v.media.insert(v.media.end(), request.media.begin(), request.media.end());
+  if (!v.media.empty()) v.mediaKey = api::mediaDigest(v.media);
   if (environment) {
     v.environment = environment;
     v.environmentKey = request.environment;

@@ -25,6 +25,10 @@ struct FrameView {
   std::string environmentKey;          // its digest, for cache keys
   glm::vec3 target{0.f};               // the point looked at (for stats.camera)
   std::string cameraSource;            // "file", "auto", "request", or "request+file" / "request+auto" when partial
+  // The frame's participating media: the scene's particle systems, then the request's (api/Media.h),
+  // and their content digest (the cache key of derived media data).
+  std::vector<api::ParticleSystem> media;
+  std::string mediaKey;
 };
 
 // Reversed-Z, infinite far plane (see above).

@@ -31,6 +31,7 @@ static_assert(kUnitShadow2D < kUnitMaterial0, "shadow units overlap the material
 static_assert(kUnitLdmDistance < kUnitIblDfg && kUnitIblDfg < kUnitIblPrefiltered &&
                   kUnitIblPrefiltered < kUnitAoEmission && kUnitAoEmission < kUnitCount,
               "image-based lighting units follow the specular pass's units");
+static_assert(sizeof(MediaParticle) == 64, "std430 MediaParticle must be 64 bytes");
 // Kept for existing callers: the first material texture unit.
 inline constexpr int kMaterialTextureUnit0 = kUnitMaterial0;
 

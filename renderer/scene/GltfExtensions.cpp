@@ -23,6 +23,7 @@ const std::vector<std::string>& supportedExtensions() {
       "KHR_materials_unlit",
       "KHR_draco_mesh_compression",  // decoded at load (GltfCompression.cpp)
       "EXT_meshopt_compression",     // decoded at load (GltfCompression.cpp)
+      "RADIANT_particle_system",     // participating media, api/schema/media.json (GltfLoader.cpp)
   };
   return k;
 }

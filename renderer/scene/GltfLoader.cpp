@@ -16,6 +16,9 @@
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>  // Debian ships tinygltf as a shared library: no TINYGLTF_IMPLEMENTATION here
 
+#include "api/Media.h"
+#include "api/Types.h"
+#include "api/Validate.h"
 #include "renderer/scene/GltfCompression.h"
 #include "renderer/scene/GltfExtensions.h"
 #include "renderer/scene/GltfPackage.h"
@@ -506,6 +509,28 @@ float number(const tinygltf::Value& v, const char* key, float fallback) {
   return v.Has(key) && v.Get(key).IsNumber() ? float(v.Get(key).GetNumberAsDouble()) : fallback;
 }
 
+// A tinygltf extension value as JSON, so the request's schema validator can check it.
+nlohmann::json toJson(const tinygltf::Value& v) {
+  if (v.IsBool()) return v.Get<bool>();
+  if (v.IsInt()) return v.Get<int>();
+  if (v.IsNumber()) return v.GetNumberAsDouble();
+  if (v.IsString()) return v.Get<std::string>();
+  if (v.IsArray()) {
+    nlohmann::json a = nlohmann::json::array();
+    for (std::size_t i = 0; i < v.ArrayLen(); ++i) a.push_back(toJson(v.Get(int(i))));
+    return a;
+  }
+  if (v.IsObject()) {
+    nlohmann::json o = nlohmann::json::object();
+    for (const auto& k : v.Keys()) o[k] = toJson(v.Get(k));
+    return o;
+  }
+  return nullptr;
+}
+
+// Particles of all RADIANT_particle_system nodes of one file together.
+constexpr std::size_t kMaxSceneParticles = std::size_t(1) << 20;
+
 class Converter {
 public:
   Converter(const tinygltf::Model& model, std::size_t maxBytes) : m_(model), maxBytes_(maxBytes) {}
@@ -743,6 +768,59 @@ private:
     }
     if (node.camera >= 0 && !scene_.camera.fromFile) addCamera(node, world, ptr);
     if (const auto* e = extension(node.extensions, "KHR_lights_punctual")) addLight(*e, world, ptr);
+    if (const auto* e = extension(node.extensions, "RADIANT_particle_system")) addParticleSystem(*e, world, ptr);
+  }
+
+  // RADIANT_particle_system (api/schema/media.json, "gltf_particles"): the request's particle-system
+  // schema with particles as accessors, in node-local space.
+  void addParticleSystem(const tinygltf::Value& e, const glm::mat4& world, const std::string& ptr) {
+    const std::string eptr = ptr + "/extensions/RADIANT_particle_system";
+    nlohmann::json system;
+    try {
+      system = api::validate(api::gltfMediaSchema(), toJson(e), eptr);
+    } catch (const api::ApiError& err) {
+      throw SceneError(err.pointer, err.detail());
+    }
+    api::ParticleColumns columns;
+    const bool explicitParticles = system.contains("particles");
+    if (explicitParticles) {
+      const nlohmann::json& p = system["particles"];
+      const std::string pp = eptr + "/particles";
+      auto accessor = [&](const char* key) { return p[key].get<int>(); };
+      columns.positions = asVec3(readFloats(m_, accessor("positions"), TINYGLTF_TYPE_VEC3, pp + "/positions", maxBytes_));
+      columns.radii = readFloats(m_, accessor("radii"), TINYGLTF_TYPE_SCALAR, pp + "/radii", maxBytes_);
+      if (p.contains("tau")) columns.tau = readFloats(m_, accessor("tau"), TINYGLTF_TYPE_SCALAR, pp + "/tau", maxBytes_);
+      if (p.contains("albedo"))
+        columns.albedo = asVec3(readFloats(m_, accessor("albedo"), TINYGLTF_TYPE_VEC3, pp + "/albedo", maxBytes_));
+      if (p.contains("temperature"))
+        columns.temperature =
+            readFloats(m_, accessor("temperature"), TINYGLTF_TYPE_SCALAR, pp + "/temperature", maxBytes_);
+      const std::size_t n = columns.positions.size();
+      for (const auto& [key, size] : {std::pair<const char*, std::size_t>{"radii", columns.radii.size()},
+                                      {"tau", columns.tau.size()}, {"albedo", columns.albedo.size()},
+                                      {"temperature", columns.temperature.size()}})
+        if (p.contains(key) && size != n)
+          throw SceneError(pp + "/" + key, std::string(key) + " has " + std::to_string(size) +
+                                               " elements, positions has " + std::to_string(n));
+    }
+    std::size_t used = 0;
+    for (const auto& s : scene_.media) used += s.particles.size();
+    api::ParticleSystem ps;
+    try {
+      ps = api::makeParticleSystem(system, explicitParticles ? &columns : nullptr, eptr,
+                                   used < kMaxSceneParticles ? kMaxSceneParticles - used : 0);
+    } catch (const api::ApiError& err) {
+      throw SceneError(err.pointer, err.detail());
+    }
+    // Node-local to world: centres through the matrix, radii by its largest axis scale.
+    const float scale = std::max({glm::length(glm::vec3(world[0])), glm::length(glm::vec3(world[1])),
+                                  glm::length(glm::vec3(world[2]))});
+    for (auto& p : ps.particles) {
+      p.position = glm::vec3(world * glm::vec4(p.position, 1.f));
+      p.radius *= scale;
+    }
+    if (ps.name.empty()) ps.name = scene_.nodeNames.back();
+    scene_.media.push_back(std::move(ps));
   }
 
   void addCamera(const tinygltf::Node& node, const glm::mat4& world, const std::string& ptr) {

@@ -34,6 +34,25 @@ SceneFeatures computeFeatures(const Scene& scene) {
   }
   f.textures = static_cast<int>(scene.textures.size());
   f.hasCamera = scene.camera.fromFile;
+  f = mediaFeatures(f, scene.media);
+  // Particles are part of what the automatic camera frames.
+  for (const auto& s : scene.media)
+    for (const auto& p : s.particles) {
+      f.bounds.extend(p.position - glm::vec3(p.radius));
+      f.bounds.extend(p.position + glm::vec3(p.radius));
+    }
+  return f;
+}
+
+SceneFeatures mediaFeatures(const SceneFeatures& scene, const std::vector<api::ParticleSystem>& extra) {
+  SceneFeatures f = scene;
+  for (const auto& s : extra) {
+    if (s.particles.empty()) continue;
+    ++f.particleSystems;
+    f.particles += s.particles.size();
+    if (s.emits()) ++f.emissiveMedia;
+    else ++f.scatteringMedia;
+  }
   return f;
 }
 

@@ -17,6 +17,8 @@
 
 #include <glm/glm.hpp>
 
+#include "api/Media.h"
+
 namespace radiant {
 
 struct Bounds {
@@ -160,8 +162,14 @@ struct SceneFeatures {
   std::size_t triangles = 0;
   Bounds bounds;
   bool hasCamera = false;
+  // Participating media (glTF RADIANT_particle_system nodes): systems, their particles, and how many
+  // systems emit (fire) or scatter (smoke, dust, cloud). A request's media add to these per frame
+  // (mediaFeatures below), so the planner runs media techniques only when a frame has media.
+  int particleSystems = 0, emissiveMedia = 0, scatteringMedia = 0;
+  std::size_t particles = 0;
   int lightCount() const { return pointLights + spotLights + directionalLights; }
   bool hasEmissive() const { return emissiveTriangles > 0; }
+  bool hasMedia() const { return particles > 0; }
 };
 
 struct Scene {
@@ -173,6 +181,8 @@ struct Scene {
   std::vector<Light> lights;
   Camera camera;  // the first camera in the file, or a default that frames the bounds
   SceneFeatures features;
+  // Particle systems from RADIANT_particle_system nodes, in world space (api/Media.h).
+  std::vector<api::ParticleSystem> media;
   std::vector<std::string> nodeNames;  // every node of the default scene, depth-first order ("" unnamed)
   // What the loader could not honour (an unsupported optional extension, ...): frames list them in
   // stats.warnings, so nothing is dropped silently.
@@ -188,6 +198,9 @@ struct Scene {
 // Recomputes Scene::features (and bounds) from the scene's contents. The loader calls it; code that
 // builds or edits a Scene by hand calls it too.
 SceneFeatures computeFeatures(const Scene& scene);
+
+// The media counts of SceneFeatures for the scene's systems plus `extra` (a request's media).
+SceneFeatures mediaFeatures(const SceneFeatures& scene, const std::vector<api::ParticleSystem>& extra);
 
 // A camera that frames `bounds` from the +Z side, looking at the centre, for the given aspect.
 // yfov in radians (the default is glTF viewers' customary 39.6 degrees).

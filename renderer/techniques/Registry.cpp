@@ -11,6 +11,7 @@
 #include "renderer/techniques/shadow_maps/ShadowMaps.h"
 #include "renderer/techniques/specular/Specular.h"
 #include "renderer/techniques/transparency/Transparency.h"
+#include "renderer/techniques/spherical_billboards/SphericalBillboards.h"
 
 namespace radiant {
 
@@ -29,7 +30,9 @@ std::vector<std::unique_ptr<Technique>> createTechniques() {
   // default), and the planner gives both classes to light_volumes when the request names it.
   t.push_back(std::make_unique<LightVolumesPass>());
   t.push_back(std::make_unique<AmbientOcclusionPass>());
-  t.push_back(std::make_unique<TransparencyPass>());  // last of the beauty passes: composites over them
+  t.push_back(std::make_unique<TransparencyPass>());  // composites alphaMode BLEND surfaces over the lit frame
+  // Media compose over every opaque and blended contribution (beauty = beauty * T + C): after all of them.
+  t.push_back(std::make_unique<SphericalBillboardsPass>());
   t.push_back(std::make_unique<ReferencePass>());
   return t;
 }

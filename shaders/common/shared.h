@@ -128,4 +128,26 @@ struct MaterialParams {
                    // dielectric F0 = min(F0(ior) rgb, 1), F90 = 1, scaled by a; (1, 1, 1, 1) without it
 };
 
+// ---------------------------------------------------------------------------------------------------
+// Participating media (renderer/techniques/spherical_billboards, shaders/spherical_billboards).
+
+RADIANT_CONST int kProfileConstant = 0;
+RADIANT_CONST int kProfileThesis = 1;       // thesis eq. 7.4
+RADIANT_CONST int kProfileLinearExact = 2;  // tau (1 - |x - c| / r), integrated exactly
+
+RADIANT_CONST int kPhaseIsotropic = 0;
+RADIANT_CONST int kPhaseHenyeyGreenstein = 1;
+RADIANT_CONST int kPhaseCornetteShanks = 2;  // thesis eq. 1.3
+
+// The particle buffer's binding (after the scene's materials, lights and shadows).
+RADIANT_CONST int kBindingMediaParticles = 3;
+
+// One particle as the billboard shaders read it, in draw order (back to front).
+struct MediaParticle {
+  vec4 centerRadius;  // xyz world centre, w radius
+  vec4 sourceTau;     // rgb the direction-independent source ((1 - a) L_e + a L_ambient), w tau
+  vec4 albedoG;       // rgb albedo (scales the punctual lights' in-scattering), w phase g
+  ivec4 models;       // x density profile (kProfile*), y phase model (kPhase*), zw unused
+};
+
 #endif

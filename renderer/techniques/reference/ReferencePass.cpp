@@ -8,12 +8,58 @@
 #include "renderer/frame/PassContext.h"
 #include "renderer/frame/RayScenes.h"
 #include "renderer/reference/LightTracer.h"
+#include "renderer/raytracing/ParticleMedium.h"
+#include "renderer/reference/VolumeTracer.h"
 
 namespace radiant {
+
+namespace {
+
+// The volumetric reference's image of the frame's media: RGB radiance ("media") or the transmittance
+// ("media_transmittance"), cached by what shapes it.
+const Image& mediaReferenceImage(FrameResources& res, const Scene& scene, const FrameView& view,
+                                 const ReferenceRequest& r, bool* cacheHit) {
+  reference::VolumeOptions o;
+  o.mode = reference::mediaModeFromString(r.mediaMode);
+  o.spp = r.spp;
+  o.maxScattering = std::max(1, r.maxBounces);
+  o.seed = view.seed;
+  o.sky = view.ambient;
+  const glm::mat4& w = view.camera.world;
+  const nlohmann::json key = {{"scene", res.sceneKey()}, {"media", view.mediaKey},
+                              {"camera", std::vector<float>(&w[0][0], &w[0][0] + 16)},
+                              {"projection", static_cast<int>(view.camera.projection)},
+                              {"yfov", view.camera.yfov}, {"mag", {view.camera.xmag, view.camera.ymag}},
+                              {"znear", view.camera.znear}, {"size", {view.width, view.height}},
+                              {"spp", o.spp}, {"mode", r.mediaMode}, {"max_scattering", o.maxScattering},
+                              {"seed", o.seed}, {"sky", {o.sky.x, o.sky.y, o.sky.z}}};
+  bool built = false;
+  const Image& rgba = res.cached<Image>("reference:media", key.dump(), [&] {
+    built = true;
+    const rt::ParticleMedium medium(view.media);
+    return std::make_unique<Image>(
+        reference::VolumeTracer(sharedRayScene(res, scene), medium).render(view.camera, view.width, view.height, o));
+  });
+  if (cacheHit) *cacheHit = !built;
+  const bool transmittance = r.aov == "media_transmittance";
+  return res.cached<Image>("reference:" + r.aov, key.dump(), [&] {
+    auto out = std::make_unique<Image>(Image::make("reference", rgba.width, rgba.height, transmittance ? 1 : 3));
+    for (std::size_t p = 0; p < static_cast<std::size_t>(rgba.width) * rgba.height; ++p)
+      for (int c = 0; c < out->channels; ++c) out->pixels[p * out->channels + c] = rgba.pixels[p * 4 + (transmittance ? 3 : c)];
+    return out;
+  });
+}
+
+}  // namespace
 
 const Image& referenceImage(FrameResources& res, const Scene& scene, const FrameView& view,
                             const ReferenceRequest& r, bool* cacheHit, std::uint64_t* rays, bool* lightTraced,
                             const std::function<void(double)>& progress) {
+  if (r.aov == "media" || r.aov == "media_transmittance") {
+    if (rays) *rays = 0;
+    if (lightTraced) *lightTraced = false;
+    return mediaReferenceImage(res, scene, view, r, cacheHit);
+  }
   const rt::RayScene& rayScene = sharedRayScene(res, scene);
   const reference::PathTracer tracer(rayScene);
   reference::ReferenceOptions o;
@@ -105,9 +151,10 @@ const TechniqueInfo& ReferencePass::info() const {
   return i;
 }
 
-Requirements ReferencePass::requirements(const Scene& scene, const api::RenderRequest&) const {
-  const SceneFeatures& f = scene.features;
-  return f.triangles > 0 ? Requirements::ok() : Requirements::skip("the scene has no triangles");
+Requirements ReferencePass::requirements(const Scene& scene, const api::RenderRequest& request) const {
+  const SceneFeatures f = mediaFeatures(scene.features, request.media);
+  return f.triangles > 0 || f.hasMedia() ? Requirements::ok()
+                                         : Requirements::skip("the scene has no triangles and no media");
 }
 
 ReferenceRequest referenceRequestFrom(const Params& params) {
@@ -120,6 +167,7 @@ ReferenceRequest referenceRequestFrom(const Params& params) {
   r.russianRoulette = params.get<bool>("russian_roulette", true);
   r.aoRadius = params.get<float>("ao_radius", 0.5f);
   r.aoDefinition = params.get<std::string>("ao_definition", "cosine");
+  r.mediaMode = params.get<std::string>("media_mode", "single_scatter_unshadowed");
   return r;
 }
 

@@ -12,8 +12,10 @@
 
 namespace radiant {
 
-// Reference image of `aov` ("beauty", "direct", "indirect", "caustics", "ao", "reference") for the
-// frame's view. For "ao", aoDefinition is "volumetric" (thesis eq. 4.6) or "cosine" (cosine-weighted step).
+// Reference image of `aov` ("beauty", "direct", "indirect", "caustics", "ao", "reference", "media",
+// "media_transmittance") for the frame's view. For "ao", aoDefinition is "volumetric" (thesis eq. 4.6)
+// or "cosine" (cosine-weighted step). The media AOVs come from the volumetric reference
+// (renderer/reference/VolumeTracer.h) over the frame's particle systems (FrameView::media).
 // Caustics: when the scene has a material with a Dirac-delta lobe, "beauty" and "indirect" are the path
 // tracer without the caustic paths L S+ D E plus the light tracer's caustics (renderer/reference/
 // LightTracer.h), so that a point light's caustic through glass is in the ground truth, counted once;
@@ -27,6 +29,8 @@ struct ReferenceRequest {
   bool russianRoulette = true;
   float aoRadius = 0.5f;
   std::string aoDefinition = "cosine";
+  // aov "media" / "media_transmittance": the volumetric reference's light transport.
+  std::string mediaMode = "single_scatter_unshadowed";
 };
 // The reference pass's parameters (its schema, defaults filled in) as a ReferenceRequest.
 ReferenceRequest referenceRequestFrom(const Params& params);

@@ -247,6 +247,14 @@ TEST(RealDaemon, RendersBuiltinsRejectsBadInputAndStopsCleanly) {
   EXPECT_EQ(r->status, 422);
   EXPECT_EQ(json::parse(r->body)["pointer"], "/passes/shadow_maps/shadow_map_size");
   EXPECT_EQ(c.Post("/v1/renders", R"({"scene":{"builtin":"no_such_scene"}})", "application/json")->status, 404);
+  // Participating media: above the server's particle limit (65536 by default) is 422 at the count.
+  req.erase("passes");
+  req["media"] = json::array({{{"kind", "smoke"}, {"generator", {{"count", 70000}}}}});
+  r = c.Post("/v1/renders", req.dump(), "application/json");
+  EXPECT_EQ(r->status, 422);
+  EXPECT_EQ(json::parse(r->body)["type"], "https://radiant.dev/problems/limit-exceeded");
+  EXPECT_EQ(json::parse(r->body)["pointer"], "/media/0/generator/count");
+  req.erase("media");
 
   // Eight concurrent clients, each with its own image size: every PNG has its own request's size.
   std::vector<std::future<std::string>> concurrent;

@@ -10,7 +10,7 @@ namespace {
 
 TEST(BuiltinScenes, NamesAreTheShippedScenes) {
   EXPECT_EQ(builtinSceneNames(),
-            (std::vector<std::string>{"ao_creases", "cornell_box", "cornell_glass", "cornell_glossy", "cornell_mirror"}));
+            (std::vector<std::string>{"ao_creases", "cornell_box", "cornell_glass", "cornell_glossy", "cornell_mirror", "explosion"}));
 }
 
 TEST(BuiltinScenes, UnknownNameIsASceneError) {
@@ -34,6 +34,7 @@ TEST(BuiltinScenes, EmbeddedTextMatchesTheFileOnDisk) {
 
 TEST(BuiltinScenes, EveryOneHasOnePointLightACameraAndGeometry) {
   for (const auto& name : builtinSceneNames()) {
+    if (name == "explosion") continue;  // the media scene: two lights, no sphere (ExplosionIsThesisChapter7s)
     const Scene s = loadBuiltinScene(name);
     EXPECT_EQ(s.features.pointLights, 1) << name;
     EXPECT_EQ(s.features.lightCount(), 1) << name;
@@ -46,6 +47,28 @@ TEST(BuiltinScenes, EveryOneHasOnePointLightACameraAndGeometry) {
     EXPECT_GT(p.y, s.features.bounds.min.y) << name;
     EXPECT_LT(p.y, s.features.bounds.max.y + 1.f) << name;
   }
+}
+
+TEST(BuiltinScenes, ExplosionIsThesisChapter7s) {
+  // Thesis 7.3: 115 fire, 28 smoke and 16 dust particles, in a room with a camera and lights.
+  const Scene s = loadBuiltinScene("explosion");
+  ASSERT_EQ(s.media.size(), 3u);
+  EXPECT_EQ(s.media[0].kind, api::MediumKind::Fire);
+  EXPECT_EQ(s.media[0].particles.size(), 115u);
+  EXPECT_EQ(s.media[1].kind, api::MediumKind::Smoke);
+  EXPECT_EQ(s.media[1].particles.size(), 28u);
+  EXPECT_EQ(s.media[2].kind, api::MediumKind::Dust);
+  EXPECT_EQ(s.media[2].particles.size(), 16u);
+  for (const auto& p : s.media[0].particles) {
+    EXPECT_GE(p.temperature, 2500.f);  // Fig. 7.10: fire spans 2500-3200 K
+    EXPECT_LT(p.temperature, 3200.f);
+  }
+  EXPECT_EQ(s.features.particles, 159u);
+  EXPECT_EQ(s.features.emissiveMedia, 1);
+  EXPECT_EQ(s.features.scatteringMedia, 2);
+  EXPECT_TRUE(s.features.hasCamera);
+  EXPECT_EQ(s.features.pointLights, 2);
+  EXPECT_TRUE(s.warnings.empty());
 }
 
 TEST(BuiltinScenes, CornellBoxLayout) {

@@ -1,0 +1,202 @@
+#include "renderer/techniques/spherical_billboards/SphericalBillboards.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "renderer/frame/PassContext.h"
+#include "renderer/raytracing/Media.h"
+
+namespace radiant {
+
+const TechniqueInfo& SphericalBillboardsPass::info() const {
+  static const TechniqueInfo i{"spherical_billboards",
+                               "Particle media as spherical billboards (thesis ch. 7): fire, smoke, dust; "
+                               "planar and soft-particle baselines",
+                               {},
+                               {"gbuffer_position"},
+                               {"media", "media_transmittance"},
+                               true,
+                               true,
+                               {"media"}};
+  return i;
+}
+
+Requirements SphericalBillboardsPass::requirements(const Scene& scene, const api::RenderRequest& request) const {
+  const SceneFeatures f = mediaFeatures(scene.features, request.media);
+  return f.hasMedia() ? Requirements::ok()
+                      : Requirements::skip("the frame has no participating media (no RADIANT_particle_system "
+                                           "node in the scene, no media in the request)");
+}
+
+std::vector<gpu::MediaParticle> SphericalBillboardsPass::gpuParticles(const std::vector<api::ParticleSystem>& media,
+                                                                     glm::vec3 ambient, glm::vec3 eye,
+                                                                     glm::vec3 forward, bool orthographic, bool sort) {
+  std::vector<gpu::MediaParticle> out;
+  std::vector<float> key;
+  for (const api::ParticleSystem& s : media) {
+    const int profile = s.profile == api::DensityProfile::Thesis        ? gpu::kProfileThesis
+                        : s.profile == api::DensityProfile::LinearExact ? gpu::kProfileLinearExact
+                                                                        : gpu::kProfileConstant;
+    const int phase = s.phase == api::PhaseModel::HenyeyGreenstein ? gpu::kPhaseHenyeyGreenstein
+                      : s.phase == api::PhaseModel::CornetteShanks ? gpu::kPhaseCornetteShanks
+                                                                   : gpu::kPhaseIsotropic;
+    for (const api::Particle& p : s.particles) {
+      if (!(p.tau > 0.f)) continue;
+      // (1 - a) L_e + a L_ambient: a uniform sky integrates the phase function to 1.
+      const glm::vec3 emitted = s.emits() ? s.emissionScale * rt::blackbodyRgb(p.temperature) : glm::vec3(0.f);
+      const glm::vec3 source = (1.f - p.albedo) * emitted + p.albedo * ambient;
+      out.push_back({glm::vec4(p.position, p.radius), glm::vec4(source, p.tau), glm::vec4(p.albedo, s.g),
+                     glm::ivec4(profile, phase, 0, 0)});
+      key.push_back(orthographic ? glm::dot(p.position - eye, forward) : glm::length(p.position - eye));
+    }
+  }
+  if (!sort) return out;
+  std::vector<std::size_t> order(out.size());
+  std::iota(order.begin(), order.end(), std::size_t(0));
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key[a] > key[b]; });
+  std::vector<gpu::MediaParticle> sorted(out.size());
+  for (std::size_t i = 0; i < order.size(); ++i) sorted[i] = out[order[i]];
+  return sorted;
+}
+
+void SphericalBillboardsPass::prepare(const Scene&, const Params& params, FrameResources& res) {
+  const FrameView& view = res.view();
+  const std::string method = params.get<std::string>("method", "spherical");
+  method_ = method == "planar" ? 1 : method == "soft" ? 2 : 0;
+  chord_ = params.get<std::string>("chord", "exact") == "screen_parallel" ? 1 : 0;
+  ratio_ = params.get<float>("resolution_ratio", 1.f);
+  softScale_ = params.get<float>("soft_scale", 1.f);
+  depthAware_ = params.get<std::string>("upsampling", "depth_aware") == "depth_aware";
+  const glm::vec3 forward = -glm::normalize(glm::vec3(view.camera.world[2]));
+  const bool ortho = view.camera.projection == ProjectionType::Orthographic;
+  particles_ = gpuParticles(view.media, view.ambient, view.eye, forward, ortho, params.get<bool>("sort", true));
+
+  // Overdraw estimate: covered pixels of every particle's disc over the image (the cost driver, 7.3).
+  const float pixelsPerUnit = ortho ? 0.5f * view.height / view.camera.ymag
+                                    : 0.5f * view.height / std::tan(0.5f * view.camera.yfov);
+  double covered = 0.0;
+  for (const auto& p : particles_) {
+    const float r = p.centerRadius.w;
+    const float z = ortho ? 1.f : glm::dot(glm::vec3(p.centerRadius) - view.eye, forward);
+    const double rp = z > r ? r * pixelsPerUnit / std::sqrt(z * z - r * r) : 1e30;
+    covered += std::min(3.14159265 * rp * rp, double(view.width) * view.height);
+  }
+  overdraw_ = covered / (double(view.width) * view.height);
+
+  if (vao_.id() == 0) vao_ = gl::VertexArray("spherical_billboards");
+  const int w = view.width, h = view.height;
+  gl::Texture& media = res.texture("media", GL_TEXTURE_2D, GL_RGBA32F, w, h);
+  media.setFilter(GL_NEAREST, GL_NEAREST);
+  gl::Framebuffer& fb = res.framebuffer("media");
+  fb.attach(GL_COLOR_ATTACHMENT0, media);
+  fb.setDrawBuffers({GL_COLOR_ATTACHMENT0});
+  fb.checkComplete("SphericalBillboardsPass::prepare");
+  lowWidth_ = std::max(1, static_cast<int>(std::ceil(w * ratio_)));
+  lowHeight_ = std::max(1, static_cast<int>(std::ceil(h * ratio_)));
+  if (ratio_ < 1.f) {
+    gl::Texture& low = res.texture("media_layer", GL_TEXTURE_2D, GL_RGBA32F, lowWidth_, lowHeight_);
+    low.setFilter(GL_NEAREST, GL_NEAREST);
+    gl::Framebuffer& lfb = res.framebuffer("media_layer");
+    lfb.attach(GL_COLOR_ATTACHMENT0, low);
+    lfb.setDrawBuffers({GL_COLOR_ATTACHMENT0});
+    lfb.checkComplete("SphericalBillboardsPass::prepare (layer)");
+  }
+  gl::Framebuffer& compose = res.framebuffer("media_compose");
+  compose.attach(GL_COLOR_ATTACHMENT0, res.texture("beauty", GL_TEXTURE_2D, GL_RGBA32F, w, h));
+  compose.setDrawBuffers({GL_COLOR_ATTACHMENT0});
+  compose.checkComplete("SphericalBillboardsPass::prepare (compose)");
+  // Capacity in powers of two, so a sweep over particle counts rarely reallocates.
+  std::size_t capacity = 64;
+  while (capacity < particles_.size()) capacity *= 2;
+  res.buffer("media_particles", capacity * sizeof(gpu::MediaParticle));
+}
+
+void SphericalBillboardsPass::execute(PassContext& ctx) {
+  FrameResources& res = ctx.resources;
+  const FrameView& view = ctx.view;
+  gl::Buffer& buffer = res.buffer("media_particles");
+  if (!particles_.empty()) buffer.upload(particles_.data(), particles_.size() * sizeof(gpu::MediaParticle));
+  const bool hasDepth = res.hasTexture("gbuffer_position") && res.written("gbuffer_position");
+  const bool layered = ratio_ < 1.f;
+  vao_.bind();
+
+  // 1. Particles, back to front, into the layer (or the full-resolution target at ratio 1).
+  gl::Framebuffer& target = res.framebuffer(layered ? "media_layer" : "media");
+  target.bind();
+  const int tw = layered ? lowWidth_ : view.width, th = layered ? lowHeight_ : view.height;
+  glViewport(0, 0, tw, th);
+  const float clear[4] = {0.f, 0.f, 0.f, 1.f};  // no light, transmittance 1
+  glClearNamedFramebufferfv(target.id(), GL_COLOR, 0, clear);
+  glDisable(GL_DEPTH_TEST);
+  glDepthMask(GL_FALSE);
+  glDisable(GL_CULL_FACE);
+  glEnable(GL_BLEND);
+  glBlendEquation(GL_FUNC_ADD);
+  // C = alpha L + (1 - alpha) C; T = (1 - alpha) T.
+  glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE_MINUS_SRC_ALPHA);
+  if (hasDepth) res.texture("gbuffer_position").bindUnit(0);
+  buffer.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingMediaParticles);
+  ctx.gpu.lights.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingLights);
+  const gl::Program& prog = ctx.shaders.program({"spherical_billboards/particle.vert", "spherical_billboards/particle.frag"});
+  prog.use();
+  prog.setMat4("u_view", &view.view[0][0]);
+  prog.setMat4("u_proj", &view.proj[0][0]);
+  prog.setMat4("u_invViewProj", &view.invViewProj[0][0]);
+  prog.set("u_znear", view.camera.znear);
+  prog.set("u_orthographic", view.camera.projection == ProjectionType::Orthographic ? 1 : 0);
+  prog.set("u_hasDepth", hasDepth ? 1 : 0);
+  const float targetSize[2] = {static_cast<float>(tw), static_cast<float>(th)};
+  prog.set("u_targetSize", targetSize, 2);
+  glProgramUniform2i(prog.id(), prog.uniformLocation("u_fullSize"), view.width, view.height);
+  prog.set("u_method", method_);
+  prog.set("u_chord", chord_);
+  prog.set("u_softScale", softScale_);
+  prog.set("u_lightCount", static_cast<int>(ctx.scene.lights.size()));
+  if (!particles_.empty()) glDrawArraysInstanced(GL_TRIANGLES, 0, 6, static_cast<GLsizei>(particles_.size()));
+  glDisable(GL_BLEND);
+
+  // 2. The layer to full resolution.
+  if (layered) {
+    gl::Framebuffer& fb = res.framebuffer("media");
+    fb.bind();
+    glViewport(0, 0, view.width, view.height);
+    res.texture("media_layer").bindUnit(0);
+    if (hasDepth) res.texture("gbuffer_position").bindUnit(1);
+    const gl::Program& up = ctx.shaders.program({"common/fullscreen.vert", "spherical_billboards/upsample.frag"});
+    up.use();
+    up.set("u_hasDepth", hasDepth ? 1 : 0);
+    up.set("u_depthAware", depthAware_ ? 1 : 0);
+    glProgramUniform2i(up.id(), up.uniformLocation("u_lowSize"), lowWidth_, lowHeight_);
+    glProgramUniform2i(up.id(), up.uniformLocation("u_fullSize"), view.width, view.height);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+  }
+  res.markWritten("media");
+  res.markWritten("media_transmittance");
+
+  // 3. beauty = beauty * T + C. A frame without opaque passes starts from the sky.
+  gl::Framebuffer& compose = res.framebuffer("media_compose");
+  compose.bind();
+  glViewport(0, 0, view.width, view.height);
+  if (!res.written("beauty")) {
+    const float sky[4] = {view.ambient.x, view.ambient.y, view.ambient.z, 1.f};
+    glClearNamedFramebufferfv(compose.id(), GL_COLOR, 0, sky);
+  }
+  glEnable(GL_BLEND);
+  glBlendEquation(GL_FUNC_ADD);
+  glBlendFuncSeparate(GL_ONE, GL_SRC_ALPHA, GL_ZERO, GL_ONE);
+  res.texture("media").bindUnit(0);
+  const gl::Program& comp = ctx.shaders.program({"common/fullscreen.vert", "spherical_billboards/compose.frag"});
+  comp.use();
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glDisable(GL_BLEND);
+  glDepthMask(GL_TRUE);
+  res.markWritten("beauty");
+
+  ctx.stats.counters["particles"] = static_cast<double>(particles_.size());
+  ctx.stats.counters["overdraw_estimate"] = overdraw_;
+  ctx.stats.counters["layer_width"] = lowWidth_;
+  ctx.stats.counters["layer_height"] = lowHeight_;
+}
+
+}  // namespace radiant
