@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <set>
 #include <stdexcept>
 
 #include "api/Aovs.h"
@@ -305,11 +306,17 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     // PassStats must not move while the profiler holds pointers to them.
     stats.passes.resize(plan.passes.size());
     std::vector<Params> params(plan.passes.size());
+    std::set<int> shadowMapExclusions;  // meshes whose shadows a pass supplies itself (light_volumes)
     for (std::size_t i = 0; i < plan.passes.size(); ++i) {
       Technique* t = plan.passes[i];
       stats.passes[i].name = t->info().name;
       auto p = request.passes.find(t->info().name);
       params[i] = Params(api::techniqueParams(t->info().name, p == request.passes.end() ? nlohmann::json() : p->second));
+      for (int m : t->shadowMapExclusions(scene, params[i])) shadowMapExclusions.insert(m);
+    }
+    im.resources.setShadowMapExclusions(std::move(shadowMapExclusions));
+    for (std::size_t i = 0; i < plan.passes.size(); ++i) {
+      Technique* t = plan.passes[i];
       t->prepare(scene, params[i], im.resources);
       gl::checkError(("prepare " + t->info().name).c_str());
     }

@@ -58,6 +58,10 @@ public:
     return it == lightPaths_.end() ? std::string() : it->second;
   }
 
+  // Meshes the shadow maps leave out this frame (Technique::shadowMapExclusions, set by the Renderer).
+  void setShadowMapExclusions(std::set<int> meshes) { shadowMapExclusions_ = std::move(meshes); }
+  const std::set<int>& shadowMapExclusions() const { return shadowMapExclusions_; }
+
   // Outputs written this frame (the planner and readback consult it).
   void markWritten(const std::string& name) {
     written_.insert(name);
@@ -106,6 +110,7 @@ private:
   std::map<std::string, Entry> cache_;
   std::set<std::string> written_;
   std::map<std::string, std::string> lightPaths_;
+  std::set<int> shadowMapExclusions_;
   std::set<std::string> declaredThisFrame_;
   std::set<std::string> passWrites_;
 };

@@ -99,6 +99,10 @@ public:
   virtual void prepare(const Scene& scene, const Params& params, FrameResources& resources) = 0;
   // The only place GL is issued. Must not allocate GL objects.
   virtual void execute(PassContext& context) = 0;
+  // Meshes (Scene::meshes indices) to leave out of this frame's shadow maps because this pass supplies
+  // their shadows itself (light_volumes' negative beams), so that the two never both apply. Called
+  // before any prepare().
+  virtual std::vector<int> shadowMapExclusions(const Scene&, const Params&) const { return {}; }
 };
 
 }  // namespace radiant

@@ -41,6 +41,28 @@ public:
     return *this;
   }
 
+  // An n x n x 2 triangle grid in the plane y = c.y spanning c.x +- half, c.z +- half, facing +y (up) or
+  // -y: a finely tessellated quad (light_volumes builds one beam per triangle).
+  SceneBuilder& gridY(glm::vec3 c, float half, int n, bool up, int mat, const std::string& name = "grid") {
+    MeshInstance m;
+    m.name = name;
+    m.material = mat;
+    for (int i = 0; i <= n; ++i)
+      for (int j = 0; j <= n; ++j) {
+        m.positions.push_back({c.x - half + 2.f * half * i / n, c.y, c.z - half + 2.f * half * j / n});
+        m.normals.push_back({0.f, up ? 1.f : -1.f, 0.f});
+      }
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) {
+        const std::uint32_t a = i * (n + 1) + j, b = a + n + 1;
+        if (up) m.indices.insert(m.indices.end(), {a, a + 1, b, a + 1, b + 1, b});  // counter-clockwise from +y
+        else m.indices.insert(m.indices.end(), {a, b, a + 1, a + 1, b, b + 1});
+      }
+    for (auto& p : m.positions) m.bounds.extend(p);
+    scene_.meshes.push_back(std::move(m));
+    return *this;
+  }
+
   // An axis-aligned solid box of outward-facing quads (names "<name>+x", "<name>-y", ...).
   SceneBuilder& box(glm::vec3 lo, glm::vec3 hi, int mat, const std::string& name = "box") {
     const glm::vec3 c = 0.5f * (lo + hi), e = 0.5f * (hi - lo);

@@ -13,17 +13,31 @@ struct Primitive {
   glm::vec4 record;
 };
 
-// The box of the cone's part s0 <= s <= s1: the hull of its end disks (the radius a + b |s| is convex
-// in s, so it lies below the chord), each disk's box having half-extents r sqrt(1 - N_i^2).
-Bounds segmentBox(const BeamCone& c, float s0, float s1) {
+// The box of beam b's part s0 <= s <= s1 (s = (F - C).N along its cone's axis). The flux triangle at
+// s has the vertices X_k(s) = V_k + ((s - h_k) / kappa_k) d_k, linear in s, so the part lies in the
+// convex hull of the six end vertices; glossy beams add the cone's padding (its radius minus the
+// specular radius, at each end). Cones that are unbounded (a glossy padding past kMaxCullAngle) use
+// the disks of the cone itself, clamped to the scene by the caller.
+Bounds segmentBox(const Beam& beam, const BeamCone& c, float s0, float s1) {
   const glm::vec3 C(c.originRadius), N(c.axisSlope);
-  const float a = c.originRadius.w, b = c.axisSlope.w;
   Bounds box;
+  if (c.originRadius.w >= 1e29f) {
+    box.extend(glm::vec3(-1e30f));
+    box.extend(glm::vec3(1e30f));
+    return box;
+  }
+  const glm::vec3 V[3] = {glm::vec3(beam.vertexA), glm::vec3(beam.vertexB), glm::vec3(beam.vertexC)};
+  const glm::vec3 d[3] = {glm::vec3(beam.dirA), glm::vec3(beam.dirB), glm::vec3(beam.dirC)};
+  const BeamCone specular = beamCone([&] { Beam b = beam; b.fluxSigma.w = 0.f; return b; }(), 0.f);
   for (float s : {s0, s1}) {
-    const float r = std::min(a + b * std::abs(s), 1e30f);
-    const glm::vec3 e = r * glm::sqrt(glm::max(glm::vec3(0.f), glm::vec3(1.f) - N * N));
-    box.extend(C + s * N - e);
-    box.extend(C + s * N + e);
+    const float pad = std::max(0.f, (c.originRadius.w + c.axisSlope.w * std::abs(s)) -
+                                        (specular.originRadius.w + specular.axisSlope.w * std::abs(s)));
+    for (int k = 0; k < 3; ++k) {
+      const float kappa = std::max(glm::dot(d[k], N), 1e-4f);
+      const glm::vec3 X = V[k] + ((s - glm::dot(V[k] - C, N)) / kappa) * d[k];
+      box.extend(X - glm::vec3(pad));
+      box.extend(X + glm::vec3(pad));
+    }
   }
   return box;
 }
@@ -60,7 +74,7 @@ int build(std::vector<Primitive>& prims, int begin, int end, int depth, BeamBvh&
 
 }  // namespace
 
-BeamBvh buildBeamBvh(const std::vector<BeamCone>& cones, const Bounds& boundsIn) {
+BeamBvh buildBeamBvh(const std::vector<Beam>& beams, const std::vector<BeamCone>& cones, const Bounds& boundsIn) {
   BeamBvh out;
   Bounds bounds = boundsIn;
   const glm::vec3 pad(1e-3f * std::max(bounds.radius(), 1e-6f));
@@ -71,9 +85,9 @@ BeamBvh buildBeamBvh(const std::vector<BeamCone>& cones, const Bounds& boundsIn)
       {bounds.min.x, bounds.max.y, bounds.min.z}, {bounds.max.x, bounds.max.y, bounds.min.z},
       {bounds.min.x, bounds.min.y, bounds.max.z}, {bounds.max.x, bounds.min.y, bounds.max.z},
       {bounds.min.x, bounds.max.y, bounds.max.z}, {bounds.max.x, bounds.max.y, bounds.max.z}};
-  const int beams = static_cast<int>(cones.size());
-  for (int g0 = 0; g0 < beams; g0 += kBeamsPerGroup) {
-    const int g1 = std::min(beams, g0 + kBeamsPerGroup);
+  const int count = static_cast<int>(cones.size());
+  for (int g0 = 0; g0 < count; g0 += kBeamsPerGroup) {
+    const int g1 = std::min(count, g0 + kBeamsPerGroup);
     std::vector<Primitive> prims;
     for (int i = g0; i < g1; ++i) {
       const BeamCone& c = cones[i];
@@ -92,7 +106,7 @@ BeamBvh buildBeamBvh(const std::vector<BeamCone>& cones, const Bounds& boundsIn)
       const int n = std::clamp(static_cast<int>(std::ceil(len / std::max(2.f * rMax, 1e-6f * len))), 1, kMaxSegmentsPerBeam);
       for (int k = 0; k < n; ++k) {
         const float s0 = sMin + len * k / n, s1 = k + 1 == n ? sMax : sMin + len * (k + 1) / n;
-        Bounds box = segmentBox(c, s0, s1);
+        Bounds box = segmentBox(beams[i], c, s0, s1);
         box.min = glm::max(box.min, bounds.min);
         box.max = glm::min(box.max, bounds.max);
         if (box.empty()) continue;

@@ -1,7 +1,8 @@
 #pragma once
 // The culled traversal of light_volumes (the paper's stated limit, §4.5, is a linear loop over every
-// beam per fragment, O(W H B)): a BVH over each beam's culling bound (BeamCone), which is cut into
-// segments along its axis so that a long oblique beam is not one scene-sized box. A fragment gathers
+// beam per fragment, O(W H B)): a BVH over each beam, cut into segments along its cone's axis (so that
+// a long oblique beam is not one scene-sized box), each boxed by the hull of its end flux triangles
+// (plus the glossy padding). A fragment gathers
 // only the beams whose segment boxes contain it, and of those only the one segment whose axial
 // range holds it (so a beam never counts twice). Beams are grouped (kBeamsPerGroup consecutive
 // beams, one BVH each) so that one dispatch's traversal stays below llvmpipe's 65535 loop iterations.
@@ -27,7 +28,8 @@ struct BeamBvh {
   int depth = 0;
 };
 
-// The BVH of `cones` inside `bounds` (the receivers' world bounds: nothing outside receives).
-BeamBvh buildBeamBvh(const std::vector<BeamCone>& cones, const Bounds& bounds);
+// The BVH of the beams (with their cones) inside `bounds` (the receivers' world bounds: nothing outside
+// receives).
+BeamBvh buildBeamBvh(const std::vector<Beam>& beams, const std::vector<BeamCone>& cones, const Bounds& bounds);
 
 }  // namespace radiant::light_volumes

@@ -63,17 +63,20 @@ Requirements LightVolumesPass::requirements(const Scene& scene, const api::Rende
   return Requirements::ok();
 }
 
+std::vector<int> LightVolumesPass::shadowMapExclusions(const Scene& scene, const Params& params) const {
+  // Negative beams are the scatterers' first-order shadows: the shadow maps must not add theirs too
+  // (notes A7).
+  std::vector<int> out;
+  if (params.get<std::string>("shadows", "shadow_map") != "negative_beams") return out;
+  for (std::size_t m = 0; m < scene.meshes.size(); ++m)
+    if (scene.material(scene.meshes[m].material).scattersNarrowLobe()) out.push_back(static_cast<int>(m));
+  return out;
+}
+
 void LightVolumesPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
   light_volumes::BeamOptions o;
   o.sigmaScale = params.get<float>("sigma_scale", 1.1f);
   o.negativeBeams = params.get<std::string>("shadows", "shadow_map") == "negative_beams";
-  // Negative beams need the scatterers removed as shadow-map casters, or their shadows double (notes
-  // A7); the shadow maps cannot exclude meshes yet, so the GPU path refuses rather than double them.
-  if (o.negativeBeams)
-    throw api::ApiError(422, "invalid-value", "Invalid light_volumes parameter",
-                        "shadows = negative_beams needs the shadow maps to skip the scatterers, which they cannot yet; "
-                        "use shadow_map",
-                        "/passes/light_volumes/shadows");
   o.maxConcentration = params.get<float>("max_concentration", 1e4f);
   o.maxTriangleSigma = params.get<float>("max_triangle_sigma", 0.5f);
   o.specularFallback = params.get<std::string>("tessellation_fallback", "specular") == "specular";
@@ -106,7 +109,7 @@ void LightVolumesPass::prepare(const Scene& scene, const Params& params, FrameRe
     c->beams = light_volumes::buildBeams(scene, o, receiverDistance);
     c->setupMs = msSince(t0);
     t0 = Clock::now();
-    c->bvh = light_volumes::buildBeamBvh(c->beams.cones, scene.features.bounds);
+    c->bvh = light_volumes::buildBeamBvh(c->beams.beams, c->beams.cones, scene.features.bounds);
     c->bvhMs = msSince(t0);
     return c;
   });

@@ -23,6 +23,7 @@ public:
   Requirements requirements(const Scene&, const api::RenderRequest&) const override;
   void prepare(const Scene&, const Params&, FrameResources&) override;
   void execute(PassContext&) override;
+  std::vector<int> shadowMapExclusions(const Scene&, const Params&) const override;
 
   struct Cache {
     light_volumes::BeamSet beams;

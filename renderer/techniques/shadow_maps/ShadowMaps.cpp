@@ -95,8 +95,10 @@ void ShadowMapsPass::prepare(const Scene& scene, const Params& params, FrameReso
   res.framebuffer("shadow");
   res.buffer("shadow_info", infos_.size() * sizeof(gpu::ShadowInfo));
 
-  // The maps depend on geometry, lights and size only.
-  const std::string digest = res.sceneKey() + "|" + std::to_string(size_);
+  // The maps depend on geometry, lights, size and the meshes left out (Technique::shadowMapExclusions).
+  excluded_ = res.shadowMapExclusions();
+  std::string digest = res.sceneKey() + "|" + std::to_string(size_);
+  for (int m : excluded_) digest += "|-" + std::to_string(m);
   bool built = false;
   res.cached<ShadowMapsCacheEntry>("shadow_maps", digest, [&] {
     built = true;
@@ -110,6 +112,7 @@ void ShadowMapsPass::execute(PassContext& ctx) {
   res.buffer("shadow_info").upload(infos_.data(), infos_.size() * sizeof(gpu::ShadowInfo));
   res.markWritten("shadow_maps");
   ctx.stats.counters["maps_rendered"] = mapsValid_ ? 0.0 : static_cast<double>(draws_.size());
+  ctx.stats.counters["meshes_excluded"] = static_cast<double>(excluded_.size());
   if (mapsValid_) return;
 
   gl::Framebuffer& fb = res.framebuffer("shadow");
@@ -142,7 +145,7 @@ void ShadowMapsPass::execute(PassContext& ctx) {
     prog.set("u_lightPosition", &origin[0], 3);
     prog.set("u_lightDirection", &dir[0], 3);
     prog.set("u_orthographic", ortho ? 1 : 0);
-    ctx.gpu.draw(prog, false);
+    ctx.gpu.drawMeshes(prog, false, [&](std::size_t m) { return !excluded_.count(static_cast<int>(m)); });
   }
   ctx.stats.counters["map_size"] = size_;
 }

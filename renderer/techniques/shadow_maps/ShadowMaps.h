@@ -1,4 +1,5 @@
 #pragma once
+#include <set>
 #include <vector>
 
 #include "renderer/frame/GpuTypes.h"
@@ -33,6 +34,7 @@ private:
     glm::mat4 viewProj;
   };
   std::vector<Draw> draws_;
+  std::set<int> excluded_;  // meshes left out of the maps this frame
 };
 
 }  // namespace radiant
