@@ -386,7 +386,8 @@ TEST_F(Fleet, BadRoutingInputGetsAProblemNeverAnotherDaemonsJob) {
   EXPECT_EQ(r->status, 200);
 }
 
-// Last (gtest runs a suite's tests in order): it kills a daemon.
+// It kills a daemon: last when the binary runs whole (gtest keeps the order); under CTest each test
+// runs in its own process with its own fleet.
 TEST_F(Fleet, ZFailoverADaemonKilledMidSweepLosesNoPoint) {
   const fs::path& d = *dir_;
   json base = pngRequest("", 0);
