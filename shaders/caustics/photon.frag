@@ -2,7 +2,9 @@
 // pixel the light ray is followed through the generator and the environment in the layered distance
 // maps of the specular pass (ch. 5, Algorithm 3) to its first non-specular hit h. One path, no
 // branching: a reflection multiplies the power by F, a refraction by (1 - F) and the transmission
-// tint (power, not radiance: no 1 / eta^2), total internal reflection reflects with F = 1.
+// tint (power, not radiance: no 1 / eta^2), total internal reflection reflects with F = 1. A
+// refractor's entry reflection (F) is a second hit image of its own (u_reflectFirst), so that the
+// weak reflection caustic is not lost (the thesis follows the refraction only).
 // The power of a pixel is the light's power through it (exact solid angle x intensity for point and
 // spot lights, pixel area x irradiance for directional lights).
 #define LDM_TRACING
@@ -22,6 +24,7 @@ uniform int u_light;
 uniform int u_orthographic;  // 1: directional light (orthographic light camera)
 uniform float u_halfExtent;  // tan(half field of view) (perspective) or half the side (orthographic)
 uniform int u_maxDepth;
+uniform int u_reflectFirst;  // 1: at a refractor's entry take the Fresnel reflection (second hit image)
 uniform int u_photonResolution;
 
 layout(location = 0) out vec4 o_hit;
@@ -99,7 +102,11 @@ void main() {
       float eta = entering ? ior : 1.0 / ior;  // n_t / n_i
       float F = fresnelDielectric(cosI, eta);
       vec3 rf = refract(R, nn, 1.0 / eta);
-      if (F >= 1.0 || dot(rf, rf) == 0.0) {  // total internal reflection
+      if (depth == 1 && u_reflectFirst != 0) {  // the reflection branch of the entry: power x F
+        power *= F;
+        R = normalize(reflect(R, nn));
+        pos += nn * eps;
+      } else if (F >= 1.0 || dot(rf, rf) == 0.0) {  // total internal reflection
         R = normalize(reflect(R, nn));
         pos += nn * eps;
       } else {

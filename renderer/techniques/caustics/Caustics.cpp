@@ -143,6 +143,7 @@ void CausticsPass::prepare(const Scene& scene, const Params& params, FrameResour
   secantSteps_ = std::clamp(params.get<int>("secant_steps", 4), 0, 32);
   splatRadius_ = std::clamp(params.get<float>("splat_radius", 0.02f), 1e-4f, 10.f);
   energyCheck_ = params.get<bool>("energy_check", false);
+  fresnelReflection_ = params.get<bool>("fresnel_reflection", true);
 
   generators_ = SpecularPass::specularMeshes(scene);
   pairs_.clear();
@@ -158,6 +159,10 @@ void CausticsPass::prepare(const Scene& scene, const Params& params, FrameResour
         continue;
       }
       pairs_.push_back(p);
+      if (fresnelReflection_ && scene.material(m.material).isTransmissive()) {
+        p.reflectFirst = true;
+        pairs_.push_back(p);
+      }
     }
 
   const int P = photonResolution_;
@@ -267,6 +272,7 @@ void CausticsPass::execute(PassContext& ctx) {
     photonProg.set("u_orthographic", pair.camera.orthographic ? 1 : 0);
     photonProg.set("u_halfExtent", pair.camera.halfExtent);
     photonProg.set("u_maxDepth", maxDepth_);
+    photonProg.set("u_reflectFirst", pair.reflectFirst ? 1 : 0);
     photonProg.set("u_photonResolution", P);
     const std::size_t mesh = generators_[pair.generator];
     ctx.gpu.drawMeshes(photonProg, true, [&](std::size_t m) { return m == mesh; });
@@ -380,7 +386,7 @@ void CausticsPass::execute(PassContext& ctx) {
   counters["adds_to_beauty"] = owns ? 1.0 : 0.0;
 
   counters["generators"] = G;
-  counters["pairs"] = static_cast<double>(pairs_.size());
+  counters["pairs"] = static_cast<double>(pairs_.size());  // (light, generator, branch) hit images
   counters["pairs_light_inside_generator"] = skippedPairs_;
   counters["photon_resolution"] = P;
   counters["cube_resolution"] = C;

@@ -341,7 +341,7 @@ TEST(Caustics, TotalInternalReflectionEverywhereGivesZeroCaustics) {
   RenderOutput out = renderer().render(scene, request(32, {{"energy_check", true}}));
   const Image& caustics = findAov(out, "caustics");
   expectFinite(caustics);
-  EXPECT_EQ(counter(out, "caustics", "pairs"), 1.0);
+  EXPECT_EQ(counter(out, "caustics", "pairs"), 2.0);  // the refraction image and the entry-reflection image
   EXPECT_EQ(counter(out, "caustics", "valid_photons"), 0.0);
   EXPECT_EQ(*std::max_element(caustics.pixels.begin(), caustics.pixels.end()), 0.f);
 }
@@ -550,5 +550,43 @@ TEST(Caustics, SlabPlateauAgreesWithTheReferenceLightTracer) {
   EXPECT_GT(count, 120);
   EXPECT_NEAR(sumOurs / sumRef, 1.0, 0.02);
 }
+// The entry's Fresnel reflection of a refractor (fresnel_reflection, the second hit image): a point
+// light I at (0, 2, 0) over a glass slab whose top face lies at y = 1.2 lights the ceiling y = 3 from
+// its image at (0, 0.4, 0): E = I F(cos_i) cos(theta_r) / d^2 with the exact dielectric F of ior 1.5,
+// inside the footprint |x|, |z| < 0.5 (3 - 0.4) / (1.2 - 0.4) = 1.625 (2%). The reflection inside the
+// slab off its bottom face, (1 - F)^2 F more, is not traced (one path per hit image); with
+// fresnel_reflection false the ceiling gets nothing.
+TEST(Caustics, GlassEntryReflectionLightsTheCeilingWithTheFresnelFactor) {
+  testing::SceneBuilder b;
+  const float I = 20.f;
+  b.solidBox({-0.5f, 1.0f, -0.5f}, {0.5f, 1.2f, 0.5f}, b.material(testing::glass(1.5f)), "slab");
+  b.quad({0, 3, 0}, {2.5f, 0, 0}, {0, 0, 2.5f}, b.material(testing::lambertian()), "ceiling");
+  b.pointLight({0, 2, 0}, I);
+  const float half = 2.f;
+  b.scene().camera = testing::orthoCamera({0, 2.5f, 0}, {0, 1, 0}, {0, 0, 1}, half, 2.f);
+  Scene scene = b.build("caustics-glass-reflection");
+  const int n = 64;
+  RenderOutput out = renderer().render(scene, request(n, {{"cube_resolution", 512}}));
+  const Image& caustics = findAov(out, "caustics");
+  expectFinite(caustics);
+  const float margin = 3.f * 2.f * half / n;
+  const double edge = 0.5 * (3.0 - 0.4) / (1.2 - 0.4);
+  int inside = 0;
+  for (int py = 0; py < n; ++py)
+    for (int px = 0; px < n; ++px) {
+      const double x = -half + 2.0 * half * (px + 0.5) / n, z = half - 2.0 * half * (py + 0.5) / n;
+      if (std::max(std::abs(x), std::abs(z)) > edge - margin) continue;
+      const double h = 3.0 - 0.4, d2 = x * x + h * h + z * z, d = std::sqrt(d2);
+      const double F = rt::fresnelDielectric(static_cast<float>(h / d), 1.5f);
+      const double expected = I * F * (h / d) / d2 / kPi;
+      EXPECT_NEAR(caustics.at(px, py)[1], expected, 0.02 * expected) << px << "," << py;
+      ++inside;
+    }
+  EXPECT_GT(inside, 2000);
+  RenderOutput off = renderer().render(scene, request(n, {{"cube_resolution", 512}, {"fresnel_reflection", false}}));
+  const Image& none = findAov(off, "caustics");
+  EXPECT_EQ(*std::max_element(none.pixels.begin(), none.pixels.end()), 0.f);
+}
+
 }  // namespace
 }  // namespace radiant
