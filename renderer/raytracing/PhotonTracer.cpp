@@ -1,5 +1,7 @@
 #include "renderer/raytracing/PhotonTracer.h"
 
+#include "renderer/raytracing/Particles.h"
+
 #include <algorithm>
 #include <atomic>
 
@@ -11,9 +13,6 @@ namespace radiant::rt {
 namespace {
 
 constexpr std::uint64_t kBlock = 1024;  // photons per work item; records are concatenated in block order
-// A path that keeps bouncing off albedo-1 surfaces is ended by Russian roulette with at least this
-// probability per bounce (survivors are re-weighted, so the estimate stays unbiased).
-constexpr float kMaxSurvival = 0.95f;
 
 bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
@@ -58,21 +57,7 @@ void tracePhoton(const RayScene& rays, const SceneLights& lights, const PhotonOp
     if (!sh.bsdf.sample(woL, uLobe, uFresnel, uDir, s) || s.delta) return;
     narrowLobePath = narrowLobePath && (s.flags & (kLobeGlossy | kLobeSpecular)) != 0 &&
                      rays.materialOf(hit.mesh).scattersNarrowLobe();
-    const glm::vec3 wi = sh.frame.toWorld(s.wi);
-    const float gi = glm::dot(wi, sh.ngFacing);
-    if (s.wi.z > 0.f ? gi <= 0.f : gi >= 0.f) return;  // leaked through the geometric surface
-    // Adjoint BSDF with shading normals (Veach 1997, eq. 5.21): |wo.ns| |wi.ng| / (|wo.ng| |wi.ns|).
-    const float den = std::abs(glm::dot(wo, sh.ngFacing)) * std::abs(s.wi.z);
-    const float num = std::abs(woL.z) * std::abs(gi);
-    if (!(den > 0.f)) return;
-    glm::vec3 weight = s.weight * (num / den);
-    if (o.russianRoulette) {
-      const float q = std::min(kMaxSurvival, maxComponent(weight));
-      if (!(q > 0.f) || sampler.next() >= q) return;
-      weight /= q;
-    }
-    flux *= weight;
-    ray = Ray{RayScene::offsetOrigin(hit.p, hit.ng, hit.offsetScale, wi), wi, 0.f, kInf};
+    if (!continueParticle(hit, sh, wo, woL, s, o.russianRoulette, sampler, flux, ray)) return;
   }
 }
 

@@ -13,6 +13,7 @@
 
 #include "renderer/raytracing/CameraRays.h"
 #include "renderer/raytracing/Lights.h"
+#include "renderer/raytracing/Particles.h"
 #include "renderer/raytracing/RayScene.h"
 
 namespace radiant::reference {
@@ -23,7 +24,6 @@ using namespace radiant::rt;
 constexpr std::uint64_t kMinPathsPerBlock = 4096;
 constexpr std::uint64_t kBlocksPerWave = 8;  // images in flight; summed in block order
 constexpr int kRussianRouletteStart = 3;
-constexpr float kMaxSurvival = 0.95f;
 
 bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
@@ -81,22 +81,10 @@ struct Tracer {
       GltfBsdf::Sample s;
       if (!sh.bsdf.sample(wpL, uLobe, uFresnel, uDir, s)) return;
       if (caustics && !s.delta) return;  // no longer L S+ D: nothing later can be a caustic
-      const glm::vec3 wi = sh.frame.toWorld(s.wi);
-      const float gi = glm::dot(wi, sh.ngFacing);
-      if (s.wi.z > 0.f ? gi <= 0.f : gi >= 0.f) return;  // leaked through the geometric surface
-      // Adjoint BSDF with shading normals (Veach 1997, eq. 5.21), as in the photon tracer.
-      const float den = std::abs(glm::dot(wp, sh.ngFacing)) * std::abs(s.wi.z);
-      const float num = std::abs(wpL.z) * std::abs(gi);
-      if (!(den > 0.f)) return;
-      glm::vec3 weight = s.weight * (num / den);
       if (s.delta) ++deltas;
-      if (o.russianRoulette && k >= kRussianRouletteStart) {
-        const float q = std::min(kMaxSurvival, maxComponent(weight));
-        if (!(q > 0.f) || sampler.next() >= q) return;
-        weight /= q;
-      }
-      beta *= weight;
-      ray = Ray{RayScene::offsetOrigin(hit.p, hit.ng, hit.offsetScale, wi), wi, 0.f, kInf};
+      // Adjoint BSDF with shading normals and roulette from the fourth event on, as the photon tracer.
+      if (!continueParticle(hit, sh, wp, wpL, s, o.russianRoulette && k >= kRussianRouletteStart, sampler, beta, ray))
+        return;
     }
   }
 };
