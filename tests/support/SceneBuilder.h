@@ -173,6 +173,19 @@ private:
   Scene scene_;
 };
 
+// An orthographic camera at z = 10 looking down -z, covering [-half, half]^2 in x, y (znear 0.01).
+inline Camera orthoCameraAlongZ(float half) {
+  Camera c;
+  c.projection = ProjectionType::Orthographic;
+  c.xmag = c.ymag = half;
+  c.znear = 0.01f;
+  c.zfar = 100.f;
+  c.world = glm::mat4(1.f);
+  c.world[3] = glm::vec4(0, 0, 10, 1);
+  c.fromFile = true;
+  return c;
+}
+
 // World x,z of the centre of pixel (px, py) for topDownOrtho(h, half) at the given resolution
 // (row 0 = top of the image = world -z).
 inline glm::vec2 topDownPixelToWorld(int px, int py, int size, float half) {

@@ -34,19 +34,6 @@ using nlohmann::json;
 using testing::aov;
 using testing::renderer;
 
-// Orthographic camera at z = 10 looking down -z over [-half, half]^2.
-Camera orthoCamera(float half) {
-  Camera c;
-  c.projection = ProjectionType::Orthographic;
-  c.xmag = c.ymag = half;
-  c.znear = 0.01f;
-  c.zfar = 100.f;
-  c.world = glm::mat4(1.f);
-  c.world[3] = glm::vec4(0, 0, 10, 1);
-  c.fromFile = true;
-  return c;
-}
-
 Camera perspectiveCamera(glm::vec3 eye, float yfovDeg, float znear = 0.05f) {
   Camera c;
   c.yfov = glm::radians(yfovDeg);
@@ -87,7 +74,7 @@ Scene emptyScene(const Camera& camera) {
 TEST(SphericalBillboards, ExactChordAlphaOfAnUnclippedConstantSphere) {
   const float r = 1.f, tau = 0.8f, half = 1.25f;
   const int n = 48;
-  const RenderOutput out = render(emptyScene(orthoCamera(half)), n, {{"media", json::array({sphereMedium(r, tau)})}});
+  const RenderOutput out = render(emptyScene(testing::orthoCameraAlongZ(half)), n, {{"media", json::array({sphereMedium(r, tau)})}});
   ASSERT_TRUE(testing::allFinite(out));
   const Image& T = aov(out, "media_transmittance");
   double maxErr = 0;
@@ -150,7 +137,7 @@ TEST(SphericalBillboards, ClippingByAnOpaquePlaneIsContinuousPlanarJumps) {
   const glm::vec3 u = glm::normalize(glm::vec3(1, 0, s)) * 4.f, v(0, 4, 0);
   b.quad({0, 0, 0}, u, v, grey, "plane");
   Scene scene = b.build("media-clip");
-  scene.camera = orthoCamera(half);
+  scene.camera = testing::orthoCameraAlongZ(half);
   const int row = n / 2;  // y = -half / n, close to the centre line
   std::vector<double> spherical(n), planar(n);
   for (const char* method : {"spherical", "planar"}) {
@@ -234,7 +221,7 @@ TEST(SphericalBillboards, TransmittanceIsIndependentOfTheDrawOrder) {
   }
   const float half = 1.2f;
   const int n = 32;
-  const Scene scene = emptyScene(orthoCamera(half));
+  const Scene scene = emptyScene(testing::orthoCameraAlongZ(half));
   std::vector<Image> images;
   for (int k = 0; k < 3; ++k) {
     json shuffled = particles;
@@ -353,7 +340,7 @@ TEST(SphericalBillboards, LowResolutionLayersStayCloseDepthAwareBeatsBilinearAtE
   b.quad({-1.0f, 0, 0.3f}, {1.0f, 0, 0}, {0, 2, 0}, grey, "wall");
   b.pointLight({0, 2, 2}, 10.f);
   Scene scene = b.build("media-layers");
-  scene.camera = orthoCamera(1.25f);
+  scene.camera = testing::orthoCameraAlongZ(1.25f);
   json smoke = {{"kind", "dust"}, {"tau", 1.5}, {"seed", 9},
                 {"generator", {{"count", 30}, {"extent", {0.8, 0.8, 0.5}}, {"radius", 0.3}}}};
   auto media = [&](json params) {
@@ -390,7 +377,7 @@ TEST(SphericalBillboards, PlannedOnlyWithMediaAndComposedIntoBeauty) {
   b.quad({0, 0, -1}, {3, 0, 0}, {0, 3, 0}, white, "back");
   b.pointLight({0, 0, 2}, 5.f);
   Scene scene = b.build("media-plan");
-  scene.camera = orthoCamera(1.25f);
+  scene.camera = testing::orthoCameraAlongZ(1.25f);
   const RenderOutput without = render(scene, 32, {{"outputs", json::array({{{"format", "exr"}, {"aovs", {"beauty"}}}})}});
   ASSERT_TRUE(without.stats.skipped.count("spherical_billboards"));
   EXPECT_NE(without.stats.skipped.at("spherical_billboards").find("no participating media"), std::string::npos);

@@ -118,6 +118,23 @@ TEST(Sampling, VndfReflectionSamplesFollowPdf) {
     }
 }
 
+// Non-delta samples of b at wo follow b.pdf (histogram against the pdf) and carry the weight
+// f |cos| / pdf with that same pdf (the MIS weights rely on it).
+void expectSampleWeightsFollowPdf(const GltfBsdf& b, const glm::vec3& wo, const char* label) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> U(0.f, 1.f);
+  expectSamplesFollowPdf(
+      [&](glm::vec2 u, float ul, glm::vec3& w) {
+        GltfBsdf::Sample s;
+        if (!b.sample(wo, ul, U(rng), u, s) || s.delta) return false;
+        const glm::vec3 expectW = b.eval(wo, s.wi) * std::abs(s.wi.z) / b.pdf(wo, s.wi);
+        EXPECT_NEAR(s.weight.x, expectW.x, 1e-3f * (1.f + expectW.x));
+        w = s.wi;
+        return true;
+      },
+      [&](const glm::vec3& w) { return b.pdf(wo, w); }, true, label, 200000);
+}
+
 TEST(Sampling, GltfBsdfSamplesFollowPdf) {
   struct Case { float metallic, roughness, transmission; };
   for (const Case c : {Case{0.f, 0.5f, 0.f}, Case{0.3f, 0.4f, 0.f}, Case{1.f, 0.7f, 0.f}, Case{0.f, 0.5f, 1.f},
@@ -131,19 +148,7 @@ TEST(Sampling, GltfBsdfSamplesFollowPdf) {
       b.ior = 1.5f;
       b.eta = eta;
       const glm::vec3 wo = glm::normalize(glm::vec3(0.5f, 0.2f, 0.8f));
-      std::mt19937 rng(3);
-      std::uniform_real_distribution<float> U(0.f, 1.f);
-      expectSamplesFollowPdf(
-          [&](glm::vec2 u, float ul, glm::vec3& w) {
-            GltfBsdf::Sample s;
-            if (!b.sample(wo, ul, U(rng), u, s) || s.delta) return false;
-            // The weight must be f |cos| / pdf with the same pdf() (the MIS weights rely on it).
-            const glm::vec3 expectW = b.eval(wo, s.wi) * std::abs(s.wi.z) / b.pdf(wo, s.wi);
-            EXPECT_NEAR(s.weight.x, expectW.x, 1e-3f * (1.f + expectW.x));
-            w = s.wi;
-            return true;
-          },
-          [&](const glm::vec3& w) { return b.pdf(wo, w); }, true, "gltf bsdf", 200000);
+      expectSampleWeightsFollowPdf(b, wo, "gltf bsdf");
     }
 }
 
@@ -391,18 +396,7 @@ TEST(LayeredBsdf, PdfIsTheDensityOfItsSamples) {
     const double mass = integrate([&](const glm::vec3& w) { return double(b.pdf(wo, w)); }, true, 1000, 256);
     EXPECT_LE(mass, 1.0 + 2e-3) << c.coat << " " << c.sheen << " " << c.transmission;
     EXPECT_GT(mass, 0.95) << c.coat << " " << c.sheen << " " << c.transmission;
-    std::mt19937 rng(3);
-    std::uniform_real_distribution<float> U(0.f, 1.f);
-    expectSamplesFollowPdf(
-        [&](glm::vec2 u, float ul, glm::vec3& w) {
-          GltfBsdf::Sample s;
-          if (!b.sample(wo, ul, U(rng), u, s) || s.delta) return false;
-          const glm::vec3 expectW = b.eval(wo, s.wi) * std::abs(s.wi.z) / b.pdf(wo, s.wi);
-          EXPECT_NEAR(s.weight.x, expectW.x, 1e-3f * (1.f + expectW.x));
-          w = s.wi;
-          return true;
-        },
-        [&](const glm::vec3& w) { return b.pdf(wo, w); }, true, "layered bsdf", 200000);
+    expectSampleWeightsFollowPdf(b, wo, "layered bsdf");
   }
 }
 

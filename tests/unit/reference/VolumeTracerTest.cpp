@@ -16,18 +16,6 @@
 namespace radiant::reference {
 namespace {
 
-// An orthographic camera on +z looking down -z at the origin, covering [-half, half]^2.
-Camera orthoCamera(float half) {
-  Camera c;
-  c.projection = ProjectionType::Orthographic;
-  c.xmag = c.ymag = half;
-  c.znear = 0.01f;
-  c.zfar = 100.f;
-  c.world = glm::mat4(1.f);
-  c.world[3] = glm::vec4(0, 0, 10, 1);
-  return c;
-}
-
 api::ParticleSystem sphere(api::MediumKind kind, float r, float tau, glm::vec3 albedo,
                            api::DensityProfile profile = api::DensityProfile::Constant, float kelvin = 0.f) {
   api::ParticleSystem s;
@@ -58,7 +46,7 @@ TEST(VolumeTracer, TransmittanceAlongAChordIsExact) {
     VolumeOptions o;
     o.spp = 1;  // the pixel centre
     o.mode = MediaMode::EmissionAbsorption;
-    const Image img = VolumeTracer(f.rays, medium).render(orthoCamera(half), n, n, o);
+    const Image img = VolumeTracer(f.rays, medium).render(testing::orthoCameraAlongZ(half), n, n, o);
     for (int y = 0; y < n; ++y)
       for (int x = 0; x < n; ++x) {
         const glm::vec2 p = pixelToWorld(x, y, n, half);
@@ -81,7 +69,7 @@ TEST(VolumeTracer, FireEmitsItsBlackBodyTimesOpacity) {
   VolumeOptions o;
   o.spp = 1;
   o.mode = MediaMode::EmissionAbsorption;
-  const Image img = VolumeTracer(f.rays, medium).render(orthoCamera(1.2f), 24, 24, o);
+  const Image img = VolumeTracer(f.rays, medium).render(testing::orthoCameraAlongZ(1.2f), 24, 24, o);
   for (int y = 0; y < 24; ++y)
     for (int x = 0; x < 24; ++x)
       for (int c = 0; c < 3; ++c)
@@ -103,7 +91,7 @@ TEST(VolumeTracer, AlbedoOneInAWhiteFurnaceReturnsTheFurnaceRadiance) {
   o.spp = 1;
   o.mode = MediaMode::SingleScatterUnshadowed;  // source = albedo * sky: exact
   const int n = 16;
-  Image img = VolumeTracer(f.rays, medium).render(orthoCamera(1.2f), n, n, o);
+  Image img = VolumeTracer(f.rays, medium).render(testing::orthoCameraAlongZ(1.2f), n, n, o);
   for (int y = 0; y < n; ++y)
     for (int x = 0; x < n; ++x)
       for (int c = 0; c < 3; ++c)  // up to float rounding of the piecewise depths
@@ -113,7 +101,7 @@ TEST(VolumeTracer, AlbedoOneInAWhiteFurnaceReturnsTheFurnaceRadiance) {
   // so a pixel's media radiance is sky times the fraction of its samples that collided: mean 1 - T.
   o.mode = MediaMode::Full;
   o.spp = 64;
-  img = VolumeTracer(f.rays, medium).render(orthoCamera(1.2f), n, n, o);
+  img = VolumeTracer(f.rays, medium).render(testing::orthoCameraAlongZ(1.2f), n, n, o);
   double sum = 0, expected = 0, variance = 0;
   for (int y = 0; y < n; ++y)
     for (int x = 0; x < n; ++x) {
