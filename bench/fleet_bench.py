@@ -1,13 +1,17 @@
 #!/usr/bin/env python3
 """Throughput through 1, 2 and 3 radiantd behind nginx, and the proxy's overhead per request.
 
-    python3 bench/fleet_bench.py --radiantd build/server/radiantd [--renders 96] [--concurrency 6]
+    python3 bench/fleet_bench.py --radiantd build/server/radiantd [--radiant build/client/radiant]
+                                 [--renders 96] [--concurrency 6] [--sweep-points 48]
 
 Starts the daemons (--daemon-id d0..) and nginx with deploy/nginx/radiant.conf (listen port and
 daemon addresses replaced, as tests/http/fleet does) on ephemeral loopback ports, then:
   - throughput: `renders` small renders (32x32, direct lighting, 8 scenes round robin, each with its
     X-Radiant-Scene header) from `concurrency` client threads, through the proxy, for 1, 2, 3 daemons;
     Median of --rounds interleaved rounds;
+  - sweep (with --radiant): `radiant sweep` of 8 scene files x N/8 settings through the proxy, with
+    --inflight 2 per daemon, for 1, 2, 3 daemons: wall time, points/s, efficiency per daemon, and how
+    many daemons the scenes landed on (from the records' `server`/daemon id);
   - overhead: 200 sequential GET /v1/health and 200 small renders, direct and through the proxy
     (one daemon), interleaved; medians and their difference.
 Prints a Markdown table for docs/PERFORMANCE.md.
@@ -155,9 +159,42 @@ def throughput(port, sc, n, concurrency):
     return n / (time.perf_counter() - t0)
 
 
+def sweep_spec(tmp, n_points):
+    """8 scene files (uploaded by the client) x n_points/8 settings of the direct pass's PCF radius."""
+    files = []
+    for k, (b, _) in enumerate(scenes()):
+        f = tmp / f"scene{k}.gltf"
+        f.write_bytes(b)
+        files.append(str(f))
+    settings = list(range(max(1, n_points // len(files))))
+    base = {"scene": {"file": files[0]}, "width": 32, "height": 32, "passes": {"photon_gi": False},
+            "outputs": [{"format": "png", "aovs": ["beauty"]}]}
+    spec = {"name": "fleet-bench", "base": base,
+            "axes": {"scene.file": files, "passes.direct.pcf_radius": settings}, "repeats": 1, "warmup": 0}
+    path = tmp / "sweep.json"
+    path.write_text(json.dumps(spec))
+    return path, len(files) * len(settings)
+
+
+def run_sweep(radiant, port, spec, out, inflight):
+    t0 = time.perf_counter()
+    r = subprocess.run([radiant, "--server", f"http://127.0.0.1:{port}", "sweep", str(spec), "-o", str(out),
+                        "--inflight", str(inflight)], capture_output=True, text=True)
+    dt = time.perf_counter() - t0
+    if r.returncode != 0:
+        raise RuntimeError(f"radiant sweep: {r.returncode} {r.stderr[-400:]}")
+    recs = [json.loads(l) for l in out.read_text().splitlines() if l.strip()]
+    bad = [x for x in recs if "error" in x]
+    if bad:
+        raise RuntimeError(f"radiant sweep: {len(bad)} points failed: {bad[0]}")
+    return dt, recs
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--radiantd", required=True)
+    ap.add_argument("--radiant", help="the client, for the sweep measurement (skipped without it)")
+    ap.add_argument("--sweep-points", type=int, default=48)
     ap.add_argument("--renders", type=int, default=96)
     ap.add_argument("--concurrency", type=int, default=6)
     ap.add_argument("--overhead-n", type=int, default=200)
@@ -188,6 +225,25 @@ def main():
                     ng.terminate()
                     ng.wait()
         rows = [(n, statistics.median(rates[n])) for n in (1, 2, 3)]
+        sweep_rows = []
+        if a.radiant:
+            spec, points = sweep_spec(tmp, a.sweep_points)
+            sweeps = {1: [], 2: [], 3: []}
+            for rnd in range(a.rounds):
+                for n in (1, 2, 3):
+                    d = tmp / f"s{rnd}n{n}"
+                    d.mkdir()
+                    ng, port = start_nginx(d, [p for _, p in daemons[:n]])
+                    try:
+                        dt, recs = run_sweep(a.radiant, port, spec, d / "r.jsonl", 2 * n)
+                        if len(recs) != points:
+                            raise RuntimeError(f"sweep: {len(recs)} records for {points} points")
+                        sweeps[n].append(dt)
+                        print(f"round {rnd}: sweep of {points} points, {n} daemon(s): {dt:.2f} s", file=sys.stderr)
+                    finally:
+                        ng.terminate()
+                        ng.wait()
+            sweep_rows = [(n, statistics.median(sweeps[n])) for n in (1, 2, 3)]
         one_scene = statistics.median(rates["one scene"])
         # Overhead, one daemon: direct against through the proxy, interleaved.
         (tmp / "overhead").mkdir()
@@ -211,6 +267,13 @@ def main():
         print("|---|---|---|---|")
         for n, r in rows:
             print(f"| {n} | {r:.1f} | {r / rows[0][1]:.2f} | {r / rows[0][1] / n:.2f} |")
+        if sweep_rows:
+            print(f"\n`radiant sweep` of {points} points (8 scene files x {points // 8} PCF radii, 32x32, uploads "
+                  f"included), --inflight 2 per daemon, median of {a.rounds} interleaved rounds:\n")
+            print("| daemons | wall s | points/s | speed-up | efficiency per daemon |")
+            print("|---|---|---|---|---|")
+            for n, t in sweep_rows:
+                print(f"| {n} | {t:.2f} | {points / t:.1f} | {sweep_rows[0][1] / t:.2f} | {sweep_rows[0][1] / t / n:.2f} |")
         print(f"\nThe same {a.renders} renders on one scene, one daemon: {one_scene:.1f} renders/s "
               f"({one_scene / rows[0][1]:.1f}x the 8-scene rate: a scene switch costs the caches)")
         print(f"\n| request (median of {a.overhead_n}) | direct ms | through nginx ms | overhead ms |")

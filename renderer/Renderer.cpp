@@ -174,7 +174,7 @@ struct Renderer::Impl {
   std::vector<std::unique_ptr<Technique>> techniques = createTechniques();
   // GPU copies of recently used scenes, most recent last; keyed by digest (or address when unnamed).
   std::vector<std::pair<std::string, std::unique_ptr<GpuScene>>> gpuScenes;
-  static constexpr std::size_t kGpuSceneCache = 4;
+  std::size_t gpuSceneCapacity = 4;
 
   const GpuScene& gpuScene(const Scene& scene, api::FrameStats& stats) {
     const std::string key = scene.digest.empty() ? "addr:" + std::to_string(reinterpret_cast<std::uintptr_t>(&scene))
@@ -189,7 +189,7 @@ struct Renderer::Impl {
     const auto t0 = Clock::now();
     auto g = std::make_unique<GpuScene>(scene);
     stats.uploadMs = msSince(t0);
-    if (gpuScenes.size() >= kGpuSceneCache) gpuScenes.erase(gpuScenes.begin());
+    while (gpuScenes.size() >= gpuSceneCapacity) gpuScenes.erase(gpuScenes.begin());
     gpuScenes.emplace_back(key, std::move(g));
     return *gpuScenes.back().second;
   }
@@ -204,6 +204,11 @@ Renderer::Renderer(const DeviceOptions& options) : impl_(std::make_unique<Impl>(
 }
 
 Renderer::~Renderer() = default;
+
+void Renderer::setGpuSceneCapacity(std::size_t scenes) {
+  impl_->gpuSceneCapacity = std::max<std::size_t>(1, scenes);
+  while (impl_->gpuScenes.size() > impl_->gpuSceneCapacity) impl_->gpuScenes.erase(impl_->gpuScenes.begin());
+}
 
 const DeviceInfo& Renderer::device() const { return impl_->device->info(); }
 

@@ -40,6 +40,8 @@ std::string usage() {
   --max-decode-bytes N      memory one scene or image may decode into: pixels of every image,
                             expanded accessors of every mesh instance (default 536870912)
   --scene-cache-bytes N     decoded scenes kept in memory, in bytes (default 1073741824)
+  --gpu-scenes N            scenes kept uploaded to the GPU with their derived data (BVH, shadow maps,
+                            photon maps), least recently used evicted (default 4, at most 256)
   --read-timeout S          seconds to receive one request, headers and body (default 30)
   --keep-alive-timeout S    seconds an idle keep-alive connection stays open (default 2)
   --shutdown-grace S        after SIGTERM, seconds frame and job GETs are still served (default 10)
@@ -113,6 +115,7 @@ void apply(ServerConfig& c, const std::string& name, const std::string& v, std::
   else if (name == "gl-debug") c.glDebug = v != "false" && v != "0";
   else if (name == "max-json-depth") c.limits.maxJsonDepth = static_cast<std::size_t>(toInt(flag, v, 8, 1000));
   else if (name == "max-decode-bytes") c.maxDecodeBytes = static_cast<std::size_t>(toInt(flag, v, 1 << 20, 1ll << 40));
+  else if (name == "gpu-scenes") c.gpuScenes = static_cast<int>(toInt(flag, v, 1, 256));
   else if (name == "scene-cache-bytes") c.sceneCacheBytes = static_cast<std::size_t>(toInt(flag, v, 1 << 20, 1ll << 40));
   else if (name == "read-timeout") c.readTimeoutS = toDouble(flag, v);
   else if (name == "keep-alive-timeout") c.keepAliveTimeoutS = toDouble(flag, v);

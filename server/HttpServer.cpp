@@ -432,6 +432,7 @@ struct HttpServer::Impl {
                 {"max_decode_bytes", config.maxDecodeBytes},
                 {"max_frame_bytes", config.maxFrameBytes},
                 {"scene_cache_bytes", config.sceneCacheBytes},
+                {"gpu_scenes", config.gpuScenes},
                 {"read_timeout_s", config.readTimeoutS},
                 {"keep_alive_timeout_s", config.keepAliveTimeoutS},
                 {"shutdown_grace_s", config.shutdownGraceS},

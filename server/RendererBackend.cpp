@@ -16,7 +16,9 @@ namespace {
 
 class RendererBackend final : public RenderBackend {
 public:
-  explicit RendererBackend(const DeviceOptions& options) : renderer_(options) {}
+  RendererBackend(const DeviceOptions& options, int gpuScenes) : renderer_(options) {
+    renderer_.setGpuSceneCapacity(static_cast<std::size_t>(gpuScenes));
+  }
   DeviceInfo device() const override { return renderer_.device(); }
   RenderOutput render(const Scene& scene, const api::RenderRequest& request, const std::atomic<bool>* cancel,
                       const FrameInputs& inputs) override {
@@ -37,7 +39,8 @@ BackendHooks rendererHooks(const ServerConfig& config) {
   device.debug = config.glDebug;
 
   BackendHooks h;
-  h.createBackend = [device] { return std::make_unique<RendererBackend>(device); };
+  const int gpuScenes = config.gpuScenes;
+  h.createBackend = [device, gpuScenes] { return std::make_unique<RendererBackend>(device, gpuScenes); };
   const std::size_t maxBytes = config.maxBodyBytes;
   const std::size_t maxDecoded = config.maxDecodeBytes;
   const std::size_t maxDepth = config.limits.maxJsonDepth;

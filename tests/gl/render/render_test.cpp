@@ -261,6 +261,30 @@ TEST(RenderCore, DerivedDataIsCachedAcrossFrames) {
     if (c.what == "shadow_maps") EXPECT_FALSE(c.hit);
 }
 
+// The GPU scene cache keeps the `capacity` most recently used scenes: with capacity 2, A B A hits A
+// again, and A B C A has evicted it (least recently used first).
+TEST(RenderCore, GpuSceneCacheKeepsTheMostRecentlyUsedScenes) {
+  auto gpuHit = [](const RenderOutput& o) {
+    for (const auto& c : o.stats.cache)
+      if (c.what == "gpu_scene") return c.hit;
+    ADD_FAILURE() << "no gpu_scene cache entry in the stats";
+    return false;
+  };
+  Renderer& r = renderer();
+  r.setGpuSceneCapacity(2);
+  Scene a = umbraScene(1.f, "lru-a"), b = umbraScene(1.f, "lru-b"), c = umbraScene(1.f, "lru-c");
+  EXPECT_FALSE(gpuHit(r.render(a, request(8))));
+  EXPECT_FALSE(gpuHit(r.render(b, request(8))));
+  EXPECT_TRUE(gpuHit(r.render(a, request(8))));
+  EXPECT_FALSE(gpuHit(r.render(c, request(8))));  // evicts b, the least recently used
+  EXPECT_TRUE(gpuHit(r.render(a, request(8))));
+  EXPECT_FALSE(gpuHit(r.render(b, request(8))));
+  r.setGpuSceneCapacity(1);                        // shrinking evicts at once
+  EXPECT_TRUE(gpuHit(r.render(b, request(8))));
+  EXPECT_FALSE(gpuHit(r.render(a, request(8))));
+  r.setGpuSceneCapacity(4);
+}
+
 TEST(RenderCore, GrazingViewsStayFinite) {
   // A camera almost in the plane of the floor: NdotV -> 0 everywhere.
   Scene scene = planeScene().pointLight({0, 1, 0}, 3.f).build("grazing");
