@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Throughput through 1, 2 and 3 radiantd behind nginx, and the proxy's overhead per request.
 
-    python3 bench/fleet_bench.py --radiantd build/server/radiantd [--radiant build/client/radiant]
+    python3 bench/fleet_bench.py --radiantd build/server/radiantd [--radiant build/client/radiant] [--gpu-scenes N]
                                  [--renders 96] [--concurrency 6] [--sweep-points 48]
 
 Starts the daemons (--daemon-id d0..) and nginx with deploy/nginx/radiant.conf (listen port and
@@ -43,8 +43,8 @@ def free_port():
     return p
 
 
-def start_daemon(radiantd, ident, log):
-    p = subprocess.Popen([radiantd, "--port", "0", "--daemon-id", ident], stdout=subprocess.PIPE, stderr=open(log, "w"), text=True)
+def start_daemon(radiantd, ident, log, extra=()):
+    p = subprocess.Popen([radiantd, "--port", "0", "--daemon-id", ident, *extra], stdout=subprocess.PIPE, stderr=open(log, "w"), text=True)
     line = p.stdout.readline()
     m = re.match(r"radiantd listening on http://127\.0\.0\.1:(\d+)", line)
     if not m:
@@ -199,11 +199,13 @@ def main():
     ap.add_argument("--concurrency", type=int, default=6)
     ap.add_argument("--overhead-n", type=int, default=200)
     ap.add_argument("--rounds", type=int, default=3, help="throughput rounds (median reported)")
+    ap.add_argument("--gpu-scenes", type=int, help="radiantd --gpu-scenes for every daemon (default: radiantd's)")
     a = ap.parse_args()
     tmp = Path(tempfile.mkdtemp(prefix="radiant-fleet-bench-"))
     procs = []
     try:
-        daemons = [start_daemon(a.radiantd, f"d{i}", tmp / f"d{i}.log") for i in range(3)]
+        extra = ("--gpu-scenes", str(a.gpu_scenes)) if a.gpu_scenes else ()
+        daemons = [start_daemon(a.radiantd, f"d{i}", tmp / f"d{i}.log", extra) for i in range(3)]
         procs += [p for p, _ in daemons]
         for _, port in daemons:
             wait_ready(port)
@@ -261,6 +263,7 @@ def main():
                 times["render " + name].append((time.perf_counter() - t0) * 1e3)
         med = {k: statistics.median(v) for k, v in times.items()}
         print(f"GL renderer: {renderer}; date: {time.strftime('%Y-%m-%d', time.gmtime())}; "
+              f"radiantd --gpu-scenes {a.gpu_scenes or 'default (4)'}; "
               f"{a.renders} renders 32x32 (direct lighting, 8 scenes), {a.concurrency} client threads, "
               f"median of {a.rounds} interleaved rounds\n")
         print("| daemons | renders/s | speed-up | efficiency per daemon |")
