@@ -28,6 +28,8 @@ void to_json(nlohmann::json& j, const FrameStats& s) {
                      {"camera", s.camera},
                      {"scene", s.scene},
                      {"warnings", s.warnings}};
+  if (!s.budget.is_null()) j["budget"] = s.budget;
+  if (!s.refinement.is_null()) j["refinement"] = s.refinement;
 }
 
 }  // namespace radiant::api

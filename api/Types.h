@@ -62,6 +62,14 @@ struct CompareSpec {
   int maxBounces = 8;
 };
 
+// Progressive refinement of an async job (render_request.json "refine"): independent batches, averaged.
+struct RefineSpec {
+  double untilMs = 0;      // 0 = no time limit
+  double targetRmse = 0;   // 0 = no target
+  int maxBatches = 64;
+  std::string aov = "beauty";  // whose error is estimated
+};
+
 struct RenderRequest {
   std::string id;  // assigned by the server
   SceneRef scene;
@@ -81,6 +89,13 @@ struct RenderRequest {
   bool defaultLighting = true;
   std::optional<CompareSpec> compare;
   bool async = false;
+  // A quality preset ("" none, draft, preview, final, reference) or a frame time budget (0 none), both
+  // resolved against the preset table (api/presets.json) by renderer/frame/Budget.h.
+  std::string quality;
+  double timeBudgetMs = 0;
+  // Technique -> the parameter names the request gave itself (they win over quality and budget).
+  std::map<std::string, std::set<std::string>> explicitParams;
+  std::optional<RefineSpec> refine;
   // Particle systems added to the scene's own for this frame (api/Media.h), generators expanded.
   std::vector<ParticleSystem> media;
 };
@@ -114,6 +129,10 @@ struct FrameStats {
   nlohmann::json camera;  // the camera used: position, target, up, yfov_deg, source
   nlohmann::json scene;   // name, digest, bounds {min, max}, node names
   std::vector<std::string> warnings;  // things the scene has that this frame could not honour
+  // With quality or time_budget_ms: what the preset table chose per technique, predicted and measured
+  // ms, predicted error (renderer/frame/Budget.h); null otherwise. With refine: also "refinement".
+  nlohmann::json budget;
+  nlohmann::json refinement;
 };
 
 void to_json(nlohmann::json& j, const PassStats& s);

@@ -387,6 +387,30 @@ RenderRequest parseRenderRequest(const json& body, const RequestLimits& limits) 
     r.compare = CompareSpec{c["against"], c["aov"], c["spp"], c["max_bounces"]};
   }
   r.async = v["async"];
+  // The parameters the request gave itself win over quality and time_budget_ms (renderer/frame/Budget.h).
+  if (body.contains("passes"))
+    for (const auto& [name, params] : body["passes"].items())
+      if (params.is_object())
+        for (const auto& [key, value] : params.items()) r.explicitParams[name].insert(key);
+  r.quality = v["quality"].get<std::string>();
+  r.timeBudgetMs = v["time_budget_ms"].get<double>();
+  if (!r.quality.empty() && r.timeBudgetMs > 0)
+    throw ApiError(422, "invalid-value", "Invalid value",
+                   "/time_budget_ms: give either quality or time_budget_ms, not both", "/time_budget_ms");
+  if (v.contains("refine")) {
+    const json& f = v["refine"];
+    r.refine = RefineSpec{f["until_ms"].get<double>(), f["target_rmse"].get<double>(), f["max_batches"].get<int>(),
+                          f["aov"].get<std::string>()};
+    if (!r.async)
+      throw ApiError(422, "invalid-value", "Invalid value",
+                     "/refine: progressive refinement needs \"async\": true (poll the job for the current frame)",
+                     "/refine");
+    if (r.compare)
+      throw ApiError(422, "invalid-value", "Invalid value",
+                     "/refine: not together with compare (the compare block would score one batch, not the mean); "
+                     "score the finished frame against an uploaded image instead",
+                     "/refine");
+  }
   std::size_t particles = 0;
   for (std::size_t i = 0; i < v["media"].size(); ++i) {
     const std::string ptr = pointerAppend("/media", i);

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "api/Aovs.h"
+#include "api/Presets.h"
 #include "api/Validate.h"
 #include "renderer/frame/FramePlanner.h"
 #include "renderer/frame/FrameResources.h"
@@ -311,12 +312,17 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     // PassStats must not move while the profiler holds pointers to them.
     stats.passes.resize(plan.passes.size());
     std::vector<Params> params(plan.passes.size());
+    // quality / time_budget_ms: each planned technique's parameters from the preset table (api/Presets.h);
+    // without them, the request's own.
+    std::vector<std::string> planned;
+    for (Technique* t : plan.passes) planned.push_back(t->info().name);
+    api::BudgetChoice choice = api::chooseConfiguration(api::PresetTable::builtin(), planned, request);
+    for (auto& w : choice.warnings) stats.warnings.push_back(std::move(w));
     std::set<int> shadowMapExclusions;  // meshes whose shadows a pass supplies itself (light_volumes)
     for (std::size_t i = 0; i < plan.passes.size(); ++i) {
       Technique* t = plan.passes[i];
       stats.passes[i].name = t->info().name;
-      auto p = request.passes.find(t->info().name);
-      params[i] = Params(api::techniqueParams(t->info().name, p == request.passes.end() ? nlohmann::json() : p->second));
+      params[i] = Params(choice.params.at(t->info().name));
       for (int m : t->shadowMapExclusions(scene, params[i])) shadowMapExclusions.insert(m);
     }
     im.resources.setShadowMapExclusions(std::move(shadowMapExclusions));
@@ -391,6 +397,10 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     im.profiler.resolve();
     report(0.95);
     if (const std::string w = blackFrameWarning(out, stats, scene, request); !w.empty()) stats.warnings.push_back(w);
+    if (choice.active) {
+      stats.budget = std::move(choice.stats);
+      api::recordMeasured(stats.budget, stats, msSince(frameStart));  // before compare's reference
+    }
     if (request.compare) compare(im.resources, scene, view, request, inputs.compareTarget, im.techniques, out);
     stats.renderMs = msSince(frameStart);
     report(1.0);

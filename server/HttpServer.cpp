@@ -1,6 +1,8 @@
 #include "server/HttpServer.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <list>
@@ -15,6 +17,7 @@
 
 #include "api/Aovs.h"
 #include "api/JsonLimits.h"
+#include "api/Presets.h"
 #include "api/Sha256.h"
 #include "api/Validate.h"
 #include "server/FrameStore.h"
@@ -584,6 +587,8 @@ struct HttpServer::Impl {
                 {"limits", limitsJson()},
                 {"techniques", techniquesJson()},
                 {"aovs", api::aovTableJson()},
+                // quality / time_budget_ms resolve against this table (api/Presets.h, docs/API.md)
+                {"presets", api::PresetTable::builtin().data()},
                 {"request_schema", api::renderRequestSchema()}});
     }));
 
@@ -754,6 +759,35 @@ struct HttpServer::Impl {
       if (!job)
         throw api::ApiError(404, "unknown-render", "Unknown render", "no render " + std::string(req.matches[1]) + " (finished renders expire after " + std::to_string(config.frameTtlS) + " s)");
       tRequest.renderId = job->id;
+      // ?current=exr|png: a refine job's current mean (docs/API.md, "Progressive refinement").
+      if (req.has_param("current")) {
+        const std::string format = req.get_param_value("current");
+        if (format != "exr" && format != "png")
+          throw api::ApiError(400, "invalid-query", "Invalid query parameter",
+                              "current: \"" + format + "\" is not exr or png");
+        auto snap = service.current(*job);
+        if (!snap)
+          throw api::ApiError(409, "no-current-frame", "No current frame",
+                              "render " + job->id +
+                                  (job->request.refine ? " has not finished its first batch yet"
+                                                       : " does not refine (the request has no \"refine\")"));
+        api::OutputSpec spec;
+        spec.format = format == "exr" ? api::ImageFormat::Exr : api::ImageFormat::Png;
+        spec.halfFloat = false;
+        spec.aovs = {job->request.refine->aov};
+        if (spec.format == api::ImageFormat::Exr)
+          for (const auto& o : job->request.outputs)
+            for (const auto& a : o.aovs)
+              if (std::find(spec.aovs.begin(), spec.aovs.end(), a) == spec.aovs.end()) spec.aovs.push_back(a);
+        std::string bytes = hooks.encodeFrame(snap->mean, spec, 0, job->request.exposure);
+        res.set_header("X-Radiant-Batches", std::to_string(snap->batches));
+        res.set_header("X-Radiant-Estimated-Rmse",
+                       std::isfinite(snap->estimatedRmse) ? std::to_string(snap->estimatedRmse) : std::string("null"));
+        res.set_header("X-Radiant-Elapsed-Ms", std::to_string(snap->elapsedMs));
+        res.status = 200;
+        res.set_content(bytes, spec.format == api::ImageFormat::Exr ? "image/x-exr" : "image/png");
+        return;
+      }
       json body = service.describe(*job);
       if (body["progress"] == 1.0) timingHeader(res, body);
       sendJson(res, 200, body);

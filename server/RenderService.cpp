@@ -136,6 +136,12 @@ json RenderService::describe(const Job& job) {
     default: progress = 1; break;
   }
   if (job.state == JobState::Running) j["phase"] = "rendering";
+  if (job.current && !job.terminal()) {
+    const RefineSnapshot& c = *job.current;
+    j["refinement"] = {{"batches", c.batches}, {"elapsed_ms", c.elapsedMs},
+                       {"estimated_rmse", std::isfinite(c.estimatedRmse) ? json(c.estimatedRmse) : json(nullptr)},
+                       {"current", "/v1/renders/" + job.id + "?current=exr"}};
+  }
   j["progress"] = progress;
   j["timings"] = {{"queue_ms", job.queueMs}, {"render_ms", job.renderMs}, {"encode_ms", job.encodeMs}};
   if (job.state == JobState::Done) {
@@ -152,6 +158,71 @@ json RenderService::describe(const Job& job) {
     if (!p.pointer.empty()) j["error"]["pointer"] = p.pointer;
   }
   return j;
+}
+
+std::shared_ptr<const RefineSnapshot> RenderService::current(const Job& job) {
+  std::lock_guard lock(mutex_);
+  return job.current;
+}
+
+RenderOutput RenderService::refine(RenderBackend& backend, const std::shared_ptr<Job>& job, const FrameInputs& inputs) {
+  const api::RefineSpec spec = *job->request.refine;
+  api::RenderRequest batch = job->request;
+  BatchMean acc;
+  RenderOutput last;
+  const auto start = Clock::now();
+  double slowestBatchMs = 0;
+  std::string stop = "max_batches";
+  constexpr std::uint64_t kMaxSeed = 9007199254740991ull;  // the schema's bound (2^53 - 1)
+  for (int k = 0; k < spec.maxBatches; ++k) {
+    // Progress: the larger of the batches' and the time limit's fraction.
+    FrameInputs in = inputs;
+    const double done = double(k) / spec.maxBatches;
+    if (inputs.progress)
+      in.progress = [&, done](double f) {
+        const double byBatches = done + f / spec.maxBatches;
+        const double byTime = spec.untilMs > 0 ? msBetween(start, Clock::now()) / spec.untilMs : 0.0;
+        inputs.progress(std::clamp(std::max(byBatches, byTime), 0.0, 0.99));
+      };
+    batch.seed = (job->request.seed + static_cast<std::uint64_t>(k)) % (kMaxSeed + 1);
+    const auto t0 = Clock::now();
+    last = backend.render(*job->scene, batch, &job->cancel, in);
+    slowestBatchMs = std::max(slowestBatchMs, msBetween(t0, Clock::now()));
+    acc.add(last.aovs);
+    auto snap = std::make_shared<RefineSnapshot>();
+    snap->mean = acc.mean();
+    snap->batches = acc.batches();
+    snap->estimatedRmse = acc.estimatedRmse(spec.aov);
+    snap->elapsedMs = msBetween(start, Clock::now());
+    const double estimate = snap->estimatedRmse;
+    const double elapsed = snap->elapsedMs;
+    {
+      std::lock_guard lock(mutex_);
+      job->current = std::move(snap);
+      if (k == 0 && std::none_of(last.aovs.begin(), last.aovs.end(), [&](const Image& i) { return i.aov == spec.aov; }))
+        throw api::ApiError(422, "invalid-value", "Invalid value",
+                            "/refine/aov: the frame has no AOV \"" + spec.aov + "\" (name it in outputs)", "/refine/aov");
+    }
+    if (spec.targetRmse > 0 && std::isfinite(estimate) && estimate <= spec.targetRmse) { stop = "target_rmse"; break; }
+    if (spec.untilMs > 0 && elapsed >= spec.untilMs) { stop = "until_ms"; break; }
+    // Another batch must end before the request timeout (with the slowest batch's time to spare).
+    if (Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double, std::milli>(
+                           2 * slowestBatchMs + 1000)) > job->deadline) {
+      stop = "request_timeout";
+      break;
+    }
+    if (job->cancel) break;
+  }
+  RenderOutput out;
+  out.aovs = acc.mean();
+  out.stats = std::move(last.stats);  // the last batch's passes and counters
+  const double estimate = acc.estimatedRmse(spec.aov);
+  out.stats.refinement = {{"batches", acc.batches()}, {"aov", spec.aov}, {"stopped_by", stop},
+                          {"elapsed_ms", msBetween(start, Clock::now())},
+                          {"estimated_rmse", std::isfinite(estimate) ? json(estimate) : json(nullptr)},
+                          {"seeds", {job->request.seed, batch.seed}}};
+  out.stats.renderMs = msBetween(start, Clock::now());
+  return out;
 }
 
 RenderService::CancelResult RenderService::cancel(const std::string& id) {
@@ -264,7 +335,8 @@ void RenderService::renderLoop() {
       FrameInputs inputs{job->compareTarget.get(), job->environment.get()};
       Job* raw = job.get();
       inputs.progress = [raw](double f) { raw->renderProgress.store(f); };
-      output = backend->render(*job->scene, job->request, &job->cancel, inputs);
+      output = job->request.refine ? refine(*backend, job, inputs)
+                                   : backend->render(*job->scene, job->request, &job->cancel, inputs);
     } catch (const api::ApiError& e) {
       problem = Problem{e.status, e.type, e.title, e.detail(), e.pointer};
     } catch (const std::exception& e) {

@@ -26,6 +26,7 @@
 #include "server/Config.h"
 #include "server/FrameStore.h"
 #include "server/Metrics.h"
+#include "server/Refinement.h"
 
 namespace radiant::server {
 
@@ -63,6 +64,8 @@ struct Job {
   api::FrameStats stats;
   std::vector<FrameInfo> frames;
   std::optional<Problem> error;
+  // refine jobs: the mean of the batches so far, replaced after every batch (null before the first).
+  std::shared_ptr<const RefineSnapshot> current;
   bool terminal() const { return state == JobState::Done || state == JobState::Failed || state == JobState::Canceled; }
 };
 
@@ -85,6 +88,8 @@ public:
   // Blocks until the job is terminal or `until`; returns whether it is terminal.
   bool waitFor(const std::shared_ptr<Job>& job, Clock::time_point until);
   nlohmann::json describe(const Job& job);  // state, progress, stats/frames or error
+  // A refine job's current mean and its estimated error (null before its first batch, or not refining).
+  std::shared_ptr<const RefineSnapshot> current(const Job& job);
 
   enum class CancelResult { NotFound, Removed, Requested, Forgotten };
   CancelResult cancel(const std::string& id);
@@ -106,6 +111,8 @@ private:
   void housekeepingLoop();
   void finishLocked(Job& job, JobState state, std::optional<Problem> error);
   void encode(const std::shared_ptr<Job>& job, RenderOutput output);
+  // Renders a refine job's batches (seeds seed, seed + 1, ...) until its stop rule and returns their mean.
+  RenderOutput refine(RenderBackend& backend, const std::shared_ptr<Job>& job, const FrameInputs& inputs);
 
   const ServerConfig config_;
   const BackendHooks hooks_;

@@ -120,6 +120,7 @@ int main(int argc, char** argv) {
       if (a != "beauty") aovEnum.push_back(a);
     request["properties"]["outputs"]["items"]["properties"]["aovs"]["items"]["enum"] = aovEnum;
     request["properties"]["compare"]["properties"]["aov"]["enum"] = aovEnum;
+    request["properties"]["refine"]["properties"]["aov"]["enum"] = aovEnum;
 
     std::ostringstream text;
     text << request.dump(2) << "\n";

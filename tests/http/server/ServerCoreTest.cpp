@@ -2,6 +2,7 @@
 // scene store, metrics, shutdown. Talks real HTTP on an ephemeral loopback port.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <future>
@@ -330,6 +331,63 @@ TEST(ServerCore, AsyncProgressFollowsTheRenderer) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   EXPECT_EQ(state["progress"], 1.0);
+}
+
+// Polls an async job until it is done (or 5 s have passed); returns its last state.
+json pollUntilDone(httplib::Client& c, const std::string& location) {
+  json state = json::object();
+  for (int i = 0; i < 1000 && state.value("state", "") != "done"; ++i) {
+    state = body(c.Get(location.c_str()));
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return state;
+}
+
+// Progressive refinement over the fake backend, whose beauty is seed + 0.25 everywhere: batches with
+// seeds s, s+1, ..., s+n-1 average to s + (n-1)/2 + 0.25, and their sample variance (n(n+1)/12) gives the
+// standard error of the mean sqrt((n+1)/12) in closed form.
+TEST(ServerCore, RefineAveragesBatchesAndEstimatesTheStandardError) {
+  TestServer s;
+  s.waitReady();
+  auto c = s.client();
+  json b = renderBody(10);
+  b["async"] = true;
+  b["refine"] = {{"max_batches", 4}};
+  auto r = post(c, "/v1/renders", b);
+  ASSERT_EQ(r->status, 202) << r->body;
+  const std::string location = r->get_header_value("Location");
+  json state = pollUntilDone(c, location);
+  ASSERT_EQ(state["state"], "done") << state.dump();
+  const json& f = state["stats"]["refinement"];
+  EXPECT_EQ(f["batches"], 4);
+  EXPECT_EQ(f["stopped_by"], "max_batches");
+  EXPECT_NEAR(f["estimated_rmse"].get<double>(), std::sqrt(5.0 / 12.0), 1e-6);
+  EXPECT_EQ(f["seeds"], json::array({10, 13}));
+  // The job's frame is the mean, and ?current=exr serves it with its estimate.
+  const std::string frame = c.Get(state["frames"][0]["url"].get<std::string>().c_str())->body;
+  EXPECT_NEAR(json::parse(frame.substr(frame.find('{')))["value"].get<double>(), 10 + 1.5 + 0.25, 1e-5);
+  auto cur = c.Get((location + "?current=exr").c_str());
+  ASSERT_EQ(cur->status, 200) << cur->body;
+  EXPECT_EQ(cur->get_header_value("X-Radiant-Batches"), "4");
+  EXPECT_NEAR(std::stod(cur->get_header_value("X-Radiant-Estimated-Rmse")), std::sqrt(5.0 / 12.0), 1e-5);
+  EXPECT_NEAR(json::parse(cur->body.substr(cur->body.find('{')))["value"].get<double>(), 11.75, 1e-5);
+  expectProblem(c.Get((location + "?current=tiff").c_str()), 400, "invalid-query", "");
+
+  // A target error ends it early: after n batches the estimate is sqrt((n+1)/12), 0.5 at n = 2.
+  b["refine"] = {{"max_batches", 50}, {"target_rmse", 0.51}};
+  r = post(c, "/v1/renders", b);
+  state = pollUntilDone(c, r->get_header_value("Location"));
+  EXPECT_EQ(state["stats"]["refinement"]["batches"], 2);
+  EXPECT_EQ(state["stats"]["refinement"]["stopped_by"], "target_rmse");
+
+  // Not refining: no current frame; refine without async: 422 naming /refine.
+  json plain = renderBody(3);
+  plain["async"] = true;
+  r = post(c, "/v1/renders", plain);
+  expectProblem(c.Get((r->get_header_value("Location") + "?current=exr").c_str()), 409, "no-current-frame", "");
+  json sync = renderBody(3);
+  sync["refine"] = json::object();
+  expectProblem(post(c, "/v1/renders", sync), 422, "invalid-value", "/refine");
 }
 
 TEST(ServerCore, AsyncRenderPollsToDone) {

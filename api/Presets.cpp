@@ -1,0 +1,244 @@
+#include "api/Presets.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "api/Validate.h"
+#include "embedded/radiant_api_presets.h"
+
+namespace radiant::api {
+
+using nlohmann::json;
+
+namespace {
+
+const json& emptyArray() {
+  static const json a = json::array();
+  return a;
+}
+
+// sum of coef * product of vars; a var is "pixels" or a numeric parameter (a boolean counts as 0/1).
+double evalTerms(const json& terms, const json& params, double pixels) {
+  double ms = 0.0;
+  for (const auto& t : terms) {
+    double v = t.value("coef", 0.0);
+    for (const auto& name : t.value("vars", json::array())) {
+      const std::string n = name.get<std::string>();
+      if (n == "pixels") v *= pixels;
+      else if (params.contains(n) && params[n].is_number()) v *= params[n].get<double>();
+      else if (params.contains(n) && params[n].is_boolean()) v *= params[n].get<bool>() ? 1.0 : 0.0;
+      else throw std::logic_error("preset table: cost term names '" + n + "', which is no numeric parameter");
+    }
+    ms += v;
+  }
+  return ms;
+}
+
+json paramsOf(const RenderRequest& request, const std::string& technique) {
+  auto it = request.passes.find(technique);
+  return techniqueParams(technique, it == request.passes.end() ? json() : it->second);
+}
+
+// A front point's parameters under the request's own: the request's explicit keys win.
+json merged(const json& base, const json& point, const std::set<std::string>& explicitKeys) {
+  json p = base;
+  for (const auto& [k, v] : point.items())
+    if (!explicitKeys.count(k)) p[k] = v;
+  return p;
+}
+
+bool overridden(const json& point, const std::set<std::string>& explicitKeys) {
+  for (const auto& [k, v] : point.items())
+    if (explicitKeys.count(k)) return true;
+  return false;
+}
+
+json chosenSubset(const json& params, const json& point) {
+  json out = json::object();
+  for (const auto& [k, v] : point.items()) out[k] = params[k];
+  return out;
+}
+
+}  // namespace
+
+double passCostMs(const PassStats& pass) {
+  double ms = pass.cpuMs;
+  for (const char* prepared : {"trace_ms", "splat_build_ms"}) {
+    auto it = pass.counters.find(prepared);
+    if (it != pass.counters.end() && std::isfinite(it->second)) ms += it->second;
+  }
+  return ms;
+}
+
+PresetTable::PresetTable(json table) : table_(std::move(table)) {
+  if (!table_.is_object() || !table_.contains("techniques") || !table_["techniques"].is_object())
+    throw std::invalid_argument("preset table: no \"techniques\" object");
+}
+
+const PresetTable& PresetTable::builtin() {
+  static const PresetTable t(json::parse(embedded_presets::find("presets.json")));
+  return t;
+}
+
+bool PresetTable::hasFront(const std::string& technique) const { return !front(technique).empty(); }
+
+bool PresetTable::hasModel(const std::string& technique) const {
+  const json& t = table_["techniques"];
+  return t.contains(technique) && t[technique].contains("model");
+}
+
+double PresetTable::predictMs(const std::string& technique, const json& params, double pixels) const {
+  if (!hasModel(technique)) return -1.0;
+  return std::max(0.0, evalTerms(table_["techniques"][technique]["model"]["terms"], params, pixels));
+}
+
+double PresetTable::predictOverheadMs(double pixels) const {
+  if (!table_.contains("overhead")) return 0.0;
+  return std::max(0.0, evalTerms(table_["overhead"]["terms"], json::object(), pixels));
+}
+
+const json& PresetTable::front(const std::string& technique) const {
+  const json& t = table_["techniques"];
+  if (!t.contains(technique) || !t[technique].contains("front")) return emptyArray();
+  return t[technique]["front"];
+}
+
+int PresetTable::presetIndex(const std::string& technique, const std::string& quality) const {
+  const json& t = table_["techniques"];
+  if (!t.contains(technique) || !t[technique].contains("presets")) return -1;
+  const json& p = t[technique]["presets"];
+  return p.contains(quality) ? p[quality].get<int>() : -1;
+}
+
+BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std::string>& planned,
+                                 const RenderRequest& request) {
+  BudgetChoice c;
+  for (const auto& t : planned) c.params[t] = paramsOf(request, t);
+  c.active = !request.quality.empty() || request.timeBudgetMs > 0;
+  if (!c.active) return c;
+  const double pixels = double(request.width) * request.height;
+  const json& gen = table.data().value("generated", json::object());
+  c.stats = {{"table", {{"generated", gen.value("date", "")}, {"command", gen.value("command", "")},
+                        {"device", gen.value("device", json())}}}};
+  if (!request.quality.empty()) c.stats["quality"] = request.quality;
+  else c.stats["time_budget_ms"] = request.timeBudgetMs;
+
+  auto explicitOf = [&](const std::string& t) {
+    auto it = request.explicitParams.find(t);
+    return it == request.explicitParams.end() ? std::set<std::string>{} : it->second;
+  };
+  auto errorBlock = [&](const std::string& t, const json& point, bool overriddenByRequest) {
+    if (overriddenByRequest) return json(nullptr);  // the measured point is not what runs
+    json e = table.data()["techniques"][t].value("error", json::object());
+    e["value"] = point["error"];
+    return e;
+  };
+
+  json techniques = json::object();
+  double fixedMs = table.predictOverheadMs(pixels);
+  // One candidate list per modelled technique with a front: (params, predicted ms, error, point index).
+  struct Candidate {
+    json params;
+    double ms, error;
+    int point;
+  };
+  std::map<std::string, std::vector<Candidate>> candidates;
+  for (const auto& t : planned) {
+    const std::set<std::string> given = explicitOf(t);
+    json entry = json::object();
+    if (!given.empty()) entry["explicit"] = given;
+    const json& front = table.front(t);
+    if (!request.quality.empty() && !front.empty()) {
+      const int i = table.presetIndex(t, request.quality);
+      if (i >= 0 && i < int(front.size())) {
+        c.params[t] = techniqueParams(t, merged(c.params[t], front[i]["params"], given));
+        entry["params"] = chosenSubset(c.params[t], front[i]["params"]);
+        entry["point"] = i;
+        entry["predicted_error"] = errorBlock(t, front[i], overridden(front[i]["params"], given));
+      }
+    } else if (request.timeBudgetMs > 0 && !front.empty() && table.hasModel(t)) {
+      std::vector<Candidate> all;
+      for (std::size_t i = 0; i < front.size(); ++i) {
+        json p = techniqueParams(t, merged(c.params[t], front[i]["params"], given));
+        const double ms = table.predictMs(t, p, pixels);
+        all.push_back({std::move(p), ms, front[i]["error"].get<double>(), int(i)});
+      }
+      // The front at this frame's pixel count: by predicted cost, then only points that lower the error.
+      std::stable_sort(all.begin(), all.end(), [](const Candidate& a, const Candidate& b) { return a.ms < b.ms; });
+      std::vector<Candidate> kept;
+      for (auto& a : all)
+        if (kept.empty() || a.error < kept.back().error) kept.push_back(std::move(a));
+      candidates[t] = std::move(kept);
+      techniques[t] = entry;
+      continue;
+    }
+    const double ms = table.predictMs(t, c.params[t], pixels);
+    entry["predicted_ms"] = ms >= 0 ? json(ms) : json(nullptr);
+    if (ms >= 0) fixedMs += ms;
+    techniques[t] = entry;
+  }
+
+  if (request.timeBudgetMs > 0) {
+    std::map<std::string, std::size_t> at;
+    double spent = fixedMs;
+    for (const auto& [t, list] : candidates) {
+      at[t] = 0;
+      spent += list[0].ms;
+    }
+    if (spent > request.timeBudgetMs)
+      c.warnings.push_back("time_budget_ms " + std::to_string(request.timeBudgetMs) +
+                           " is below the predicted cost of the cheapest configuration (" + std::to_string(spent) +
+                           " ms): rendering that");
+    for (;;) {
+      std::string best;
+      double bestRate = -1.0, bestMs = 0.0;
+      for (const auto& [t, list] : candidates) {
+        const std::size_t i = at[t];
+        if (i + 1 >= list.size()) continue;
+        const double dMs = std::max(list[i + 1].ms - list[i].ms, 1e-9);
+        const double rate = std::log(list[i].error / list[i + 1].error) / dMs;
+        if (rate > bestRate) {
+          bestRate = rate;
+          best = t;
+          bestMs = dMs;
+        }
+      }
+      if (best.empty() || spent + bestMs > request.timeBudgetMs) break;
+      spent += bestMs;
+      ++at[best];
+    }
+    for (const auto& [t, list] : candidates) {
+      const Candidate& k = list[at[t]];
+      const json& point = table.front(t)[k.point];
+      c.params[t] = k.params;
+      json& entry = techniques[t];
+      entry["params"] = chosenSubset(k.params, point["params"]);
+      entry["point"] = k.point;
+      entry["predicted_ms"] = k.ms;
+      entry["predicted_error"] = errorBlock(t, point, overridden(point["params"], explicitOf(t)));
+    }
+  }
+  double total = table.predictOverheadMs(pixels);
+  for (const auto& t : planned) {
+    if (!techniques[t].contains("predicted_ms")) {
+      const double ms = table.predictMs(t, c.params[t], pixels);
+      techniques[t]["predicted_ms"] = ms >= 0 ? json(ms) : json(nullptr);
+    }
+    if (techniques[t]["predicted_ms"].is_number()) total += techniques[t]["predicted_ms"].get<double>();
+  }
+  c.stats["techniques"] = techniques;
+  c.stats["predicted_overhead_ms"] = table.predictOverheadMs(pixels);
+  c.stats["predicted_ms"] = total;
+  return c;
+}
+
+void recordMeasured(json& budget, const FrameStats& stats, double frameMs) {
+  if (!budget.is_object()) return;
+  for (const auto& p : stats.passes)
+    if (budget["techniques"].contains(p.name)) budget["techniques"][p.name]["measured_ms"] = passCostMs(p);
+  budget["measured_ms"] = frameMs;
+}
+
+}  // namespace radiant::api

@@ -1,0 +1,42 @@
+#pragma once
+// Progressive refinement (render request "refine"): the mean of independent batches of a frame, and
+// the estimated error of that mean. Each batch is a whole frame rendered with its own seed, so the
+// batches are independent and identically distributed per pixel; the standard error of the mean of
+// pixel channel c is s_c / sqrt(n), s_c^2 the unbiased sample variance over the n batches. The estimate
+// reported is their RMS over pixels and colour channels, comparable to metrics.rmse (renderer/metrics):
+//   estimated RMSE = sqrt( mean_c s_c^2 / n ).
+// It estimates the variance part of the error only: a biased estimator (photon_gi's kernel blur) has a
+// true error the estimate does not see.
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "renderer/Image.h"
+
+namespace radiant::server {
+
+class BatchMean {
+public:
+  // The first batch fixes the AOVs and their sizes; a later batch must have the same.
+  void add(const std::vector<Image>& aovs);
+  int batches() const { return n_; }
+  std::vector<Image> mean() const;
+  // NaN with fewer than 2 batches or when `aov` is not among the batches' AOVs.
+  double estimatedRmse(const std::string& aov) const;
+
+private:
+  std::vector<Image> layout_;  // names and sizes (pixels unused)
+  std::vector<std::vector<double>> sum_, sumSq_;
+  int n_ = 0;
+};
+
+// What GET /v1/renders/{id} shows of a refining job: the mean so far and its estimated error.
+struct RefineSnapshot {
+  std::vector<Image> mean;
+  int batches = 0;
+  double estimatedRmse = std::numeric_limits<double>::quiet_NaN();
+  double elapsedMs = 0;
+};
+
+}  // namespace radiant::server

@@ -1,0 +1,178 @@
+// Quality presets and time budgets (api/Presets.h): the choice follows the table's model and front,
+// explicit parameters win, a larger budget never raises a technique's predicted error, and the table
+// embedded in the binary (api/presets.json) is a well-formed, generated front.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "api/Presets.h"
+#include "api/Validate.h"
+
+using nlohmann::json;
+using namespace radiant::api;
+
+namespace {
+
+// photon_gi: ms = 2 + 1e-4 photons + 1e-5 pixels C^2 (a closed form to check predictMs against);
+// ambient_occlusion: ms = 1e-4 pixels samples; direct: 0.5 + 1e-5 pixels; overhead 3 ms.
+json syntheticTable() {
+  return json::parse(R"({
+    "generated": {"by": "test", "date": "2026-12-02", "command": "none"},
+    "overhead": {"terms": [{"coef": 3, "vars": []}]},
+    "techniques": {
+      "photon_gi": {
+        "model": {"terms": [{"coef": 2, "vars": []}, {"coef": 1e-4, "vars": ["photons"]},
+                            {"coef": 1e-5, "vars": ["pixels", "C", "C"]}]},
+        "error": {"metric": "rmse", "aov": "indirect", "scene": "cornell_box", "width": 64, "height": 64},
+        "front": [{"params": {"photons": 20000, "C": 10}, "error": 0.08},
+                  {"params": {"photons": 100000, "C": 10}, "error": 0.05},
+                  {"params": {"photons": 250000, "C": 20}, "error": 0.03},
+                  {"params": {"photons": 1000000, "C": 20}, "error": 0.02}],
+        "presets": {"draft": 0, "preview": 1, "final": 2, "reference": 3}},
+      "ambient_occlusion": {
+        "model": {"terms": [{"coef": 1e-4, "vars": ["pixels", "samples"]}]},
+        "error": {"metric": "rmse", "aov": "ao", "scene": "ao_creases", "width": 64, "height": 64},
+        "front": [{"params": {"samples": 4}, "error": 0.1}, {"params": {"samples": 16}, "error": 0.06},
+                  {"params": {"samples": 64}, "error": 0.05}],
+        "presets": {"draft": 0, "preview": 1, "final": 1, "reference": 2}},
+      "direct": {"model": {"terms": [{"coef": 0.5, "vars": []}, {"coef": 1e-5, "vars": ["pixels"]}]}}
+    }})");
+}
+
+RenderRequest request(const json& extra) {
+  json body{{"scene", {{"builtin", "cornell_box"}}}, {"width", 100}, {"height", 100}};
+  body.update(extra);
+  return parseRenderRequest(body);
+}
+
+const std::vector<std::string> kPlanned{"gbuffer", "direct", "photon_gi", "ambient_occlusion"};
+
+}  // namespace
+
+TEST(Presets, PredictsTheModelsClosedForm) {
+  const PresetTable t(syntheticTable());
+  const json p = techniqueParams("photon_gi", json{{"photons", 50000}, {"C", 30}});
+  EXPECT_DOUBLE_EQ(t.predictMs("photon_gi", p, 1e4), 2 + 1e-4 * 50000 + 1e-5 * 1e4 * 900);
+  EXPECT_DOUBLE_EQ(t.predictOverheadMs(1e4), 3.0);
+  EXPECT_LT(t.predictMs("gbuffer", json::object(), 1e4), 0.0);  // no model
+}
+
+TEST(Presets, QualityTakesThePresetsPointAndExplicitParametersWin) {
+  const PresetTable t(syntheticTable());
+  const BudgetChoice c = chooseConfiguration(t, kPlanned, request({{"quality", "final"}}));
+  ASSERT_TRUE(c.active);
+  EXPECT_EQ(c.params.at("photon_gi")["photons"], 250000);
+  EXPECT_EQ(c.params.at("photon_gi")["C"], 20);
+  EXPECT_EQ(c.params.at("photon_gi")["kernel"], "biweight");  // the rest keeps the schema default
+  EXPECT_EQ(c.params.at("ambient_occlusion")["samples"], 16);
+  EXPECT_DOUBLE_EQ(c.stats["techniques"]["photon_gi"]["predicted_error"]["value"].get<double>(), 0.03);
+  // predicted frame ms = overhead + direct + photon_gi + AO, gbuffer unmodelled (null)
+  const double expected = 3 + (0.5 + 0.1) + (2 + 25 + 0.1 * 400) + 1e-4 * 1e4 * 16;
+  EXPECT_NEAR(c.stats["predicted_ms"].get<double>(), expected, 1e-9);
+  EXPECT_TRUE(c.stats["techniques"]["gbuffer"]["predicted_ms"].is_null());
+
+  // The request's own photons win; the measured point is then not what runs, so no predicted error.
+  const BudgetChoice e =
+      chooseConfiguration(t, kPlanned, request({{"quality", "final"}, {"passes", {{"photon_gi", {{"photons", 5000}}}}}}));
+  EXPECT_EQ(e.params.at("photon_gi")["photons"], 5000);
+  EXPECT_EQ(e.params.at("photon_gi")["C"], 20);
+  EXPECT_TRUE(e.stats["techniques"]["photon_gi"]["predicted_error"].is_null());
+  EXPECT_EQ(e.stats["techniques"]["photon_gi"]["explicit"], json::array({"photons"}));
+  // Neither quality nor budget: the request's parameters, untouched.
+  const BudgetChoice none = chooseConfiguration(t, kPlanned, request(json::object()));
+  EXPECT_FALSE(none.active);
+  EXPECT_EQ(none.params.at("photon_gi"), techniqueParams("photon_gi"));
+}
+
+TEST(Presets, LargerBudgetsNeverRaiseAPredictedErrorAndFitWhenTheyCan) {
+  const PresetTable t(syntheticTable());
+  // Cheapest frame: 3 + 0.6 + (2 + 2 + 10) + 4 = 21.6 ms; dearest: 3 + 0.6 + (2 + 100 + 40) + 64 = 209.6 ms.
+  double lastPg = 1e9, lastAo = 1e9, lastMs = 0;
+  int changes = 0;
+  for (double budget = 22; budget <= 400; budget += 1.0) {
+    const BudgetChoice c = chooseConfiguration(t, kPlanned, request({{"time_budget_ms", budget}}));
+    const json& s = c.stats["techniques"];
+    const double pg = s["photon_gi"]["predicted_error"]["value"], ao = s["ambient_occlusion"]["predicted_error"]["value"];
+    const double ms = c.stats["predicted_ms"];
+    EXPECT_LE(ms, budget + 1e-9) << budget;
+    EXPECT_LE(pg, lastPg) << budget;
+    EXPECT_LE(ao, lastAo) << budget;
+    EXPECT_GE(ms, lastMs - 1e-9) << budget;
+    EXPECT_TRUE(c.warnings.empty());
+    changes += (pg < lastPg) + (ao < lastAo);
+    lastPg = pg, lastAo = ao, lastMs = ms;
+  }
+  EXPECT_EQ(changes, 2 + 3 + 2);  // every front point of both techniques is reached (first ones count as changes)
+  EXPECT_DOUBLE_EQ(lastPg, 0.02);
+  EXPECT_DOUBLE_EQ(lastAo, 0.05);
+  // Below the cheapest configuration: the cheapest, with a warning.
+  const BudgetChoice low = chooseConfiguration(t, kPlanned, request({{"time_budget_ms", 5}}));
+  EXPECT_EQ(low.params.at("photon_gi")["photons"], 20000);
+  ASSERT_EQ(low.warnings.size(), 1u);
+  EXPECT_NE(low.warnings[0].find("below the predicted cost"), std::string::npos);
+}
+
+TEST(Presets, QualityAndBudgetTogetherAreRefused) {
+  try {
+    request({{"quality", "draft"}, {"time_budget_ms", 100}});
+    FAIL();
+  } catch (const ApiError& e) {
+    EXPECT_EQ(e.status, 422);
+    EXPECT_EQ(e.pointer, "/time_budget_ms");
+  }
+  try {
+    request({{"quality", "best"}});
+    FAIL();
+  } catch (const ApiError& e) {
+    EXPECT_EQ(e.pointer, "/quality");
+  }
+}
+
+TEST(Presets, RefineNeedsAsyncAndNoCompare) {
+  for (const json& extra : {json{{"refine", {{"until_ms", 100}}}},
+                            json{{"async", true}, {"refine", json::object()}, {"compare", json::object()}}}) {
+    try {
+      request(extra);
+      FAIL() << extra.dump();
+    } catch (const ApiError& e) {
+      EXPECT_EQ(e.status, 422);
+      EXPECT_EQ(e.pointer, "/refine");
+    }
+  }
+  const RenderRequest r = request({{"async", true}, {"refine", {{"target_rmse", 0.01}}}});
+  ASSERT_TRUE(r.refine);
+  EXPECT_EQ(r.refine->maxBatches, 64);
+  EXPECT_DOUBLE_EQ(r.refine->targetRmse, 0.01);
+  EXPECT_EQ(r.refine->aov, "beauty");
+}
+
+// The generated table in the binary: fronts sorted by cost with falling error, presets in order, every
+// point a valid configuration of its technique, and a header that says how it was made.
+TEST(Presets, TheEmbeddedTableIsAGeneratedParetoFront) {
+  const PresetTable& t = PresetTable::builtin();
+  EXPECT_NE(t.data()["generated"]["by"].get<std::string>().find("bench/presets.py"), std::string::npos);
+  int fronts = 0;
+  for (const auto& [name, entry] : t.data()["techniques"].items()) {
+    if (!entry.contains("front")) continue;
+    ++fronts;
+    const json& front = entry["front"];
+    ASSERT_FALSE(front.empty()) << name;
+    for (std::size_t i = 0; i < front.size(); ++i) {
+      EXPECT_NO_THROW(techniqueParams(name, front[i]["params"])) << name;
+      if (i > 0) {
+        EXPECT_LT(front[i]["error"].get<double>(), front[i - 1]["error"].get<double>()) << name;
+        EXPECT_GE(front[i]["predicted_ms"].get<double>(), front[i - 1]["predicted_ms"].get<double>()) << name;
+      }
+    }
+    int last = -1;
+    for (const char* q : {"draft", "preview", "final", "reference"}) {
+      const int i = t.presetIndex(name, q);
+      EXPECT_GE(i, last) << name << " " << q;
+      EXPECT_LT(i, int(front.size())) << name << " " << q;
+      last = i;
+    }
+    EXPECT_EQ(last, int(front.size()) - 1) << name;
+    EXPECT_TRUE(t.hasModel(name)) << name;
+  }
+  EXPECT_GE(fronts, 3);  // reference, photon_gi, ambient_occlusion
+}
