@@ -18,7 +18,9 @@ const TechniqueInfo& SphericalBillboardsPass::info() const {
                                {"media", "media_transmittance"},
                                true,
                                true,
-                               {"media"}};
+                               {"media"},
+                               /*claimsWhenNamed=*/false,
+                               /*exclusive=*/true};  // the default owner of the media AOV: first in the registry
   return i;
 }
 
