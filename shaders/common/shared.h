@@ -150,4 +150,25 @@ struct MediaParticle {
   ivec4 models;       // x density profile (kProfile*), y phase model (kPhase*), zw unused
 };
 
+// ---------------------------------------------------------------------------------------------------
+// Illumination networks (renderer/techniques/illumination_network, shaders/illumination_network).
+
+// One network node: a point of the medium with its local extinction, albedo and emission.
+struct NetworkNode {
+  vec4 positionTau;  // xyz world position, w extinction at the node
+  vec4 albedo;       // rgb single-scattering albedo, w unused
+  vec4 emission;     // rgb source per unit opacity ((1 - a) L_e), w unused
+};
+
+// One shared direction: w the direction of propagation, u and v the window's axes.
+struct NetworkDirection {
+  vec4 w, u, v;  // xyz, w unused
+};
+
+// One directional light as the network sees it: propagation direction and irradiance.
+struct NetworkLight {
+  vec4 direction;   // xyz unit, w unused
+  vec4 irradiance;  // rgb, w unused
+};
+
 #endif
