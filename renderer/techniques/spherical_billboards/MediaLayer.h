@@ -1,0 +1,16 @@
+#pragma once
+// The media layer every media technique writes and composes (spherical_billboards, depth_impostors;
+// one of them per frame, FramePlanner): the "media" target (RGBA32F: RGB premultiplied radiance,
+// A transmittance) and its composition into beauty, beauty = beauty * T + C (thesis 7.2.3).
+#include "renderer/frame/FrameResources.h"
+#include "renderer/frame/PassContext.h"
+
+namespace radiant {
+
+// Declares the media texture and framebuffer (w x h) and the composition framebuffer over beauty.
+void declareMediaLayer(FrameResources& res, int w, int h);
+// Composes the written media target into beauty (a frame without opaque passes starts from the sky)
+// and marks beauty written.
+void composeMediaIntoBeauty(PassContext& ctx);
+
+}  // namespace radiant
