@@ -27,10 +27,7 @@ const TechniqueInfo& DepthImpostorsPass::info() const {
 }
 
 Requirements DepthImpostorsPass::requirements(const Scene& scene, const api::RenderRequest& request) const {
-  const SceneFeatures f = mediaFeatures(scene.features, request.media);
-  return f.hasMedia() ? Requirements::ok()
-                      : Requirements::skip("the frame has no participating media (no RADIANT_particle_system "
-                                           "node in the scene, no media in the request)");
+  return mediaRequirements(scene, request);
 }
 
 GroundTruth DepthImpostorsPass::groundTruth(const Params&, const std::string& aov) const {
@@ -119,18 +116,7 @@ void DepthImpostorsPass::execute(PassContext& ctx) {
   if (blocks > 0) set.orderBuffer.upload(order_.data(), order_.size() * sizeof(int));
   const bool hasDepth = res.hasTexture("gbuffer_position") && res.written("gbuffer_position");
 
-  gl::Framebuffer& target = res.framebuffer("media");
-  target.bind();
-  glViewport(0, 0, view.width, view.height);
-  const float clear[4] = {0.f, 0.f, 0.f, 1.f};
-  glClearNamedFramebufferfv(target.id(), GL_COLOR, 0, clear);
-  glDisable(GL_DEPTH_TEST);
-  glDepthMask(GL_FALSE);
-  glDisable(GL_CULL_FACE);
-  glEnable(GL_BLEND);
-  glBlendEquation(GL_FUNC_ADD);
-  // C = alpha L + (1 - alpha) C; T = (1 - alpha) T.
-  glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE_MINUS_SRC_ALPHA);
+  beginMediaLayer(res.framebuffer("media"), view.width, view.height);
   vao_.bind();
   if (hasDepth) res.texture("gbuffer_position").bindUnit(0);
   set.front.bindUnit(1);

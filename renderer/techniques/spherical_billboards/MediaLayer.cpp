@@ -4,6 +4,26 @@
 
 namespace radiant {
 
+Requirements mediaRequirements(const Scene& scene, const api::RenderRequest& request) {
+  const SceneFeatures f = mediaFeatures(scene.features, request.media);
+  return f.hasMedia() ? Requirements::ok()
+                      : Requirements::skip("the frame has no participating media (no RADIANT_particle_system "
+                                           "node in the scene, no media in the request)");
+}
+
+void beginMediaLayer(const gl::Framebuffer& target, int w, int h) {
+  target.bind();
+  glViewport(0, 0, w, h);
+  const float clear[4] = {0.f, 0.f, 0.f, 1.f};  // no light, transmittance 1
+  glClearNamedFramebufferfv(target.id(), GL_COLOR, 0, clear);
+  glDisable(GL_DEPTH_TEST);
+  glDepthMask(GL_FALSE);
+  glDisable(GL_CULL_FACE);
+  glEnable(GL_BLEND);
+  glBlendEquation(GL_FUNC_ADD);
+  glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE_MINUS_SRC_ALPHA);
+}
+
 void declareMediaLayer(FrameResources& res, int w, int h) {
   gl::Texture& media = res.texture("media", GL_TEXTURE_2D, GL_RGBA32F, w, h);
   media.setFilter(GL_NEAREST, GL_NEAREST);

@@ -26,10 +26,7 @@ const TechniqueInfo& SphericalBillboardsPass::info() const {
 }
 
 Requirements SphericalBillboardsPass::requirements(const Scene& scene, const api::RenderRequest& request) const {
-  const SceneFeatures f = mediaFeatures(scene.features, request.media);
-  return f.hasMedia() ? Requirements::ok()
-                      : Requirements::skip("the frame has no participating media (no RADIANT_particle_system "
-                                           "node in the scene, no media in the request)");
+  return mediaRequirements(scene, request);
 }
 
 std::vector<gpu::MediaParticle> SphericalBillboardsPass::gpuParticles(const std::vector<api::ParticleSystem>& media,
@@ -119,19 +116,8 @@ void SphericalBillboardsPass::execute(PassContext& ctx) {
   vao_.bind();
 
   // 1. Particles, back to front, into the layer (or the full-resolution target at ratio 1).
-  gl::Framebuffer& target = res.framebuffer(layered ? "media_layer" : "media");
-  target.bind();
   const int tw = layered ? lowWidth_ : view.width, th = layered ? lowHeight_ : view.height;
-  glViewport(0, 0, tw, th);
-  const float clear[4] = {0.f, 0.f, 0.f, 1.f};  // no light, transmittance 1
-  glClearNamedFramebufferfv(target.id(), GL_COLOR, 0, clear);
-  glDisable(GL_DEPTH_TEST);
-  glDepthMask(GL_FALSE);
-  glDisable(GL_CULL_FACE);
-  glEnable(GL_BLEND);
-  glBlendEquation(GL_FUNC_ADD);
-  // C = alpha L + (1 - alpha) C; T = (1 - alpha) T.
-  glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE_MINUS_SRC_ALPHA);
+  beginMediaLayer(res.framebuffer(layered ? "media_layer" : "media"), tw, th);
   if (hasDepth) res.texture("gbuffer_position").bindUnit(0);
   buffer.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingMediaParticles);
   ctx.gpu.lights.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingLights);
