@@ -7,6 +7,7 @@
 
 #include "renderer/frame/PassContext.h"
 #include "renderer/raytracing/ParticleMedium.h"
+#include "renderer/techniques/spherical_billboards/MediaLayer.h"
 
 namespace radiant {
 
@@ -45,10 +46,7 @@ GroundTruth IlluminationNetworkPass::groundTruth(const Params&, const std::strin
 }
 
 Requirements IlluminationNetworkPass::requirements(const Scene& scene, const api::RenderRequest& request) const {
-  const SceneFeatures f = mediaFeatures(scene.features, request.media);
-  return f.hasMedia() ? Requirements::ok()
-                      : Requirements::skip("the frame has no participating media (no RADIANT_particle_system "
-                                           "node in the scene, no media in the request)");
+  return mediaRequirements(scene, request);
 }
 
 int IlluminationNetworkPass::autoWindow(int nodes) {
@@ -124,17 +122,7 @@ void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, 
                   glm::vec4(0.f), glm::ivec4(gpu::kProfileLinearExact, gpu::kPhaseIsotropic, 0, 0)};
 
   if (vao_.id() == 0) vao_ = gl::VertexArray("illumination_network");
-  const int w = view.width, h = view.height;
-  gl::Texture& media = res.texture("media", GL_TEXTURE_2D, GL_RGBA32F, w, h);
-  media.setFilter(GL_NEAREST, GL_NEAREST);
-  gl::Framebuffer& fb = res.framebuffer("media");
-  fb.attach(GL_COLOR_ATTACHMENT0, media);
-  fb.setDrawBuffers({GL_COLOR_ATTACHMENT0});
-  fb.checkComplete("IlluminationNetworkPass::prepare");
-  gl::Framebuffer& compose = res.framebuffer("media_compose");
-  compose.attach(GL_COLOR_ATTACHMENT0, res.texture("beauty", GL_TEXTURE_2D, GL_RGBA32F, w, h));
-  compose.setDrawBuffers({GL_COLOR_ATTACHMENT0});
-  compose.checkComplete("IlluminationNetworkPass::prepare (compose)");
+  declareMediaLayer(res, view.width, view.height);
   res.buffer("network_splats", std::max<std::size_t>(1, splats_.size()) * sizeof(gpu::MediaParticle));
   res.buffer("network_order", std::max<std::size_t>(1, order_.size()) * sizeof(int));
 }
@@ -178,17 +166,7 @@ void IlluminationNetworkPass::execute(PassContext& ctx) {
   // The splats as spherical billboards (exact chords, no lights: the source is the network's).
   const bool hasDepth = res.hasTexture("gbuffer_position") && res.written("gbuffer_position");
   vao_.bind();
-  gl::Framebuffer& target = res.framebuffer("media");
-  target.bind();
-  glViewport(0, 0, view.width, view.height);
-  const float clear[4] = {0.f, 0.f, 0.f, 1.f};
-  glClearNamedFramebufferfv(target.id(), GL_COLOR, 0, clear);
-  glDisable(GL_DEPTH_TEST);
-  glDepthMask(GL_FALSE);
-  glDisable(GL_CULL_FACE);
-  glEnable(GL_BLEND);
-  glBlendEquation(GL_FUNC_ADD);
-  glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE_MINUS_SRC_ALPHA);
+  beginMediaLayer(res.framebuffer("media"), view.width, view.height);
   if (hasDepth) res.texture("gbuffer_position").bindUnit(0);
   splats.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingMediaParticles);
   ctx.gpu.lights.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingLights);
@@ -212,25 +190,8 @@ void IlluminationNetworkPass::execute(PassContext& ctx) {
   res.markWritten("media");
   res.markWritten("media_transmittance");
 
-  if (res.ownsLightPath("illumination_network", "media")) {
-    gl::Framebuffer& compose = res.framebuffer("media_compose");
-    compose.bind();
-    glViewport(0, 0, view.width, view.height);
-    if (!res.written("beauty")) {
-      const float sky[4] = {view.ambient.x, view.ambient.y, view.ambient.z, 1.f};
-      glClearNamedFramebufferfv(compose.id(), GL_COLOR, 0, sky);
-    }
-    glEnable(GL_BLEND);
-    glBlendEquation(GL_FUNC_ADD);
-    glBlendFuncSeparate(GL_ONE, GL_SRC_ALPHA, GL_ZERO, GL_ONE);
-    res.texture("media").bindUnit(0);
-    const gl::Program& comp = ctx.shaders.program({"common/fullscreen.vert", "spherical_billboards/compose.frag"});
-    comp.use();
-    glDrawArrays(GL_TRIANGLES, 0, 3);
-    glDisable(GL_BLEND);
-    res.markWritten("beauty");
-  }
-  glDepthMask(GL_TRUE);
+  // The planner runs this exclusive pass only when it owns the media light path.
+  composeMediaIntoBeauty(ctx);
 
   auto& c = ctx.stats.counters;
   c["nodes"] = gpu.nodes();
