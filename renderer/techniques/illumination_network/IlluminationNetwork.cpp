@@ -14,6 +14,7 @@ namespace radiant {
 namespace {
 constexpr int kMaxLights = 8;
 constexpr std::size_t kMaxLinks = std::size_t(1) << 20;  // N x D: 16 MiB per radiance buffer
+constexpr std::size_t kMaxBins = std::size_t(1) << 22;   // D x M^2: 16 MiB per bin table (three of them)
 }  // namespace
 
 struct IlluminationNetworkPass::Network {
@@ -63,6 +64,11 @@ void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, 
                         "nodes x directions = " + std::to_string(std::size_t(N) * D) + " exceeds " +
                             std::to_string(kMaxLinks) + " links",
                         "/passes/illumination_network/nodes");
+  if (std::size_t(D) * std::size_t(M) * std::size_t(M) > kMaxBins)
+    throw api::ApiError(422, "invalid-value", "Network window too large",
+                        "directions x window^2 = " + std::to_string(std::size_t(D) * M * M) + " exceeds " +
+                            std::to_string(kMaxBins) + " bins",
+                        "/passes/illumination_network/window");
   const auto seed = params.get<std::uint64_t>("seed", 0);
   const bool fibonacci = params.get<std::string>("sampling", "fibonacci") == "fibonacci";
   const float splatScale = params.get<float>("splat_radius", 1.f);

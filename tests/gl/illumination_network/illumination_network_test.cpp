@@ -106,6 +106,24 @@ TEST(IlluminationNetworkPass, OwnsMediaWhenNamedComposesBeautyAndReportsItsNetwo
   EXPECT_EQ(cornerT, 1.0);    // outside the cloud and every splat
 }
 
+TEST(IlluminationNetworkPass, OversizedNetworksAre422sNamingTheField) {
+  const Scene scene = cloudScene();
+  auto pointerOf = [&](json params) -> std::string {
+    try {
+      render(scene, {{"illumination_network", params}});
+    } catch (const api::ApiError& e) {
+      EXPECT_EQ(e.status, 422);
+      return e.pointer;
+    }
+    return "no error";
+  };
+  EXPECT_EQ(pointerOf({{"nodes", 65536}, {"directions", 32}}), "/passes/illumination_network/nodes");
+  EXPECT_EQ(pointerOf({{"nodes", 64}, {"directions", 512}, {"window", 256}}), "/passes/illumination_network/window");
+  // The renderer keeps serving.
+  const RenderOutput ok = render(scene, network(64, 8, {{"iterations", 1}}));
+  EXPECT_TRUE(testing::allFinite(ok));
+}
+
 TEST(IlluminationNetworkPass, CachedNetworkWarmStartsAndConvergesFurther) {
   const Scene scene = cloudScene();
   json params = network(256, 32, {{"iterations", 4}, {"warm_start", true}, {"seed", 77}});
