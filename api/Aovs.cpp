@@ -48,9 +48,12 @@ const std::vector<AovInfo>& aovTable() {
          "gbuffer", true, ""},
         {0, "reference", F::Rgba32F, "reference", 0, 3, {"reference.R", "reference.G", "reference.B"}, B::Overwrite,
          "reference", true, ""},
-        // Participating media (the media techniques; spherical_billboards first): RGB = the media's
-        // radiance in front of the first surface (premultiplied), A = the camera ray's transmittance to
-        // it; beauty = opaque * A + RGB. Scored against the volumetric reference (VolumeTracer.h).
+        // Participating media: RGB = the media's radiance in front of the first surface
+        // (premultiplied), A = the camera ray's transmittance to it; beauty = opaque * A + RGB. Scored
+        // against the volumetric reference (VolumeTracer.h), in the mode of the technique that wrote it.
+        // Several media techniques produce it, exactly one per frame (light-path class "media",
+        // TechniqueInfo::exclusive): spherical_billboards by default (the producer named here), the one
+        // the request names in passes otherwise.
         {0, "media", F::Rgba32F, "media", 0, 3, {"media.R", "media.G", "media.B"}, B::Overwrite,
          "spherical_billboards", true, "media"},
         {0, "media_transmittance", F::Rgba32F, "media", 3, 1, {"media_transmittance.Y"}, B::Overwrite,

@@ -18,7 +18,8 @@ namespace radiant::api {
 
 enum class AovFormat { Rgba32F, Rgba16F, R32F };  // the GPU format of the resource it is read from
 
-// Overwrite: exactly one technique writes it. Accumulate: every pass with addsToBeauty adds its
+// Overwrite: exactly one technique writes it per frame (AovInfo::producer, or for the media AOVs the
+// media technique that owns the frame's "media" light-path class). Accumulate: every pass with addsToBeauty adds its
 // light into it (beauty); it exists in every frame even when nothing drew.
 enum class AovBlend { Overwrite, Accumulate };
 
@@ -31,7 +32,7 @@ struct AovInfo {
   int channels;                  // channels of the image (1 or 3)
   std::vector<std::string> exr;  // EXR channel names, one per channel
   AovBlend blend;
-  std::string producer;          // Overwrite: the technique that writes it ("compare" for error)
+  std::string producer;          // Overwrite: the technique that writes it by default ("compare" for error)
   bool requestable;              // may appear in outputs[].aovs (error and the compare reference may not)
   // What compare() scores it against when compare.against is "reference": a reference-pass mode
   // (beauty, direct, indirect, ao), or "" when the AOV has no ground truth the reference can render

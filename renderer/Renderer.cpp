@@ -52,7 +52,8 @@ std::size_t sanitize(std::vector<float>& v) {
 // Scores the compared AOV against the ground truth; adds stats.metrics and the "error" and
 // "reference" AOVs.
 void compare(FrameResources& resources, const Scene& scene, const FrameView& view, const api::RenderRequest& request,
-             const Image* target, const std::vector<std::unique_ptr<Technique>>& techniques, RenderOutput& out) {
+             const Image* target, const std::vector<std::unique_ptr<Technique>>& techniques,
+             const std::vector<Technique*>& planned, RenderOutput& out) {
   const api::CompareSpec& c = *request.compare;
   auto test = std::find_if(out.aovs.begin(), out.aovs.end(), [&](const Image& i) { return i.aov == c.aov; });
   if (test == out.aovs.end())
@@ -70,16 +71,20 @@ void compare(FrameResources& resources, const Scene& scene, const FrameView& vie
     // groundTruth, with the frame's parameters of that technique): a reference mode and its
     // parameters, or none, which is an error rather than a score against something else (the specular
     // AOV used to be scored against full beauty).
+    // The producer is the frame's: the media AOVs have several, one per frame (FramePlanner).
     const api::AovInfo* info = api::findAov(c.aov);
     GroundTruth truth;
     if (info && !info->producer.empty()) {
-      auto t = std::find_if(techniques.begin(), techniques.end(),
-                            [&](const auto& tech) { return tech->info().name == info->producer; });
-      if (t != techniques.end()) {
-        auto given = request.passes.find(info->producer);
-        const Params params(api::techniqueParams(info->producer,
-                                                 given == request.passes.end() ? nlohmann::json() : given->second));
-        truth = (*t)->groundTruth(params, c.aov);
+      const Technique* producer = nullptr;
+      for (const Technique* p : planned)
+        if (std::count(p->info().outputs.begin(), p->info().outputs.end(), c.aov)) producer = p;
+      for (const auto& tech : techniques)
+        if (!producer && tech->info().name == info->producer) producer = tech.get();
+      if (producer) {
+        const std::string& name = producer->info().name;
+        auto given = request.passes.find(name);
+        const Params params(api::techniqueParams(name, given == request.passes.end() ? nlohmann::json() : given->second));
+        truth = producer->groundTruth(params, c.aov);
       }
     } else if (info) {
       truth = GroundTruth::fromAovTable(c.aov);  // beauty: the sum of every pass
@@ -401,7 +406,7 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
       stats.budget = std::move(choice.stats);
       api::recordMeasured(stats.budget, stats, msSince(frameStart));  // before compare's reference
     }
-    if (request.compare) compare(im.resources, scene, view, request, inputs.compareTarget, im.techniques, out);
+    if (request.compare) compare(im.resources, scene, view, request, inputs.compareTarget, im.techniques, plan.passes, out);
     stats.renderMs = msSince(frameStart);
     report(1.0);
     if (nonFinite) stats.passes.back().counters["non_finite_pixels_zeroed"] = static_cast<double>(nonFinite);

@@ -52,6 +52,21 @@ FramePlan planFrame(const std::vector<Technique*>& techniques, const Scene& scen
                           "/passes/" + name);
     wanted.insert(it->second);
   }
+  // Two named techniques that each must be the only supplier of a light-path class (the media
+  // techniques): the request is contradictory. The pointer names the later one in registry order.
+  std::map<std::string, std::string> namedExclusive;  // class -> the first named exclusive claimant
+  for (Technique* t : techniques) {
+    const auto& info = t->info();
+    if (!info.exclusive || !request.passes.count(info.name)) continue;
+    for (const auto& cls : info.lightPaths) {
+      auto [it, fresh] = namedExclusive.emplace(cls, info.name);
+      if (!fresh)
+        throw api::ApiError(422, "conflicting-passes", "Conflicting passes",
+                            "passes names both " + it->second + " and " + info.name + ", which both supply '" + cls +
+                                "': one technique per frame owns it (name one of them)",
+                            "/passes/" + info.name);
+    }
+  }
   for (Technique* t : techniques) {
     const auto& info = t->info();
     if (beautyWanted && info.onByDefault) wanted.insert(t);
@@ -113,6 +128,18 @@ FramePlan planFrame(const std::vector<Technique*>& techniques, const Scene& scen
       for (const auto& cls : t->info().lightPaths) plan.lightPaths.emplace(cls, t->info().name);
   for (Technique* t : plan.passes)
     for (const auto& cls : t->info().lightPaths) plan.lightPaths.emplace(cls, t->info().name);
+  // An exclusive technique that lost one of its classes does not run at all (the media AOV has one
+  // writer per frame). Nothing reads the outputs of the exclusive techniques, so no pass loses an input.
+  std::erase_if(plan.passes, [&](Technique* t) {
+    const auto& info = t->info();
+    if (!info.exclusive) return false;
+    for (const auto& cls : info.lightPaths)
+      if (const std::string& owner = plan.lightPaths.at(cls); owner != info.name) {
+        plan.skipped[info.name] = cls + " is owned by " + owner;
+        return true;
+      }
+    return false;
+  });
   return plan;
 }
 

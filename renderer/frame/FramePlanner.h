@@ -3,7 +3,9 @@
 // the request asks for and keeps the passes that produce them, plus the passes the request names and
 // the on-by-default beauty contributors; then it pulls in the producers of their inputs. A pass whose
 // requirements() says skip is dropped with its reason; a pass whose required input has no producer is
-// dropped with "needs <input>, which <producer> did not produce: <reason>".
+// dropped with "needs <input>, which <producer> did not produce: <reason>". Light-path classes go to
+// one technique each (TechniqueInfo::lightPaths, claimsWhenNamed); an exclusive technique that does
+// not own its classes is dropped with "<class> is owned by <owner>" (one media technique per frame).
 #include <map>
 #include <set>
 #include <string>
@@ -29,7 +31,8 @@ bool isFrameAov(const std::string& aov);
 std::string undeclaredWrite(const TechniqueInfo& info, const std::set<std::string>& written);
 
 // `techniques` is in the canonical execution order (renderer/techniques/Registry.cpp).
-// Throws api::ApiError (422) for a requested pass or AOV that no technique knows.
+// Throws api::ApiError (422) for a requested pass or AOV that no technique knows, and for a request
+// that names two exclusive techniques sharing a light-path class (pointer: the later one's /passes/<name>).
 FramePlan planFrame(const std::vector<Technique*>& techniques, const Scene& scene,
                     const api::RenderRequest& request);
 

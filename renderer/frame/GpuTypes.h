@@ -32,6 +32,9 @@ static_assert(kUnitLdmDistance < kUnitIblDfg && kUnitIblDfg < kUnitIblPrefiltere
                   kUnitIblPrefiltered < kUnitAoEmission && kUnitAoEmission < kUnitCount,
               "image-based lighting units follow the specular pass's units");
 static_assert(sizeof(MediaParticle) == 64, "std430 MediaParticle must be 64 bytes");
+static_assert(sizeof(NetworkNode) == 48 && sizeof(NetworkDirection) == 48 && sizeof(NetworkLight) == 32,
+              "std430 network records are whole vec4s");
+static_assert(sizeof(ImpostorBlock) == 64, "std430 ImpostorBlock must be 64 bytes");
 // Kept for existing callers: the first material texture unit.
 inline constexpr int kMaterialTextureUnit0 = kUnitMaterial0;
 

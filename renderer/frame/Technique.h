@@ -32,6 +32,11 @@ struct TechniqueInfo {
   // When the request names this technique, it owns its classes ahead of registry order (a request
   // that asks for light_volumes gets them even when caustics, earlier in the registry, also runs).
   bool claimsWhenNamed = false;
+  // Its light-path classes admit one supplier per frame: when another planned technique owns one of
+  // them, the planner drops this one (skipped: "<class> is owned by <owner>") instead of running it
+  // beside the owner, and a request that names two exclusive techniques sharing a class is a 422. The
+  // media techniques: each writes the media AOV and composes it into beauty (class "media").
+  bool exclusive = false;
 };
 
 // Run or skip, and the reason if skipped. The planner records the reason in the frame stats.

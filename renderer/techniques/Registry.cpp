@@ -2,9 +2,11 @@
 
 #include "renderer/techniques/ambient_occlusion/AmbientOcclusion.h"
 #include "renderer/techniques/caustics/Caustics.h"
+#include "renderer/techniques/depth_impostors/DepthImpostors.h"
 #include "renderer/techniques/direct/Direct.h"
 #include "renderer/techniques/env_diffuse/EnvDiffuse.h"
 #include "renderer/techniques/gbuffer/GBuffer.h"
+#include "renderer/techniques/illumination_network/IlluminationNetwork.h"
 #include "renderer/techniques/light_volumes/LightVolumes.h"
 #include "renderer/techniques/photon_gi/PhotonGi.h"
 #include "renderer/techniques/reference/ReferencePass.h"
@@ -33,6 +35,10 @@ std::vector<std::unique_ptr<Technique>> createTechniques() {
   t.push_back(std::make_unique<TransparencyPass>());  // composites alphaMode BLEND surfaces over the lit frame
   // Media compose over every opaque and blended contribution (beauty = beauty * T + C): after all of them.
   t.push_back(std::make_unique<SphericalBillboardsPass>());
+  // The other media techniques after it: spherical_billboards, first, owns the media AOV by default;
+  // the one a request names owns it instead (TechniqueInfo::exclusive, claimsWhenNamed).
+  t.push_back(std::make_unique<DepthImpostorsPass>());
+  t.push_back(std::make_unique<IlluminationNetworkPass>());  // multiple scattering: owns media when named
   t.push_back(std::make_unique<ReferencePass>());
   return t;
 }

@@ -147,7 +147,39 @@ struct MediaParticle {
   vec4 centerRadius;  // xyz world centre, w radius
   vec4 sourceTau;     // rgb the direction-independent source ((1 - a) L_e + a L_ambient), w tau
   vec4 albedoG;       // rgb albedo (scales the punctual lights' in-scattering), w phase g
-  ivec4 models;       // x density profile (kProfile*), y phase model (kPhase*), zw unused
+  ivec4 models;       // x density profile (kProfile*), y phase model (kPhase*), z block (depth_impostors), w unused
+};
+
+// depth_impostors (renderer/techniques/depth_impostors): one block of particles and its impostor tile.
+RADIANT_CONST int kBindingImpostorBlocks = 4;
+RADIANT_CONST int kBindingImpostorOrder = 5;  // int[]: the blocks back to front
+RADIANT_CONST int kMaxImpostorSlices = 16;  // K: 4 slices per RGBA texture, at most 4 textures
+struct ImpostorBlock {
+  vec4 centerRadius;  // xyz world centre, w radius of the sphere bounding its particles
+  vec4 source;        // rgb the particles' direction-independent source (tau r^3 weighted), w unused
+  vec4 albedoG;       // rgb albedo (tau r^3 weighted), w phase g
+  ivec4 info;         // x impostor tile, y phase model (kPhase*), z light group (slice), w particle count
+};
+
+// ---------------------------------------------------------------------------------------------------
+// Illumination networks (renderer/techniques/illumination_network, shaders/illumination_network).
+
+// One network node: a point of the medium with its local extinction, albedo and emission.
+struct NetworkNode {
+  vec4 positionTau;  // xyz world position, w extinction at the node
+  vec4 albedo;       // rgb single-scattering albedo, w unused
+  vec4 emission;     // rgb source per unit opacity ((1 - a) L_e), w unused
+};
+
+// One shared direction: w the direction of propagation, u and v the window's axes.
+struct NetworkDirection {
+  vec4 w, u, v;  // xyz, w unused
+};
+
+// One directional light as the network sees it: propagation direction and irradiance.
+struct NetworkLight {
+  vec4 direction;   // xyz unit, w unused
+  vec4 irradiance;  // rgb, w unused
 };
 
 #endif

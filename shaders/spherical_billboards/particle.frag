@@ -16,6 +16,7 @@
 //   (unshadowed, thesis 7.2.1) scattered by the phase function at the middle of the ray's segment in
 //   the particle (the closest point to the centre for the screen-parallel and planar chords).
 #include "common/lights.glsl"
+#include "common/particle_density.glsl"
 #include "common/phase.glsl"
 
 layout(std430, binding = kBindingMediaParticles) readonly buffer Particles { MediaParticle particles[]; };
@@ -34,17 +35,6 @@ uniform int u_lightCount;
 
 flat in int v_particle;
 layout(location = 0) out vec4 o_color;
-
-// 2 \int_0^t sqrt(d^2 + s^2) ds.
-float falloffG(float t, float d) { return t * sqrt(d * d + t * t) + (d > 0.0 ? d * d * asinh(t / d) : 0.0); }
-
-// Optical depth of [a, b] (line parameters from the closest point to the centre, at distance d).
-float segmentDepth(int profile, float tau, float r, float d, float a, float b) {
-  if (!(b > a)) return 0.0;
-  if (profile == kProfileConstant) return tau * (b - a);
-  if (profile == kProfileThesis) return tau * (1.0 - d / r) * (b - a);  // eq. 7.4
-  return max(0.0, tau * ((b - a) - (falloffG(b, d) - falloffG(a, d)) / (2.0 * r)));
-}
 
 // The particle's radiance towards the camera at x for a ray along dir.
 vec3 source(MediaParticle q, vec3 x, vec3 dir) {

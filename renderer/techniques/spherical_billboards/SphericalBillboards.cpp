@@ -6,6 +6,7 @@
 
 #include "renderer/frame/PassContext.h"
 #include "renderer/raytracing/Media.h"
+#include "renderer/techniques/spherical_billboards/MediaLayer.h"
 
 namespace radiant {
 
@@ -18,22 +19,23 @@ const TechniqueInfo& SphericalBillboardsPass::info() const {
                                {"media", "media_transmittance"},
                                true,
                                true,
-                               {"media"}};
+                               {"media"},
+                               /*claimsWhenNamed=*/false,
+                               /*exclusive=*/true};  // the default owner of the media AOV: first in the registry
   return i;
 }
 
 Requirements SphericalBillboardsPass::requirements(const Scene& scene, const api::RenderRequest& request) const {
-  const SceneFeatures f = mediaFeatures(scene.features, request.media);
-  return f.hasMedia() ? Requirements::ok()
-                      : Requirements::skip("the frame has no participating media (no RADIANT_particle_system "
-                                           "node in the scene, no media in the request)");
+  return mediaRequirements(scene, request);
 }
 
 std::vector<gpu::MediaParticle> SphericalBillboardsPass::gpuParticles(const std::vector<api::ParticleSystem>& media,
                                                                      glm::vec3 ambient, glm::vec3 eye,
-                                                                     glm::vec3 forward, bool orthographic, bool sort) {
+                                                                     glm::vec3 forward, bool orthographic, bool sort,
+                                                                     std::vector<int>* systemOf) {
   std::vector<gpu::MediaParticle> out;
   std::vector<float> key;
+  if (systemOf) systemOf->clear();
   for (const api::ParticleSystem& s : media) {
     const int profile = s.profile == api::DensityProfile::Thesis        ? gpu::kProfileThesis
                         : s.profile == api::DensityProfile::LinearExact ? gpu::kProfileLinearExact
@@ -49,9 +51,10 @@ std::vector<gpu::MediaParticle> SphericalBillboardsPass::gpuParticles(const std:
       out.push_back({glm::vec4(p.position, p.radius), glm::vec4(source, p.tau), glm::vec4(p.albedo, s.g),
                      glm::ivec4(profile, phase, 0, 0)});
       key.push_back(orthographic ? glm::dot(p.position - eye, forward) : glm::length(p.position - eye));
+      if (systemOf) systemOf->push_back(static_cast<int>(&s - media.data()));
     }
   }
-  if (!sort) return out;
+  if (!sort || systemOf) return out;  // systemOf: unsorted, so that it stays parallel
   std::vector<std::size_t> order(out.size());
   std::iota(order.begin(), order.end(), std::size_t(0));
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key[a] > key[b]; });
@@ -86,12 +89,7 @@ void SphericalBillboardsPass::prepare(const Scene&, const Params& params, FrameR
 
   if (vao_.id() == 0) vao_ = gl::VertexArray("spherical_billboards");
   const int w = view.width, h = view.height;
-  gl::Texture& media = res.texture("media", GL_TEXTURE_2D, GL_RGBA32F, w, h);
-  media.setFilter(GL_NEAREST, GL_NEAREST);
-  gl::Framebuffer& fb = res.framebuffer("media");
-  fb.attach(GL_COLOR_ATTACHMENT0, media);
-  fb.setDrawBuffers({GL_COLOR_ATTACHMENT0});
-  fb.checkComplete("SphericalBillboardsPass::prepare");
+  declareMediaLayer(res, w, h);
   lowWidth_ = std::max(1, static_cast<int>(std::ceil(w * ratio_)));
   lowHeight_ = std::max(1, static_cast<int>(std::ceil(h * ratio_)));
   if (ratio_ < 1.f) {
@@ -102,10 +100,6 @@ void SphericalBillboardsPass::prepare(const Scene&, const Params& params, FrameR
     lfb.setDrawBuffers({GL_COLOR_ATTACHMENT0});
     lfb.checkComplete("SphericalBillboardsPass::prepare (layer)");
   }
-  gl::Framebuffer& compose = res.framebuffer("media_compose");
-  compose.attach(GL_COLOR_ATTACHMENT0, res.texture("beauty", GL_TEXTURE_2D, GL_RGBA32F, w, h));
-  compose.setDrawBuffers({GL_COLOR_ATTACHMENT0});
-  compose.checkComplete("SphericalBillboardsPass::prepare (compose)");
   // Capacity in powers of two, so a sweep over particle counts rarely reallocates.
   std::size_t capacity = 64;
   while (capacity < particles_.size()) capacity *= 2;
@@ -122,19 +116,8 @@ void SphericalBillboardsPass::execute(PassContext& ctx) {
   vao_.bind();
 
   // 1. Particles, back to front, into the layer (or the full-resolution target at ratio 1).
-  gl::Framebuffer& target = res.framebuffer(layered ? "media_layer" : "media");
-  target.bind();
   const int tw = layered ? lowWidth_ : view.width, th = layered ? lowHeight_ : view.height;
-  glViewport(0, 0, tw, th);
-  const float clear[4] = {0.f, 0.f, 0.f, 1.f};  // no light, transmittance 1
-  glClearNamedFramebufferfv(target.id(), GL_COLOR, 0, clear);
-  glDisable(GL_DEPTH_TEST);
-  glDepthMask(GL_FALSE);
-  glDisable(GL_CULL_FACE);
-  glEnable(GL_BLEND);
-  glBlendEquation(GL_FUNC_ADD);
-  // C = alpha L + (1 - alpha) C; T = (1 - alpha) T.
-  glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE_MINUS_SRC_ALPHA);
+  beginMediaLayer(res.framebuffer(layered ? "media_layer" : "media"), tw, th);
   if (hasDepth) res.texture("gbuffer_position").bindUnit(0);
   buffer.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingMediaParticles);
   ctx.gpu.lights.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingLights);
@@ -174,24 +157,8 @@ void SphericalBillboardsPass::execute(PassContext& ctx) {
   res.markWritten("media");
   res.markWritten("media_transmittance");
 
-  // 3. beauty = beauty * T + C. A frame without opaque passes starts from the sky.
-  gl::Framebuffer& compose = res.framebuffer("media_compose");
-  compose.bind();
-  glViewport(0, 0, view.width, view.height);
-  if (!res.written("beauty")) {
-    const float sky[4] = {view.ambient.x, view.ambient.y, view.ambient.z, 1.f};
-    glClearNamedFramebufferfv(compose.id(), GL_COLOR, 0, sky);
-  }
-  glEnable(GL_BLEND);
-  glBlendEquation(GL_FUNC_ADD);
-  glBlendFuncSeparate(GL_ONE, GL_SRC_ALPHA, GL_ZERO, GL_ONE);
-  res.texture("media").bindUnit(0);
-  const gl::Program& comp = ctx.shaders.program({"common/fullscreen.vert", "spherical_billboards/compose.frag"});
-  comp.use();
-  glDrawArrays(GL_TRIANGLES, 0, 3);
-  glDisable(GL_BLEND);
-  glDepthMask(GL_TRUE);
-  res.markWritten("beauty");
+  // 3. beauty = beauty * T + C.
+  composeMediaIntoBeauty(ctx);
 
   ctx.stats.counters["particles"] = static_cast<double>(particles_.size());
   ctx.stats.counters["overdraw_estimate"] = overdraw_;

@@ -30,10 +30,12 @@ public:
 
   // The particles of `media` as the shaders read them, with their direction-independent source
   // radiance, sorted back to front for the view from `eye` (forward: the view direction, the sort key
-  // of orthographic cameras) when `sort` (else in the systems' order).
+  // of orthographic cameras) when `sort` (else in the systems' order). `systemOf` (when given; the
+  // particles are then unsorted) receives each particle's index in `media`.
   static std::vector<gpu::MediaParticle> gpuParticles(const std::vector<api::ParticleSystem>& media,
                                                       glm::vec3 ambient, glm::vec3 eye, glm::vec3 forward,
-                                                      bool orthographic, bool sort);
+                                                      bool orthographic, bool sort,
+                                                      std::vector<int>* systemOf = nullptr);
 
 private:
   std::vector<gpu::MediaParticle> particles_;

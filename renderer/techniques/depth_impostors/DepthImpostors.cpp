@@ -1,0 +1,173 @@
+#include "renderer/techniques/depth_impostors/DepthImpostors.h"
+
+#include <algorithm>
+#include <numeric>
+
+#include "renderer/frame/FrameResources.h"
+#include "renderer/frame/FrameView.h"
+#include "renderer/frame/PassContext.h"
+#include "renderer/techniques/spherical_billboards/MediaLayer.h"
+#include "renderer/techniques/spherical_billboards/SphericalBillboards.h"
+
+namespace radiant {
+
+const TechniqueInfo& DepthImpostorsPass::info() const {
+  static const TechniqueInfo i{"depth_impostors",
+                               "Particle clouds as blocks with double-layered depth impostors and light slices "
+                               "(thesis ch. 8): self-shadowed single scattering",
+                               {},
+                               {"gbuffer_position"},
+                               {"media", "media_transmittance"},
+                               /*addsToBeauty=*/true,
+                               /*onByDefault=*/false,
+                               {"media"},
+                               /*claimsWhenNamed=*/true,
+                               /*exclusive=*/true};
+  return i;
+}
+
+Requirements DepthImpostorsPass::requirements(const Scene& scene, const api::RenderRequest& request) const {
+  return mediaRequirements(scene, request);
+}
+
+GroundTruth DepthImpostorsPass::groundTruth(const Params&, const std::string& aov) const {
+  if (aov == "media") return {nlohmann::json{{"aov", "media"}, {"media_mode", "single_scatter"}}};
+  return GroundTruth::fromAovTable(aov);
+}
+
+void DepthImpostorsPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
+  const FrameView& view = res.view();
+  particlesPerBlock_ = params.get<int>("particles_per_block", 64);
+  requestedRes_ = params.get<int>("impostor_resolution", 32);
+  const int K = params.get<int>("slices", 8);
+  const int sliceRes = params.get<int>("slice_resolution", 128);
+  clipScaling_ = params.get<std::string>("clip_scaling", "exponential") == "linear" ? 0 : 1;
+  forwardScatter_ = params.get<bool>("forward_scatter", false) ? 1 : 0;
+  const glm::vec3 forward = -glm::normalize(glm::vec3(view.camera.world[2]));
+  const bool ortho = view.camera.projection == ProjectionType::Orthographic;
+
+  // Blocks: the medium and b only (a sweep over the other knots, the camera or the light reuses them).
+  const std::string blockKey = view.mediaKey + "|b=" + std::to_string(particlesPerBlock_);
+  const impostors::BlockSet& blocks = res.cached<impostors::BlockSet>("depth_impostors.blocks", blockKey, [&] {
+    std::vector<int> systemOf;
+    const auto particles =
+        SphericalBillboardsPass::gpuParticles(view.media, view.ambient, view.eye, forward, ortho, false, &systemOf);
+    return std::make_unique<impostors::BlockSet>(impostors::buildBlocks(particles, systemOf, particlesPerBlock_));
+  });
+  const impostors::AtlasLayout layout = impostors::atlasLayout(static_cast<int>(blocks.blocks.size()), requestedRes_);
+  if (!blocks.blocks.empty() && layout.res == 0)
+    throw api::ApiError(422, "out-of-range", "Too many blocks",
+                        std::to_string(blocks.blocks.size()) + " blocks do not fit the impostor atlas (" +
+                            std::to_string(impostors::AtlasLayout::kMaxAtlas) + " texels a side, tiles of at least " +
+                            std::to_string(impostors::AtlasLayout::kMinRes) + "); raise particles_per_block",
+                        "/passes/depth_impostors/particles_per_block");
+
+  // The view axis and the shadowed light (the first punctual light).
+  viewAxis_ = ortho ? impostors::ImpostorAxis{0, forward} : impostors::ImpostorAxis{1, view.eye};
+  hasLight_ = !scene.lights.empty() && !blocks.blocks.empty();
+  glm::vec3 lo(1e30f), hi(-1e30f);
+  for (const auto& b : blocks.blocks) lo = glm::min(lo, b.center - b.radius), hi = glm::max(hi, b.center + b.radius);
+  glm::vec3 sliceAxis(0.f, -1.f, 0.f);
+  if (hasLight_) {
+    const Light& l = scene.lights.front();
+    if (l.type == LightType::Directional) {
+      lightAxis_ = {0, glm::normalize(l.direction)};
+      sliceAxis = lightAxis_.axis;
+    } else {
+      lightAxis_ = {1, l.position};
+      const glm::vec3 toCenter = 0.5f * (lo + hi) - l.position;
+      sliceAxis = glm::length(toCenter) > 0.f ? glm::normalize(toCenter) : glm::vec3(0.f, -1.f, 0.f);
+    }
+  }
+  frame_ = impostors::fitSliceFrame(blocks.blocks, sliceAxis, K);
+
+  // Impostors and slices: everything they are drawn from.
+  auto f3 = [](const glm::vec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); };
+  const nlohmann::json key = {{"blocks", blockKey},
+                              {"res", layout.res},
+                              {"slices", K},
+                              {"slice_res", sliceRes},
+                              {"view", {viewAxis_.mode, f3(viewAxis_.axis)}},
+                              {"light", hasLight_ ? nlohmann::json{lightAxis_.mode, f3(lightAxis_.axis), f3(sliceAxis)}
+                                                  : nlohmann::json(nullptr)}};
+  set_ = &res.cached<impostors::ImpostorSet>("depth_impostors.impostors", key.dump(), [&] {
+    return std::make_unique<impostors::ImpostorSet>(blocks, layout, K, sliceRes);
+  });
+
+  // Back to front (a few thousand blocks at most: sorted on the CPU every frame).
+  order_.resize(blocks.blocks.size());
+  std::iota(order_.begin(), order_.end(), 0);
+  std::vector<float> dist(blocks.blocks.size());
+  for (std::size_t i = 0; i < dist.size(); ++i)
+    dist[i] = ortho ? glm::dot(blocks.blocks[i].center - view.eye, forward) : glm::length(blocks.blocks[i].center - view.eye);
+  std::stable_sort(order_.begin(), order_.end(), [&](int a, int b) { return dist[a] > dist[b]; });
+
+  if (vao_.id() == 0) vao_ = gl::VertexArray("depth_impostors.gather");
+  declareMediaLayer(res, view.width, view.height);
+}
+
+void DepthImpostorsPass::execute(PassContext& ctx) {
+  FrameResources& res = ctx.resources;
+  const FrameView& view = ctx.view;
+  impostors::ImpostorSet& set = *set_;
+  const bool rebuilt = !set.built;
+  if (rebuilt) set.build(ctx.shaders, viewAxis_, hasLight_ ? &lightAxis_ : nullptr, frame_);
+  const int blocks = static_cast<int>(set.blocks().blocks.size());
+  if (blocks > 0) set.orderBuffer.upload(order_.data(), order_.size() * sizeof(int));
+  const bool hasDepth = res.hasTexture("gbuffer_position") && res.written("gbuffer_position");
+
+  beginMediaLayer(res.framebuffer("media"), view.width, view.height);
+  vao_.bind();
+  if (hasDepth) res.texture("gbuffer_position").bindUnit(0);
+  set.front.bindUnit(1);
+  set.back.bindUnit(2);
+  set.transmittance.bindUnit(3);
+  for (int i = 0; i < 4; ++i) set.sliceTextures[i].bindUnit(4 + i);
+  set.blockBuffer.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingImpostorBlocks);
+  set.orderBuffer.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingImpostorOrder);
+  ctx.gpu.lights.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingLights);
+  const gl::Program& prog = ctx.shaders.program({"depth_impostors/gather.vert", "depth_impostors/gather.frag"});
+  prog.use();
+  prog.setMat4("u_view", &view.view[0][0]);
+  prog.setMat4("u_proj", &view.proj[0][0]);
+  prog.setMat4("u_invViewProj", &view.invViewProj[0][0]);
+  prog.set("u_znear", view.camera.znear);
+  prog.set("u_orthographic", view.camera.projection == ProjectionType::Orthographic ? 1 : 0);
+  prog.set("u_hasDepth", hasDepth ? 1 : 0);
+  const float targetSize[2] = {static_cast<float>(view.width), static_cast<float>(view.height)};
+  prog.set("u_targetSize", targetSize, 2);
+  glProgramUniform2i(prog.id(), prog.uniformLocation("u_fullSize"), view.width, view.height);
+  prog.set("u_axisMode", viewAxis_.mode);
+  prog.set("u_axis", &viewAxis_.axis.x, 3);
+  prog.set("u_res", set.layout().res);
+  prog.set("u_tilesX", set.layout().tilesX);
+  prog.set("u_clipScaling", clipScaling_);
+  prog.set("u_lightCount", static_cast<int>(ctx.scene.lights.size()));
+  prog.set("u_shadowedLight", hasLight_ ? 0 : -1);
+  const impostors::SliceFrame& f = set.frame();
+  prog.set("u_slices", set.slices());
+  prog.set("u_sliceCenter", &f.center.x, 3);
+  prog.set("u_sliceAxis", &f.axis.x, 3);
+  prog.set("u_sliceU", &f.u.x, 3);
+  prog.set("u_sliceV", &f.v.x, 3);
+  prog.set("u_sliceHalf", f.halfSize);
+  prog.set("u_sliceDmin", f.dmin);
+  prog.set("u_sliceDmax", f.dmax);
+  prog.set("u_forwardScatter", forwardScatter_);
+  prog.set("u_sliceTexel", 1.f / static_cast<float>(set.sliceResolution()));
+  if (blocks > 0) glDrawArraysInstanced(GL_TRIANGLES, 0, 6, blocks);
+  glDisable(GL_BLEND);
+  res.markWritten("media");
+  res.markWritten("media_transmittance");
+  composeMediaIntoBeauty(ctx);
+
+  ctx.stats.counters["particles"] = static_cast<double>(set.blocks().particles.size());
+  ctx.stats.counters["blocks"] = blocks;
+  ctx.stats.counters["particles_per_block"] = particlesPerBlock_;
+  ctx.stats.counters["impostor_resolution"] = set.layout().res;  // may be below the requested one (atlas limit)
+  ctx.stats.counters["slices"] = set.slices();
+  ctx.stats.counters["shadowed_lights"] = hasLight_ ? 1 : 0;
+  ctx.stats.counters["impostors_rebuilt"] = rebuilt ? 1 : 0;
+}
+
+}  // namespace radiant

@@ -1,0 +1,41 @@
+#pragma once
+// Hierarchical depth impostors (thesis ch. 8, Algorithm 6): self-shadowed single scattering for large
+// particle clouds. Particles are grouped into blocks (spatial clusters, Blocks.h); every block gets a
+// depth impostor for the view and for the shadowed light (front depth MIN, back depth MAX,
+// transmittance multiplied, one pass); the blocks' light impostors are accumulated into K light
+// slices, 4 per RGBA texture, by commutative multiplicative blending (no sorting); and the blocks are
+// gathered back to front, their opacity scaled where the scene depth lies inside the block, the
+// light's transmittance interpolated between the enclosing slices (Impostors.h, shaders/depth_impostors).
+//
+// Owns the media AOV when the request names it (TechniqueInfo::exclusive, claimsWhenNamed), otherwise
+// spherical_billboards does. The first punctual light of the scene is shadowed by the slices, the
+// others and the sky are not (the sky adds albedo * ambient per block). Ground truth: the volumetric
+// reference's single_scatter mode. Blocks and impostors are cached by the medium and parameters, the
+// impostors also by the camera and the light.
+#include <vector>
+
+#include "renderer/frame/Technique.h"
+#include "renderer/gl/Gl.h"
+#include "renderer/techniques/depth_impostors/Impostors.h"
+
+namespace radiant {
+
+class DepthImpostorsPass final : public Technique {
+public:
+  const TechniqueInfo& info() const override;
+  Requirements requirements(const Scene&, const api::RenderRequest&) const override;
+  GroundTruth groundTruth(const Params& params, const std::string& aov) const override;
+  void prepare(const Scene&, const Params&, FrameResources&) override;
+  void execute(PassContext&) override;
+
+private:
+  impostors::ImpostorSet* set_ = nullptr;  // cached in FrameResources
+  impostors::ImpostorAxis viewAxis_, lightAxis_;
+  impostors::SliceFrame frame_;
+  bool hasLight_ = false;
+  std::vector<int> order_;  // blocks back to front
+  gl::VertexArray vao_;
+  int clipScaling_ = 1, forwardScatter_ = 0, particlesPerBlock_ = 0, requestedRes_ = 0;
+};
+
+}  // namespace radiant

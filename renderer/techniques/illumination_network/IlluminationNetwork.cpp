@@ -1,0 +1,223 @@
+#include "renderer/techniques/illumination_network/IlluminationNetwork.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+
+#include "renderer/frame/PassContext.h"
+#include "renderer/raytracing/ParticleMedium.h"
+#include "renderer/techniques/spherical_billboards/MediaLayer.h"
+
+namespace radiant {
+
+namespace {
+constexpr int kMaxLights = 8;
+constexpr std::size_t kMaxLinks = std::size_t(1) << 20;  // N x D: 16 MiB per radiance buffer
+constexpr std::size_t kMaxBins = std::size_t(1) << 22;   // D x M^2: 16 MiB per bin table (three of them)
+}  // namespace
+
+struct IlluminationNetworkPass::Network {
+  std::unique_ptr<rt::ParticleMedium> medium;  // for the exact light transmittance
+  network::NodeSet nodes;
+  std::vector<network::Direction> dirs;
+  std::unique_ptr<network::NetworkGpu> gpu;
+  double occupancy = 0.0, contraction = 0.0, splatRadius = 0.0;
+  int longestChain = 0;
+  bool stateValid = false;  // the GPU radiance holds an earlier request's solution
+};
+
+const TechniqueInfo& IlluminationNetworkPass::info() const {
+  static const TechniqueInfo i{"illumination_network",
+                               "Multiple scattering in static particle media by illumination networks (thesis ch. 9)",
+                               {},
+                               {"gbuffer_position"},
+                               {"media", "media_transmittance"},
+                               true,
+                               false,
+                               {"media"},
+                               /*claimsWhenNamed=*/true,
+                               /*exclusive=*/true};  // owns the media AOV when the request names it
+  return i;
+}
+
+GroundTruth IlluminationNetworkPass::groundTruth(const Params&, const std::string& aov) const {
+  if (aov != "media" && aov != "media_transmittance") return {};
+  return {nlohmann::json{{"aov", aov}, {"media_mode", "full"}}};
+}
+
+Requirements IlluminationNetworkPass::requirements(const Scene& scene, const api::RenderRequest& request) const {
+  return mediaRequirements(scene, request);
+}
+
+int IlluminationNetworkPass::autoWindow(int nodes) {
+  return std::max(1, static_cast<int>(std::lround(std::cbrt(4.0 * nodes / 3.14159265358979))));
+}
+
+void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
+  const FrameView& view = res.view();
+  const int N = params.get<int>("nodes", 1024), D = params.get<int>("directions", 128);
+  int M = params.get<int>("window", 0);
+  if (M == 0) M = autoWindow(N);
+  if (std::size_t(N) * std::size_t(D) > kMaxLinks)
+    throw api::ApiError(422, "invalid-value", "Network too large",
+                        "nodes x directions = " + std::to_string(std::size_t(N) * D) + " exceeds " +
+                            std::to_string(kMaxLinks) + " links",
+                        "/passes/illumination_network/nodes");
+  if (std::size_t(D) * std::size_t(M) * std::size_t(M) > kMaxBins)
+    throw api::ApiError(422, "invalid-value", "Network window too large",
+                        "directions x window^2 = " + std::to_string(std::size_t(D) * M * M) + " exceeds " +
+                            std::to_string(kMaxBins) + " bins",
+                        "/passes/illumination_network/window");
+  const auto seed = params.get<std::uint64_t>("seed", 0);
+  const bool fibonacci = params.get<std::string>("sampling", "fibonacci") == "fibonacci";
+  const float splatScale = params.get<float>("splat_radius", 1.f);
+  const std::string digest = view.mediaKey + "|" + std::to_string(N) + "|" + std::to_string(D) + "|" +
+                             std::to_string(M) + "|" + params.subsetKey({"seed", "sampling"});
+  fresh_ = false;
+  net_ = &res.cached<Network>("illumination_network", digest, [&] {
+    auto n = std::make_unique<Network>();
+    n->medium = std::make_unique<rt::ParticleMedium>(view.media);
+    n->nodes = network::sampleNodes(*n->medium, N, seed);
+    n->dirs = network::makeDirections(D, fibonacci, seed);
+    const auto W = network::phaseWeights(n->dirs, n->nodes.phase, n->nodes.g);
+    n->gpu = std::make_unique<network::NetworkGpu>(n->nodes, n->dirs, W, M, kMaxLights);
+    fresh_ = true;
+    return n;
+  });
+  iterations_ = params.get<int>("iterations", 32);
+  warm_ = params.get<bool>("warm_start", true) && net_->stateValid;
+
+  // Directional lights (the network's lights) and their transmittance to every node, recomputed per
+  // frame since lights move: exact through the medium, or from the network's chains along each light.
+  lights_.clear();
+  ignoredLights_ = 0;
+  for (const Light& l : scene.lights) {
+    if (l.type != LightType::Directional || !(glm::length(l.direction) > 0.f) ||
+        static_cast<int>(lights_.size()) == kMaxLights) {
+      ++ignoredLights_;
+      continue;
+    }
+    lights_.push_back({glm::normalize(l.direction), l.color * l.intensity});
+  }
+  transmittance_ = params.get<std::string>("light_transmittance", "exact") == "network"
+                       ? network::lightTransmittance(net_->nodes, lights_, M)
+                       : network::lightTransmittance(net_->nodes, lights_, *net_->medium);
+
+  // Splats: each node a linear-falloff sphere carrying mass / N of the optical mass, of radius
+  // splat_radius times the mean node spacing (V / N)^(1/3), V = mass / (mean node extinction).
+  const auto& nodes = net_->nodes.nodes;
+  double meanTau = 0.0;
+  for (const auto& n : nodes) meanTau += n.tau / double(nodes.size());
+  const double volume = meanTau > 0.0 ? net_->nodes.mass / meanTau : 0.0;
+  const double r = splatScale * std::cbrt(volume / double(std::max<std::size_t>(1, nodes.size())));
+  const double m = net_->nodes.mass / double(std::max<std::size_t>(1, nodes.size()));
+  const float tauSplat = r > 0.0 ? static_cast<float>(3.0 * m / (3.14159265358979 * r * r * r)) : 0.f;
+  net_->splatRadius = r;
+  const glm::vec3 forward = -glm::normalize(glm::vec3(view.camera.world[2]));
+  const bool ortho = view.camera.projection == ProjectionType::Orthographic;
+  std::vector<float> key(nodes.size());
+  for (std::size_t p = 0; p < nodes.size(); ++p)
+    key[p] = ortho ? glm::dot(nodes[p].position - view.eye, forward) : glm::length(nodes[p].position - view.eye);
+  order_.resize(nodes.size());
+  std::iota(order_.begin(), order_.end(), 0);
+  std::stable_sort(order_.begin(), order_.end(), [&](int a, int b) { return key[std::size_t(a)] > key[std::size_t(b)]; });
+  splats_.resize(nodes.size());
+  for (std::size_t s = 0; s < nodes.size(); ++s)
+    splats_[s] = {glm::vec4(nodes[std::size_t(order_[s])].position, static_cast<float>(r)), glm::vec4(0.f, 0.f, 0.f, tauSplat),
+                  glm::vec4(0.f), glm::ivec4(gpu::kProfileLinearExact, gpu::kPhaseIsotropic, 0, 0)};
+
+  if (vao_.id() == 0) vao_ = gl::VertexArray("illumination_network");
+  declareMediaLayer(res, view.width, view.height);
+  res.buffer("network_splats", std::max<std::size_t>(1, splats_.size()) * sizeof(gpu::MediaParticle));
+  res.buffer("network_order", std::max<std::size_t>(1, order_.size()) * sizeof(int));
+}
+
+void IlluminationNetworkPass::execute(PassContext& ctx) {
+  FrameResources& res = ctx.resources;
+  const FrameView& view = ctx.view;
+  network::NetworkGpu& gpu = *net_->gpu;
+  const bool build = !gpu.visibilityBuilt();
+  if (build) {
+    gpu.buildVisibility(ctx.shaders);
+    // Link statistics, once per network.
+    const network::Visibility V = gpu.downloadVisibility();
+    net_->occupancy = V.occupancy();
+    net_->longestChain = V.longestChain();
+    double q = 0.0;
+    for (int p = 0; p < V.nodes; ++p)
+      for (int i = 0; i < V.directions; ++i) {
+        const std::size_t at = std::size_t(p) * V.directions + i;
+        const int up = V.upstream[at];
+        const glm::vec3 a = net_->nodes.nodes[std::size_t(up >= 0 ? up : p)].albedo;
+        q = std::max(q, 1.0 - double(V.alpha[at]) * (1.0 - double(std::max(a.x, std::max(a.y, a.z)))));
+      }
+    net_->contraction = q;
+  }
+  gpu.setLights(lights_, transmittance_);
+  if (!warm_) gpu.clearRadiance();
+  const std::vector<double> residuals = gpu.iterate(ctx.shaders, iterations_, view.ambient);
+  net_->stateValid = true;
+
+  gl::Buffer& splats = res.buffer("network_splats");
+  gl::Buffer& order = res.buffer("network_order");
+  if (!splats_.empty()) {
+    splats.upload(splats_.data(), splats_.size() * sizeof(gpu::MediaParticle));
+    order.upload(order_.data(), order_.size() * sizeof(int));
+  }
+  const glm::vec3 toCamera = glm::normalize(glm::vec3(view.camera.world[2]));
+  gpu.cameraSources(ctx.shaders, order, splats, view.camera.projection == ProjectionType::Orthographic, view.eye,
+                    toCamera);
+
+  // The splats as spherical billboards (exact chords, no lights: the source is the network's).
+  const bool hasDepth = res.hasTexture("gbuffer_position") && res.written("gbuffer_position");
+  vao_.bind();
+  beginMediaLayer(res.framebuffer("media"), view.width, view.height);
+  if (hasDepth) res.texture("gbuffer_position").bindUnit(0);
+  splats.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingMediaParticles);
+  ctx.gpu.lights.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingLights);
+  const gl::Program& prog = ctx.shaders.program({"spherical_billboards/particle.vert", "spherical_billboards/particle.frag"});
+  prog.use();
+  prog.setMat4("u_view", &view.view[0][0]);
+  prog.setMat4("u_proj", &view.proj[0][0]);
+  prog.setMat4("u_invViewProj", &view.invViewProj[0][0]);
+  prog.set("u_znear", view.camera.znear);
+  prog.set("u_orthographic", view.camera.projection == ProjectionType::Orthographic ? 1 : 0);
+  prog.set("u_hasDepth", hasDepth ? 1 : 0);
+  const float targetSize[2] = {static_cast<float>(view.width), static_cast<float>(view.height)};
+  prog.set("u_targetSize", targetSize, 2);
+  glProgramUniform2i(prog.id(), prog.uniformLocation("u_fullSize"), view.width, view.height);
+  prog.set("u_method", 0);
+  prog.set("u_chord", 0);
+  prog.set("u_softScale", 1.f);
+  prog.set("u_lightCount", 0);
+  if (!splats_.empty()) glDrawArraysInstanced(GL_TRIANGLES, 0, 6, static_cast<GLsizei>(splats_.size()));
+  glDisable(GL_BLEND);
+  res.markWritten("media");
+  res.markWritten("media_transmittance");
+
+  // The planner runs this exclusive pass only when it owns the media light path.
+  composeMediaIntoBeauty(ctx);
+
+  auto& c = ctx.stats.counters;
+  c["nodes"] = gpu.nodes();
+  c["directions"] = gpu.directions();
+  c["window"] = gpu.window();
+  c["link_occupancy"] = net_->occupancy;  // fraction of links that see the sky
+  c["longest_chain"] = net_->longestChain;
+  c["contraction_factor"] = net_->contraction;
+  c["visibility_built"] = build ? 1 : 0;
+  c["warm_start"] = warm_ ? 1 : 0;
+  c["iterations"] = iterations_;
+  c["directional_lights"] = static_cast<double>(lights_.size());
+  c["ignored_lights"] = ignoredLights_;
+  c["splat_radius"] = net_->splatRadius;
+  for (std::size_t n = 0; n < residuals.size(); ++n) {
+    char name[32];
+    std::snprintf(name, sizeof name, "residual_%03zu", n + 1);
+    c[name] = residuals[n];
+  }
+  if (!residuals.empty()) c["residual_last"] = residuals.back();
+}
+
+}  // namespace radiant

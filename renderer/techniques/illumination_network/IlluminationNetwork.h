@@ -1,0 +1,55 @@
+#pragma once
+// Illumination networks (thesis ch. 9, Algorithm 7): multiple scattering in a static particle medium
+// under directional lights, a uniform sky and emission. N nodes sampled from the frame's media in
+// proportion to their extinction carry the incoming radiance of D shared directions; the visibility
+// network V (N x D: upstream node and link opacity) is built on the GPU by per-direction binning in
+// an M x M window and cached with the nodes by medium digest and the parameters that shape it; each
+// request iterates eq. 9.1 `iterations` times, warm-started from the cached radiance (so when only
+// the lights move the previous solution is the start, §9.2). The final image splats every node as a
+// spherical billboard (the spherical_billboards shaders, exact chords) carrying its share of the
+// medium's optical mass and the radiance it sends towards the camera.
+//
+// Writes the `media` AOV (premultiplied radiance, transmittance in media_transmittance) and, when it
+// owns the "media" light path, composes beauty = beauty * T + media. Ground truth: the volumetric
+// reference's `full` mode. CPU side and oracles: Network.h; GPU: NetworkGpu.h.
+#include <memory>
+#include <vector>
+
+#include "renderer/frame/GpuTypes.h"
+#include "renderer/frame/Technique.h"
+#include "renderer/gl/Gl.h"
+#include "renderer/techniques/illumination_network/Network.h"
+#include "renderer/techniques/illumination_network/NetworkGpu.h"
+
+namespace radiant {
+
+class IlluminationNetworkPass final : public Technique {
+public:
+  const TechniqueInfo& info() const override;
+  GroundTruth groundTruth(const Params&, const std::string& aov) const override;
+  Requirements requirements(const Scene&, const api::RenderRequest&) const override;
+  void prepare(const Scene&, const Params&, FrameResources&) override;
+  void execute(PassContext&) override;
+
+  // The window M for "window": 0 (auto). A column through the centre of the bounding sphere holds
+  // about 4N / (pi M^2) nodes, so its links are 2R pi M^2 / (4N) long while a bin is 2R / M wide;
+  // M = round((4N / pi)^(1/3)) makes the two equal (cubic cells: M = 11 for N = 1024, and 11 nodes per
+  // central column), far below the thesis' upper bound, where most links see the sky (notes §4
+  // "Occupancy"). At least 1.
+  static int autoWindow(int nodes);
+
+  struct Network;  // the cached derived data (nodes, directions, GPU network)
+
+private:
+  Network* net_ = nullptr;
+  bool fresh_ = false, warm_ = false;
+  int iterations_ = 0;
+  std::vector<network::DirectionalLight> lights_;
+  std::vector<double> transmittance_;
+  int ignoredLights_ = 0;
+  std::vector<gpu::MediaParticle> splats_;
+  std::vector<int> order_;
+  gl::VertexArray vao_;
+};
+
+}  // namespace radiant

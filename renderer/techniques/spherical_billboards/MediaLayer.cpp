@@ -1,0 +1,62 @@
+#include "renderer/techniques/spherical_billboards/MediaLayer.h"
+
+#include "renderer/frame/FrameView.h"
+
+namespace radiant {
+
+Requirements mediaRequirements(const Scene& scene, const api::RenderRequest& request) {
+  const SceneFeatures f = mediaFeatures(scene.features, request.media);
+  return f.hasMedia() ? Requirements::ok()
+                      : Requirements::skip("the frame has no participating media (no RADIANT_particle_system "
+                                           "node in the scene, no media in the request)");
+}
+
+void beginMediaLayer(const gl::Framebuffer& target, int w, int h) {
+  target.bind();
+  glViewport(0, 0, w, h);
+  const float clear[4] = {0.f, 0.f, 0.f, 1.f};  // no light, transmittance 1
+  glClearNamedFramebufferfv(target.id(), GL_COLOR, 0, clear);
+  glDisable(GL_DEPTH_TEST);
+  glDepthMask(GL_FALSE);
+  glDisable(GL_CULL_FACE);
+  glEnable(GL_BLEND);
+  glBlendEquation(GL_FUNC_ADD);
+  glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE_MINUS_SRC_ALPHA);
+}
+
+void declareMediaLayer(FrameResources& res, int w, int h) {
+  gl::Texture& media = res.texture("media", GL_TEXTURE_2D, GL_RGBA32F, w, h);
+  media.setFilter(GL_NEAREST, GL_NEAREST);
+  gl::Framebuffer& fb = res.framebuffer("media");
+  fb.attach(GL_COLOR_ATTACHMENT0, media);
+  fb.setDrawBuffers({GL_COLOR_ATTACHMENT0});
+  fb.checkComplete("declareMediaLayer");
+  gl::Framebuffer& compose = res.framebuffer("media_compose");
+  compose.attach(GL_COLOR_ATTACHMENT0, res.texture("beauty", GL_TEXTURE_2D, GL_RGBA32F, w, h));
+  compose.setDrawBuffers({GL_COLOR_ATTACHMENT0});
+  compose.checkComplete("declareMediaLayer (compose)");
+}
+
+void composeMediaIntoBeauty(PassContext& ctx) {
+  FrameResources& res = ctx.resources;
+  const FrameView& view = ctx.view;
+  gl::Framebuffer& compose = res.framebuffer("media_compose");
+  compose.bind();
+  glViewport(0, 0, view.width, view.height);
+  if (!res.written("beauty")) {
+    const float sky[4] = {view.ambient.x, view.ambient.y, view.ambient.z, 1.f};
+    glClearNamedFramebufferfv(compose.id(), GL_COLOR, 0, sky);
+  }
+  glEnable(GL_BLEND);
+  glBlendEquation(GL_FUNC_ADD);
+  glBlendFuncSeparate(GL_ONE, GL_SRC_ALPHA, GL_ZERO, GL_ONE);
+  res.texture("media").bindUnit(0);
+  const gl::Program& comp = ctx.shaders.program({"common/fullscreen.vert", "common/media_compose.frag"});
+  comp.use();
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glDisable(GL_BLEND);
+  glDepthMask(GL_TRUE);
+  res.markWritten("beauty");
+}
+
+}  // namespace radiant

@@ -1,0 +1,20 @@
+// Final gathering (thesis 8.1.3): blocks back to front, each as a screen quad covering its bounding
+// sphere (common/sphere_quad.glsl); u_order maps the draw index to the block.
+#include "common/shared.h"
+#include "common/sphere_quad.glsl"
+#include "depth_impostors/frame.glsl"
+
+layout(std430, binding = kBindingImpostorOrder) readonly buffer Order { int order[]; };
+
+uniform mat4 u_view;
+uniform mat4 u_proj;
+uniform float u_znear;
+uniform int u_orthographic;
+
+flat out int v_block;
+
+void main() {
+  v_block = order[gl_InstanceID];
+  const vec4 cr = blocks[v_block].centerRadius;
+  gl_Position = sphereQuadVertex(cr.xyz, cr.w, gl_VertexID, u_view, u_proj, u_znear, u_orthographic == 1);
+}

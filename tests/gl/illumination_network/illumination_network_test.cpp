@@ -1,0 +1,176 @@
+// illumination_network through the Renderer on llvmpipe: planning, media ownership, caching and
+// warm starts, stats, and accuracy against the volumetric reference's `full` mode on the thesis'
+// default cloud: a homogeneous sphere of albedo 0.9 and optical diameter 2 R tau = 20 (R = 1,
+// tau = 10), isotropic phase, lit by a directional light and a uniform sky.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include <gtest/gtest.h>
+
+#include "api/Validate.h"
+#include "renderer/Renderer.h"
+#include "tests/support/RenderTestSupport.h"
+#include "tests/support/SceneBuilder.h"
+
+namespace radiant {
+namespace {
+
+using nlohmann::json;
+using testing::aov;
+using testing::renderer;
+
+const json kCloud = {{"kind", "cloud"}, {"tau", 10.0}, {"albedo", {0.9, 0.9, 0.9}},
+                     {"particles", json::array({{{"p", {0, 0, 0}}, {"r", 1.0}}})}};
+constexpr int kSize = 32;
+
+Scene cloudScene() {
+  testing::SceneBuilder b;
+  b.directionalLight(glm::normalize(glm::vec3(1.f, -0.6f, -0.5f)), 3.f);
+  Scene s = b.build("network-cloud");
+  s.camera = testing::orthoCameraAlongZ(1.2f);
+  return s;
+}
+
+RenderOutput render(const Scene& scene, json passes, json aovs = {"beauty", "media", "media_transmittance"}) {
+  json body = {{"scene", {{"builtin", "unused"}}},
+               {"width", kSize},
+               {"height", kSize},
+               {"ambient", {0.3, 0.35, 0.45}},
+               {"media", json::array({kCloud})},
+               {"outputs", json::array({{{"format", "exr"}, {"aovs", aovs}}})},
+               {"passes", passes}};
+  return renderer().render(scene, api::parseRenderRequest(body));
+}
+
+// The reference image (cached by the renderer across the calls of this process).
+const Image& reference(const Scene& scene) {
+  static RenderOutput out = render(
+      scene, {{"spherical_billboards", false},
+              {"reference", {{"aov", "media"}, {"media_mode", "full"}, {"spp", 256}, {"max_bounces", 64}}}},
+      {"reference"});
+  return aov(out, "reference");
+}
+
+// Relative RMSE of RGB over the image (4 x 4 blocks averaged first, which keeps the reference's
+// Monte Carlo noise, about 3% per pixel at 256 spp, below a 1% floor while the cloud's structure,
+// 8 blocks across, stays resolved).
+double relativeError(const Image& a, const Image& ref) {
+  const int B = 4, n = kSize / B;
+  double e2 = 0, mean = 0;
+  for (int by = 0; by < n; ++by)
+    for (int bx = 0; bx < n; ++bx)
+      for (int c = 0; c < 3; ++c) {
+        double sa = 0, sr = 0;
+        for (int y = 0; y < B; ++y)
+          for (int x = 0; x < B; ++x) sa += a.at(bx * B + x, by * B + y)[c], sr += ref.at(bx * B + x, by * B + y)[c];
+        e2 += std::pow((sa - sr) / (B * B), 2);
+        mean += sr / (B * B);
+      }
+  return std::sqrt(e2 / (n * n * 3)) / (mean / (n * n * 3));
+}
+
+json network(int N, int D, json extra = json::object()) {
+  json p = {{"nodes", N}, {"directions", D}, {"iterations", 64}, {"warm_start", false}};
+  for (auto& [k, v] : extra.items()) p[k] = v;
+  return {{"spherical_billboards", false}, {"illumination_network", p}};
+}
+
+TEST(IlluminationNetworkPass, OwnsMediaWhenNamedComposesBeautyAndReportsItsNetwork) {
+  const Scene scene = cloudScene();
+  const RenderOutput out = render(scene, network(256, 32, {{"iterations", 8}}));
+  ASSERT_TRUE(testing::allFinite(out));
+  EXPECT_EQ(out.stats.lightPaths.at("media"), "illumination_network");
+  const auto* p = testing::pass(out, "illumination_network");
+  ASSERT_NE(p, nullptr);
+  EXPECT_EQ(p->counters.at("nodes"), 256);
+  EXPECT_EQ(p->counters.at("window"), 7);  // round((4 * 256 / pi)^(1/3)) = round(6.88)
+  EXPECT_EQ(p->counters.at("visibility_built"), 1);
+  const double occ = p->counters.at("link_occupancy");
+  EXPECT_GT(occ, 0.0);
+  EXPECT_LT(occ, 1.0);
+  for (int n = 1; n <= 8; ++n) EXPECT_TRUE(p->counters.count("residual_00" + std::to_string(n)));
+  EXPECT_FALSE(p->counters.count("residual_009"));
+  // beauty = sky * T + media (no opaque surfaces: the frame starts from the sky).
+  const Image& b = aov(out, "beauty");
+  const Image& m = aov(out, "media");
+  const Image& T = aov(out, "media_transmittance");
+  const float sky[3] = {0.3f, 0.35f, 0.45f};
+  double maxErr = 0, centreT = T.at(kSize / 2, kSize / 2)[0], cornerT = T.at(0, 0)[0];
+  for (int y = 0; y < kSize; ++y)
+    for (int x = 0; x < kSize; ++x)
+      for (int c = 0; c < 3; ++c)
+        maxErr = std::max(maxErr, double(std::abs(b.at(x, y)[c] - (sky[c] * T.at(x, y)[0] + m.at(x, y)[c]))));
+  EXPECT_LT(maxErr, 1e-5);
+  EXPECT_LT(centreT, 1e-3);   // optical diameter 20 through the centre
+  EXPECT_EQ(cornerT, 1.0);    // outside the cloud and every splat
+}
+
+TEST(IlluminationNetworkPass, OversizedNetworksAre422sNamingTheField) {
+  const Scene scene = cloudScene();
+  auto pointerOf = [&](json params) -> std::string {
+    try {
+      render(scene, {{"illumination_network", params}});
+    } catch (const api::ApiError& e) {
+      EXPECT_EQ(e.status, 422);
+      return e.pointer;
+    }
+    return "no error";
+  };
+  EXPECT_EQ(pointerOf({{"nodes", 65536}, {"directions", 32}}), "/passes/illumination_network/nodes");
+  EXPECT_EQ(pointerOf({{"nodes", 64}, {"directions", 512}, {"window", 256}}), "/passes/illumination_network/window");
+  // The renderer keeps serving.
+  const RenderOutput ok = render(scene, network(64, 8, {{"iterations", 1}}));
+  EXPECT_TRUE(testing::allFinite(ok));
+}
+
+TEST(IlluminationNetworkPass, CachedNetworkWarmStartsAndConvergesFurther) {
+  const Scene scene = cloudScene();
+  json params = network(256, 32, {{"iterations", 4}, {"warm_start", true}, {"seed", 77}});
+  const RenderOutput first = render(scene, params);
+  const RenderOutput second = render(scene, params);
+  const auto* a = testing::pass(first, "illumination_network");
+  const auto* b = testing::pass(second, "illumination_network");
+  ASSERT_TRUE(a && b);
+  EXPECT_EQ(testing::cacheEvent(first, "illumination_network"), 0);
+  EXPECT_EQ(testing::cacheEvent(second, "illumination_network"), 1);
+  EXPECT_EQ(a->counters.at("warm_start"), 0);
+  EXPECT_EQ(b->counters.at("warm_start"), 1);
+  EXPECT_EQ(b->counters.at("visibility_built"), 0);
+  // Iterations 5-8 continue where 1-4 stopped: each residual below the first request's last.
+  std::printf("residuals: cold 1..4 %.3g %.3g %.3g %.3g, warm 5..8 %.3g %.3g %.3g %.3g\n",
+              a->counters.at("residual_001"), a->counters.at("residual_002"), a->counters.at("residual_003"),
+              a->counters.at("residual_004"), b->counters.at("residual_001"), b->counters.at("residual_002"),
+              b->counters.at("residual_003"), b->counters.at("residual_004"));
+  EXPECT_LT(b->counters.at("residual_001"), a->counters.at("residual_004"));
+  EXPECT_LT(b->counters.at("residual_last"), a->counters.at("residual_last"));
+}
+
+// The image error falls with N (the splats shrink and the chains refine). It does not measurably fall
+// with D at these sizes: at N = 1024 the errors for D = 8, 32, 128 were 0.327, 0.322, 0.326 (the
+// splats' lumpiness dominates; the thesis also found the image "not too sensitive" to D), so D is
+// not asserted here; docs/PERFORMANCE.md has the N x D table. The goal of the issue: at N = 1024,
+// D = 128 the error is at most half that of unshadowed single scattering (measured 0.326 against
+// 0.755).
+TEST(IlluminationNetworkPass, ErrorAgainstTheFullReferenceFallsWithNodesAndIsHalfOfSingleScattering) {
+  const Scene scene = cloudScene();
+  const Image& ref = reference(scene);
+  auto error = [&](int N, int D) {
+    const RenderOutput out = render(scene, network(N, D));
+    const double e = relativeError(aov(out, "media"), ref);
+    std::printf("N %4d D %3d: relative error against full %.4f (sky links %.3f, window %.0f)\n", N, D, e,
+                testing::pass(out, "illumination_network")->counters.at("link_occupancy"),
+                testing::pass(out, "illumination_network")->counters.at("window"));
+    return e;
+  };
+  const double n256 = error(256, 128), d128 = error(1024, 128);
+  EXPECT_LT(d128, 0.85 * n256);  // measured 0.456 -> 0.326 (D = 64)
+  // Unshadowed single scattering (spherical_billboards on the same cloud) for scale.
+  const RenderOutput sb = render(scene, {{"spherical_billboards", json::object()}});
+  const double single = relativeError(aov(sb, "media"), ref);
+  std::printf("spherical_billboards (single scattering, unshadowed): %.4f\n", single);
+  EXPECT_LT(2 * d128, single);
+}
+
+}  // namespace
+}  // namespace radiant

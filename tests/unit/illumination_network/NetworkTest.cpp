@@ -1,0 +1,195 @@
+// The illumination network's CPU double-precision iteration (renderer/techniques/illumination_network/
+// Network.h) against its exact oracles (notes thesis-ch6-9.md §4):
+//   quadrature: normalised phase columns sum to 1 (unnormalised ones do not, the more so as g grows);
+//   furnace: albedo 1, no sources, uniform sky L: I = L is the fixed point, reached monotonically from 0;
+//   pure absorber: exact after as many iterations as the longest chain, not before;
+//   contraction: |I^{n+1} - I^n| <= q |I^n - I^{n-1}|, q = max(1 - alpha (1 - a)); the fixed point does
+//     not depend on the start; a warm start after a light rotation needs fewer iterations than a cold one.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "renderer/raytracing/ParticleMedium.h"
+#include "renderer/techniques/illumination_network/Network.h"
+
+namespace radiant::network {
+namespace {
+
+// A homogeneous constant-density sphere of radius 1 (one particle) with extinction tau.
+std::vector<api::ParticleSystem> cloudSphere(float tau, float albedo) {
+  api::ParticleSystem s;
+  s.kind = api::MediumKind::Cloud;
+  api::Particle p;
+  p.radius = 1.f, p.tau = tau, p.albedo = glm::vec3(albedo);
+  s.particles = {p};
+  return {s};
+}
+
+struct Net {
+  NodeSet nodes;
+  std::vector<Direction> dirs;
+  Visibility vis;
+  std::vector<float> W;
+  Problem pb;
+  Net(float tau, float albedo, int N, int D, int M, std::vector<DirectionalLight> lights = {}, glm::dvec3 sky = glm::dvec3(1.0)) {
+    rt::ParticleMedium medium(cloudSphere(tau, albedo));
+    nodes = sampleNodes(medium, N, 7);
+    dirs = makeDirections(D, true, 3);
+    vis = buildVisibility(nodes, dirs, M);
+    W = phaseWeights(dirs, api::PhaseModel::Isotropic, 0.f);
+    pb.nodes = &nodes, pb.dirs = &dirs, pb.visibility = &vis, pb.weights = &W;
+    setLights(std::move(lights), M);
+    pb.sky = sky;
+  }
+  void setLights(std::vector<DirectionalLight> lights, int M) {
+    pb.lights = std::move(lights);
+    pb.transmittance = lightTransmittance(nodes, pb.lights, M);
+  }
+  std::size_t size() const { return nodes.nodes.size() * dirs.size(); }
+};
+
+double maxDiff(const std::vector<glm::dvec3>& a, const std::vector<glm::dvec3>& b) {
+  double m = 0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    const glm::dvec3 d = glm::abs(a[k] - b[k]);
+    m = std::max(m, std::max(d.x, std::max(d.y, d.z)));
+  }
+  return m;
+}
+
+TEST(IlluminationNetwork, NodesFollowTheExtinctionAndFillTheSphere) {
+  rt::ParticleMedium medium(cloudSphere(10.f, 0.9f));
+  const NodeSet ns = sampleNodes(medium, 4000, 1);
+  ASSERT_EQ(ns.nodes.size(), 4000u);
+  EXPECT_NEAR(ns.radius, 1.f, 1e-6f);
+  EXPECT_NEAR(ns.mass, 4.0 / 3.0 * M_PI * 10.0, 1e-9);
+  // Uniform in the ball: the fraction within radius 1/2 is 1/8 (binomial sd 0.0052 at n = 4000).
+  int inner = 0;
+  for (const Node& n : ns.nodes) {
+    EXPECT_LE(glm::length(n.position), 1.f + 1e-6f);
+    EXPECT_FLOAT_EQ(n.tau, 10.f);
+    EXPECT_FLOAT_EQ(n.albedo.x, 0.9f);
+    inner += glm::length(n.position) < 0.5f;
+  }
+  EXPECT_NEAR(inner / 4000.0, 0.125, 0.02);
+}
+
+TEST(IlluminationNetwork, NormalisedPhaseColumnsSumToOneUnnormalisedDoNot) {
+  for (int D : {32, 128}) {
+    const auto dirs = makeDirections(D, false, 11);
+    for (float g : {0.f, 0.5f, 0.9f}) {
+      const auto W = phaseWeights(dirs, api::PhaseModel::HenyeyGreenstein, g);
+      double worst = 0;
+      for (int i = 0; i < D; ++i) {
+        double s = 0;
+        for (int d = 0; d < D; ++d) s += W[std::size_t(d) * D + i];
+        worst = std::max(worst, std::abs(s - 1.0));
+      }
+      const double dev = quadratureDeviation(dirs, api::PhaseModel::HenyeyGreenstein, g);
+      std::printf("D %d g %.1f: unnormalised column-sum deviation %.3f, normalised %.1e\n", D, g, dev, worst);
+      EXPECT_LT(worst, 1e-6);
+      if (g == 0.f) EXPECT_LT(dev, 1e-6);       // isotropic rows are exact for any directions
+      if (g >= 0.9f) EXPECT_GT(dev, 0.1);       // a sharp lobe is badly integrated by random directions
+    }
+  }
+}
+
+TEST(IlluminationNetwork, FurnaceReachesTheSkyRadianceMonotonically) {
+  Net net(2.f, 1.f, 200, 32, 6);  // optical radius 2: the furnace converges in a few hundred steps
+  std::vector<glm::dvec3> I(net.size(), glm::dvec3(0.0)), next;
+  double residual = 1;
+  int n = 0;
+  for (; n < 3000 && residual > 1e-9; ++n) {
+    residual = iterate(net.pb, I, next);
+    for (std::size_t k = 0; k < I.size(); ++k) ASSERT_GE(next[k].x, I[k].x - 1e-15) << "iteration " << n;
+    I.swap(next);
+  }
+  double err = 0;
+  for (const auto& v : I) err = std::max(err, std::abs(v.x - 1.0));
+  std::printf("furnace: %d iterations, max |I - L| %.2e, sky links %.3f\n", n, err, net.vis.occupancy());
+  EXPECT_LT(err, 1e-7);
+  for (const auto& v : I) EXPECT_LE(v.x, 1.0 + 1e-12);  // never above the fixed point
+}
+
+TEST(IlluminationNetwork, PureAbsorberIsExactAfterTheLongestChain) {
+  Net net(4.f, 0.f, 300, 16, 8);
+  const int longest = net.vis.longestChain();
+  ASSERT_GT(longest, 2);
+  // Closed form: the sky attenuated along the chain, L prod (1 - alpha) over the links from the boundary.
+  std::vector<double> exact(net.size());
+  for (int p = 0; p < net.vis.nodes; ++p)
+    for (int i = 0; i < net.vis.directions; ++i) {
+      double t = 1;
+      for (int q = p; q >= 0; q = net.vis.upstream[std::size_t(q) * 16 + i]) t *= 1.0 - net.vis.alpha[std::size_t(q) * 16 + i];
+      exact[std::size_t(p) * 16 + i] = t;
+    }
+  std::vector<glm::dvec3> I(net.size(), glm::dvec3(5.0)), next;
+  double errBefore = 0, errAfter = 0;
+  for (int n = 1; n <= longest; ++n) {
+    iterate(net.pb, I, next);
+    I.swap(next);
+    double err = 0;
+    for (std::size_t k = 0; k < I.size(); ++k) err = std::max(err, std::abs(I[k].x - exact[k]));
+    if (n == longest - 1) errBefore = err;
+    if (n == longest) errAfter = err;
+  }
+  std::printf("absorber: longest chain %d, error after %d iterations %.2e, after %d %.2e\n", longest, longest - 1,
+              errBefore, longest, errAfter);
+  EXPECT_LT(errAfter, 1e-12);
+  EXPECT_GT(errBefore, 1e-6);
+  // In a homogeneous sphere the chain's product is the transmittance e^(-tau (z_p - z_first + boundary)).
+  const int p = 0, i = 3;
+  int first = p;
+  while (net.vis.upstream[std::size_t(first) * 16 + i] >= 0) first = net.vis.upstream[std::size_t(first) * 16 + i];
+  const Direction& d = net.dirs[i];
+  const double depth = 4.0 * (depthAlong(d, net.nodes.center, net.nodes.nodes[p].position) -
+                              depthAlong(d, net.nodes.center, net.nodes.nodes[first].position) +
+                              boundaryDistance(d, net.nodes.center, net.nodes.radius, net.nodes.nodes[first].position));
+  EXPECT_NEAR(exact[std::size_t(p) * 16 + i], std::exp(-depth), 1e-5);
+}
+
+TEST(IlluminationNetwork, ContractsWithTheStatedFactorToOneFixedPoint) {
+  const std::vector<DirectionalLight> light = {{glm::normalize(glm::vec3(1, -1, 0)), glm::vec3(3.f)}};
+  Net net(10.f, 0.9f, 256, 32, 8, light, glm::dvec3(0.2, 0.3, 0.5));
+  const double q = contractionFactor(net.pb);
+  ASSERT_LT(q, 1.0);
+  auto solve = [&](std::vector<glm::dvec3> I, int& iterations, bool checkRate) {
+    std::vector<glm::dvec3> next;
+    double last = -1;
+    for (iterations = 0; iterations < 5000; ++iterations) {
+      const double r = iterate(net.pb, I, next);
+      I.swap(next);
+      if (checkRate && last >= 0) EXPECT_LE(r, q * last + 1e-13) << "iteration " << iterations;
+      last = r;
+      if (r < 1e-10) break;
+    }
+    return I;
+  };
+  int coldIterations = 0, randomIterations = 0;
+  const auto cold = solve(std::vector<glm::dvec3>(net.size(), glm::dvec3(0.0)), coldIterations, true);
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> u(0.0, 10.0);
+  std::vector<glm::dvec3> start(net.size());
+  for (auto& v : start) v = glm::dvec3(u(rng), u(rng), u(rng));
+  const auto other = solve(start, randomIterations, true);
+  std::printf("contraction: q %.4f, %d iterations from 0, %d from random, fixed points differ by %.2e\n", q,
+              coldIterations, randomIterations, maxDiff(cold, other));
+  EXPECT_LT(maxDiff(cold, other), 1e-8);
+
+  // A light rotated by 10 degrees: warm-started from the old solution against a cold start.
+  const float c = std::cos(0.1745f), s = std::sin(0.1745f);
+  const glm::vec3 w0 = light[0].w;
+  net.setLights({{glm::normalize(glm::vec3(c * w0.x - s * w0.y, s * w0.x + c * w0.y, 0.f)), glm::vec3(3.f)}}, 8);
+  int warm = 0, coldAgain = 0;
+  const auto warmed = solve(cold, warm, false);
+  const auto fresh = solve(std::vector<glm::dvec3>(net.size(), glm::dvec3(0.0)), coldAgain, false);
+  std::printf("light rotated 10 deg: %d iterations warm, %d cold\n", warm, coldAgain);
+  EXPECT_LT(warm, coldAgain);
+  EXPECT_LT(maxDiff(warmed, fresh), 1e-8);
+}
+
+}  // namespace
+}  // namespace radiant::network
