@@ -424,6 +424,7 @@ struct HttpServer::Impl {
                 {"max_width", config.limits.maxWidth},
                 {"max_height", config.limits.maxHeight},
                 {"max_samples", config.limits.maxSamples},
+                {"max_photons", config.limits.maxPhotons},
                 {"max_particles", config.limits.maxParticles},
                 {"max_queue", config.maxQueue},
                 {"request_timeout_s", config.requestTimeoutS},
