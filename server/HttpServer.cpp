@@ -445,7 +445,11 @@ struct HttpServer::Impl {
     for (const auto& t : api::techniqueSchemas()) {
       json j = api::to_json_value(t);
       bool available = hooks.techniques.empty();
-      for (const auto& d : hooks.techniques) available = available || d.name == t.name;
+      for (const auto& d : hooks.techniques)
+        if (d.name == t.name) {
+          available = true;
+          j["ground_truths"] = d.groundTruths;
+        }
       j["available"] = available;
       out.push_back(j);
       seen.insert(t.name);
@@ -453,7 +457,7 @@ struct HttpServer::Impl {
     for (const auto& d : hooks.techniques)
       if (!seen.count(d.name))  // implemented but without a schema file: usable with no parameters
         out.push_back(json{{"name", d.name}, {"description", d.description}, {"outputs", d.outputs},
-                           {"params", json::object()}, {"available", true}});
+                           {"params", json::object()}, {"available", true}, {"ground_truths", d.groundTruths}});
     return out;
   }
 
