@@ -66,7 +66,50 @@ json checkType(const std::string& type, const json& v, const std::string& pointe
   return v;
 }
 
+// Caps every value whose schema declares "x-cost" (Validate.h), walking the validated request beside
+// its schema. Values the request does not carry (a pass it does not name) are not there to cap.
+void capCosts(const json& schema, const json& value, const std::string& pointer, const RequestLimits& limits) {
+  if (auto c = schema.find("x-cost"); c != schema.end() && value.is_number_integer()) {
+    const std::string kind = c->get<std::string>();
+    if (const auto l = costLimit(kind, limits); l && value.get<long long>() > l->max)
+      throw ApiError(422, "limit-exceeded", "Server limit exceeded",
+                     pointer + ": " + std::to_string(value.get<long long>()) + " is above this server's " + kind +
+                         " limit " + std::to_string(l->max) + " (radiantd " + l->flag + ")",
+                     pointer);
+  }
+  if (value.is_object()) {
+    if (auto p = schema.find("properties"); p != schema.end())
+      for (const auto& [key, sub] : p->items())
+        if (auto it = value.find(key); it != value.end()) capCosts(sub, *it, pointerAppend(pointer, key), limits);
+  } else if (value.is_array()) {
+    if (auto items = schema.find("items"); items != schema.end())
+      for (std::size_t i = 0; i < value.size(); ++i) capCosts(*items, value[i], pointerAppend(pointer, i), limits);
+  }
+}
+
+void collectCosts(const json& schema, const std::string& pointer, std::vector<std::pair<std::string, std::string>>& out) {
+  if (!schema.is_object()) return;
+  if (auto c = schema.find("x-cost"); c != schema.end()) out.emplace_back(pointer, c->get<std::string>());
+  if (auto p = schema.find("properties"); p != schema.end())
+    for (const auto& [key, sub] : p->items()) collectCosts(sub, pointerAppend(pointer, key), out);
+  if (auto items = schema.find("items"); items != schema.end()) collectCosts(*items, pointer + "/*", out);
+}
+
 }  // namespace
+
+std::optional<CostLimit> costLimit(std::string_view cost, const RequestLimits& limits) {
+  if (cost == "samples") return CostLimit{limits.maxSamples, "--max-samples"};
+  if (cost == "photons") return CostLimit{limits.maxPhotons, "--max-photons"};
+  if (cost == "particles") return CostLimit{static_cast<long long>(limits.maxParticles), "--max-particles"};
+  if (cost == "none") return std::nullopt;
+  throw std::logic_error("schema: unknown x-cost \"" + std::string(cost) + "\"");
+}
+
+std::vector<std::pair<std::string, std::string>> costParameters(const json& schema) {
+  std::vector<std::pair<std::string, std::string>> out;
+  collectCosts(schema, "", out);
+  return out;
+}
 
 std::string pointerAppend(const std::string& pointer, std::string_view token) {
   std::string out = pointer + "/";
@@ -266,12 +309,7 @@ json normaliseRenderRequest(const json& body, const RequestLimits& limits) {
   };
   limit("/width", v["width"].get<long long>(), limits.maxWidth, "width");
   limit("/height", v["height"].get<long long>(), limits.maxHeight, "height");
-  for (const auto& [pass, params] : v["passes"].items())
-    for (const char* key : {"spp", "samples"})
-      if (params.is_object() && params.contains(key) && params[key].is_number())
-        limit(pointerAppend(pointerAppend("/passes", pass), key), params[key].get<long long>(), limits.maxSamples,
-              "samples");
-  if (v.contains("compare")) limit("/compare/spp", v["compare"]["spp"].get<long long>(), limits.maxSamples, "samples");
+  capCosts(renderRequestSchema(), v, "", limits);
 
   const json& outputs = v["outputs"];
   for (std::size_t i = 0; i < outputs.size(); ++i)

@@ -7,6 +7,13 @@
 // description, items, minItems, maxItems, minProperties, maxProperties, pattern. Annotations ("title",
 // "$id", "x-outputs") are ignored. Every property with a default is filled in when absent.
 //
+// Cost: an integer parameter whose value buys work or memory carries "x-cost", naming the server limit
+// that caps it (costLimit below): "samples" (per pixel: spp, AO samples, light paths per pixel),
+// "photons" (per frame), "particles" (per media system; their sum is capped again in api/Media.cpp),
+// or "none" for a parameter whose name looks like a cost but is not one (ppm_base_photons is a radius
+// calibration point). parseRenderRequest caps every x-cost value of the request, wherever it sits in
+// the schema; schema_cost_test fails on a cost-like parameter name without x-cost.
+//
 // Error mapping (one rule, documented in docs/API.md): every error is an api::ApiError whose pointer
 // (RFC 6901) names the offending field.
 //   400 malformed-json   the body is not JSON (pointer "")
@@ -19,6 +26,7 @@
 //   400 invalid-utf8     a string that is not UTF-8 (before parsing, see api/JsonLimits.h)
 // i.e. 400 means "this is not the shape of a request", 422 means "a request, but not one we accept".
 
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -33,13 +41,26 @@ namespace radiant::api {
 struct RequestLimits {
   int maxWidth = 4096;
   int maxHeight = 4096;
-  int maxSamples = 65536;  // caps every "spp"/"samples" parameter and compare.spp
+  int maxSamples = 65536;  // caps every x-cost "samples" parameter (spp, samples, light_paths_per_pixel, compare.spp)
+  long long maxPhotons = 4000000;  // caps every x-cost "photons" parameter (radiantd --max-photons)
   std::size_t maxJsonDepth = 64;  // nesting of the request text (radiantd --max-json-depth)
   // Uncompressed bytes of all requested output files (radiantd --max-frame-bytes); 0 = no limit.
   std::uint64_t maxOutputBytes = 0;
   // Particles of all request media systems together (radiantd --max-particles).
   std::size_t maxParticles = 65536;
 };
+
+// The limit an "x-cost" kind is capped by, and the radiantd flag that sets it; nullopt for "none".
+// Throws std::logic_error for a kind it does not know (merge_schema refuses those at build time).
+struct CostLimit {
+  long long max;
+  const char* flag;  // "--max-samples"
+};
+std::optional<CostLimit> costLimit(std::string_view cost, const RequestLimits& limits);
+// Every parameter of `schema` (recursively: properties, items) that declares "x-cost", as a JSON pointer
+// into a request with '*' for an array index ("/passes/reference/spp", "/media/*/generator/count"),
+// paired with its kind.
+std::vector<std::pair<std::string, std::string>> costParameters(const nlohmann::json& schema);
 
 // The merged request schema (technique parameter schemas included under properties.passes).
 const nlohmann::json& renderRequestSchema();

@@ -104,7 +104,9 @@ void compare(FrameResources& resources, const Scene& scene, const FrameView& vie
     for (const auto& [key, value] : truth.reference.items())
       if (key != "aov") m[key] = value;
     r.spp = c.spp;
-    r.maxBounces = c.maxBounces;
+    // A technique that computes a fixed bounce range declares it (env_diffuse: bounces + 1); otherwise
+    // the compare block's path length limit applies.
+    r.maxBounces = truth.reference.contains("max_bounces") ? r.maxBounces : c.maxBounces;
     bool hit = false;
     const auto t0 = Clock::now();
     reference = referenceImage(resources, scene, view, r, &hit);
@@ -112,7 +114,7 @@ void compare(FrameResources& resources, const Scene& scene, const FrameView& vie
       out.stats.warnings.push_back("the reference path tracer renders no participating media: compare.aov " + c.aov +
                                    " is scored without the frame's particle systems (compare.aov media scores them)");
     m["spp"] = c.spp;
-    m["max_bounces"] = c.maxBounces;
+    m["max_bounces"] = r.maxBounces;
     m["reference_cached"] = hit;
     m["reference_ms"] = msSince(t0);
     if (r.aov == "media" || r.aov == "media_transmittance") m["media_mode"] = r.mediaMode;
@@ -220,8 +222,16 @@ const DeviceInfo& Renderer::device() const { return impl_->device->info(); }
 
 std::vector<TechniqueDescription> Renderer::techniques() {
   std::vector<TechniqueDescription> out;
-  for (const auto& t : createTechniques())
-    out.push_back({t->info().name, t->info().description, t->info().outputs});
+  for (const auto& t : createTechniques()) {
+    TechniqueDescription d{t->info().name, t->info().description, t->info().outputs};
+    Params defaults;
+    if (api::findTechnique(d.name)) defaults = Params(api::techniqueParams(d.name));
+    for (const std::string& aov : d.outputs) {
+      const GroundTruth truth = t->groundTruth(defaults, aov);
+      d.groundTruths[aov] = truth.exists() ? truth.reference : nlohmann::json(nullptr);
+    }
+    out.push_back(std::move(d));
+  }
   return out;
 }
 

@@ -32,6 +32,11 @@ struct FrameInputs {
 struct TechniqueDescription {
   std::string name, description;
   std::vector<std::string> outputs;  // AOVs it produces
+  // Per output AOV, what scores it at the technique's default parameters (Technique::groundTruth): the
+  // reference pass's parameters ({"aov": "ao", "ao_radius": 0.5, ...}; "max_bounces" when the
+  // technique computes a fixed bounce range), or null when the reference renderer has none.
+  // GET /v1/info serves it as techniques[].ground_truths; the client's bench presets read it.
+  nlohmann::json groundTruths = nlohmann::json::object();
 };
 
 class Renderer {

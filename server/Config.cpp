@@ -22,7 +22,9 @@ std::string usage() {
   --config FILE             JSON file with any of these options (keys use '_': "max_queue")
   --max-body-bytes N        largest request body (default 67108864)
   --max-width N, --max-height N   largest image (default 4096, never above the schema's 4096)
-  --max-samples N           largest spp/samples of any pass and of compare (default 65536)
+  --max-samples N           largest per-pixel sample count (x-cost "samples": spp, samples, light paths
+                            per pixel, compare.spp) (default 65536)
+  --max-photons N           largest photon count of any pass (x-cost "photons") (default 4000000)
   --max-particles N         particles of a request's media systems together (default 65536)
   --max-queue N             jobs waiting behind the running one before 503 (default 16)
   --request-timeout S       seconds from submission to encoded frames (default 300)
@@ -100,6 +102,7 @@ void apply(ServerConfig& c, const std::string& name, const std::string& v, std::
   else if (name == "max-width") c.limits.maxWidth = static_cast<int>(toInt(flag, v, 1, 4096));
   else if (name == "max-height") c.limits.maxHeight = static_cast<int>(toInt(flag, v, 1, 4096));
   else if (name == "max-samples") c.limits.maxSamples = static_cast<int>(toInt(flag, v, 1, 65536));
+  else if (name == "max-photons") c.limits.maxPhotons = toInt(flag, v, 1, 4000000);
   else if (name == "max-particles") c.limits.maxParticles = static_cast<std::size_t>(toInt(flag, v, 1, 1048576));
   else if (name == "max-queue") c.maxQueue = static_cast<int>(toInt(flag, v, 1, 10000));
   else if (name == "request-timeout") c.requestTimeoutS = toDouble(flag, v);

@@ -427,6 +427,7 @@ struct HttpServer::Impl {
                 {"max_width", config.limits.maxWidth},
                 {"max_height", config.limits.maxHeight},
                 {"max_samples", config.limits.maxSamples},
+                {"max_photons", config.limits.maxPhotons},
                 {"max_particles", config.limits.maxParticles},
                 {"max_queue", config.maxQueue},
                 {"request_timeout_s", config.requestTimeoutS},
@@ -448,7 +449,11 @@ struct HttpServer::Impl {
     for (const auto& t : api::techniqueSchemas()) {
       json j = api::to_json_value(t);
       bool available = hooks.techniques.empty();
-      for (const auto& d : hooks.techniques) available = available || d.name == t.name;
+      for (const auto& d : hooks.techniques)
+        if (d.name == t.name) {
+          available = true;
+          j["ground_truths"] = d.groundTruths;
+        }
       j["available"] = available;
       out.push_back(j);
       seen.insert(t.name);
@@ -456,7 +461,7 @@ struct HttpServer::Impl {
     for (const auto& d : hooks.techniques)
       if (!seen.count(d.name))  // implemented but without a schema file: usable with no parameters
         out.push_back(json{{"name", d.name}, {"description", d.description}, {"outputs", d.outputs},
-                           {"params", json::object()}, {"available", true}});
+                           {"params", json::object()}, {"available", true}, {"ground_truths", d.groundTruths}});
     return out;
   }
 

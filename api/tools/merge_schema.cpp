@@ -34,7 +34,8 @@ void fail(const std::string& file, const std::string& what) { throw std::runtime
 
 // Technique parameters use the request schema's vocabulary; "min"/"max" are accepted as aliases.
 json normaliseParam(const std::string& file, const std::string& name, const json& p) {
-  static const std::set<std::string> kAllowed{"type", "default", "minimum", "maximum", "min", "max", "enum", "description"};
+  static const std::set<std::string> kAllowed{"type",    "default", "minimum",     "maximum", "min",
+                                              "max",     "enum",    "description", "x-cost"};
   if (!p.is_object()) fail(file, "params." + name + " must be an object");
   json out = json::object();
   for (const auto& [k, v] : p.items()) {
@@ -53,6 +54,13 @@ json normaliseParam(const std::string& file, const std::string& name, const json
   if ((type == "number" || type == "integer") && !out.contains("enum") &&
       !(out.contains("minimum") && out.contains("maximum")))
     fail(file, "params." + name + " is a " + type + " without both minimum and maximum (or an enum)");
+  // What a parameter costs (api/Validate.h, costLimit): the server limit that caps it.
+  if (out.contains("x-cost")) {
+    static const std::set<std::string> kCosts{"samples", "photons", "particles", "none"};
+    if (!out["x-cost"].is_string() || !kCosts.count(out["x-cost"].get<std::string>()))
+      fail(file, "params." + name + ".x-cost must be one of samples, photons, particles, none");
+    if (type != "integer") fail(file, "params." + name + " has an x-cost but is not an integer");
+  }
   const json& d = out["default"];
   bool typeOk = (type == "integer" && d.is_number_integer()) || (type == "number" && d.is_number()) ||
                 (type == "boolean" && d.is_boolean()) || (type == "string" && d.is_string());

@@ -114,12 +114,14 @@ const char* kReportUsage =
     "  Writes DIR/report.html (self-contained, plots inline) and DIR/report.md (plots in DIR/plots/).\n";
 
 const char* kBenchUsage =
-    "usage: radiant bench [-o DIR] [--quick] [--server URL ...] [--inflight N] [--no-report]\n"
+    "usage: radiant bench [-o DIR] [--quick] [--server URL ...] [--inflight N] [--no-report] [--dry-run]\n"
     "       radiant bench --service [-o DIR] [--requests N] [--size PX] [--scene NAME] [--throughput N]\n"
     "                               [--png-compression 0-9]\n"
     "  The standard suite: every built-in scene x every implemented technique at its presets x two\n"
     "  resolutions, with error against the reference. Writes DIR/bench.spec.json, DIR/results.jsonl (+.csv),\n"
-    "  DIR/report.html and DIR/report.md (default DIR: bench-out). Re-running resumes.\n"
+    "  DIR/report.html and DIR/report.md (default DIR: bench-out). Re-running resumes. Each technique is\n"
+    "  scored on its first output AOV that has a ground truth in the server's /v1/info (ground_truths).\n"
+    "  --dry-run: write DIR/bench.spec.json, list the points, render nothing.\n"
     "  --service: the service's overhead (end-to-end latency against the renderer's frame time) and the\n"
     "  throughput of back-to-back small requests; writes DIR/service.json and prints a Markdown table.\n";
 
@@ -203,26 +205,42 @@ int cmdReport(const GlobalOptions&, const std::vector<std::string>& args) {
 namespace {
 
 // Presets per technique: axes over its parameters. Parameters this server's schema lacks, and values
-// outside its range or enum, are dropped, so the suite follows the techniques as they change.
+// outside its range or enum, are dropped, so the suite follows the techniques as they change. What
+// scores a technique is not a preset: benchCompare() reads it from the server.
 struct Preset {
   json axes;      // dotted path -> values
-  json compare;   // compare block
+  json compare;   // compare block for a technique whose outputs have no ground truth (scored on beauty)
   json extra;     // extra request fields
 };
+
+// The compare block of a technique's sweep: its first output AOV with a ground truth in /v1/info
+// (techniques[].ground_truths, Technique::groundTruth on the server), and the bounce range the
+// technique declares with it; the preset's block when none has one.
+json benchCompare(const json& technique, const json& fallback) {
+  const json truths = technique.value("ground_truths", json::object());
+  for (const auto& aov : technique.value("outputs", json::array())) {
+    const auto t = truths.find(aov.get<std::string>());
+    if (t == truths.end() || !t->is_object()) continue;
+    json c{{"aov", aov}};
+    if (t->contains("max_bounces")) c["max_bounces"] = (*t)["max_bounces"];
+    return c;
+  }
+  return fallback;
+}
 
 Preset presetFor(const std::string& t, bool quick) {
   const std::string p = "passes." + t + ".";
   if (t == "direct")
-    return {{{p + "pcf_radius", quick ? json{0, 2} : json{0, 1, 2}}}, {{"max_bounces", 1}}, json::object()};
+    return {{{p + "pcf_radius", quick ? json{0, 2} : json{0, 1, 2}}}, json::object(), json::object()};
   if (t == "ambient_occlusion")
     return {{{p + "method", {"volumetric", "containment", "crytek", "gtao"}}, {p + "samples", quick ? json{8} : json{4, 16}}},
-            {{"aov", "ao"}},
+            json::object(),
             {{"ambient", {1, 1, 1}}}};
   if (t == "env_diffuse")
     return {{{p + "form_factor", {"polygon", "point", "classic"}},
              {p + "downsample", quick ? json{2} : json{2, 4}},
              {p + "cube_resolution", quick ? json{32} : json{64}}},
-            {{"max_bounces", 2}},
+            json::object(),
             json::object()};
   if (t == "specular")
     return {{{p + "linear_steps", quick ? json{8} : json{8, 32}}, {p + "cube_resolution", quick ? json{64} : json{128}}},
@@ -364,7 +382,7 @@ int serviceBench(const GlobalOptions& g, const fs::path& dir, int requests, int 
 
 int cmdBench(const GlobalOptions& g, const std::vector<std::string>& args) {
   fs::path dir = "bench-out";
-  bool quick = false, service = false, makeReport = true;
+  bool quick = false, service = false, makeReport = true, dryRun = false;
   int requests = 20, size = 256, throughputN = 40, pngCompression = 1;
   std::string scene = "cornell_box";
   sweep::RunOptions o;
@@ -378,6 +396,7 @@ int cmdBench(const GlobalOptions& g, const std::vector<std::string>& args) {
     else if (a == "--quick") quick = true;
     else if (a == "--service") service = true;
     else if (a == "--no-report") makeReport = false;
+    else if (a == "--dry-run") dryRun = true;
     else if (a == "--server") for (const auto& s : splitCommas(need())) o.servers.push_back(s);
     else if (a == "--inflight") o.inflight = intArg(a, need(), 1, 64);
     else if (a == "--requests") requests = intArg(a, need(), 1, 10000);
@@ -417,7 +436,7 @@ int cmdBench(const GlobalOptions& g, const std::vector<std::string>& args) {
               {"passes", {{name, json::object()}}},
               {"outputs", {{{"format", "png"}, {"aovs", {"beauty"}}}}}};
     for (const auto& [k, v] : preset.extra.items()) base[k] = v;
-    json compare = preset.compare;
+    json compare = benchCompare(t, preset.compare);
     compare["spp"] = quick ? 16 : 64;
     sweeps.push_back({{"name", "bench-" + name},
                       {"technique", name},
@@ -435,6 +454,10 @@ int cmdBench(const GlobalOptions& g, const std::vector<std::string>& args) {
   std::vector<sweep::Point> points;
   for (const auto& spec : sweep::parseSpecFile(specFile))
     for (auto& p : sweep::expand(spec)) points.push_back(std::move(p));
+  if (dryRun) {
+    std::cout << "wrote " << specFile.string() << " (" << points.size() << " points)\n";
+    return kExitOk;
+  }
   o.token = g.token;
   o.command = commandLine("bench", args);
   const fs::path results = dir / "results.jsonl";

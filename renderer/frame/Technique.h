@@ -73,7 +73,8 @@ private:
 // What scores one of a technique's AOVs (ARCHITECTURE.md, "A technique owns its knowledge"): the
 // parameters of the reference pass (api/schema/techniques/reference.json) that render its ground truth,
 // e.g. {"aov": "ao", "ao_radius": 0.5, "ao_definition": "volumetric"}; null when the reference renderer
-// has none (the compare block then refuses instead of scoring the AOV against something else).
+// has none (the compare block then refuses instead of scoring the AOV against something else). A
+// "max_bounces" in it is the technique's own bounce range and wins over compare.max_bounces.
 struct GroundTruth {
   nlohmann::json reference;
   bool exists() const { return reference.is_object(); }

@@ -309,9 +309,11 @@ inline bool refract(const glm::vec3& wo, const glm::vec3& n, float eta, glm::vec
 enum class TransportMode { Radiance, Importance };
 
 // Which lobe produced a sample. Light-path classes (LD+E, LS+DE, LG+DE) are built from these.
+// The values are shared.h's, which GLSL's sampleMaterial() sets.
 enum LobeFlags : unsigned {
-  kLobeReflection = 1u, kLobeTransmission = 2u,
-  kLobeDiffuse = 4u, kLobeGlossy = 8u, kLobeSpecular = 16u,  // specular = Dirac delta
+  kLobeReflection = unsigned(gpu::kLobeReflection), kLobeTransmission = unsigned(gpu::kLobeTransmission),
+  kLobeDiffuse = unsigned(gpu::kLobeDiffuse), kLobeGlossy = unsigned(gpu::kLobeGlossy),
+  kLobeSpecular = unsigned(gpu::kLobeSpecular),  // specular = Dirac delta
 };
 
 struct GltfBsdf {

@@ -33,6 +33,13 @@ RADIANT_CONST float kMinSheenRoughness = 0.07;
 // the same bilinear interpolation): kSheenAlbedoSize^2 floats, row r_j = j / (size - 1) over the
 // clamped roughness, column mu_i = i / (size - 1).
 RADIANT_CONST int kSheenAlbedoSize = 32;
+// Lobe flags of a BSDF sample (rt::LobeFlags, GLSL sampleMaterial): the side, then the lobe's kind
+// (specular = Dirac delta). Light-path classes (LD+E, LS+DE, LG+DE) are built from them.
+RADIANT_CONST int kLobeReflection = 1;
+RADIANT_CONST int kLobeTransmission = 2;
+RADIANT_CONST int kLobeDiffuse = 4;
+RADIANT_CONST int kLobeGlossy = 8;
+RADIANT_CONST int kLobeSpecular = 16;
 
 // ---------------------------------------------------------------------------------------------------
 // Texture units. Every sampler of every program has its own unit, so a pass can bind anything it

@@ -1,6 +1,6 @@
 // GPU half of the GPU/CPU parity test (tests/gl/materials/parity_test.cpp): evaluates the GLSL
 // material model on inputs written by the test, one invocation per case. One of PARITY_BRDF,
-// PARITY_LIGHT, PARITY_MATERIAL is defined. The results are compared with the C++ twins.
+// PARITY_SAMPLE, PARITY_LIGHT, PARITY_MATERIAL is defined. The results are compared with the C++ twins.
 // Compute shaders have no implicit derivatives: material textures are read at level 0.
 #define MATERIAL_SAMPLE(sampler, uv) textureLod(sampler, uv, 0.0)
 #include "common/brdf.glsl"
@@ -20,6 +20,22 @@ void main() {
   if (i >= uint(u_count)) return;
   BrdfCase c = cases[i];
   results[i] = vec4(gltfBsdfCos(c.n.xyz, c.nc.xyz, c.wo.xyz, c.wi.xyz, c.p, c.wi.w), 0.0);
+}
+
+#elif defined(PARITY_SAMPLE)
+// The BRDF case (wi unused but for w = eta), the random numbers, and x = 1 for importance transport.
+struct SampleCase { vec4 n; vec4 wo; vec4 wi; MaterialParams p; vec4 nc; vec4 u; vec4 mode; };
+layout(std430, binding = 3) readonly buffer Cases { SampleCase cases[]; };
+// Per case: (wi, pdf), (weight, flags), (valid, delta, 0, 0).
+layout(std430, binding = 4) writeonly buffer Results { vec4 results[]; };
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= uint(u_count)) return;
+  SampleCase c = cases[i];
+  MaterialSample s = sampleMaterial(c.n.xyz, c.nc.xyz, c.wo.xyz, c.p, c.wi.w, c.mode.x != 0.0, c.u);
+  results[3 * i + 0] = vec4(s.wi, s.pdf);
+  results[3 * i + 1] = vec4(s.weight, float(s.flags));
+  results[3 * i + 2] = vec4(s.valid ? 1.0 : 0.0, s.delta ? 1.0 : 0.0, 0.0, 0.0);
 }
 
 #elif defined(PARITY_LIGHT)

@@ -280,4 +280,10 @@ void EnvDiffusePass::execute(PassContext& ctx) {
   ctx.stats.counters["bounces"] = bounces_;
 }
 
+GroundTruth EnvDiffusePass::groundTruth(const Params& params, const std::string& aov) const {
+  GroundTruth truth = GroundTruth::fromAovTable(aov);
+  if (aov == "indirect_diffuse" && truth.exists()) truth.reference["max_bounces"] = 1 + params.get<int>("bounces", 1);
+  return truth;
+}
+
 }  // namespace radiant

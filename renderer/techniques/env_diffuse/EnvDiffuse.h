@@ -22,6 +22,9 @@ public:
   Requirements requirements(const Scene&, const api::RenderRequest&) const override;
   void prepare(const Scene&, const Params&, FrameResources&) override;
   void execute(PassContext&) override;
+  // indirect_diffuse: the reference's indirect (two or more scattering events) up to 1 + bounces, the
+  // paths the cube maps hold.
+  GroundTruth groundTruth(const Params& params, const std::string& aov) const override;
 
   // Size of the cube map the classic method convolves, and of its irradiance map.
   static constexpr int kConvolutionSourceSize = 32;

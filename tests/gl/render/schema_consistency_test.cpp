@@ -178,6 +178,10 @@ TEST(SchemaConsistency, TechniquesDeclareTheirGroundTruth) {
   const GroundTruth gtao = ao.groundTruth(
       Params(api::techniqueParams("ambient_occlusion", {{"radius", 0.25}, {"method", "gtao"}})), "ao");
   EXPECT_EQ(gtao.reference, (nlohmann::json{{"aov", "ao"}, {"ao_radius", 0.25}, {"ao_definition", "cosine"}}));
+  // env_diffuse's indirect_diffuse holds the bounces its cube maps compute: 2 .. 1 + bounces.
+  const Technique& env = *byName.at("env_diffuse");
+  EXPECT_EQ(env.groundTruth(Params(api::techniqueParams("env_diffuse", {{"bounces", 3}})), "indirect_diffuse").reference,
+            (nlohmann::json{{"aov", "indirect"}, {"max_bounces", 4}}));
   // The specular AOV has none: it is refused, not scored against beauty.
   EXPECT_FALSE(byName.at("specular")->groundTruth(Params(api::techniqueParams("specular")), "specular").exists());
 }

@@ -290,6 +290,65 @@ TEST_F(SweepAgainstDaemon, TwoByTwoGivesFourRecordsWithTheirParametersAndTimings
   fs::remove_all(dir);
 }
 
+// What scores each technique lives with the technique on the server (Technique::groundTruth): /v1/info
+// serves it, the bench presets read it from there, and compare renders it with the frame's parameters.
+TEST_F(SweepAgainstDaemon, BenchScoresEachTechniqueOnTheGroundTruthsInfoServes) {
+  httplib::Client c(daemon_->url());
+  c.set_read_timeout(120, 0);  // the render below compiles shaders and path-traces on a loaded machine
+  auto res = c.Get("/v1/info");
+  ASSERT_TRUE(res && res->status == 200);
+  const json info = json::parse(res->body);
+  std::map<std::string, json> truths;
+  for (const auto& t : info["techniques"])
+    if (t.value("available", false)) truths[t["name"]] = t.value("ground_truths", json());
+  // At the techniques' default parameters (ambient_occlusion: radius 0.5, method volumetric;
+  // env_diffuse: bounces 1, so bounces 2..2).
+  EXPECT_EQ(truths["ambient_occlusion"]["ao"],
+            (json{{"aov", "ao"}, {"ao_radius", 0.5}, {"ao_definition", "volumetric"}}));
+  EXPECT_EQ(truths["env_diffuse"]["indirect_diffuse"], (json{{"aov", "indirect"}, {"max_bounces", 2}}));
+  EXPECT_EQ(truths["direct"]["direct"], (json{{"aov", "direct"}}));
+  EXPECT_EQ(truths["caustics"]["caustics"], (json{{"aov", "caustics"}}));
+  ASSERT_TRUE(truths["specular"].contains("specular"));
+  EXPECT_TRUE(truths["specular"]["specular"].is_null());  // the reference has no specular-only mode
+
+  const auto dir = scratch("bench-spec");
+  ProcResult r = radiant(dir, {"--server", daemon_->url(), "bench", "--quick", "--dry-run", "-o", (dir / "b").string()});
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream in(dir / "b" / "bench.spec.json");
+  const json spec = json::parse(in);
+  std::map<std::string, json> compare;
+  for (const auto& s : spec["sweeps"]) compare[s["technique"]] = s["compare"];
+  EXPECT_EQ(compare["ambient_occlusion"]["aov"], "ao");
+  EXPECT_FALSE(compare["ambient_occlusion"].contains("max_bounces"));
+  EXPECT_EQ(compare["env_diffuse"]["aov"], "indirect_diffuse");
+  EXPECT_EQ(compare["env_diffuse"]["max_bounces"], 2);
+  EXPECT_EQ(compare["direct"]["aov"], "direct");
+  // No ground truth for its AOV: the preset's beauty comparison.
+  EXPECT_FALSE(compare["specular"].contains("aov"));
+  EXPECT_EQ(compare["specular"]["max_bounces"], 5);
+  // Every technique of the suite is scored on the first output that info gives a ground truth.
+  for (const auto& [name, block] : compare) {
+    std::string expected;
+    for (const auto& t : info["techniques"])
+      if (t["name"] == name)
+        for (const auto& aov : t["outputs"])
+          if (expected.empty() && truths[name].value(aov.get<std::string>(), json()).is_object()) expected = aov;
+    EXPECT_EQ(block.value("aov", ""), expected) << name;
+  }
+
+  // The declared bounce range wins over compare.max_bounces: env_diffuse with 2 bounces is scored
+  // against bounces 2..3 although the request says 8.
+  const json req{{"scene", {{"builtin", "cornell_box"}}}, {"width", 16}, {"height", 16},
+                 {"passes", {{"env_diffuse", {{"bounces", 2}}}, {"photon_gi", false}}},
+                 {"compare", {{"aov", "indirect_diffuse"}, {"spp", 1}, {"max_bounces", 8}}}};
+  res = c.Post("/v1/renders", req.dump(), "application/json");
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200) << res->body;
+  const json m = json::parse(res->body)["stats"]["metrics"];
+  EXPECT_EQ(m["reference_mode"], "indirect");
+  EXPECT_EQ(m["max_bounces"], 3);
+}
+
 TEST_F(SweepAgainstDaemon, ResumeSkipsDonePointsAndRepairsATornLine) {
   const auto dir = scratch("resume");
   const std::string out = (dir / "r.jsonl").string();
