@@ -215,6 +215,7 @@ Renderer::~Renderer() = default;
 
 void Renderer::setGpuSceneCapacity(std::size_t scenes) {
   impl_->gpuSceneCapacity = std::max<std::size_t>(1, scenes);
+  impl_->resources.setDerivedCapacity(impl_->gpuSceneCapacity);
   while (impl_->gpuScenes.size() > impl_->gpuSceneCapacity) impl_->gpuScenes.erase(impl_->gpuScenes.begin());
 }
 

@@ -54,8 +54,9 @@ public:
   RenderOutput render(const Scene& scene, const api::RenderRequest& request,
                       const std::atomic<bool>* cancel = nullptr, const FrameInputs& inputs = {});
   static std::vector<TechniqueDescription> techniques();
-  // How many scenes stay uploaded to the GPU, with the derived data keyed by the upload (BVH, shadow
-  // maps, photon maps); least recently used evicted first. Default 4; radiantd --gpu-scenes.
+  // How many scenes stay uploaded to the GPU, and how many input digests each kind of derived data
+  // (BVH, shadow maps, photon maps, environment maps) keeps; least recently used evicted first.
+  // Default 4; radiantd --gpu-scenes.
   void setGpuSceneCapacity(std::size_t scenes);
 
 private:

@@ -4,8 +4,11 @@
 // Textures, framebuffers and buffers are declared by name in a technique's prepare(): a declaration
 // with the same spec as last frame returns the same object, so steady-state frames allocate nothing.
 // Derived data (shadow maps, BVHs, cube maps, photon maps) is cached under a key together with the
-// digest of exactly the inputs it depends on; every lookup is logged as a cache hit or miss.
+// digest of exactly the inputs it depends on; every lookup is logged as a cache hit or miss. Each key
+// keeps the derived data of its `derivedCapacity` most recently used digests (renders alternating
+// between scenes or parameter sets reuse them; radiantd --gpu-scenes sets it with the scene cache).
 #include <functional>
+#include <list>
 #include <map>
 #include <memory>
 #include <set>
@@ -77,15 +80,25 @@ public:
   // builds it with `build` and stores it. Logs "key" as a hit or a miss.
   template <class T>
   T& cached(const std::string& key, const std::string& inputsDigest, const std::function<std::unique_ptr<T>()>& build) {
-    auto it = cache_.find(key);
-    const bool hit = it != cache_.end() && it->second.digest == inputsDigest;
+    std::list<Entry>& entries = cache_[key];  // most recently used first
+    auto it = entries.begin();
+    while (it != entries.end() && it->digest != inputsDigest) ++it;
+    const bool hit = it != entries.end();
     if (cacheLog_) cacheLog_->push_back({key, hit});
-    if (!hit) {
+    if (hit) {
+      entries.splice(entries.begin(), entries, it);
+    } else {
       auto value = build();
-      Entry e{inputsDigest, std::shared_ptr<void>(value.release(), [](void* p) { delete static_cast<T*>(p); })};
-      it = cache_.insert_or_assign(key, std::move(e)).first;
+      entries.push_front({inputsDigest, std::shared_ptr<void>(value.release(), [](void* p) { delete static_cast<T*>(p); })});
+      while (entries.size() > derivedCapacity_) entries.pop_back();
     }
-    return *static_cast<T*>(it->second.value.get());
+    return *static_cast<T*>(entries.front().value.get());
+  }
+  // Digests kept per cache key (at least 1; default 4).
+  void setDerivedCapacity(std::size_t n) {
+    derivedCapacity_ = n < 1 ? 1 : n;
+    for (auto& [key, entries] : cache_)
+      while (entries.size() > derivedCapacity_) entries.pop_back();
   }
   // Drops every cached entry and resource (after a GL failure the objects may be invalid).
   void clear();
@@ -107,7 +120,8 @@ private:
   std::map<std::string, std::pair<TextureSpec, gl::Texture>> textures_;
   std::map<std::string, gl::Framebuffer> framebuffers_;
   std::map<std::string, gl::Buffer> buffers_;
-  std::map<std::string, Entry> cache_;
+  std::map<std::string, std::list<Entry>> cache_;
+  std::size_t derivedCapacity_ = 4;
   std::set<std::string> written_;
   std::map<std::string, std::string> lightPaths_;
   std::set<int> shadowMapExclusions_;

@@ -262,13 +262,18 @@ TEST(RenderCore, DerivedDataIsCachedAcrossFrames) {
 }
 
 // The GPU scene cache keeps the `capacity` most recently used scenes: with capacity 2, A B A hits A
-// again, and A B C A has evicted it (least recently used first).
+// again, and A B C A has evicted it (least recently used first). The scenes' derived data (here the
+// shadow maps) is kept alike, so alternating between scenes rebuilds nothing.
 TEST(RenderCore, GpuSceneCacheKeepsTheMostRecentlyUsedScenes) {
-  auto gpuHit = [](const RenderOutput& o) {
+  auto hitOf = [](const RenderOutput& o, const char* what) {
     for (const auto& c : o.stats.cache)
-      if (c.what == "gpu_scene") return c.hit;
-    ADD_FAILURE() << "no gpu_scene cache entry in the stats";
+      if (c.what == what) return c.hit;
+    ADD_FAILURE() << "no " << what << " cache entry in the stats";
     return false;
+  };
+  auto gpuHit = [&](const RenderOutput& o) {
+    EXPECT_EQ(hitOf(o, "shadow_maps"), hitOf(o, "gpu_scene")) << "derived data follows the scene";
+    return hitOf(o, "gpu_scene");
   };
   Renderer& r = renderer();
   r.setGpuSceneCapacity(2);
