@@ -17,6 +17,7 @@
 
 #include "renderer/io/ImageIO.h"
 #include "tests/support/DaemonProcess.h"
+#include "tests/support/ImageDifference.h"
 
 namespace radiant {
 namespace {
@@ -24,28 +25,11 @@ namespace {
 using nlohmann::json;
 namespace fs = std::filesystem;
 
-struct ProcessRun {
-  int code = -1;
-  std::string out, err;
-};
+using testing::maxAbsDifference;
+using testing::ProcessRun;
 
 ProcessRun client(const std::string& server, const std::string& args, const fs::path& dir) {
-  const fs::path out = dir / "client.out", err = dir / "client.err";
-  const std::string cmd = "cd '" + dir.string() + "' && RADIANT_SERVER='" + server + "' '" RADIANT_CLIENT_PATH "' " +
-                          args + " > '" + out.string() + "' 2> '" + err.string() + "'";
-  const int status = std::system(cmd.c_str());
-  return ProcessRun{WIFEXITED(status) ? WEXITSTATUS(status) : -1, testing::slurp(out), testing::slurp(err)};
-}
-
-// Largest per-channel difference of two images of the same size and channel count.
-double maxDifference(const Image& a, const Image& b) {
-  EXPECT_EQ(a.width, b.width);
-  EXPECT_EQ(a.height, b.height);
-  EXPECT_EQ(a.channels, b.channels);
-  if (a.pixels.size() != b.pixels.size()) return INFINITY;
-  double d = 0;
-  for (std::size_t i = 0; i < a.pixels.size(); ++i) d = std::max(d, double(std::fabs(a.pixels[i] - b.pixels[i])));
-  return d;
+  return testing::runClient(RADIANT_CLIENT_PATH, server, args, dir);
 }
 
 double maxValue(const Image& a) {
@@ -102,14 +86,14 @@ TEST_F(ClientHttp, RenderWritesEveryOutputOfAMultiOutputRequest) {
   ASSERT_GT(maxValue(beauty), 0.05) << "the Cornell box is lit";
   ASSERT_GT(maxValue(albedo), 0.05);
   // The same render, so float files match exactly; the half normal within half's rounding (2^-11 relative, |n| <= 1).
-  EXPECT_EQ(maxDifference(io::readImage((d / "out" / "beauty.exr").string(), "beauty"), beauty), 0.0);
-  EXPECT_EQ(maxDifference(io::readImage((d / "out" / "albedo.exr").string(), "albedo"), albedo), 0.0);
-  EXPECT_LE(maxDifference(io::readImage((d / "out" / "normal.exr").string(), "normal"), normal), 1.0 / 2048);
+  EXPECT_EQ(maxAbsDifference(io::readImage((d / "out" / "beauty.exr").string(), "beauty"), beauty), 0.0);
+  EXPECT_EQ(maxAbsDifference(io::readImage((d / "out" / "albedo.exr").string(), "albedo"), albedo), 0.0);
+  EXPECT_LE(maxAbsDifference(io::readImage((d / "out" / "normal.exr").string(), "normal"), normal), 1.0 / 2048);
   // The PNG is sRGB(clamp(beauty)) (docs/API.md, exposure 0) to 8 bits: within half a step, plus slack for rounding.
   const Image png = io::readImage((d / "out" / "beauty.png").string());
   Image expected = beauty;
   for (float& v : expected.pixels) v = io::linearToSrgb(std::clamp(v, 0.f, 1.f));
-  EXPECT_LE(maxDifference(png, expected), 0.5 / 255 + 1e-4);
+  EXPECT_LE(maxAbsDifference(png, expected), 0.5 / 255 + 1e-4);
   // Each single-AOV file holds that AOV only.
   EXPECT_THROW(io::readImage((d / "out" / "albedo.exr").string(), "normal"), std::runtime_error);
 
@@ -117,14 +101,14 @@ TEST_F(ClientHttp, RenderWritesEveryOutputOfAMultiOutputRequest) {
   // request gives the same pixels).
   r = client(daemon_->url(), "render --builtin cornell_box --size 32x32 --float -o a.exr -o n.exr --aov albedo --aov normal", d);
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_EQ(maxDifference(io::readImage((d / "a.exr").string(), "albedo"), albedo), 0.0);
-  EXPECT_EQ(maxDifference(io::readImage((d / "n.exr").string(), "normal"), normal), 0.0);
+  EXPECT_EQ(maxAbsDifference(io::readImage((d / "a.exr").string(), "albedo"), albedo), 0.0);
+  EXPECT_EQ(maxAbsDifference(io::readImage((d / "n.exr").string(), "normal"), normal), 0.0);
   EXPECT_THROW(io::readImage((d / "a.exr").string(), "normal"), std::runtime_error);
   // --out-dir with --aov: one file per AOV in --format.
   r = client(daemon_->url(), "render --builtin cornell_box --size 32x32 --out-dir aovs --aov albedo --aov normal --format exr --float", d);
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_EQ(maxDifference(io::readImage((d / "aovs" / "albedo.exr").string(), "albedo"), albedo), 0.0);
-  EXPECT_EQ(maxDifference(io::readImage((d / "aovs" / "normal.exr").string(), "normal"), normal), 0.0);
+  EXPECT_EQ(maxAbsDifference(io::readImage((d / "aovs" / "albedo.exr").string(), "albedo"), albedo), 0.0);
+  EXPECT_EQ(maxAbsDifference(io::readImage((d / "aovs" / "normal.exr").string(), "normal"), normal), 0.0);
 
   // Usage errors before anything is sent.
   EXPECT_EQ(client(daemon_->url(), "render --builtin cornell_box -o a.exr -o b.exr --aov beauty", d).code, 2);

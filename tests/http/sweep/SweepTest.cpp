@@ -26,6 +26,7 @@
 
 #include "renderer/io/ImageIO.h"
 #include "renderer/metrics/Metrics.h"
+#include "tests/support/ImageDifference.h"
 
 using nlohmann::json;
 namespace fs = std::filesystem;
@@ -450,6 +451,26 @@ namespace {
   return ::testing::AssertionFailure() << "shown \"" << text << "\" but the results file has " << value;
 }
 
+// Each method's Pareto front (frame GPU median against rmse), computed from the results records.
+std::vector<const json*> paretoFront(const std::vector<json>& recs) {
+  std::map<std::string, std::vector<const json*>> byMethod;
+  for (const auto& rec : recs)
+    if (!rec.contains("error")) byMethod[rec["method"]].push_back(&rec);
+  std::vector<const json*> front;
+  for (auto& [m, rs] : byMethod) {
+    std::sort(rs.begin(), rs.end(), [](const json* a, const json* b) {
+      return (*a)["frame_gpu_ms"]["median"].get<double>() < (*b)["frame_gpu_ms"]["median"].get<double>();
+    });
+    double best = INFINITY;
+    for (const json* rec : rs)
+      if ((*rec)["metrics"]["rmse"].get<double>() < best) {
+        best = (*rec)["metrics"]["rmse"].get<double>();
+        front.push_back(rec);
+      }
+  }
+  return front;
+}
+
 std::string unescape(std::string s) {
   for (auto [from, to] : std::vector<std::pair<std::string, std::string>>{{"&lt;", "<"}, {"&gt;", ">"}, {"&quot;", "\""}, {"&amp;", "&"}}) {
     std::size_t at = 0;
@@ -497,22 +518,11 @@ TEST(Report, FromTheFixtureHasThePlotsAndTheResultsFilesNumbers) {
     EXPECT_NE(svgOf[plots[1]].find(">" + pass["name"].get<std::string>() + "<"), std::string::npos) << pass["name"];
 
   // The Pareto front per method, computed here from the file, is what the report labels and lists.
-  std::map<std::string, std::vector<const json*>> byMethod;
-  for (const auto& rec : recs)
-    if (!rec.contains("error")) byMethod[rec["method"]].push_back(&rec);
   std::set<std::string> frontIds;
-  for (auto& [m, rs] : byMethod) {
-    std::sort(rs.begin(), rs.end(), [](const json* a, const json* b) {
-      return (*a)["frame_gpu_ms"]["median"].get<double>() < (*b)["frame_gpu_ms"]["median"].get<double>();
-    });
-    double best = INFINITY;
-    for (const json* rec : rs)
-      if ((*rec)["metrics"]["rmse"].get<double>() < best) {
-        best = (*rec)["metrics"]["rmse"].get<double>();
-        frontIds.insert((*rec)["point_id"].get<std::string>());
-        const std::string label = "samples=" + std::to_string((*rec)["params"]["passes.ambient_occlusion.samples"].get<int>());
-        EXPECT_NE(svgOf[plots[0]].find(">" + label + "<"), std::string::npos) << label;
-      }
+  for (const json* rec : paretoFront(recs)) {
+    frontIds.insert((*rec)["point_id"].get<std::string>());
+    const std::string label = "samples=" + std::to_string((*rec)["params"]["passes.ambient_occlusion.samples"].get<int>());
+    EXPECT_NE(svgOf[plots[0]].find(">" + label + "<"), std::string::npos) << label;
   }
   std::set<std::string> mdFront;
   std::regex frontRow(R"(\| (\w+) \| samples=(\d+) \| ([\d.e+-]+) \| ([\d.e+-]+) \| `([0-9a-f]{16})` \|)");
@@ -702,17 +712,6 @@ radiant::Image halve(const radiant::Image& img) {
   return out;
 }
 
-// How far a decoded 8-bit PNG is from an expected image of display values in [0, 1].
-double maxPngDifference(const radiant::Image& png, const radiant::Image& expected) {
-  EXPECT_EQ(png.width, expected.width);
-  EXPECT_EQ(png.height, expected.height);
-  EXPECT_EQ(png.channels, expected.channels);
-  if (png.pixels.size() != expected.pixels.size()) return INFINITY;
-  double d = 0;
-  for (std::size_t i = 0; i < png.pixels.size(); ++i) d = std::max(d, double(std::fabs(png.pixels[i] - expected.pixels[i])));
-  return d;
-}
-
 radiant::Image displayed(radiant::Image img) {  // what the PNG encoder makes of linear values at exposure 0
   for (float& v : img.pixels) v = radiant::io::linearToSrgb(std::clamp(v, 0.f, 1.f));
   return img;
@@ -754,26 +753,15 @@ TEST_F(SweepAgainstDaemon, ReportShowsTheParetoPointsFramesErrorMapsAndReference
       << "every <img> is a data-URI thumbnail";
 
   // The Pareto front per method, computed here from the results file, is what is pictured.
-  std::map<std::string, std::vector<const json*>> byMethod;
-  for (const auto& rec : recs) byMethod[rec["method"]].push_back(&rec);
-  std::set<std::string> frontIds;
-  for (auto& [m, rs] : byMethod) {
-    std::sort(rs.begin(), rs.end(), [](const json* a, const json* b) {
-      return (*a)["frame_gpu_ms"]["median"].get<double>() < (*b)["frame_gpu_ms"]["median"].get<double>();
-    });
-    double best = INFINITY;
-    for (const json* rec : rs)
-      if ((*rec)["metrics"]["rmse"].get<double>() < best) {
-        best = (*rec)["metrics"]["rmse"].get<double>();
-        frontIds.insert((*rec)["point_id"].get<std::string>());
-      }
-  }
+  std::set<std::string> frontIds, methods;
+  for (const json* rec : paretoFront(recs)) frontIds.insert((*rec)["point_id"].get<std::string>());
+  for (const auto& rec : recs) methods.insert(rec["method"].get<std::string>());
   std::set<std::string> framed, errored;
   for (const auto& [id, img] : shown["frame"]) framed.insert(id);
   for (const auto& [id, img] : shown["error"]) errored.insert(id);
   EXPECT_EQ(framed, frontIds);
   EXPECT_EQ(errored, frontIds);
-  EXPECT_EQ(shown["reference"].size(), byMethod.size()) << "one reference per method (its AO definition's)";
+  EXPECT_EQ(shown["reference"].size(), methods.size()) << "one reference per method (its AO definition's)";
 
   // The pictures are the frames': each front point rendered again here, with the compare block and a
   // float EXR of the AO (its error.Y and reference layers come with it), box-filtered here.
@@ -797,17 +785,17 @@ TEST_F(SweepAgainstDaemon, ReportShowsTheParetoPointsFramesErrorMapsAndReference
     for (float v : errors[id].pixels) scale = std::max(scale, double(v));
     ASSERT_EQ(ao.width, 64);
     // 8-bit sRGB of a half-float thumbnail: half a step of rounding, and half's 2^-11 through the sRGB slope.
-    EXPECT_LE(maxPngDifference(shown["frame"][id], displayed(ao)), 1.0 / 255) << id;
+    EXPECT_LE(radiant::testing::maxAbsDifference(shown["frame"][id], displayed(ao)), 1.0 / 255) << id;
   }
   for (const auto& [id, img] : shown["reference"]) {
     ASSERT_TRUE(references.count(id)) << "a reference shown under a point that is not on the front: " << id;
-    EXPECT_LE(maxPngDifference(img, displayed(references[id])), 1.0 / 255) << id;
+    EXPECT_LE(radiant::testing::maxAbsDifference(img, displayed(references[id])), 1.0 / 255) << id;
   }
   ASSERT_GT(scale, 0.0);
   // The error maps: viridis over one scale for the section, the largest error among the pictured points.
   for (const auto& [id, err] : errors) {
     radiant::Image colour = radiant::metrics::falseColour(err, scale);
-    EXPECT_LE(maxPngDifference(shown["error"][id], colour), 1.5 / 255) << id;
+    EXPECT_LE(radiant::testing::maxAbsDifference(shown["error"][id], colour), 1.5 / 255) << id;
   }
 
   // The numbers beside the pictures are the results file's.
