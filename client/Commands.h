@@ -1,26 +1,35 @@
 #pragma once
-// One function per subcommand; main.cpp dispatches. Each returns an exit code or throws
-// UsageError / ServerError / UnreachableError (mapped to 2 / 3 / 4 by main).
+// The radiant commands. Each command file defines its subcommand with CLI11 (its options, their
+// help and checks: the one definition that --help, `radiant help` and `radiant completion` read) and
+// sets `action` to the work it does once the command line is parsed. The work returns an exit code or
+// throws UsageError / ServerError / UnreachableError (mapped to 2 / 3 / 4 by main).
 // sweep, report and bench live in commands/Sweep.cpp on top of client/sweep/ and client/report/.
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "client/HttpClient.h"
 
+namespace CLI {
+class App;
+}
+
 namespace radiant::client {
 
 struct GlobalOptions {
-  std::string server;  // base URL
-  std::string token;   // bearer token ("" = none)
+  std::string server = "http://127.0.0.1:8080";  // base URL (--server, else $RADIANT_SERVER)
+  std::string tokenFile;                         // --token-file, else $RADIANT_TOKEN_FILE
+  std::string token;                             // bearer token read from tokenFile ("" = none)
+  std::vector<std::string> commandArgs;          // the words after the command's name, as typed
 };
 
-int cmdRender(const GlobalOptions& g, const std::vector<std::string>& args);
-int cmdInfo(const GlobalOptions& g, const std::vector<std::string>& args);
-int cmdScenes(const GlobalOptions& g, const std::vector<std::string>& args);
-int cmdSweep(const GlobalOptions& g, const std::vector<std::string>& args);
-int cmdReport(const GlobalOptions& g, const std::vector<std::string>& args);
-int cmdBench(const GlobalOptions& g, const std::vector<std::string>& args);
-int cmdCompare(const GlobalOptions& g, const std::vector<std::string>& args);  // no server needed
+// The work of the parsed command.
+using Action = std::function<int()>;
+
+void addRenderCommand(CLI::App& root, const GlobalOptions& g, Action& action);
+void addInfoCommands(CLI::App& root, const GlobalOptions& g, Action& action);   // info, scenes
+void addSweepCommands(CLI::App& root, const GlobalOptions& g, Action& action);  // sweep, report, bench
+void addCompareCommand(CLI::App& root, const GlobalOptions& g, Action& action); // no server needed
 
 // Helpers shared by commands.
 std::string readFile(const std::string& path);            // throws UsageError

@@ -1,29 +1,13 @@
-// radiant: the command-line client of radiantd. See docs/API.md and `radiant help`.
-#include <cstdlib>
-#include <fstream>
-#include <functional>
+// radiant: the command-line client of radiantd. See docs/API.md and `radiant help`. The command line
+// is defined once in client/Cli.cpp (CLI11); each command's work is in client/commands/.
+#include <cctype>
 #include <iostream>
-#include <map>
 
-#include "client/Commands.h"
+#include "client/Cli.h"
 
 using namespace radiant::client;
 
 namespace {
-
-const char* kMainUsage = R"(usage: radiant [--server URL] [--token-file FILE] COMMAND [ARGS]
-commands:
-  render   render a scene file or a built-in scene to an EXR or PNG (radiant render --help)
-  info     server version, device, limits, techniques and their parameters [--json]
-  scenes   built-in and uploaded scenes [--json]
-  sweep    run a parameter sweep spec into a JSON Lines results file (radiant sweep --help)
-  report   HTML + Markdown report of sweep results (radiant report --help)
-  bench    the standard benchmark suite, or --service for the service's own overhead (radiant bench --help)
-  compare  metrics and a false-colour error image of two images from anywhere (radiant compare --help)
-The server is --server, else $RADIANT_SERVER, else http://127.0.0.1:8080. A bearer token is read from
---token-file or $RADIANT_TOKEN_FILE.
-exit codes: 0 ok, 2 usage, 3 error reported by the server, 4 server unreachable, 130 interrupted
-)";
 
 void printProblem(const ServerError& e) {
   const auto& p = e.problem;
@@ -36,40 +20,56 @@ void printProblem(const ServerError& e) {
     std::cerr << "  render id " << p["render_id"].get<std::string>() << "\n";
 }
 
+// The command that was parsed (the root when none was).
+const CLI::App& parsedCommand(const CLI::App& root) {
+  const auto parsed = root.get_subcommands();
+  return parsed.empty() ? root : *parsed.front();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::map<std::string, std::function<int(const GlobalOptions&, const std::vector<std::string>&)>> commands{
-      {"render", cmdRender}, {"info", cmdInfo}, {"scenes", cmdScenes},
-      {"sweep", cmdSweep},   {"report", cmdReport}, {"bench", cmdBench}, {"compare", cmdCompare}};
   GlobalOptions g;
-  const char* env = std::getenv("RADIANT_SERVER");
-  g.server = env && *env ? env : "http://127.0.0.1:8080";
-  std::string tokenFile = std::getenv("RADIANT_TOKEN_FILE") ? std::getenv("RADIANT_TOKEN_FILE") : "";
+  Action action;
+  const std::unique_ptr<CLI::App> app = buildCli(g, action);
   try {
-    int i = 1;
-    for (; i < argc; ++i) {
-      const std::string a = argv[i];
-      if (a == "--server" && i + 1 < argc) g.server = argv[++i];
-      else if (a.rfind("--server=", 0) == 0) g.server = a.substr(9);
-      else if (a == "--token-file" && i + 1 < argc) tokenFile = argv[++i];
-      else if (a == "--help" || a == "-h" || a == "help") {
-        std::cout << kMainUsage;
-        return kExitOk;
-      } else if (!a.empty() && a[0] == '-') throw UsageError("unknown option " + a);
-      else break;
-    }
-    if (i >= argc) throw UsageError("no command given");
-    auto cmd = commands.find(argv[i]);
-    if (cmd == commands.end()) throw UsageError(std::string("unknown command \"") + argv[i] + "\"");
-    if (!tokenFile.empty()) {
-      g.token = readFile(tokenFile);
+    app->parse(argc, argv);
+  } catch (const CLI::CallForHelp&) {
+    std::cout << parsedCommand(*app).help();
+    return kExitOk;
+  } catch (const CLI::ParseError& e) {
+    const CLI::App& cmd = parsedCommand(*app);
+    std::string what = e.what();
+    if (&cmd == app.get())  // no command parsed: name the word that is not one
+      for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        if (a == "--server" || a == "--token-file") ++i;
+        else if (!a.empty() && a[0] != '-') {
+          what = "unknown command \"" + a + "\"";
+          break;
+        }
+      }
+    std::cerr << "radiant: " << what << "\n"
+              << "usage: see `radiant " << (&cmd == app.get() ? "" : cmd.get_name() + " ") << "--help`\n";
+    return kExitUsage;
+  }
+  const CLI::App& cmd = parsedCommand(*app);
+  try {
+    // The words after the command's name, as typed (sweep records them with every result).
+    for (int i = 1; i < argc; ++i)
+      if (cmd.get_name() == argv[i]) {
+        g.commandArgs.assign(argv + i + 1, argv + argc);
+        break;
+      }
+    if (!g.tokenFile.empty()) {
+      g.token = readFile(g.tokenFile);
       while (!g.token.empty() && std::isspace(static_cast<unsigned char>(g.token.back()))) g.token.pop_back();
     }
-    return cmd->second(g, std::vector<std::string>(argv + i + 1, argv + argc));
+    if (!action) throw UsageError("no command given");
+    return action();
   } catch (const UsageError& e) {
-    std::cerr << "radiant: " << e.what() << "\n";
-    if (std::string(e.what()).find("usage:") == std::string::npos) std::cerr << kMainUsage;
+    std::cerr << "radiant: " << e.what() << "\n"
+              << "usage: see `radiant " << (&cmd == app.get() ? "" : cmd.get_name() + " ") << "--help`\n";
     return kExitUsage;
   } catch (const ServerError& e) {
     printProblem(e);

@@ -11,6 +11,8 @@ packages=(
   libgtest-dev libgmock-dev googletest libbenchmark-dev
   clang libclang-rt-14-dev  # the libFuzzer harnesses (scripts/fuzz.sh); the runtime is only recommended by clang
   curl gnuplot-nox
+  libcli11-dev  # the radiant CLI's argument parsing, --help and shell completion (client/Cli.*)
+  bsdutils      # `script`: tests/http/client runs radiant render on a pseudo-terminal
   nginx-light   # the reverse proxy in front of several daemons (deploy/nginx, tests/http/fleet)
   python3-yaml  # tests/unit/deploy parses the Kubernetes manifests
 )

@@ -7,58 +7,28 @@
 
 #include <nlohmann/json.hpp>
 
-#include "client/Commands.h"
+#include "client/Cli.h"
 #include "renderer/io/ImageIO.h"
 #include "renderer/metrics/Metrics.h"
 
 namespace radiant::client {
 namespace {
 
-constexpr const char* kUsage =
-    "usage: radiant compare TEST REFERENCE [-o error.png] [--max E] [--exposure EV] [--aov NAME] [--json]\n"
-    "  Prints RMSE, relMSE, PSNR (dB, tone-mapped), SSIM, mean and max absolute error of TEST against\n"
-    "  REFERENCE (the numbers of stats.metrics), for images from anywhere (EXR, PNG, ...).\n"
-    "  -o FILE        write the per-pixel error (luminance of |TEST - REFERENCE|) in false colour\n"
-    "                 (viridis: dark = 0, yellow = the scale); PNG\n"
-    "  --max E        the error the top of the scale stands for (default: the largest error)\n"
-    "  --exposure EV  exposure of the tone map used by PSNR and SSIM (default 0)\n"
-    "  --aov NAME     the EXR layer to read from both files (default beauty, or the file's first layer)\n"
-    "  --json         print the metrics as one JSON object\n";
-
-}  // namespace
-
-int cmdCompare(const GlobalOptions&, const std::vector<std::string>& args) {
+struct CompareOptions {
   std::vector<std::string> files;
   std::string out, aov = "beauty";
-  double maxError = 0.0;
-  float exposure = 0.f;
+  double maxError = 0.0, exposure = 0.0;
   bool asJson = false;
-  auto need = [&](std::size_t& i) -> const std::string& {
-    if (i + 1 >= args.size()) throw UsageError(args[i] + " needs a value\n" + kUsage);
-    return args[++i];
-  };
-  auto number = [&](const std::string& flag, const std::string& v) {
-    try {
-      std::size_t used = 0;
-      const double d = std::stod(v, &used);
-      if (used != v.size() || !std::isfinite(d)) throw std::invalid_argument(v);
-      return d;
-    } catch (const std::exception&) {
-      throw UsageError(flag + " needs a finite number, got '" + v + "'");
-    }
-  };
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (a == "-o" || a == "--output") out = need(i);
-    else if (a == "--max") maxError = number(a, need(i));
-    else if (a == "--exposure") exposure = static_cast<float>(number(a, need(i)));
-    else if (a == "--aov") aov = need(i);
-    else if (a == "--json") asJson = true;
-    else if (a == "-h" || a == "--help") { std::cout << kUsage; return 0; }
-    else if (!a.empty() && a[0] == '-') throw UsageError("unknown option " + a + "\n" + kUsage);
-    else files.push_back(a);
-  }
-  if (files.size() != 2) throw UsageError(std::string("compare needs two images\n") + kUsage);
+};
+
+int runCompare(const CompareOptions& o) {
+  const auto& files = o.files;
+  const std::string& out = o.out;
+  const double maxError = o.maxError;
+  const float exposure = static_cast<float>(o.exposure);
+  const bool asJson = o.asJson;
+  const std::string& aov = o.aov;
+  if (files.size() != 2) throw UsageError("compare needs two images");
   if (maxError < 0.0) throw UsageError("--max must be positive");
   Image test, reference;
   try {
@@ -95,6 +65,29 @@ int cmdCompare(const GlobalOptions&, const std::vector<std::string>& args) {
             << test.width << "x" << test.height << ")\n";
   if (!out.empty()) std::cout << "wrote " << out << " (false colour, scale 0.." << usedMax << ")\n";
   return 0;
+}
+
+}  // namespace
+
+void addCompareCommand(CLI::App& root, const GlobalOptions&, Action& action) {
+  auto o = std::make_shared<CompareOptions>();
+  CLI::App* c = root.add_subcommand("compare", "metrics and a false-colour error image of two images from anywhere");
+  c->footer(
+      "Prints RMSE, relMSE, PSNR (dB, tone-mapped), SSIM, mean and max absolute error of TEST against\n"
+      "REFERENCE (the numbers of stats.metrics), for images from anywhere (EXR, PNG, ...). Needs no server.");
+  c->add_option("images", o->files, "TEST then REFERENCE")->type_name("TEST REFERENCE")->expected(2);
+  c->add_option("-o,--output", o->out,
+                "write the per-pixel error (luminance of |TEST - REFERENCE|) in false colour (viridis: dark = 0, "
+                "yellow = the scale); PNG")
+      ->type_name("error.png");
+  c->add_option("--max", o->maxError, "the error the top of the scale stands for (default: the largest error)")
+      ->type_name("E")
+      ->check(CLI::NonNegativeNumber);
+  c->add_option("--exposure", o->exposure, "exposure of the tone map used by PSNR and SSIM (default 0)")->type_name("EV");
+  c->add_option("--aov", o->aov, "the EXR layer to read from both files (default beauty, or the file's first layer)")
+      ->type_name("NAME");
+  c->add_flag("--json", o->asJson, "print the metrics as one JSON object");
+  c->callback([&action, o] { action = [o] { return runCompare(*o); }; });
 }
 
 }  // namespace radiant::client

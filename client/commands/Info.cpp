@@ -1,15 +1,12 @@
 #include <iostream>
 
-#include "client/Commands.h"
+#include "client/Cli.h"
 
 namespace radiant::client {
 
-int cmdInfo(const GlobalOptions& g, const std::vector<std::string>& args) {
-  bool asJson = false;
-  for (const auto& a : args) {
-    if (a == "--json") asJson = true;
-    else throw UsageError("info: unexpected argument \"" + a + "\"");
-  }
+namespace {
+
+int runInfo(const GlobalOptions& g, bool asJson) {
   HttpClient http(g.server, g.token);
   const nlohmann::json info = HttpClient::expectOk(http.get("/v1/info")).json();
   if (asJson) {
@@ -41,12 +38,7 @@ int cmdInfo(const GlobalOptions& g, const std::vector<std::string>& args) {
   return kExitOk;
 }
 
-int cmdScenes(const GlobalOptions& g, const std::vector<std::string>& args) {
-  bool asJson = false;
-  for (const auto& a : args) {
-    if (a == "--json") asJson = true;
-    else throw UsageError("scenes: unexpected argument \"" + a + "\"");
-  }
+int runScenes(const GlobalOptions& g, bool asJson) {
   HttpClient http(g.server, g.token);
   const nlohmann::json s = HttpClient::expectOk(http.get("/v1/scenes")).json();
   if (asJson) {
@@ -59,6 +51,18 @@ int cmdScenes(const GlobalOptions& g, const std::vector<std::string>& args) {
   for (const auto& u : s["uploaded"])
     std::cout << "  " << u.value("digest", "?") << "  " << u.value("format", "") << "  " << u.value("bytes", 0) << " bytes\n";
   return kExitOk;
+}
+
+}  // namespace
+
+void addInfoCommands(CLI::App& root, const GlobalOptions& g, Action& action) {
+  auto infoJson = std::make_shared<bool>(false), scenesJson = std::make_shared<bool>(false);
+  CLI::App* info = root.add_subcommand("info", "server version, device, limits, techniques and their parameters");
+  info->add_flag("--json", *infoJson, "print GET /v1/info as it came");
+  info->callback([&g, &action, infoJson] { action = [&g, infoJson] { return runInfo(g, *infoJson); }; });
+  CLI::App* scenes = root.add_subcommand("scenes", "built-in and uploaded scenes");
+  scenes->add_flag("--json", *scenesJson, "print GET /v1/scenes as it came");
+  scenes->callback([&g, &action, scenesJson] { action = [&g, scenesJson] { return runScenes(g, *scenesJson); }; });
 }
 
 }  // namespace radiant::client

@@ -5,30 +5,36 @@
 #include <optional>
 #include <cmath>
 #include <iostream>
+#include <filesystem>
+#include <set>
 #include <thread>
 
 #include <unistd.h>
 
 #include "api/Sha256.h"
-#include "client/Commands.h"
+#include "client/Cli.h"
 
 namespace radiant::client {
 
 namespace {
 
-const char* kUsage =
-    "usage: radiant render (SCENE.gltf|SCENE.glb|--builtin NAME|--asset PATH) -o OUT.exr|OUT.png\n"
-    "         [--set pass.param=value ...] [--pass NAME ...] [--aov NAME ...] [--size WxH]\n"
-    "         [--exposure EV] [--seed N] [--float] [--stats stats.json] [--async] [--quiet]\n"
-    "         [--no-pass NAME ...] [--compare SPP]\n"
-    "         [--ambient R,G,B] [--environment MAP.hdr|MAP.exr] [--no-default-lighting]\n"
-    "         [--camera position=X,Y,Z;target=X,Y,Z;up=X,Y,Z;yfov=DEG] [--request REQUEST.json]\n"
-    "  --no-pass NAME   turn an on-by-default pass off (photon_gi, specular, ...)\n"
-    "  --compare SPP    score beauty against the reference path tracer at SPP samples (stats.metrics)\n"
-    "  A .gltf that references .bin or image files is packed with them into one GLB before upload\n"
-    "  (only relative paths inside its folder). --camera takes any subset of its keys; the others keep\n"
-    "  the automatic framing. --request sends REQUEST.json with the other options applied on top.\n"
-    "  --asset PATH names a file under the daemon's --asset-root instead of uploading one.\n";
+constexpr const char* kFooter =
+    "A .gltf that references .bin or image files is packed with them into one GLB before upload (only\n"
+    "relative paths inside its folder). --camera takes any subset of its keys; the others keep the automatic\n"
+    "framing. --request sends REQUEST.json with the other options applied on top. --asset PATH names a file\n"
+    "under the daemon's --asset-root instead of uploading one.";
+
+struct RenderOptions {
+  std::string sceneFile, builtin, asset, statsFile, environmentFile, requestFile, ambient, camera, size, quality;
+  std::string outDir, outFormat = "exr";
+  std::vector<std::string> outs, sets, passes, disabled, aovs;
+  int compareSpp = 0;
+  double exposure = 0;
+  unsigned long long seed = 0;
+  long long timeBudgetMs = 0;
+  bool async = false, quiet = false, fullFloat = false, noDefaultLighting = false, dryRun = false;
+  CLI::Option *exposureGiven = nullptr, *seedGiven = nullptr, *budgetGiven = nullptr;
+};
 
 // "X,Y,Z" -> [X, Y, Z] (finite numbers).
 nlohmann::json triple(const std::string& what, const std::string& text) {
@@ -129,136 +135,164 @@ nlohmann::json typedValue(const nlohmann::json& info, const std::string& pass, c
   return text;
 }
 
-}  // namespace
-
-int cmdRender(const GlobalOptions& g, const std::vector<std::string>& args) {
-  std::string sceneFile, builtin, asset, out, statsFile, environmentFile, requestFile;
-  std::optional<nlohmann::json> ambient, camera;
-  bool noDefaultLighting = false;
-  std::vector<std::pair<std::string, std::string>> sets;  // "pass.param", value
-  std::vector<std::string> passes, aovs, disabled;
-  int width = 0, height = 0, compareSpp = 0;
-  std::optional<double> exposure;
-  std::optional<unsigned long long> seed;
-  bool async = false, quiet = false, fullFloat = false;
-
-  auto need = [&](std::size_t& i) -> const std::string& {
-    if (i + 1 >= args.size()) throw UsageError(args[i] + " needs a value\n" + kUsage);
-    return args[++i];
+// Where the frames go: request["outputs"][i] is written to the i-th path (docs/API.md: frame i of
+// the response is outputs[i]). Sets the request's outputs from -o, --aov and --out-dir, or keeps a
+// --request's own when they agree with the files asked for.
+std::vector<std::string> planOutputs(const RenderOptions& o, nlohmann::json& request) {
+  auto output = [&](const std::string& format, const std::vector<std::string>& aovs) {
+    nlohmann::json out{{"format", format}, {"aovs", aovs}};
+    if (format == "exr") out["half"] = !o.fullFloat;
+    return out;
   };
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (a == "-o" || a == "--output") out = need(i);
-    else if (a == "--builtin") builtin = need(i);
-    else if (a == "--asset") asset = need(i);
-    else if (a == "--ambient") {
-      ambient = triple("--ambient", need(i));
-      for (const auto& v : *ambient)
-        if (v.get<double>() < 0) throw UsageError("--ambient: radiance must not be negative");
-    } else if (a == "--environment") environmentFile = need(i);
-    else if (a == "--camera") camera = cameraOption(need(i));
-    else if (a == "--request") requestFile = need(i);
-    else if (a == "--no-default-lighting") noDefaultLighting = true;
-    else if (a == "--set") {
-      const std::string& kv = need(i);
-      auto eq = kv.find('=');
-      auto dot = kv.find('.');
+  const std::vector<std::string> aovs = o.aovs.empty() ? std::vector<std::string>{"beauty"} : o.aovs;
+  const bool requestOutputs = request.contains("outputs") && request["outputs"].is_array() && !request["outputs"].empty();
+  auto formatOf = [&](std::size_t i) {
+    const nlohmann::json& out = request["outputs"][i];
+    return out.is_object() && out.contains("format") && out["format"].is_string() ? out["format"].get<std::string>() : "";
+  };
+  if (!o.outs.empty() && !o.outDir.empty()) throw UsageError("render: give -o files or --out-dir, not both");
+  if (o.outs.empty() && o.outDir.empty()) throw UsageError("render: -o OUT.exr|OUT.png (repeatable) or --out-dir DIR is required");
+  std::vector<std::string> formats;
+  for (const auto& f : o.outs) {
+    formats.push_back(extensionOf(f));
+    if (formats.back() != "exr" && formats.back() != "png")
+      throw UsageError("render: -o must end in .exr or .png, got \"" + f + "\"");
+  }
+  nlohmann::json outputs = nlohmann::json::array();
+  if (o.outs.size() == 1) {
+    if (formats[0] == "png" && o.aovs.size() > 1) throw UsageError("render: a png holds one AOV; use .exr for several");
+    // A --request's own outputs are kept when the first agrees with -o (which receives frame 0).
+    if (o.aovs.empty() && requestOutputs && formatOf(0) == formats[0]) return o.outs;
+    outputs.push_back(output(formats[0], aovs));
+  } else if (!o.outs.empty()) {
+    const std::size_t n = o.outs.size();
+    if (!o.aovs.empty()) {
+      if (o.aovs.size() != n)
+        throw UsageError("render: " + std::to_string(n) + " files (-o) take as many --aov (file i holds AOV i), or none; got " +
+                         std::to_string(o.aovs.size()));
+      for (std::size_t i = 0; i < n; ++i) outputs.push_back(output(formats[i], {o.aovs[i]}));
+    } else if (requestOutputs) {
+      if (request["outputs"].size() != n)
+        throw UsageError("render: --request has " + std::to_string(request["outputs"].size()) + " outputs but " +
+                         std::to_string(n) + " files (-o) were given");
+      for (std::size_t i = 0; i < n; ++i)
+        if (formatOf(i) != formats[i])
+          throw UsageError("render: -o " + o.outs[i] + " is ." + formats[i] + " but --request's outputs/" + std::to_string(i) +
+                           " is " + (formatOf(i).empty() ? "no format" : formatOf(i)));
+      return o.outs;
+    } else {
+      for (std::size_t i = 0; i < n; ++i) outputs.push_back(output(formats[i], {"beauty"}));  // beauty in each format
+    }
+  } else if (o.aovs.empty() && requestOutputs) {
+    outputs = request["outputs"];
+  } else {
+    for (const auto& aov : aovs) outputs.push_back(output(o.outFormat, {aov}));
+  }
+  request["outputs"] = outputs;
+  if (!o.outs.empty()) return o.outs;
+  // --out-dir: DIR/<aov>[+<aov>...].<format>, prefixed by the output's index when two would collide.
+  std::vector<std::string> paths;
+  std::set<std::string> used;
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    const nlohmann::json& out = outputs[i];
+    std::string name;
+    if (out.is_object() && out.contains("aovs") && out["aovs"].is_array())
+      for (const auto& a : out["aovs"]) name += (name.empty() ? "" : "+") + (a.is_string() ? a.get<std::string>() : a.dump());
+    if (name.empty()) name = "beauty";
+    const std::string format = out.is_object() ? out.value("format", "png") : "png";
+    name += "." + format;
+    if (!used.insert(name).second) name = std::to_string(i) + "-" + name;
+    used.insert(name);
+    paths.push_back((std::filesystem::path(o.outDir) / name).string());
+  }
+  return paths;
+}
+
+// The request the options describe. `http` is null on a dry run: nothing is uploaded then (digests
+// are computed locally) and --set values are typed from the schema only when the server answers.
+nlohmann::json buildRequest(const RenderOptions& o, const HttpClient& http, bool upload, const std::string& sceneBytes) {
+  nlohmann::json request = nlohmann::json::object();
+  if (!o.requestFile.empty()) {
+    request = nlohmann::json::parse(readFile(o.requestFile), nullptr, false);
+    if (request.is_discarded() || !request.is_object())
+      throw UsageError("--request: " + o.requestFile + " does not hold a JSON object");
+  }
+  const int sources = !o.sceneFile.empty() + !o.builtin.empty() + !o.asset.empty();
+  if (sources > 1 || (sources == 0 && !request.contains("scene")))
+    throw UsageError("render: give one scene: a file, --builtin NAME, --asset PATH, or a scene in --request");
+  if (!o.sets.empty() || !o.passes.empty() || !o.disabled.empty()) {
+    nlohmann::json info = nlohmann::json::object();
+    if (!o.sets.empty()) {
+      try {
+        info = HttpClient::expectOk(http.get("/v1/info")).json();
+      } catch (const std::exception&) {
+        if (upload) throw;  // a dry run without a server sends --set values as written
+      }
+    }
+    nlohmann::json p = request.contains("passes") && request["passes"].is_object() ? request["passes"] : nlohmann::json::object();
+    for (const auto& name : o.passes) p[name] = nlohmann::json::object();
+    for (const auto& name : o.disabled) p[name] = false;
+    for (const auto& kv : o.sets) {
+      const auto eq = kv.find('='), dot = kv.find('.');
       if (eq == std::string::npos || dot == std::string::npos || dot > eq || dot == 0 || dot + 1 == eq)
         throw UsageError("--set expects pass.param=value, got \"" + kv + "\"");
-      sets.emplace_back(kv.substr(0, eq), kv.substr(eq + 1));
-    } else if (a == "--pass") passes.push_back(need(i));
-    else if (a == "--no-pass") disabled.push_back(need(i));
-    else if (a == "--compare") {
-      try {
-        compareSpp = std::stoi(need(i));
-      } catch (const std::exception&) {
-        compareSpp = 0;
-      }
-      if (compareSpp <= 0) throw UsageError("--compare expects a positive sample count");
-    }
-    else if (a == "--aov") aovs.push_back(need(i));
-    else if (a == "--size") {
-      const std::string& s = need(i);
-      if (std::sscanf(s.c_str(), "%dx%d", &width, &height) != 2 || width <= 0 || height <= 0)
-        throw UsageError("--size expects WxH, got \"" + s + "\"");
-    } else if (a == "--exposure") {
-      try {
-        exposure = std::stod(need(i));
-      } catch (const std::exception&) {
-        throw UsageError("--exposure expects a number (EV)");
-      }
-    } else if (a == "--seed") {
-      try {
-        seed = std::stoull(need(i));
-      } catch (const std::exception&) {
-        throw UsageError("--seed expects a non-negative integer");
-      }
-    } else if (a == "--stats") statsFile = need(i);
-    else if (a == "--async") async = true;
-    else if (a == "--float") fullFloat = true;
-    else if (a == "--quiet" || a == "-q") quiet = true;
-    else if (a == "--help" || a == "-h") {
-      std::cout << kUsage;
-      return kExitOk;
-    } else if (!a.empty() && a[0] == '-') throw UsageError("render: unknown option " + a + "\n" + kUsage);
-    else if (sceneFile.empty()) sceneFile = a;
-    else throw UsageError("render: more than one scene given\n" + std::string(kUsage));
-  }
-  nlohmann::json request = nlohmann::json::object();
-  if (!requestFile.empty()) {
-    request = nlohmann::json::parse(readFile(requestFile), nullptr, false);
-    if (request.is_discarded() || !request.is_object())
-      throw UsageError("--request: " + requestFile + " does not hold a JSON object");
-  }
-  const int sources = !sceneFile.empty() + !builtin.empty() + !asset.empty();
-  if (sources > 1 || (sources == 0 && !request.contains("scene")))
-    throw UsageError(std::string("render: give one scene: a file, --builtin NAME, --asset PATH, or a scene in --request\n") + kUsage);
-  if (out.empty()) throw UsageError(std::string("render: -o OUT.exr|OUT.png is required\n") + kUsage);
-  const std::string format = extensionOf(out);
-  if (format != "exr" && format != "png") throw UsageError("render: -o must end in .exr or .png, got \"" + out + "\"");
-  if (format == "png" && aovs.size() > 1) throw UsageError("render: a png holds one AOV; use .exr for several");
-  std::string packNote;
-  const std::string sceneBytes = sceneFile.empty() ? "" : sceneFileBytes(sceneFile, &packNote);
-  if (!packNote.empty() && !quiet) std::cerr << packNote << "\n";
-
-  HttpClient http(g.server, g.token);
-  if (!sets.empty() || !passes.empty() || !disabled.empty()) {
-    const nlohmann::json info = HttpClient::expectOk(http.get("/v1/info")).json();
-    nlohmann::json p = request.contains("passes") && request["passes"].is_object() ? request["passes"] : nlohmann::json::object();
-    for (const auto& name : passes) p[name] = nlohmann::json::object();
-    for (const auto& name : disabled) p[name] = false;
-    for (const auto& [key, value] : sets) {
-      const std::string pass = key.substr(0, key.find('.')), param = key.substr(key.find('.') + 1);
-      p[pass][param] = typedValue(info, pass, param, value);
+      const std::string pass = kv.substr(0, dot), param = kv.substr(dot + 1, eq - dot - 1);
+      p[pass][param] = typedValue(info.contains("techniques") ? info : nlohmann::json{{"techniques", nlohmann::json::array()}},
+                                  pass, param, kv.substr(eq + 1));
     }
     request["passes"] = p;
   }
-  if (!builtin.empty()) request["scene"] = {{"builtin", builtin}};
-  else if (!asset.empty()) request["scene"] = {{"asset", asset}};
-  else if (!sceneFile.empty()) request["scene"] = {{"digest", ensureSceneUploaded(http, sceneBytes, sceneFile, !quiet)}};
-  if (ambient) request["ambient"] = *ambient;
-  if (!environmentFile.empty()) request["environment"] = ensureImageUploaded(http, environmentFile, !quiet);
-  if (camera) {
+  if (!o.builtin.empty()) request["scene"] = {{"builtin", o.builtin}};
+  else if (!o.asset.empty()) request["scene"] = {{"asset", o.asset}};
+  else if (!o.sceneFile.empty())
+    request["scene"] = {{"digest", upload ? ensureSceneUploaded(http, sceneBytes, o.sceneFile, !o.quiet) : api::sceneDigest(sceneBytes)}};
+  if (!o.ambient.empty()) {
+    const nlohmann::json ambient = triple("--ambient", o.ambient);
+    for (const auto& v : ambient)
+      if (v.get<double>() < 0) throw UsageError("--ambient: radiance must not be negative");
+    request["ambient"] = ambient;
+  }
+  if (!o.environmentFile.empty())
+    request["environment"] = upload ? ensureImageUploaded(http, o.environmentFile, !o.quiet) : api::sceneDigest(readFile(o.environmentFile));
+  if (!o.camera.empty()) {
     nlohmann::json c = request.contains("camera") && request["camera"].is_object() ? request["camera"] : nlohmann::json::object();
-    c.update(*camera);
+    c.update(cameraOption(o.camera));
     request["camera"] = c;
   }
-  if (noDefaultLighting) request["default_lighting"] = false;
-  if (width > 0) {
+  if (o.noDefaultLighting) request["default_lighting"] = false;
+  if (!o.size.empty()) {
+    int width = 0, height = 0;
+    char tail = 0;
+    if (std::sscanf(o.size.c_str(), "%dx%d%c", &width, &height, &tail) != 2 || width <= 0 || height <= 0)
+      throw UsageError("--size expects WxH, got \"" + o.size + "\"");
     request["width"] = width;
     request["height"] = height;
   }
-  if (exposure) request["exposure"] = *exposure;
-  if (seed) request["seed"] = *seed;
-  if (compareSpp > 0) request["compare"] = {{"against", "reference"}, {"aov", "beauty"}, {"spp", compareSpp}};
-  nlohmann::json output{{"format", format}, {"aovs", aovs.empty() ? std::vector<std::string>{"beauty"} : aovs}};
-  if (format == "exr") output["half"] = !fullFloat;
-  // A --request's own outputs are kept when they agree with -o (the first frame is what -o receives).
-  const bool keepOutputs = aovs.empty() && request.contains("outputs") && request["outputs"].is_array() &&
-                           !request["outputs"].empty() && request["outputs"][0].is_object() &&
-                           request["outputs"][0].value("format", "") == format;
-  if (!keepOutputs) request["outputs"] = nlohmann::json::array({output});
-  if (requestFile.empty() || async) request["async"] = async;
+  if (o.exposureGiven->count()) request["exposure"] = o.exposure;
+  if (o.seedGiven->count()) request["seed"] = o.seed;
+  // Presets and budgets are the daemon's to validate (docs/API.md); the client passes them on.
+  if (!o.quality.empty()) request["quality"] = o.quality;
+  if (o.budgetGiven->count()) request["time_budget_ms"] = o.timeBudgetMs;
+  if (o.compareSpp > 0) request["compare"] = {{"against", "reference"}, {"aov", "beauty"}, {"spp", o.compareSpp}};
+  if (o.requestFile.empty() || o.async) request["async"] = o.async;
+  return request;
+}
+
+int runRender(const GlobalOptions& g, const RenderOptions& o) {
+  std::string packNote;
+  const std::string sceneBytes = o.sceneFile.empty() ? "" : sceneFileBytes(o.sceneFile, &packNote);
+  if (!packNote.empty() && !o.quiet) std::cerr << packNote << "\n";
+
+  HttpClient http(g.server, g.token);
+  if (o.dryRun) {
+    nlohmann::json request = buildRequest(o, http, false, sceneBytes);
+    planOutputs(o, request);
+    std::cout << request.dump(2) << "\n";
+    return kExitOk;
+  }
+  nlohmann::json request = buildRequest(o, http, true, sceneBytes);
+  const std::vector<std::string> paths = planOutputs(o, request);
+  const bool async = request.value("async", false);
 
   const auto t0 = std::chrono::steady_clock::now();
   // A scene by digest routes to the daemon holding it when a proxy is in front (docs/DEPLOYMENT.md).
@@ -270,55 +304,73 @@ int cmdRender(const GlobalOptions& g, const std::vector<std::string>& args) {
   nlohmann::json result = r.json();
   if (async) {
     const std::string location = r.header("location").empty() ? "/v1/renders/" + result.value("id", "") : r.header("location");
-    const bool tty = isatty(STDERR_FILENO) && !quiet;
+    // Progress once the render has lasted a second: on a terminal a bar redrawn in place, with the
+    // time left at the rate so far; otherwise (a log, a pipe) a plain line per 10 % or change of state.
+    const bool tty = isatty(STDERR_FILENO) && !o.quiet;
+    bool shown = false;
+    std::string lastLine;
     for (;;) {
       const std::string state = result.value("state", "");
       if (state == "done") break;
       if (state == "failed" || state == "canceled") {
-        if (tty) std::cerr << "\n";
+        if (tty && shown) std::cerr << "\n";
         nlohmann::json problem = result.value("error", nlohmann::json::object());
         problem["render_id"] = result.value("id", "");
         throw ServerError(problem.value("status", 500), problem);
       }
-      if (tty) {
-        // A bar and, once rendering has visibly started, the time left at the rate so far.
-        const double progress = std::clamp(result.value("progress", 0.0), 0.0, 1.0);
-        const double elapsedS = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        const int filled = static_cast<int>(20 * progress);
+      const double progress = std::clamp(result.value("progress", 0.0), 0.0, 1.0);
+      const double elapsedS = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      if (!o.quiet && elapsedS > 1.0) {
         std::string eta;
-        if (progress > 0.06 && elapsedS > 1.0)
+        if (progress > 0.06)
           eta = " ETA " + std::to_string(static_cast<int>(elapsedS * (1.0 - progress) / progress + 0.5)) + " s";
-        std::cerr << "\r" << result.value("id", "") << ": " << state
-                  << (result.contains("queue_position") ? " (position " + result["queue_position"].dump() + ")" : "")
-                  << " [" << std::string(filled, '#') << std::string(20 - filled, '.') << "] "
-                  << static_cast<int>(100 * progress) << "%" << eta << "      " << std::flush;
+        const std::string where = result.contains("queue_position") ? " (position " + result["queue_position"].dump() + ")" : "";
+        if (tty) {
+          const int filled = static_cast<int>(20 * progress);
+          std::cerr << "\r" << result.value("id", "") << ": " << state << where << " [" << std::string(filled, '#')
+                    << std::string(20 - filled, '.') << "] " << static_cast<int>(100 * progress) << "%" << eta << "      "
+                    << std::flush;
+        } else {
+          const std::string line = result.value("id", "") + ": " + state + where + " " +
+                                   std::to_string(10 * static_cast<int>(10 * progress)) + "%";
+          if (line != lastLine) std::cerr << line << eta << "\n";
+          lastLine = line;
+        }
+        shown = true;
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(200));
       result = HttpClient::expectOk(http.get(location)).json();
     }
-    if (tty) std::cerr << "\r" << result.value("id", "") << ": done 100%          \n";
+    if (shown) std::cerr << (tty ? "\r" : "") << result.value("id", "") << ": done 100%" << (tty ? "          " : "") << "\n";
   }
-  if (!result.contains("frames") || result["frames"].empty())
-    throw ServerError(r.status, {{"title", "No frames"}, {"detail", "the server returned no frames: " + result.dump()}});
-  const std::string url = result["frames"][0]["url"];
-  const HttpResponse frame = http.get(url);
-  HttpClient::expectOk(frame);
-  writeFile(out, frame.body);
-  if (!statsFile.empty()) {
+  if (!result.contains("frames") || !result["frames"].is_array() || result["frames"].size() < paths.size())
+    throw ServerError(r.status, {{"title", "No frames"},
+                                 {"detail", "the server returned " + std::to_string(result.value("frames", nlohmann::json::array()).size()) +
+                                                " frames for " + std::to_string(paths.size()) + " files: " + result.dump()}});
+  if (!o.outDir.empty()) std::filesystem::create_directories(o.outDir);
+  std::vector<std::size_t> sizes;
+  for (std::size_t i = 0; i < paths.size(); ++i) {
+    const HttpResponse frame = http.get(result["frames"][i]["url"].get<std::string>());
+    HttpClient::expectOk(frame);
+    writeFile(paths[i], frame.body);
+    sizes.push_back(frame.body.size());
+  }
+  if (!o.statsFile.empty()) {
     nlohmann::json stats{{"id", result["id"]}, {"request", request}, {"stats", result["stats"]},
                          {"timings", result.value("timings", nlohmann::json::object())}, {"frames", result["frames"]}};
-    writeFile(statsFile, stats.dump(2) + "\n");
+    writeFile(o.statsFile, stats.dump(2) + "\n");
   }
-  if (!quiet && result.contains("stats") && result["stats"].contains("warnings") && result["stats"]["warnings"].is_array())
+  if (!o.quiet && result.contains("stats") && result["stats"].contains("warnings") && result["stats"]["warnings"].is_array())
     for (const auto& w : result["stats"]["warnings"])
       if (w.is_string()) std::cerr << "warning: " << w.get<std::string>() << "\n";
-  if (!quiet && result.contains("stats") && result["stats"].value("lighting", "") == "default")
+  if (!o.quiet && result.contains("stats") && result["stats"].value("lighting", "") == "default")
     std::cerr << "note: the scene has no lights, ambient or environment; it was lit by the default studio "
                  "environment (see docs/API.md; --ambient, --environment or --no-default-lighting change that)\n";
-  if (!quiet) {
+  if (!o.quiet) {
     const double wallMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    std::cout << "wrote " << out << " (" << frame.body.size() << " bytes, render " << result["id"].get<std::string>()
-              << ", " << static_cast<int>(wallMs) << " ms)\n";
+    for (std::size_t i = 0; i < paths.size(); ++i)
+      std::cout << "wrote " << paths[i] << " (" << sizes[i] << " bytes, render " << result["id"].get<std::string>() << ", "
+                << static_cast<int>(wallMs) << " ms)\n";
     const nlohmann::json& m = result["stats"].value("metrics", nlohmann::json());
     if (m.is_object() && m.contains("rmse"))
       std::cout << "error against the reference path tracer at " << m.value("spp", 0) << " spp: RMSE "
@@ -326,6 +378,61 @@ int cmdRender(const GlobalOptions& g, const std::vector<std::string>& args) {
                 << "\n";
   }
   return kExitOk;
+}
+
+}  // namespace
+
+void addRenderCommand(CLI::App& root, const GlobalOptions& g, Action& action) {
+  auto o = std::make_shared<RenderOptions>();
+  CLI::App* c = root.add_subcommand("render", "render a scene file or a built-in scene to an EXR or PNG");
+  c->footer(kFooter);
+  c->add_option("scene", o->sceneFile, "the scene: a .gltf or .glb file (uploaded unless the server has it)")
+      ->type_name("SCENE")
+      ->check(CLI::ExistingFile);
+  c->add_option("--builtin", o->builtin, "a built-in scene (radiant scenes)")->type_name("NAME");
+  c->add_option("--asset", o->asset, "a scene file under the daemon's --asset-root")->type_name("PATH");
+  repeated(c->add_option("-o,--output", o->outs,
+                         "a file to write: .exr (linear, AOV layers) or .png (tone mapped). Repeated: file i holds --aov i "
+                         "(or output i of --request, or beauty when no --aov)"))
+      ->type_name("OUT.exr|OUT.png");
+  c->add_option("--out-dir", o->outDir,
+                "write every output into DIR, named after its AOVs (beauty.exr, albedo.exr, ...): one per --aov, or "
+                "--request's outputs")
+      ->type_name("DIR");
+  c->add_option("--format", o->outFormat, "the format of --out-dir's files made from --aov (default exr)")
+      ->type_name(choices({"exr", "png"}))
+      ->check(CLI::IsMember({"exr", "png"}).description(""));
+  repeated(c->add_option("--set", o->sets, "a technique parameter, typed from the server's schema (repeatable)"))
+      ->type_name("PASS.PARAM=VALUE");
+  repeated(c->add_option("--pass", o->passes, "run this pass (repeatable)"))->type_name("NAME");
+  repeated(c->add_option("--no-pass", o->disabled, "turn an on-by-default pass off: photon_gi, specular, ... (repeatable)"))
+      ->type_name("NAME");
+  repeated(c->add_option("--aov", o->aovs, "an AOV to write (repeatable; default beauty)"))->type_name("NAME");
+  c->add_option("--size", o->size, "the frame size")->type_name("WxH");
+  o->exposureGiven = c->add_option("--exposure", o->exposure, "exposure of the tone map")->type_name("EV");
+  o->seedGiven = c->add_option("--seed", o->seed, "the random seed")->type_name("N");
+  c->add_option("--quality", o->quality, "a quality preset (validated by the daemon)")
+      ->type_name(choices({"draft", "preview", "final", "reference"}));
+  o->budgetGiven = c->add_option("--time-budget-ms", o->timeBudgetMs,
+                                 "let the renderer choose the most accurate configuration that fits N ms")
+                       ->type_name("N");
+  c->add_flag("--float", o->fullFloat, "32-bit float EXR channels (default: half)");
+  c->add_option("--stats", o->statsFile, "write the request, stats, timings and frames as JSON")->type_name("FILE");
+  c->add_flag("--async", o->async, "submit as an async job and poll it (a progress bar on a terminal)");
+  c->add_flag("-q,--quiet", o->quiet, "print nothing but errors");
+  c->add_option("--compare", o->compareSpp, "score beauty against the reference path tracer at SPP samples (stats.metrics)")
+      ->type_name("SPP")
+      ->check(CLI::PositiveNumber);
+  c->add_option("--ambient", o->ambient, "uniform ambient radiance")->type_name("R,G,B");
+  c->add_option("--environment", o->environmentFile, "an environment map (uploaded unless the server has it)")
+      ->type_name("MAP.hdr|MAP.exr")
+      ->check(CLI::ExistingFile);
+  c->add_flag("--no-default-lighting", o->noDefaultLighting, "render an unlit scene black instead of studio-lit");
+  c->add_option("--camera", o->camera, "any subset of the camera's keys")->type_name("position=X,Y,Z;target=X,Y,Z;up=X,Y,Z;yfov=DEG");
+  c->add_option("--request", o->requestFile, "send REQUEST.json with the other options applied on top")
+      ->type_name("REQUEST.json");
+  c->add_flag("--dry-run", o->dryRun, "print the request instead of sending it (uploads nothing)");
+  c->callback([&g, &action, o] { action = [&g, o] { return runRender(g, *o); }; });
 }
 
 }  // namespace radiant::client

@@ -11,7 +11,7 @@
 #include <iostream>
 #include <sstream>
 
-#include "client/Commands.h"
+#include "client/Cli.h"
 #include "client/report/Report.h"
 #include "client/sweep/Sweep.h"
 
@@ -44,25 +44,6 @@ std::string commandLine(const std::string& name, const std::vector<std::string>&
   return c;
 }
 
-std::vector<std::string> splitCommas(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream in(s);
-  std::string part;
-  while (std::getline(in, part, ','))
-    if (!part.empty()) out.push_back(part);
-  return out;
-}
-
-int intArg(const std::string& flag, const std::string& v, int lo, int hi) {
-  try {
-    std::size_t used = 0;
-    const int n = std::stoi(v, &used);
-    if (used == v.size() && n >= lo && n <= hi) return n;
-  } catch (const std::exception&) {
-  }
-  throw UsageError(flag + " expects an integer in " + std::to_string(lo) + ".." + std::to_string(hi) + ", got \"" + v + "\"");
-}
-
 fs::path csvPathFor(const fs::path& results) {
   fs::path csv = results;
   csv.replace_extension(".csv");
@@ -72,6 +53,8 @@ fs::path csvPathFor(const fs::path& results) {
 // Runs points into `resultsPath`, writes the CSV view; returns the exit code.
 int runPoints(const std::vector<sweep::Point>& points, const fs::path& resultsPath, sweep::RunOptions o) {
   sweep::ResultsFile results(resultsPath);
+  // Thumbnails beside the results: RESULTS.thumbs/<point>.exr.
+  o.thumbnails = resultsPath.parent_path() / (resultsPath.stem().string() + ".thumbs");
   installStopHandler();
   o.stop = &gStop;
   const sweep::RunSummary s = sweep::run(points, results, o);
@@ -100,57 +83,32 @@ int runPoints(const std::vector<sweep::Point>& points, const fs::path& resultsPa
   return s.failed > 0 ? kExitServerError : kExitOk;
 }
 
-const char* kSweepUsage =
-    "usage: radiant sweep SPEC.json [-o RESULTS.jsonl] [--server URL ...] [--inflight N] [--retry-failed]\n"
-    "                     [--dry-run] [--quiet]\n"
-    "  Runs every point of the spec (docs/SWEEPS.md) and appends one JSON line per point to RESULTS.jsonl\n"
-    "  (default: SPEC's name with .jsonl), plus a CSV view next to it. Points already in the file are skipped.\n"
-    "  --server may be repeated (or comma-separated): the points are shared between the servers.\n"
-    "  --inflight N: requests in flight per server (default 1, so latency is not queueing).\n";
-
-const char* kReportUsage =
-    "usage: radiant report RESULTS.jsonl [MORE.jsonl ...] -o DIR [--metric rmse|rel_mse|mean_abs|max_abs|psnr|ssim]\n"
-    "                      [--title TEXT]\n"
-    "  Writes DIR/report.html (self-contained, plots inline) and DIR/report.md (plots in DIR/plots/).\n";
-
-const char* kBenchUsage =
-    "usage: radiant bench [-o DIR] [--quick] [--server URL ...] [--inflight N] [--no-report] [--dry-run]\n"
-    "       radiant bench --service [-o DIR] [--requests N] [--size PX] [--scene NAME] [--throughput N]\n"
-    "                               [--png-compression 0-9]\n"
-    "  The standard suite: every built-in scene x every implemented technique at its presets x two\n"
-    "  resolutions, with error against the reference. Writes DIR/bench.spec.json, DIR/results.jsonl (+.csv),\n"
-    "  DIR/report.html and DIR/report.md (default DIR: bench-out). Re-running resumes. Each technique is\n"
-    "  scored on its first output AOV that has a ground truth in the server's /v1/info (ground_truths).\n"
-    "  --dry-run: write DIR/bench.spec.json, list the points, render nothing.\n"
-    "  --service: the service's overhead (end-to-end latency against the renderer's frame time) and the\n"
-    "  throughput of back-to-back small requests; writes DIR/service.json and prints a Markdown table.\n";
-
-}  // namespace
-
-int cmdSweep(const GlobalOptions& g, const std::vector<std::string>& args) {
+struct SweepOptions {
   std::string specFile, out;
-  sweep::RunOptions o;
+  sweep::RunOptions run;
   bool dryRun = false;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    auto need = [&]() -> const std::string& {
-      if (i + 1 >= args.size()) throw UsageError(a + " needs a value\n" + kSweepUsage);
-      return args[++i];
-    };
-    if (a == "-o" || a == "--output") out = need();
-    else if (a == "--server") for (const auto& s : splitCommas(need())) o.servers.push_back(s);
-    else if (a == "--inflight") o.inflight = intArg(a, need(), 1, 64);
-    else if (a == "--retry-failed") o.retryFailed = true;
-    else if (a == "--dry-run") dryRun = true;
-    else if (a == "--quiet" || a == "-q") o.quiet = true;
-    else if (a == "--help" || a == "-h") {
-      std::cout << kSweepUsage;
-      return kExitOk;
-    } else if (!a.empty() && a[0] == '-') throw UsageError("sweep: unknown option " + a + "\n" + kSweepUsage);
-    else if (specFile.empty()) specFile = a;
-    else throw UsageError(std::string("sweep: more than one spec given\n") + kSweepUsage);
-  }
-  if (specFile.empty()) throw UsageError(std::string("sweep: no spec given\n") + kSweepUsage);
+};
+
+struct ReportOptions {
+  std::vector<std::string> inputs;
+  std::string out;
+  report::Options report;
+};
+
+struct BenchOptions {
+  std::string dir = "bench-out";
+  bool quick = false, service = false, noReport = false, dryRun = false;
+  int requests = 20, size = 256, throughputN = 40, pngCompression = 1;
+  std::string scene = "cornell_box";
+  sweep::RunOptions run;
+};
+
+int runSweep(const GlobalOptions& g, SweepOptions so) {
+  const std::string& specFile = so.specFile;
+  std::string out = so.out;
+  sweep::RunOptions& o = so.run;
+  const bool dryRun = so.dryRun;
+  if (specFile.empty()) throw UsageError("sweep: no spec given");
   std::vector<sweep::Point> points;
   for (const auto& spec : sweep::parseSpecFile(specFile))
     for (auto& p : sweep::expand(spec)) points.push_back(std::move(p));
@@ -163,37 +121,22 @@ int cmdSweep(const GlobalOptions& g, const std::vector<std::string>& args) {
   if (out.empty()) out = fs::path(specFile).stem().string() + ".jsonl";
   if (o.servers.empty()) o.servers.push_back(g.server);
   o.token = g.token;
-  o.command = commandLine("sweep", args);
+  o.command = commandLine("sweep", g.commandArgs);
   return runPoints(points, out, o);
 }
 
-int cmdReport(const GlobalOptions&, const std::vector<std::string>& args) {
-  std::vector<std::string> inputs;
-  std::string out;
-  report::Options o;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    auto need = [&]() -> const std::string& {
-      if (i + 1 >= args.size()) throw UsageError(a + " needs a value\n" + kReportUsage);
-      return args[++i];
-    };
-    if (a == "-o" || a == "--output") out = need();
-    else if (a == "--metric") o.metric = need();
-    else if (a == "--title") o.title = need();
-    else if (a == "--help" || a == "-h") {
-      std::cout << kReportUsage;
-      return kExitOk;
-    } else if (!a.empty() && a[0] == '-') throw UsageError("report: unknown option " + a + "\n" + kReportUsage);
-    else inputs.push_back(a);
-  }
-  if (inputs.empty() || out.empty()) throw UsageError(std::string("report: give RESULTS.jsonl and -o DIR\n") + kReportUsage);
+int runReport(const GlobalOptions& g, ReportOptions ro) {
+  const std::vector<std::string>& inputs = ro.inputs;
+  const std::string& out = ro.out;
+  report::Options& o = ro.report;
+  if (inputs.empty() || out.empty()) throw UsageError("report: give RESULTS.jsonl and -o DIR");
   static const std::set<std::string> metrics{"rmse", "rel_mse", "mean_abs", "max_abs", "psnr", "ssim"};
   if (!metrics.count(o.metric)) throw UsageError("report: --metric must be one of rmse, rel_mse, mean_abs, max_abs, psnr, ssim");
   std::vector<json> records;
   for (const auto& in : inputs)
     for (auto& r : sweep::readRecords(in)) records.push_back(std::move(r));
   if (records.empty()) throw UsageError("report: no records in " + inputs.front());
-  o.command = commandLine("report", args);
+  o.command = commandLine("report", g.commandArgs);
   o.source = inputs.front();
   for (std::size_t i = 1; i < inputs.size(); ++i) o.source += ", " + inputs[i];
   const report::Summary s = report::write(records, out, o);
@@ -201,8 +144,6 @@ int cmdReport(const GlobalOptions&, const std::vector<std::string>& args) {
             << s.errors << " failed, " << s.plots << " plots)\n";
   return kExitOk;
 }
-
-namespace {
 
 // Presets per technique: axes over its parameters. Parameters this server's schema lacks, and values
 // outside its range or enum, are dropped, so the suite follows the techniques as they change. What
@@ -378,38 +319,12 @@ int serviceBench(const GlobalOptions& g, const fs::path& dir, int requests, int 
   return kExitOk;
 }
 
-}  // namespace
-
-int cmdBench(const GlobalOptions& g, const std::vector<std::string>& args) {
-  fs::path dir = "bench-out";
-  bool quick = false, service = false, makeReport = true, dryRun = false;
-  int requests = 20, size = 256, throughputN = 40, pngCompression = 1;
-  std::string scene = "cornell_box";
-  sweep::RunOptions o;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    auto need = [&]() -> const std::string& {
-      if (i + 1 >= args.size()) throw UsageError(a + " needs a value\n" + kBenchUsage);
-      return args[++i];
-    };
-    if (a == "-o" || a == "--output") dir = need();
-    else if (a == "--quick") quick = true;
-    else if (a == "--service") service = true;
-    else if (a == "--no-report") makeReport = false;
-    else if (a == "--dry-run") dryRun = true;
-    else if (a == "--server") for (const auto& s : splitCommas(need())) o.servers.push_back(s);
-    else if (a == "--inflight") o.inflight = intArg(a, need(), 1, 64);
-    else if (a == "--requests") requests = intArg(a, need(), 1, 10000);
-    else if (a == "--size") size = intArg(a, need(), 1, 4096);
-    else if (a == "--scene") scene = need();
-    else if (a == "--throughput") throughputN = intArg(a, need(), 1, 100000);
-    else if (a == "--png-compression") pngCompression = intArg(a, need(), 0, 9);
-    else if (a == "--quiet" || a == "-q") o.quiet = true;
-    else if (a == "--help" || a == "-h") {
-      std::cout << kBenchUsage;
-      return kExitOk;
-    } else throw UsageError("bench: unknown argument " + a + "\n" + kBenchUsage);
-  }
+int runBench(const GlobalOptions& g, BenchOptions bo) {
+  const fs::path dir = bo.dir;
+  const bool quick = bo.quick, service = bo.service, makeReport = !bo.noReport, dryRun = bo.dryRun;
+  const int requests = bo.requests, size = bo.size, throughputN = bo.throughputN, pngCompression = bo.pngCompression;
+  const std::string& scene = bo.scene;
+  sweep::RunOptions& o = bo.run;
   if (service) return serviceBench(g, dir, requests, size, scene, throughputN, pngCompression);
   if (o.servers.empty()) o.servers.push_back(g.server);
   // The suite follows what the (first) server implements and ships.
@@ -459,7 +374,7 @@ int cmdBench(const GlobalOptions& g, const std::vector<std::string>& args) {
     return kExitOk;
   }
   o.token = g.token;
-  o.command = commandLine("bench", args);
+  o.command = commandLine("bench", g.commandArgs);
   const fs::path results = dir / "results.jsonl";
   const int code = runPoints(points, results, o);
   if (code == 130 || !makeReport) return code;
@@ -471,6 +386,69 @@ int cmdBench(const GlobalOptions& g, const std::vector<std::string>& args) {
   std::cout << "wrote " << s.html.string() << " and " << s.markdown.string() << " (" << s.records << " points, "
             << s.errors << " failed, " << s.plots << " plots)\n";
   return code;
+}
+
+}  // namespace
+
+void addSweepCommands(CLI::App& root, const GlobalOptions& g, Action& action) {
+  auto so = std::make_shared<SweepOptions>();
+  CLI::App* sw = root.add_subcommand("sweep", "run a parameter sweep spec into a JSON Lines results file");
+  sw->footer(
+      "Runs every point of the spec (docs/SWEEPS.md) and appends one JSON line per point to RESULTS.jsonl\n"
+      "(default: SPEC's name with .jsonl), plus a CSV view next to it. Points already in the file are skipped.");
+  sw->add_option("spec", so->specFile, "the sweep spec")->type_name("SPEC.json");
+  sw->add_option("-o,--output", so->out, "the results file")->type_name("RESULTS.jsonl");
+  repeated(sw->add_option("--server", so->run.servers,
+                          "a server to share the points with (repeatable, or comma-separated; default the global one)"))
+      ->delimiter(',')
+      ->type_name("URL");
+  sw->add_option("--inflight", so->run.inflight, "requests in flight per server (default 1, so latency is not queueing)")
+      ->type_name("N")
+      ->check(CLI::Range(1, 64));
+  sw->add_flag("--retry-failed", so->run.retryFailed, "run the points recorded as failed again");
+  sw->add_flag("--dry-run", so->dryRun, "list the points instead of running them");
+  sw->add_flag("-q,--quiet", so->run.quiet, "no per-point lines and no progress bar");
+  sw->callback([&g, &action, so] { action = [&g, so] { return runSweep(g, *so); }; });
+
+  auto ro = std::make_shared<ReportOptions>();
+  CLI::App* rep = root.add_subcommand("report", "HTML + Markdown report of sweep results");
+  rep->footer("Writes DIR/report.html (self-contained, plots inline) and DIR/report.md (plots in DIR/plots/).");
+  rep->add_option("results", ro->inputs, "one or more results files")->type_name("RESULTS.jsonl");
+  rep->add_option("-o,--output", ro->out, "the report's directory")->type_name("DIR");
+  rep->add_option("--metric", ro->report.metric, "the error axis of the Pareto plots (default rmse)")
+      ->type_name(choices({"rmse", "rel_mse", "mean_abs", "max_abs", "psnr", "ssim"}));
+  rep->add_option("--title", ro->report.title, "the report's title")->type_name("TEXT");
+  rep->callback([&g, &action, ro] { action = [&g, ro] { return runReport(g, *ro); }; });
+
+  auto bo = std::make_shared<BenchOptions>();
+  CLI::App* b = root.add_subcommand("bench", "the standard benchmark suite, or --service for the service's own overhead");
+  b->footer(
+      "The standard suite: every built-in scene x every implemented technique at its presets x two\n"
+      "resolutions, with error against the reference. Writes DIR/bench.spec.json, DIR/results.jsonl (+.csv),\n"
+      "DIR/report.html and DIR/report.md. Re-running resumes. Each technique is scored on its first output\n"
+      "AOV that has a ground truth in the server's /v1/info (ground_truths).\n"
+      "--service: the service's overhead (end-to-end latency against the renderer's frame time) and the\n"
+      "throughput of back-to-back small requests; writes DIR/service.json and prints a Markdown table.");
+  b->add_option("-o,--output", bo->dir, "the output directory (default bench-out)")->type_name("DIR");
+  b->add_flag("--quick", bo->quick, "three scenes, smaller frames, fewer repeats");
+  b->add_flag("--service", bo->service, "measure the service's overhead and throughput instead");
+  b->add_flag("--no-report", bo->noReport, "write the results only");
+  b->add_flag("--dry-run", bo->dryRun, "write DIR/bench.spec.json and list the points; render nothing");
+  repeated(b->add_option("--server", bo->run.servers, "a server to share the points with (repeatable, or comma-separated)"))
+      ->delimiter(',')
+      ->type_name("URL");
+  b->add_option("--inflight", bo->run.inflight, "requests in flight per server")->type_name("N")->check(CLI::Range(1, 64));
+  b->add_option("--requests", bo->requests, "--service: sequential requests (default 20)")->type_name("N")->check(CLI::Range(1, 10000));
+  b->add_option("--size", bo->size, "--service: frame size in pixels (default 256)")->type_name("PX")->check(CLI::Range(1, 4096));
+  b->add_option("--scene", bo->scene, "--service: the built-in scene (default cornell_box)")->type_name("NAME");
+  b->add_option("--throughput", bo->throughputN, "--service: back-to-back requests per throughput run (default 40)")
+      ->type_name("N")
+      ->check(CLI::Range(1, 100000));
+  b->add_option("--png-compression", bo->pngCompression, "--service: zlib level of the PNGs (default 1)")
+      ->type_name("0-9")
+      ->check(CLI::Range(0, 9));
+  b->add_flag("-q,--quiet", bo->run.quiet, "no per-point lines and no progress bar");
+  b->callback([&g, &action, bo] { action = [&g, bo] { return runBench(g, *bo); }; });
 }
 
 }  // namespace radiant::client

@@ -16,7 +16,10 @@
 #include <sstream>
 
 #include "client/Commands.h"
+#include "client/report/Thumbnails.h"
 #include "client/sweep/Sweep.h"
+#include "renderer/io/ImageIO.h"
+#include "renderer/metrics/Metrics.h"
 
 namespace radiant::client::report {
 
@@ -235,6 +238,90 @@ Summary write(const std::vector<json>& all, const fs::path& dir, const Options& 
     mdBody << "![" << md(p.title) << "](" << p.file << ")\n\n";
   };
 
+  // The Pareto points' pictures: the frame, its error in false colour (one scale for the section, the
+  // largest error among them) and the reference once, from the thumbnails the sweep kept.
+  int thumbCounter = 0;
+  auto thumbnails = [&](const std::vector<std::pair<const json*, std::string>>& front, const auto& label) {
+    struct Shown {
+      const json* r;
+      std::string method;
+      Thumbnail t;
+    };
+    std::vector<Shown> shown;
+    for (const auto& [r, method] : front) {
+      const json t = r->value("thumbnail", json());
+      if (!t.is_object() || !t.contains("file")) continue;
+      try {
+        shown.push_back({r, method, readThumbnail(t["file"].get<std::string>(), t.value("aov", "beauty"))});
+      } catch (const std::exception&) {  // moved or deleted: the report goes on without it
+      }
+    }
+    if (shown.empty()) return;
+    double scale = 0;
+    for (const auto& sh : shown)
+      for (float v : sh.t.error.pixels) scale = std::max(scale, double(v));
+    fs::create_directories(dir / "thumbs");
+    auto png = [&](const Image& img, const std::string& name, bool falseColour) {
+      std::string bytes;
+      if (falseColour) {
+        Image colour = metrics::falseColour(img, scale);
+        for (float& v : colour.pixels) v = io::srgbToLinear(v);  // the PNG encoder applies the sRGB transfer
+        bytes = io::encodePng(colour, 0.f, 9);
+      } else {
+        bytes = io::encodePng(img, 0.f, 9);
+      }
+      writeFile((dir / "thumbs" / name).string(), bytes);
+      return bytes;
+    };
+    auto img = [&](const std::string& bytes, const std::string& point, const std::string& kind, const std::string& alt) {
+      return "<img class=\"thumb\" data-point=\"" + html(point) + "\" data-kind=\"" + kind + "\" alt=\"" + html(alt) +
+             "\" width=\"128\" src=\"" + pngDataUri(bytes) + "\">";
+    };
+    const std::string id = "thumbs-" + std::to_string(++thumbCounter);
+    const Shown& first = shown.front();
+    // One row each: frames, error maps, and the reference, once per method (an AO method's reference
+    // is its own AO definition's).
+    body << "<figure id=\"" << id << "\" class=\"thumbs\"><table class=\"thumbs\"><tr><th></th>";
+    mdBody << "| |";
+    for (const auto& sh : shown) {
+      const std::string l = (sh.method.empty() ? "" : sh.method + " ") + label(*sh.r);
+      body << "<th>" << html(l) << "<br><span class=\"n\" data-key=\"frame_gpu_ms.median\">"
+           << formatNumber(num(*sh.r, "frame_gpu_ms")) << "</span> ms, " << html(o.metric)
+           << " <span class=\"n\" data-key=\"metric\">" << formatNumber(metricOf(*sh.r, o.metric)) << "</span></th>";
+      mdBody << " " << md(l) << " |";
+    }
+    mdBody << "\n|---|";
+    for (std::size_t i = 0; i < shown.size(); ++i) mdBody << "---|";
+    body << "</tr>\n<tr><td class=\"note\">frame</td>";
+    mdBody << "\n| frame |";
+    std::string errorRow = "<tr><td class=\"note\">error (false colour, 0.." + formatNumber(scale) + ")</td>";
+    std::string referenceRow = "<tr><td class=\"note\">reference</td>";
+    std::string mdErrors = "| error 0.." + formatNumber(scale) + " |", mdReferences = "| reference |";
+    for (std::size_t i = 0; i < shown.size(); ++i) {
+      const Shown& sh = shown[i];
+      const std::string point = sh.r->value("point_id", "");
+      const std::string frameName = id + "-" + point + "-frame.png", errorName = id + "-" + point + "-error.png";
+      body << "<td>" << img(png(sh.t.frame, frameName, false), point, "frame", "frame " + point) << "</td>";
+      errorRow += "<td>" + img(png(sh.t.error, errorName, true), point, "error", "error " + point) + "</td>";
+      mdBody << " ![frame](thumbs/" << frameName << ") |";
+      mdErrors += " ![error](thumbs/" + errorName + ") |";
+      if (i == 0 || shown[i - 1].method != sh.method) {
+        const std::string refName = id + "-" + point + "-reference.png";
+        referenceRow += "<td>" + img(png(sh.t.reference, refName, false), point, "reference", "reference " + sh.method) + "</td>";
+        mdReferences += " ![reference](thumbs/" + refName + ") |";
+      } else {
+        referenceRow += "<td></td>";
+        mdReferences += " |";
+      }
+    }
+    body << "</tr>\n" << errorRow << "</tr>\n" << referenceRow << "</tr></table><figcaption>" << html(
+        "The Pareto points' frames (" + std::string(first.t.frame.aov) + ", exposure 0, box-filtered to at most " +
+        std::to_string(kThumbnailPx) + " px) and their per-pixel error against the reference, in false colour (viridis, "
+        "dark = 0, yellow = " + formatNumber(scale) + ", the largest error shown), and the reference each method is "
+        "scored against.") << "</figcaption></figure>\n";
+    mdBody << "\n" << mdErrors << "\n" << mdReferences << "\n\n";
+  };
+
   // Per section: Pareto plot and stacked pass timings.
   body << "<h2 id=\"sections\">Time against error, and where the time goes</h2>\n";
   mdBody << "## Time against error\n\n";
@@ -267,6 +354,7 @@ Summary write(const std::vector<json>& all, const fs::path& dir, const Options& 
     // Pareto.
     std::ostringstream data, plot;
     std::vector<std::string> frontRows;
+    std::vector<std::pair<const json*, std::string>> frontRecords;  // with their method
     double xlo = INFINITY, xhi = 0, ylo = INFINITY, yhi = 0;
     int blocks = 0;
     std::vector<std::string> plotCmds;
@@ -286,6 +374,7 @@ Summary write(const std::vector<json>& all, const fs::path& dir, const Options& 
       for (const auto& p : pts) data << p.first << "\t" << p.second << "\n";
       data << "\n\n";
       for (auto i : front) {
+        frontRecords.push_back({rs[i], methods[m]});
         data << pts[i].first << "\t" << pts[i].second << "\t" << cell(label(*rs[i])) << "\n";
         frontRows.push_back("| " + md(methods[m].empty() ? "-" : methods[m]) + " | " + md(label(*rs[i])) + " | " +
                             formatNumber(pts[i].first) + " | " + formatNumber(pts[i].second) + " | `" +
@@ -315,6 +404,7 @@ Summary write(const std::vector<json>& all, const fs::path& dir, const Options& 
       mdBody << "| method | parameters | frame GPU ms | " << md(o.metric) << " | point |\n|---|---|---|---|---|\n";
       for (const auto& row : frontRows) mdBody << row << "\n";
       mdBody << "\n";
+      thumbnails(frontRecords, label);
     } else if (std::all_of(s.records.begin(), s.records.end(), [](const json* r) { return techniqueSkipped(*r); })) {
       const std::string why = valueText((*s.records.front())["skipped"][s.technique]);
       body << "<p class=\"note\">The planner skipped " << html(s.technique) << " here: " << html(why)
@@ -580,6 +670,8 @@ Summary write(const std::vector<json>& all, const fs::path& dir, const Options& 
           " td.n{text-align:right;font-variant-numeric:tabular-nums} tr.error td{background:#fde8e8}"
           " thead th{background:#f0f0f0;position:sticky;top:0}\n"
           ".note{color:#666;font-style:italic} .table-wrap{overflow-x:auto;max-width:100%}\n"
+          "table.thumbs td,table.thumbs th{border:none;vertical-align:top;font-size:11px;font-weight:normal}"
+          " img.thumb{image-rendering:pixelated;display:block}\n"
           "</style></head>\n<body>\n<h1>"
        << html(o.title) << "</h1>\n"
        << head.str() << "<nav><ul>\n" << toc.str() << "<li><a href=\"#axes\">Cost against each axis</a></li>"

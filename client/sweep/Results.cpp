@@ -70,7 +70,12 @@ std::vector<json> readRecords(const fs::path& path) {
   std::string line;
   while (std::getline(in, line)) {
     json r = json::parse(line, nullptr, false);
-    if (r.is_object() && r.contains("point_id")) out.push_back(std::move(r));
+    if (!r.is_object() || !r.contains("point_id")) continue;
+    // A thumbnail is named relative to its results file; readers get a path they can open.
+    if (r.contains("thumbnail") && r["thumbnail"].is_object() && r["thumbnail"].contains("file") &&
+        r["thumbnail"]["file"].is_string() && fs::path(r["thumbnail"]["file"].get<std::string>()).is_relative())
+      r["thumbnail"]["file"] = (path.parent_path() / r["thumbnail"]["file"].get<std::string>()).string();
+    out.push_back(std::move(r));
   }
   return out;
 }

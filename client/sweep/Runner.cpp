@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "client/Commands.h"
+#include "client/report/Thumbnails.h"
 #include "client/sweep/Sweep.h"
 
 namespace radiant::client::sweep {
@@ -20,6 +21,7 @@ namespace radiant::client::sweep {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+namespace fs = std::filesystem;
 
 struct Interrupted {};
 // The server (not the point) failed: unreachable, shutting down, or refusing our token.
@@ -44,6 +46,7 @@ struct Server {
 // One render as the runner saw it.
 struct Rendered {
   json result;
+  std::vector<std::string> frames;  // the encoded frames, in the order of the request's outputs
   double latencyMs = 0;
   std::string daemon;  // X-Radiant-Daemon of the answer ("" for a daemon without --daemon-id)
 };
@@ -157,6 +160,7 @@ public:
       }
       servers_.push_back(std::move(s));
     }
+    if (!o_.thumbnails.empty()) fs::create_directories(o_.thumbnails);
     sh_.summary.total = static_cast<int>(points.size());
     for (const auto& p : points) {
       if (results_.done(p.id, o_.retryFailed)) ++sh_.summary.skipped;
@@ -362,14 +366,16 @@ private:
         HttpClient::expectOk(r);
         json result = r.json();
         bool frameLost = false;
+        std::vector<std::string> frames;
         for (const auto& f : result.value("frames", json::array())) {
-          const HttpResponse frame = s.http->get(f.value("url", ""));
+          HttpResponse frame = s.http->get(f.value("url", ""));
           // The daemon holding the frames died after rendering: render again elsewhere.
           if (s.fleet && (frame.status == 502 || frame.status == 504) && retries < kFleetRetries) {
             frameLost = true;
             break;
           }
           HttpClient::expectOk(frame);
+          frames.push_back(std::move(frame.body));
         }
         if (frameLost) {
           ++retries;
@@ -381,7 +387,7 @@ private:
           s.http->del("/v1/renders/" + result.value("id", ""));  // free the frame store; not timed
         } catch (const std::exception&) {
         }
-        return {std::move(result), latency, r.header("x-radiant-daemon")};
+        return {std::move(result), std::move(frames), latency, r.header("x-radiant-daemon")};
       } catch (const UnreachableError& e) {
         throw ServerGone(e.what());
       }
@@ -404,10 +410,32 @@ private:
       std::map<std::string, std::pair<std::vector<double>, std::vector<double>>> perPass;
       json last;
       std::set<std::string> daemons;  // behind a proxy: which daemons rendered this point
+      // The compare render also asks for an EXR of the compared AOV, which then carries the error and
+      // reference layers (docs/API.md): the point's thumbnail. It is not timed.
+      const std::string compareAov = p.compare.is_object() ? p.compare.value("aov", "beauty") : "beauty";
       for (int k = 0; k < untimed + p.repeats; ++k) {
         json body = request;
-        if (k == 0 && !p.compare.is_null()) body["compare"] = p.compare;
-        auto [result, ms, daemon] = renderOnce(s, p, body);
+        std::size_t thumbnailFrame = SIZE_MAX;
+        if (k == 0 && !p.compare.is_null()) {
+          body["compare"] = p.compare;
+          if (!o_.thumbnails.empty()) {
+            if (!body.contains("outputs") || !body["outputs"].is_array()) body["outputs"] = json::array();
+            const json exr{{"format", "exr"}, {"aovs", {compareAov}}, {"half", false}};
+            if (body["outputs"].size() < 8 && std::find(body["outputs"].begin(), body["outputs"].end(), exr) == body["outputs"].end()) {
+              thumbnailFrame = body["outputs"].size();
+              body["outputs"].push_back(exr);
+            }
+          }
+        }
+        auto [result, frames, ms, daemon] = renderOnce(s, p, body);
+        if (thumbnailFrame < frames.size()) {
+          try {
+            const fs::path file = o_.thumbnails / (p.id + ".exr");
+            writeFile(file.string(), report::encodeThumbnail(report::thumbnailFromFrame(frames[thumbnailFrame], compareAov)));
+            record["thumbnail"] = {{"file", (o_.thumbnails.filename() / file.filename()).string()}, {"aov", compareAov}};
+          } catch (const std::runtime_error&) {  // no error/reference layers (a failed compare): no thumbnail
+          }
+        }
         if (!daemon.empty()) daemons.insert(daemon);
         const json stats = result.value("stats", json::object());
         if (k == 0 && !p.compare.is_null()) record["metrics"] = stats.value("metrics", json());

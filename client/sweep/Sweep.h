@@ -77,7 +77,9 @@ private:
   int fd_ = -1;
 };
 
-std::vector<json> readRecords(const std::filesystem::path& path);  // skips lines that are not JSON
+// Skips lines that are not JSON; a record's relative thumbnail.file comes back relative to the working
+// directory (it is stored relative to the results file).
+std::vector<json> readRecords(const std::filesystem::path& path);
 // Last record per point id, in first-appearance order.
 std::vector<json> latestRecords(const std::vector<json>& records);
 void writeCsv(const std::vector<json>& records, const std::filesystem::path& out);
@@ -91,6 +93,9 @@ struct RunOptions {
   bool retryFailed = false;
   bool quiet = false;
   std::string command;     // recorded in every record
+  // "" = none; else the folder (beside the results file) where each point's compare render leaves a
+  // thumbnail EXR (frame, error, reference: client/report/Thumbnails.h), named in its record.
+  std::filesystem::path thumbnails;
   const std::atomic<bool>* stop = nullptr;  // set by SIGINT/SIGTERM
 };
 

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -32,6 +33,22 @@ inline fs::path scratch(const std::string& name) {
 inline std::string slurp(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
   return std::string((std::istreambuf_iterator<char>(in)), {});
+}
+
+struct ProcessRun {
+  int code = -1;
+  std::string out, err;
+};
+
+// Runs the radiant client at `clientPath` with ARGS (shell words) in `dir`, with RADIANT_SERVER=server;
+// its stdout and stderr are kept apart.
+inline ProcessRun runClient(const std::string& clientPath, const std::string& server, const std::string& args,
+                            const fs::path& dir) {
+  const fs::path out = dir / "client.out", err = dir / "client.err";
+  const std::string cmd = "cd '" + dir.string() + "' && RADIANT_SERVER='" + server + "' '" + clientPath + "' " + args +
+                          " > '" + out.string() + "' 2> '" + err.string() + "'";
+  const int status = std::system(cmd.c_str());
+  return ProcessRun{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
 }
 
 // A daemon process started with fork/exec; the port is read from its first stdout line.

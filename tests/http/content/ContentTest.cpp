@@ -27,17 +27,10 @@ namespace {
 using nlohmann::json;
 namespace fs = std::filesystem;
 
-struct ProcessRun {
-  int code = -1;
-  std::string out, err;
-};
+using testing::ProcessRun;
 
 ProcessRun client(const std::string& server, const std::string& args, const fs::path& dir) {
-  const fs::path out = dir / "client.out", err = dir / "client.err";
-  const std::string cmd = "cd '" + dir.string() + "' && RADIANT_SERVER='" + server + "' '" RADIANT_CLIENT_PATH "' " +
-                          args + " > '" + out.string() + "' 2> '" + err.string() + "'";
-  const int status = std::system(cmd.c_str());
-  return ProcessRun{WIFEXITED(status) ? WEXITSTATUS(status) : -1, testing::slurp(out), testing::slurp(err)};
+  return testing::runClient(RADIANT_CLIENT_PATH, server, args, dir);
 }
 
 // Each shipped form of each sample: model name -> (form folder -> the .gltf/.glb in it).

@@ -32,18 +32,11 @@ using radiant::testing::Daemon;
 using radiant::testing::scratch;
 using radiant::testing::slurp;
 
-struct ProcessRun {
-  int code = -1;
-  std::string out, err;
-};
+using radiant::testing::ProcessRun;
 
 // Runs the radiant client with RADIANT_SERVER=server.
 ProcessRun client(const std::string& server, const std::string& args, const fs::path& dir) {
-  const fs::path out = dir / "client.out", err = dir / "client.err";
-  const std::string cmd = "cd '" + dir.string() + "' && RADIANT_SERVER='" + server + "' '" RADIANT_CLIENT_PATH "' " +
-                          args + " > '" + out.string() + "' 2> '" + err.string() + "'";
-  const int status = std::system(cmd.c_str());
-  return ProcessRun{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
+  return radiant::testing::runClient(RADIANT_CLIENT_PATH, server, args, dir);
 }
 
 json fakeFrame(const std::string& bytes) {

@@ -8,7 +8,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cstring>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -21,6 +23,10 @@
 
 #include <httplib.h>
 #include <nlohmann/json.hpp>
+
+#include "renderer/io/ImageIO.h"
+#include "renderer/metrics/Metrics.h"
+#include "tests/support/ImageDifference.h"
 
 using nlohmann::json;
 namespace fs = std::filesystem;
@@ -152,6 +158,7 @@ public:
     return 0;
   }
   const std::string& url() const { return url_; }
+  int port() const { return port_; }
 
 private:
   pid_t pid_ = -1;
@@ -164,7 +171,7 @@ struct ProcResult {
   std::string out, err;
 };
 
-ProcResult radiant(const fs::path& dir, const std::vector<std::string>& args, std::chrono::seconds timeout = std::chrono::seconds(80)) {
+ProcResult runRadiant(const fs::path& dir, const std::vector<std::string>& args, std::chrono::seconds timeout = std::chrono::seconds(80)) {
   std::vector<std::string> argv{RADIANT_CLIENT_PATH};
   argv.insert(argv.end(), args.begin(), args.end());
   const pid_t pid = spawn(argv, dir / "client.out", dir / "client.err", nullptr);
@@ -232,7 +239,7 @@ TEST_F(SweepAgainstDaemon, TwoByTwoGivesFourRecordsWithTheirParametersAndTimings
   const auto dir = scratch("2x2");
   writeJson(dir / "spec.json", aoSpec({"volumetric", "gtao"}, {4, 8}));
   const int rendersBefore = daemon_->rendersDone();
-  ProcResult r = radiant(dir, {"--server", daemon_->url(), "sweep", (dir / "spec.json").string(), "-o", (dir / "r.jsonl").string()});
+  ProcResult r = runRadiant(dir, {"--server", daemon_->url(), "sweep", (dir / "spec.json").string(), "-o", (dir / "r.jsonl").string()});
   ASSERT_EQ(r.code, 0) << r.err;
   // 4 points x (1 warm-up carrying compare + 2 timed repeats).
   EXPECT_EQ(daemon_->rendersDone() - rendersBefore, 12);
@@ -353,7 +360,7 @@ TEST_F(SweepAgainstDaemon, ResumeSkipsDonePointsAndRepairsATornLine) {
   const auto dir = scratch("resume");
   const std::string out = (dir / "r.jsonl").string();
   writeJson(dir / "half.json", aoSpec({"volumetric", "containment"}, {4}));
-  ProcResult r = radiant(dir, {"--server", daemon_->url(), "sweep", (dir / "half.json").string(), "-o", out});
+  ProcResult r = runRadiant(dir, {"--server", daemon_->url(), "sweep", (dir / "half.json").string(), "-o", out});
   ASSERT_EQ(r.code, 0) << r.err;
   ASSERT_EQ(records(out).size(), 2u);
   // A writer killed mid-line leaves half a record: the next run cuts it.
@@ -361,7 +368,7 @@ TEST_F(SweepAgainstDaemon, ResumeSkipsDonePointsAndRepairsATornLine) {
   // The full spec: the 2 done points are skipped, the other 2 run.
   writeJson(dir / "full.json", aoSpec({"volumetric", "containment"}, {4, 16}));
   const int before = daemon_->rendersDone();
-  r = radiant(dir, {"--server", daemon_->url(), "sweep", (dir / "full.json").string(), "-o", out});
+  r = runRadiant(dir, {"--server", daemon_->url(), "sweep", (dir / "full.json").string(), "-o", out});
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("4 points, 2 already in"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("incomplete last line"), std::string::npos) << r.err;
@@ -373,7 +380,7 @@ TEST_F(SweepAgainstDaemon, ResumeSkipsDonePointsAndRepairsATornLine) {
   EXPECT_EQ(ids.size(), 4u);
   // A third run has nothing to do.
   const int before2 = daemon_->rendersDone();
-  r = radiant(dir, {"--server", daemon_->url(), "sweep", (dir / "full.json").string(), "-o", out});
+  r = runRadiant(dir, {"--server", daemon_->url(), "sweep", (dir / "full.json").string(), "-o", out});
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("4 points, 4 already in"), std::string::npos) << r.err;
   EXPECT_EQ(daemon_->rendersDone(), before2);
@@ -388,7 +395,7 @@ TEST_F(SweepAgainstDaemon, TwoServersShareThePoints) {
   ASSERT_TRUE(second.ready());
   writeJson(dir / "spec.json", aoSpec({"volumetric", "containment", "gtao"}, {4, 8}));
   const int before1 = daemon_->rendersDone(), before2 = second.rendersDone();
-  ProcResult r = radiant(dir, {"sweep", (dir / "spec.json").string(), "-o", (dir / "r.jsonl").string(), "--server",
+  ProcResult r = runRadiant(dir, {"sweep", (dir / "spec.json").string(), "-o", (dir / "r.jsonl").string(), "--server",
                         daemon_->url(), "--server", second.url()});
   ASSERT_EQ(r.code, 0) << r.err;
   const auto recs = records(dir / "r.jsonl");
@@ -412,7 +419,7 @@ TEST_F(SweepAgainstDaemon, ASceneFileIsUploadedOncePerServer) {
                                 {"axes", {{"passes.direct.pcf_radius", {0, 1, 2, 3}}}},
                                 {"repeats", 1},
                                 {"warmup", 0}});
-  ProcResult r = radiant(dir, {"--server", daemon_->url(), "sweep", (dir / "spec.json").string(), "-o",
+  ProcResult r = runRadiant(dir, {"--server", daemon_->url(), "sweep", (dir / "spec.json").string(), "-o",
                                (dir / "r.jsonl").string(), "--inflight", "3"});
   ASSERT_EQ(r.code, 0) << r.err;
   const auto recs = records(dir / "r.jsonl");
@@ -466,7 +473,7 @@ TEST(SweepServerLoss, AServerThatDiesLeavesConsistentResultsAndAClearError) {
   // A new server picks up where the dead one stopped.
   Daemon fresh(dir / "fresh.log");
   ASSERT_TRUE(fresh.ready());
-  ProcResult r = radiant(dir, {"--server", fresh.url(), "sweep", (dir / "spec.json").string(), "-o", out.string()});
+  ProcResult r = runRadiant(dir, {"--server", fresh.url(), "sweep", (dir / "spec.json").string(), "-o", out.string()});
   ASSERT_EQ(r.code, 0) << r.err;
   const auto all = records(out);
   ASSERT_EQ(all.size(), static_cast<std::size_t>(points));
@@ -503,6 +510,26 @@ namespace {
   return ::testing::AssertionFailure() << "shown \"" << text << "\" but the results file has " << value;
 }
 
+// Each method's Pareto front (frame GPU median against rmse), computed from the results records.
+std::vector<const json*> paretoFront(const std::vector<json>& recs) {
+  std::map<std::string, std::vector<const json*>> byMethod;
+  for (const auto& rec : recs)
+    if (!rec.contains("error")) byMethod[rec["method"]].push_back(&rec);
+  std::vector<const json*> front;
+  for (auto& [m, rs] : byMethod) {
+    std::sort(rs.begin(), rs.end(), [](const json* a, const json* b) {
+      return (*a)["frame_gpu_ms"]["median"].get<double>() < (*b)["frame_gpu_ms"]["median"].get<double>();
+    });
+    double best = INFINITY;
+    for (const json* rec : rs)
+      if ((*rec)["metrics"]["rmse"].get<double>() < best) {
+        best = (*rec)["metrics"]["rmse"].get<double>();
+        front.push_back(rec);
+      }
+  }
+  return front;
+}
+
 std::string unescape(std::string s) {
   for (auto [from, to] : std::vector<std::pair<std::string, std::string>>{{"&lt;", "<"}, {"&gt;", ">"}, {"&quot;", "\""}, {"&amp;", "&"}}) {
     std::size_t at = 0;
@@ -516,7 +543,7 @@ std::string unescape(std::string s) {
 TEST(Report, FromTheFixtureHasThePlotsAndTheResultsFilesNumbers) {
   const auto dir = scratch("report");
   const fs::path fixture = fs::path(RADIANT_SOURCE_DIR) / "tests" / "data" / "sweep_results.jsonl";
-  ProcResult r = radiant(dir, {"report", fixture.string(), "-o", (dir / "out").string()});
+  ProcResult r = runRadiant(dir, {"report", fixture.string(), "-o", (dir / "out").string()});
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("7 points, 1 failed, 4 plots"), std::string::npos) << r.out;
   const std::string page = slurp(dir / "out" / "report.html");
@@ -550,22 +577,11 @@ TEST(Report, FromTheFixtureHasThePlotsAndTheResultsFilesNumbers) {
     EXPECT_NE(svgOf[plots[1]].find(">" + pass["name"].get<std::string>() + "<"), std::string::npos) << pass["name"];
 
   // The Pareto front per method, computed here from the file, is what the report labels and lists.
-  std::map<std::string, std::vector<const json*>> byMethod;
-  for (const auto& rec : recs)
-    if (!rec.contains("error")) byMethod[rec["method"]].push_back(&rec);
   std::set<std::string> frontIds;
-  for (auto& [m, rs] : byMethod) {
-    std::sort(rs.begin(), rs.end(), [](const json* a, const json* b) {
-      return (*a)["frame_gpu_ms"]["median"].get<double>() < (*b)["frame_gpu_ms"]["median"].get<double>();
-    });
-    double best = INFINITY;
-    for (const json* rec : rs)
-      if ((*rec)["metrics"]["rmse"].get<double>() < best) {
-        best = (*rec)["metrics"]["rmse"].get<double>();
-        frontIds.insert((*rec)["point_id"].get<std::string>());
-        const std::string label = "samples=" + std::to_string((*rec)["params"]["passes.ambient_occlusion.samples"].get<int>());
-        EXPECT_NE(svgOf[plots[0]].find(">" + label + "<"), std::string::npos) << label;
-      }
+  for (const json* rec : paretoFront(recs)) {
+    frontIds.insert((*rec)["point_id"].get<std::string>());
+    const std::string label = "samples=" + std::to_string((*rec)["params"]["passes.ambient_occlusion.samples"].get<int>());
+    EXPECT_NE(svgOf[plots[0]].find(">" + label + "<"), std::string::npos) << label;
   }
   std::set<std::string> mdFront;
   std::regex frontRow(R"(\| (\w+) \| samples=(\d+) \| ([\d.e+-]+) \| ([\d.e+-]+) \| `([0-9a-f]{16})` \|)");
@@ -660,27 +676,27 @@ TEST(Report, FromTheFixtureHasThePlotsAndTheResultsFilesNumbers) {
   EXPECT_NE(mdText.find("- Produced by: `radiant sweep tests/data/sweep_fixture.spec.json"), std::string::npos);
 
   // Bad usage exits 2.
-  EXPECT_EQ(radiant(dir, {"report", (dir / "missing.jsonl").string(), "-o", (dir / "x").string()}).code, 2);
-  EXPECT_EQ(radiant(dir, {"report", fixture.string()}).code, 2);
+  EXPECT_EQ(runRadiant(dir, {"report", (dir / "missing.jsonl").string(), "-o", (dir / "x").string()}).code, 2);
+  EXPECT_EQ(runRadiant(dir, {"report", fixture.string()}).code, 2);
   fs::remove_all(dir);
 }
 
 TEST(SweepSpec, BadSpecsAreUsageErrorsNamingTheKey) {
   const auto dir = scratch("spec");
   writeJson(dir / "typo.json", {{"base", {{"scene", {{"builtin", "cornell_box"}}}}}, {"axis", json::object()}});
-  ProcResult r = radiant(dir, {"--server", "http://127.0.0.1:1", "sweep", (dir / "typo.json").string(), "--dry-run"});
+  ProcResult r = runRadiant(dir, {"--server", "http://127.0.0.1:1", "sweep", (dir / "typo.json").string(), "--dry-run"});
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("/axis: unknown key"), std::string::npos) << r.err;
   writeJson(dir / "zip.json", {{"base", {{"scene", {{"builtin", "cornell_box"}}}}},
                                {"zip", {{{"width", {16, 32}}, {"height", {16}}}}}});
-  r = radiant(dir, {"sweep", (dir / "zip.json").string(), "--dry-run"});
+  r = runRadiant(dir, {"sweep", (dir / "zip.json").string(), "--dry-run"});
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("equal lengths"), std::string::npos) << r.err;
   // Product of axes x zipped groups: 3 x 2 points.
   writeJson(dir / "ok.json", {{"base", {{"scene", {{"builtin", "cornell_box"}}}}},
                               {"axes", {{"passes.direct.pcf_radius", {0, 1, 2}}}},
                               {"zip", {{{"width", {16, 32}}, {"height", {8, 24}}}}}});
-  r = radiant(dir, {"sweep", (dir / "ok.json").string(), "--dry-run"});
+  r = runRadiant(dir, {"sweep", (dir / "ok.json").string(), "--dry-run"});
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("6 points"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("height=24 pcf_radius=1 width=32"), std::string::npos) << r.out;
@@ -712,11 +728,145 @@ TEST(SweepInterrupt, CtrlCStopsCleanlyAndTheNextRunResumes) {
   for (const auto& rec : partial) EXPECT_EQ(rec["latency_ms"]["n"], 2) << rec.dump();
   // The CSV view was written on the way out, one row per record.
   EXPECT_EQ(lines(dir / "r.csv").size(), partial.size() + 1);
-  ProcResult r = radiant(dir, {"--server", daemon.url(), "sweep", (dir / "spec.json").string(), "-o", out.string()});
+  ProcResult r = runRadiant(dir, {"--server", daemon.url(), "sweep", (dir / "spec.json").string(), "-o", out.string()});
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find(std::to_string(points) + " points, " + std::to_string(partial.size()) + " already in"),
             std::string::npos)
       << r.err;
   EXPECT_EQ(records(out).size(), static_cast<std::size_t>(points));
+  fs::remove_all(dir);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The report's pictures: the Pareto points' frames, their error maps and the reference, embedded.
+
+namespace {
+
+std::string base64Decode(const std::string& in) {
+  std::string out;
+  unsigned v = 0;
+  int bits = 0;
+  for (char c : in) {
+    const char* digits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    const char* at = std::strchr(digits, c);
+    if (c == '=' || !at || !c) break;
+    v = v << 6 | static_cast<unsigned>(at - digits);
+    bits += 6;
+    if (bits >= 8) {
+      bits -= 8;
+      out += static_cast<char>((v >> bits) & 0xff);
+    }
+  }
+  return out;
+}
+
+// The mean of each 2x2 block: a 128 px frame's 64 px thumbnail, computed here independently.
+radiant::Image halve(const radiant::Image& img) {
+  radiant::Image out = radiant::Image::make(img.aov, img.width / 2, img.height / 2, img.channels);
+  for (int y = 0; y < out.height; ++y)
+    for (int x = 0; x < out.width; ++x)
+      for (int c = 0; c < img.channels; ++c)
+        out.at(x, y)[c] = (img.at(2 * x, 2 * y)[c] + img.at(2 * x + 1, 2 * y)[c] + img.at(2 * x, 2 * y + 1)[c] +
+                           img.at(2 * x + 1, 2 * y + 1)[c]) / 4;
+  return out;
+}
+
+radiant::Image displayed(radiant::Image img) {  // what the PNG encoder makes of linear values at exposure 0
+  for (float& v : img.pixels) v = radiant::io::linearToSrgb(std::clamp(v, 0.f, 1.f));
+  return img;
+}
+
+}  // namespace
+
+TEST_F(SweepAgainstDaemon, ReportShowsTheParetoPointsFramesErrorMapsAndReference) {
+  const auto dir = scratch("thumbs");
+  json spec = aoSpec({"volumetric", "gtao"}, {4, 16}, 1);
+  spec["base"]["width"] = 128;  // 64 px thumbnails: a 2x2 box filter
+  spec["base"]["height"] = 128;
+  writeJson(dir / "spec.json", spec);
+  ProcResult r = runRadiant(dir, {"--server", daemon_->url(), "sweep", (dir / "spec.json").string(), "-o", (dir / "r.jsonl").string()});
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = runRadiant(dir, {"report", (dir / "r.jsonl").string(), "-o", (dir / "out").string()});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto recs = records(dir / "r.jsonl");
+  ASSERT_EQ(recs.size(), 4u);
+  for (const auto& rec : recs) {
+    ASSERT_TRUE(rec.contains("thumbnail")) << rec.dump();
+    EXPECT_EQ(rec["thumbnail"]["file"], "r.thumbs/" + rec["point_id"].get<std::string>() + ".exr");
+    EXPECT_EQ(rec["thumbnail"]["aov"], "ao");
+    EXPECT_LT(fs::file_size(dir / rec["thumbnail"]["file"].get<std::string>()), 64u * 1024);
+  }
+  const std::string page = slurp(dir / "out" / "report.html");
+  EXPECT_LT(page.size(), 1u << 20) << "one offline file of reasonable size";
+  EXPECT_EQ(page.find("src=\"http"), std::string::npos);
+
+  // Every embedded picture, by point and kind.
+  std::map<std::string, std::map<std::string, radiant::Image>> shown;  // kind -> point -> image
+  std::regex imgRe(R"re(<img class="thumb" data-point="([0-9a-f]+)" data-kind="(\w+)" alt="[^"]*" width="128" src="data:image/png;base64,([A-Za-z0-9+/=]+)">)re");
+  int images = 0;
+  for (auto it = std::sregex_iterator(page.begin(), page.end(), imgRe); it != std::sregex_iterator(); ++it, ++images)
+    shown[(*it)[2]][(*it)[1]] = radiant::io::decodeImage(base64Decode((*it)[3]));
+  int imgTags = 0;
+  for (std::size_t at = 0; (at = page.find("<img", at)) != std::string::npos; ++at) ++imgTags;
+  EXPECT_EQ(images, imgTags)
+      << "every <img> is a data-URI thumbnail";
+
+  // The Pareto front per method, computed here from the results file, is what is pictured.
+  std::set<std::string> frontIds, methods;
+  for (const json* rec : paretoFront(recs)) frontIds.insert((*rec)["point_id"].get<std::string>());
+  for (const auto& rec : recs) methods.insert(rec["method"].get<std::string>());
+  std::set<std::string> framed, errored;
+  for (const auto& [id, img] : shown["frame"]) framed.insert(id);
+  for (const auto& [id, img] : shown["error"]) errored.insert(id);
+  EXPECT_EQ(framed, frontIds);
+  EXPECT_EQ(errored, frontIds);
+  EXPECT_EQ(shown["reference"].size(), methods.size()) << "one reference per method (its AO definition's)";
+
+  // The pictures are the frames': each front point rendered again here, with the compare block and a
+  // float EXR of the AO (its error.Y and reference layers come with it), box-filtered here.
+  httplib::Client http("127.0.0.1", daemon_->port());
+  http.set_read_timeout(120, 0);
+  std::map<std::string, radiant::Image> errors;
+  std::map<std::string, radiant::Image> references;
+  double scale = 0;
+  for (const auto& rec : recs) {
+    const std::string id = rec["point_id"];
+    if (!frontIds.count(id)) continue;
+    json request = rec["request"];
+    request["outputs"] = {{{"format", "exr"}, {"aovs", {"ao"}}, {"half", false}}};
+    auto res = http.Post("/v1/renders", request.dump(), "application/json");
+    ASSERT_TRUE(res && res->status == 200) << (res ? res->body : "no answer");
+    auto frame = http.Get(json::parse(res->body)["frames"][0]["url"].get<std::string>().c_str());
+    ASSERT_TRUE(frame && frame->status == 200);
+    const radiant::Image ao = halve(radiant::io::decodeImage(frame->body, "ao"));
+    errors[id] = halve(radiant::io::decodeImage(frame->body, "error"));
+    references[id] = halve(radiant::io::decodeImage(frame->body, "reference"));
+    for (float v : errors[id].pixels) scale = std::max(scale, double(v));
+    ASSERT_EQ(ao.width, 64);
+    // 8-bit sRGB of a half-float thumbnail: half a step of rounding, and half's 2^-11 through the sRGB slope.
+    EXPECT_LE(radiant::testing::maxAbsDifference(shown["frame"][id], displayed(ao)), 1.0 / 255) << id;
+  }
+  for (const auto& [id, img] : shown["reference"]) {
+    ASSERT_TRUE(references.count(id)) << "a reference shown under a point that is not on the front: " << id;
+    EXPECT_LE(radiant::testing::maxAbsDifference(img, displayed(references[id])), 1.0 / 255) << id;
+  }
+  ASSERT_GT(scale, 0.0);
+  // The error maps: viridis over one scale for the section, the largest error among the pictured points.
+  for (const auto& [id, err] : errors) {
+    radiant::Image colour = radiant::metrics::falseColour(err, scale);
+    EXPECT_LE(radiant::testing::maxAbsDifference(shown["error"][id], colour), 1.5 / 255) << id;
+  }
+
+  // The numbers beside the pictures are the results file's.
+  for (const auto& rec : recs) {
+    if (!frontIds.count(rec["point_id"])) continue;
+    const std::string label = "samples=" + std::to_string(rec["params"]["passes.ambient_occlusion.samples"].get<int>());
+    std::smatch m;
+    const std::regex head("<th>" + rec["method"].get<std::string>() + " " + label +
+                          R"re(<br><span class="n" data-key="frame_gpu_ms.median">([^<]+)</span> ms, rmse <span class="n" data-key="metric">([^<]+)</span></th>)re");
+    ASSERT_TRUE(std::regex_search(page, m, head)) << label;
+    EXPECT_TRUE(showsNumber(m[1], rec["frame_gpu_ms"]["median"]));
+    EXPECT_TRUE(showsNumber(m[2], rec["metrics"]["rmse"]));
+  }
   fs::remove_all(dir);
 }

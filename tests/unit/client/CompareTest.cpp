@@ -10,7 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "client/Commands.h"
+#include "client/Cli.h"
 #include "renderer/io/ImageIO.h"
 #include "renderer/metrics/Metrics.h"
 
@@ -18,6 +18,12 @@ namespace radiant {
 namespace {
 
 namespace fs = std::filesystem;
+
+// A command line through the CLI's one definition, run in this process.
+int runCommand(const std::vector<std::string>& args) {
+  client::GlobalOptions g;
+  return client::parseCommandLine(g, args)();
+}
 
 Image constant(const std::string& aov, int w, int h, glm::vec3 v) {
   Image img = Image::make(aov, w, h, 3);
@@ -53,7 +59,7 @@ TEST(Compare, PrintsTheServiceMetricsAndWritesTheFalseColourError) {
   io::writeFile(a, io::encodeExr({constant("beauty", 8, 4, glm::vec3(1.1f))}, false));
   io::writeFile(b, io::encodeExr({constant("beauty", 8, 4, glm::vec3(1.0f))}, false));
   ::testing::internal::CaptureStdout();
-  EXPECT_EQ(client::cmdCompare({}, {a, b, "-o", png, "--json"}), 0);
+  EXPECT_EQ(runCommand({"compare", a, b, "-o", png, "--json"}), 0);
   const nlohmann::json j = nlohmann::json::parse(::testing::internal::GetCapturedStdout());
   EXPECT_NEAR(j["rmse"].get<double>(), 0.1, 1e-5);
   EXPECT_NEAR(j["mean_abs"].get<double>(), 0.1, 1e-5);
@@ -71,8 +77,8 @@ TEST(Compare, PrintsTheServiceMetricsAndWritesTheFalseColourError) {
   // Images of different sizes are a usage error, not a crash.
   const std::string small = (dir / "small.exr").string();
   io::writeFile(small, io::encodeExr({constant("beauty", 2, 2, glm::vec3(1.f))}, false));
-  EXPECT_THROW(client::cmdCompare({}, {a, small}), client::UsageError);
-  EXPECT_THROW(client::cmdCompare({}, {a}), client::UsageError);
+  EXPECT_THROW(runCommand({"compare", a, small}), client::UsageError);
+  EXPECT_THROW(runCommand({"compare", a}), client::UsageError);
 }
 
 }  // namespace
