@@ -1,23 +1,3 @@
-// The G-buffer's material texture lookup: the box filter of the texture over the pixel's footprint,
-// the parallelogram dFdx(uv), dFdy(uv) spans. That is the integral the reference estimates (jittered
-// rays over the pixel, bilinear level 0). One trilinear tap filters a region about 1.7 times wider
-// than the footprint (a level-lambda texel's box convolved with the bilinear tent: standard deviation
-// rho/2 against the footprint box's rho/sqrt(12)) and, in atlases without gutters, bleeds the
-// background between the UV islands into their edges (the Fox sample's texture). kFootprintTaps^2
-// stratified taps, each filtered over its own cell (textureGrad with the gradients / kFootprintTaps),
-// approach the box as the tap count grows; supersampling (RenderRequest::supersampling) halves the
-// footprint again.
-const int kFootprintTaps = 2;
-vec4 footprintSample(sampler2D s, vec2 uv) {
-  const vec2 dx = dFdx(uv), dy = dFdy(uv);
-  const float n = float(kFootprintTaps);
-  vec4 sum = vec4(0.0);
-  for (int i = 0; i < kFootprintTaps; ++i)
-    for (int j = 0; j < kFootprintTaps; ++j)
-      sum += textureGrad(s, uv + ((float(i) + 0.5) / n - 0.5) * dx + ((float(j) + 0.5) / n - 0.5) * dy, dx / n, dy / n);
-  return sum / (n * n);
-}
-#define MATERIAL_SAMPLE(sampler, uv) footprintSample(sampler, uv)
 #include "common/material.glsl"
 
 in vec3 v_position;
