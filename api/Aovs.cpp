@@ -7,7 +7,9 @@ namespace radiant::api {
 const std::vector<AovInfo>& aovTable() {
   using F = AovFormat;
   using B = AovBlend;
-  // name, format, resource, first channel, channels, EXR names, blend, producer, requestable, ground truth.
+  constexpr AovResolve Nearest = AovResolve::Nearest;
+  // name, format, resource, first channel, channels, EXR names, blend, producer, requestable, ground truth,
+  // resolve (Average unless given).
   // Beauty is EXR's default layer (R, G, B) so viewers show it first; the others are "<aov>.<channel>".
   static const std::vector<AovInfo> table = [] {
     std::vector<AovInfo> t = {
@@ -32,18 +34,18 @@ const std::vector<AovInfo>& aovTable() {
         {0, "light_volumes", F::Rgba32F, "light_volumes", 0, 3,
          {"light_volumes.R", "light_volumes.G", "light_volumes.B"}, B::Overwrite, "light_volumes", true, ""},
         {0, "ao", F::R32F, "ao", 0, 1, {"ao.Y"}, B::Overwrite, "ambient_occlusion", true, "ao"},
-        {0, "depth", F::Rgba32F, "gbuffer_position", 3, 1, {"depth.Z"}, B::Overwrite, "gbuffer", true, ""},
+        {0, "depth", F::Rgba32F, "gbuffer_position", 3, 1, {"depth.Z"}, B::Overwrite, "gbuffer", true, "", Nearest},
         {0, "gbuffer_position", F::Rgba32F, "gbuffer_position", 0, 3,
-         {"gbuffer_position.R", "gbuffer_position.G", "gbuffer_position.B"}, B::Overwrite, "gbuffer", true, ""},
+         {"gbuffer_position.R", "gbuffer_position.G", "gbuffer_position.B"}, B::Overwrite, "gbuffer", true, "", Nearest},
         {0, "normal", F::Rgba16F, "normal", 0, 3, {"normal.R", "normal.G", "normal.B"}, B::Overwrite, "gbuffer", true,
-         ""},
+         "", Nearest},
         {0, "geometric_normal", F::Rgba16F, "geometric_normal", 0, 3,
-         {"geometric_normal.R", "geometric_normal.G", "geometric_normal.B"}, B::Overwrite, "gbuffer", true, ""},
+         {"geometric_normal.R", "geometric_normal.G", "geometric_normal.B"}, B::Overwrite, "gbuffer", true, "", Nearest},
         {0, "albedo", F::Rgba16F, "albedo", 0, 3, {"albedo.R", "albedo.G", "albedo.B"}, B::Overwrite, "gbuffer", true,
          ""},
         // metallic, roughness, occlusion, transmission (KHR_materials_transmission) in R, G, B, A.
         {0, "material", F::Rgba16F, "material", 0, 4, {"material.R", "material.G", "material.B", "material.A"},
-         B::Overwrite, "gbuffer", true, ""},
+         B::Overwrite, "gbuffer", true, "", Nearest},
         {0, "emission", F::Rgba16F, "emission", 0, 3, {"emission.R", "emission.G", "emission.B"}, B::Overwrite,
          "gbuffer", true, ""},
         {0, "reference", F::Rgba32F, "reference", 0, 3, {"reference.R", "reference.G", "reference.B"}, B::Overwrite,
@@ -81,6 +83,7 @@ const char* toString(AovFormat f) {
   }
 }
 const char* toString(AovBlend b) { return b == AovBlend::Accumulate ? "accumulate" : "overwrite"; }
+const char* toString(AovResolve r) { return r == AovResolve::Nearest ? "nearest" : "average"; }
 
 nlohmann::json aovTableJson() {
   nlohmann::json out = nlohmann::json::array();
@@ -89,6 +92,7 @@ nlohmann::json aovTableJson() {
                    {"format", toString(a.format)},
                    {"channels", a.exr},
                    {"blend", toString(a.blend)},
+                   {"resolve", toString(a.resolve)},
                    {"producer", a.producer.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.producer)},
                    {"requestable", a.requestable},
                    {"ground_truth", a.groundTruth.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.groundTruth)}});

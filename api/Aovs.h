@@ -23,6 +23,12 @@ enum class AovFormat { Rgba32F, Rgba16F, R32F };  // the GPU format of the resou
 // light into it (beauty); it exists in every frame even when nothing drew.
 enum class AovBlend { Overwrite, Accumulate };
 
+// How a supersampled frame (RenderRequest::supersampling = k) resolves the k x k samples of a pixel:
+// Average, the box filter, for what is linear in radiance or reflectance (the pixel integral the
+// reference estimates); Nearest, the sample nearest the pixel centre, for geometry, whose average
+// across a silhouette names no surface (a depth between the two, a normal of neither).
+enum class AovResolve { Average, Nearest };
+
 struct AovInfo {
   int id;                        // index in aovTable()
   std::string name;              // as in requests ("beauty", "depth")
@@ -38,6 +44,7 @@ struct AovInfo {
   // (beauty, direct, indirect, ao), or "" when the AOV has no ground truth the reference can render
   // (then compare.aov naming it is a 422, instead of silently scoring against beauty).
   std::string groundTruth;
+  AovResolve resolve = AovResolve::Average;
 };
 
 const std::vector<AovInfo>& aovTable();
@@ -46,6 +53,7 @@ const AovInfo* findAov(std::string_view name);
 
 const char* toString(AovFormat f);  // "RGBA32F" | "RGBA16F" | "R32F"
 const char* toString(AovBlend b);   // "overwrite" | "accumulate"
+const char* toString(AovResolve r); // "average" | "nearest"
 
 // The table as GET /v1/info serves it: [{"name", "format", "channels": [EXR names], "blend",
 // "producer", "requestable", "ground_truth"}].

@@ -25,6 +25,7 @@ void to_json(nlohmann::json& j, const FrameStats& s) {
                      {"device", s.device},
                      {"metrics", s.metrics},
                      {"lighting", s.lighting},
+                     {"supersampling", s.supersampling},
                      {"camera", s.camera},
                      {"scene", s.scene},
                      {"warnings", s.warnings}};

@@ -87,6 +87,10 @@ struct RenderRequest {
   // With no lights, emission, ambient or environment, light the scene with the default studio
   // environment (renderer/scene/StudioEnvironment.h); false renders such a scene black.
   bool defaultLighting = true;
+  // Samples per pixel axis of the raster passes (the schema's "supersampling", default 1 there too):
+  // they run at (k width) x (k height) and readback resolves each AOV to width x height
+  // (api::AovResolve).
+  int supersampling = 1;
   std::optional<CompareSpec> compare;
   bool async = false;
   // A quality preset ("" none, draft, preview, final, reference) or a frame time budget (0 none), both
@@ -126,6 +130,7 @@ struct FrameStats {
   // What lit the frame: "scene" (its lights or emission), "ambient", "environment", "default" (the
   // studio environment, see RenderRequest::defaultLighting) or "none".
   std::string lighting;
+  int supersampling = 1;  // the raster's samples per pixel axis this frame used (RenderRequest::supersampling, capped)
   nlohmann::json camera;  // the camera used: position, target, up, yfov_deg, source
   nlohmann::json scene;   // name, digest, bounds {min, max}, node names
   std::vector<std::string> warnings;  // things the scene has that this frame could not honour

@@ -40,6 +40,25 @@ AovSource aovSource(const std::string& aov) {
   return {a->resource, a->firstChannel, a->channels};
 }
 
+// Resolves a read-back RGBA frame of (k out.width) x (k out.height), GL rows (bottom first), into `out`
+// (top row first): the box average of each pixel's k x k samples for radiance and reflectance, the
+// sample nearest the pixel centre for geometry (api::AovResolve). k = 1 copies.
+void resolveSupersampled(const std::vector<float>& rgba, int width, int height, int k, const AovSource& src, Image& out) {
+  const bool average = api::findAov(out.aov)->resolve == api::AovResolve::Average;
+  const int j0 = average ? 0 : k / 2, j1 = average ? k : k / 2 + 1;
+  const float weight = 1.f / static_cast<float>((j1 - j0) * (j1 - j0));
+  for (int y = 0; y < out.height; ++y)
+    for (int x = 0; x < out.width; ++x) {
+      float* p = out.at(x, y);
+      for (int c = 0; c < src.channels; ++c) p[c] = 0.f;
+      for (int sy = j0; sy < j1; ++sy) {
+        const float* row = &rgba[static_cast<std::size_t>(height - 1 - (y * k + sy)) * width * 4];
+        for (int sx = j0; sx < j1; ++sx)
+          for (int c = 0; c < src.channels; ++c) p[c] += weight * row[(x * k + sx) * 4 + src.firstChannel + c];
+      }
+    }
+}
+
 // Replaces NaN and Inf by 0 and counts them: output is never NaN or Inf, and the stats say if a pass
 // produced any (which is a bug to fix, not to hide).
 std::size_t sanitize(std::vector<float>& v) {
@@ -172,6 +191,14 @@ std::string blackFrameWarning(const RenderOutput& out, const api::FrameStats& st
     cause = "no light reaches the camera (every light is occluded, outside the view, or of zero intensity)";
   }
   return "black frame: the beauty's brightest pixel is below 1e-6; " + cause;
+}
+
+int rasterSupersampling(int requested, int width, int height, bool runsReference) {
+  if (runsReference) return 1;
+  constexpr double kMaxPixels = 4096.0 * 4096.0;
+  int k = std::clamp(requested, 1, 4);
+  while (k > 1 && double(k) * k * width * height > kMaxPixels) --k;
+  return k;
 }
 
 struct Renderer::Impl {
@@ -312,13 +339,24 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     if (!request.environment.empty() && !inputs.environment)
       throw api::ApiError(422, "invalid-value", "Environment not supplied",
                           "the environment image " + request.environment + " was not supplied", "/environment");
-    const FrameView view = makeFrameView(scene, request, inputs.environment);
-    stats.camera = cameraStats(view);
-    const GpuScene& gpu = im.gpuScene(scene, stats);
-
     std::vector<Technique*> all;
     for (auto& t : im.techniques) all.push_back(t.get());
     FramePlan plan = planFrame(all, scene, request);
+    // The passes run on the supersampled view; readback resolves to outView (the request's size), on
+    // which compare() renders the reference.
+    const int k = rasterSupersampling(
+        request.supersampling, request.width, request.height,
+        std::any_of(plan.passes.begin(), plan.passes.end(), [](const Technique* t) { return t->info().name == "reference"; }));
+    stats.supersampling = k;
+    api::RenderRequest supersampled = request;
+    supersampled.width *= k;
+    supersampled.height *= k;
+    const FrameView view = makeFrameView(scene, supersampled, inputs.environment);
+    FrameView outView = view;
+    outView.width = request.width;
+    outView.height = request.height;
+    stats.camera = cameraStats(view);
+    const GpuScene& gpu = im.gpuScene(scene, stats);
     stats.skipped = plan.skipped;
     stats.lightPaths = plan.lightPaths;
 
@@ -392,18 +430,13 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     std::size_t nonFinite = 0;
     for (const std::string& aov : aovs) {
       const AovSource src = aovSource(aov);
-      Image img = Image::make(aov, view.width, view.height, src.channels);
+      Image img = Image::make(aov, outView.width, outView.height, src.channels);
       if (im.resources.hasTexture(src.texture) && im.resources.written(aov)) {
         im.resources.texture(src.texture).download(0, GL_RGBA, GL_FLOAT, rgba.data(), rgba.size() * sizeof(float));
-        // GL's row 0 is the bottom row; images are stored top row first.
-        for (int y = 0; y < view.height; ++y) {
-          const float* row = &rgba[static_cast<std::size_t>(view.height - 1 - y) * view.width * 4];
-          for (int x = 0; x < view.width; ++x)
-            for (int c = 0; c < src.channels; ++c) img.at(x, y)[c] = row[x * 4 + src.firstChannel + c];
-        }
+        resolveSupersampled(rgba, view.width, view.height, k, src, img);
       } else if (aov == "beauty" || aov == "direct") {
         // Nothing was drawn (no geometry): the frame shows the sky.
-        for (int i = 0; i < view.width * view.height; ++i)
+        for (int i = 0; i < outView.width * outView.height; ++i)
           for (int c = 0; c < 3; ++c) img.pixels[static_cast<std::size_t>(i) * 3 + c] = view.ambient[c];
       }
       nonFinite += sanitize(img.pixels);
@@ -417,7 +450,8 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
       stats.budget = std::move(choice.stats);
       api::recordMeasured(stats.budget, stats, msSince(frameStart));  // before compare's reference
     }
-    if (request.compare) compare(im.resources, scene, view, request, inputs.compareTarget, im.techniques, plan.passes, out);
+    if (request.compare)
+      compare(im.resources, scene, outView, request, inputs.compareTarget, im.techniques, plan.passes, out);
     stats.renderMs = msSince(frameStart);
     report(1.0);
     if (nonFinite) stats.passes.back().counters["non_finite_pixels_zeroed"] = static_cast<double>(nonFinite);

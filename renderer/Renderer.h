@@ -39,6 +39,13 @@ struct TechniqueDescription {
   nlohmann::json groundTruths = nlohmann::json::object();
 };
 
+// The raster's samples per pixel axis for a frame of width x height that asks for `requested`
+// (RenderRequest::supersampling, 1-4): 1 when the frame runs the reference pass, which integrates the
+// pixel itself, and at most what keeps k^2 width height within 4096^2 pixels, the largest frame the
+// limits allow at one sample, so that supersampling never raises a frame's memory above what a request
+// may already ask for. stats.supersampling reports it.
+int rasterSupersampling(int requested, int width, int height, bool runsReference);
+
 class Renderer {
 public:
   explicit Renderer(const DeviceOptions& options = {});

@@ -489,5 +489,60 @@ TEST(RenderCore, BlackFrameIsWarnedWithItsCause) {
   EXPECT_FALSE(hasBlack(lit));
 }
 
+// Supersampling (RenderRequest::supersampling = k): the passes render k x k samples per pixel, at the
+// centres ((i + 1/2) / k) of the pixel's cells, and readback averages radiance over them, so a pixel
+// half covered by an edge gets the covered fraction of the samples, as the reference's pixel integral
+// gets the covered area. An unlit quad of base colour c = 0.8 (KHR_materials_unlit: radiance c,
+// nothing lights it) over a black sky, its right edge at x = 0.07 inside pixel column 4, which spans
+// x in [0, 0.25] (8 pixels over [-1, 1]): sample columns at x = 0.125 (k = 1), 0.0625 and 0.1875
+// (k = 2), 0.03125 + 0.0625 i (k = 4) lie left of the edge 0, 1 and 1 times out of 1, 2 and 4, so the
+// column's beauty is exactly 0, c/2 and c/4. Geometry is not averaged: depth is the sample nearest
+// the centre, 0 (sky) or 10 (the quad, seen from z = 10), never a blend of the two.
+TEST(RenderCore, SupersamplingAveragesRadianceOverThePixelAndKeepsGeometryUnblended) {
+  SceneBuilder b;
+  Material unlit;
+  unlit.baseColorFactor = glm::vec4(0.8f, 0.8f, 0.8f, 1.f);
+  unlit.unlit = true;
+  const int mat = b.material(unlit);
+  const float edge = 0.07f, left = -3.f;
+  b.quad({0.5f * (edge + left), 0, 0}, {0.5f * (edge - left), 0, 0}, {0, 3.f, 0}, mat, "card");  // normal +z
+  b.scene().camera = testing::orthoCameraAlongZ(1.f);
+  const Scene scene = b.build();
+  const float expected[] = {0.f, 0.4f, 0.f, 0.2f};  // by k = 1, 2, (3 unused), 4
+  for (int k : {1, 2, 4}) {
+    SCOPED_TRACE(k);
+    api::RenderRequest req = request(8, {"beauty", "depth"});
+    req.supersampling = k;
+    req.defaultLighting = false;
+    const RenderOutput out = renderer().render(scene, req);
+    EXPECT_EQ(out.stats.supersampling, k);
+    const Image& beauty = aov(out, "beauty");
+    const Image& depth = aov(out, "depth");
+    ASSERT_EQ(beauty.width, 8);
+    ASSERT_EQ(depth.height, 8);
+    for (int y = 0; y < 8; ++y) {
+      EXPECT_NEAR(beauty.at(3, y)[0], 0.8f, 1e-3f) << "fully covered column";
+      EXPECT_NEAR(beauty.at(4, y)[0], expected[k - 1], 1e-3f) << "the edge's column, row " << y;
+      EXPECT_NEAR(beauty.at(5, y)[0], 0.f, 1e-6f) << "sky column";
+      for (int x = 0; x < 8; ++x) {
+        const float d = depth.at(x, y)[0];
+        EXPECT_TRUE(d == 0.f || std::abs(d - 10.f) < 1e-3f) << "depth " << d << " at " << x << "," << y;
+      }
+    }
+  }
+}
+
+// The cap: k^2 width height stays within 4096^2 (the largest frame at one sample), and a frame that
+// runs the reference pass is not supersampled.
+TEST(RenderCore, SupersamplingIsCappedByTheFrameMemoryAndOffForTheReferencePass) {
+  EXPECT_EQ(rasterSupersampling(2, 128, 128, false), 2);
+  EXPECT_EQ(rasterSupersampling(4, 1024, 1024, false), 4);
+  EXPECT_EQ(rasterSupersampling(4, 2048, 2048, false), 2);
+  EXPECT_EQ(rasterSupersampling(2, 4096, 4096, false), 1);
+  EXPECT_EQ(rasterSupersampling(3, 4096, 1024, false), 2);
+  EXPECT_EQ(rasterSupersampling(2, 128, 128, true), 1);
+  EXPECT_EQ(rasterSupersampling(9, 16, 16, false), 4);
+}
+
 }  // namespace
 }  // namespace radiant
