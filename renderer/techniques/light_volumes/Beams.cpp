@@ -1,7 +1,11 @@
 #include "renderer/techniques/light_volumes/Beams.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <map>
+#include <mutex>
+#include <random>
 
 #include "renderer/raytracing/Bsdf.h"
 #include "renderer/raytracing/Lights.h"
@@ -19,7 +23,56 @@ bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y
 glm::vec4 v4(const glm::vec3& v, float w) { return {v.x, v.y, v.z, w}; }
 
 
+constexpr int kAlbedoMu = 33, kAlbedoStrata = 64;
+using AlbedoRow = std::array<glm::vec2, kAlbedoMu>;
+
+// (A, B) of ggxReflectionAlbedo at mu: VNDF sampling of h about wo (the direction towards the light)
+// makes f cos / pdf = F G2 / G1 (Heitz 2018, eq. 19), so A is the mean of G2 / G1 over the reflected
+// directions above the horizon and B the mean of G2 / G1 (1 - wo.h)^5.
+glm::vec2 albedoAt(float mu, float alpha) {
+  mu = std::clamp(mu, 1e-4f, 1.f);
+  const glm::vec3 wo(std::sqrt(1.f - mu * mu), 0.f, mu);
+  const float g1 = rt::smithG1(mu, alpha);
+  double a = 0.0, b = 0.0;
+  // Jittered strata with a fixed seed: the strata's midpoints alone are biased by ~0.7% (the map from
+  // the unit square to h is singular at the disk's rim, where wi crosses the horizon).
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<float> jitter(0.f, 1.f);
+  for (int i = 0; i < kAlbedoStrata; ++i)
+    for (int j = 0; j < kAlbedoStrata; ++j) {
+      const glm::vec2 u((i + jitter(rng)) / kAlbedoStrata, (j + jitter(rng)) / kAlbedoStrata);
+      const glm::vec3 h = rt::sampleGgxVndf(wo, alpha, u);
+      const glm::vec3 wi = rt::reflect(wo, h);
+      if (wi.z <= 0.f) continue;
+      const double w = rt::smithG2HeightCorrelated(wo.z, wi.z, alpha) / g1;
+      a += w;
+      b += w * rt::schlickWeight(glm::dot(wo, h));
+    }
+  const double n = double(kAlbedoStrata) * kAlbedoStrata;
+  return {float(a / n), float(b / n)};
+}
+
+const AlbedoRow& albedoRow(float alpha) {
+  static std::mutex mutex;
+  static std::map<float, AlbedoRow> rows;  // a few entries: one per distinct roughness of the scene
+  const std::lock_guard<std::mutex> lock(mutex);
+  auto it = rows.find(alpha);
+  if (it != rows.end()) return it->second;
+  AlbedoRow row;
+  for (int k = 0; k < kAlbedoMu; ++k) row[k] = albedoAt(float(k) / (kAlbedoMu - 1), alpha);
+  return rows.emplace(alpha, row).first->second;
+}
+
 }  // namespace
+
+glm::vec2 ggxReflectionAlbedo(float mu, float alpha) {
+  mu = std::clamp(mu, 0.f, 1.f);
+  if (!(alpha > 0.f)) return {1.f, rt::schlickWeight(mu)};
+  const AlbedoRow& row = albedoRow(alpha);
+  const float x = mu * (kAlbedoMu - 1);
+  const int k = std::min(int(x), kAlbedoMu - 2);
+  return glm::mix(row[k], row[k + 1], x - float(k));
+}
 
 float solidAngle(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
   const float la = glm::length(a), lb = glm::length(b), lc = glm::length(c);
@@ -151,9 +204,15 @@ bool appendTriangleBeams(const Light& light, const TriangleInput& t, const BeamO
   // Reflection: metal (conductor Fresnel, Schlick with f0 = baseColor), the opaque dielectric's
   // specular layer and, for transmissive materials, the exact dielectric Fresnel (Bsdf.h).
   {
-    const glm::vec3 weight = metal * rt::schlickFresnel(base, cosIn) +
-                             glm::vec3((1.f - metal) * (1.f - trans) * rt::schlickFresnel(rt::f0FromIor(m.ior), cosIn)) +
-                             glm::vec3((1.f - metal) * trans * rt::fresnelDielectric(cosIn, eta));
+    // Glossy: the lobe's directional albedo (Schlick over the microfacets and the Smith loss), not
+    // Fresnel at the mean normal. The transmissive dielectric keeps its exact Fresnel at cos theta_i
+    // times the Smith loss A.
+    const glm::vec2 ab = m.roughnessFactor > 0.f ? ggxReflectionAlbedo(cosIn, rt::alphaFromRoughness(m.roughnessFactor))
+                                                 : glm::vec2(1.f, rt::schlickWeight(cosIn));
+    auto schlickAlbedo = [&](const glm::vec3& f0) { return f0 * (ab.x - ab.y) + glm::vec3(ab.y); };
+    const glm::vec3 weight = metal * schlickAlbedo(base) +
+                             (1.f - metal) * (1.f - trans) * schlickAlbedo(glm::vec3(rt::f0FromIor(m.ior))) +
+                             glm::vec3((1.f - metal) * trans * rt::fresnelDielectric(cosIn, eta) * ab.x);
     if (!t.refract && rt::maxComponent(weight) > 0.f) {
       glm::vec3 d[3];
       for (int k = 0; k < 3; ++k) d[k] = rt::reflect(-w[k], n[k]);

@@ -75,7 +75,7 @@ std::vector<int> LightVolumesPass::shadowMapExclusions(const Scene& scene, const
 
 void LightVolumesPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
   light_volumes::BeamOptions o;
-  o.sigmaScale = params.get<float>("sigma_scale", 1.1f);
+  o.sigmaScale = params.get<float>("sigma_scale", light_volumes::kSigmaScaleFit);
   o.negativeBeams = params.get<std::string>("shadows", "shadow_map") == "negative_beams";
   o.maxConcentration = params.get<float>("max_concentration", 1e4f);
   o.maxTriangleSigma = params.get<float>("max_triangle_sigma", 0.5f);
