@@ -254,8 +254,10 @@ bool appendTriangleBeams(const Light& light, const TriangleInput& t, const BeamO
 
 BeamSet buildBeams(const Scene& scene, const BeamOptions& o, const ReceiverDistance& receiverDistance) {
   BeamSet out;
-  for (const Light& light : scene.lights) {
-    for (const MeshInstance& mesh : scene.meshes) {
+  for (std::size_t li = 0; li < scene.lights.size(); ++li) {
+    const Light& light = scene.lights[li];
+    for (std::size_t mi = 0; mi < scene.meshes.size(); ++mi) {
+      const MeshInstance& mesh = scene.meshes[mi];
       const Material& mat = scene.material(mesh.material);
       if (!mat.scattersNarrowLobe()) continue;
       const std::size_t first = out.beams.size();
@@ -280,6 +282,7 @@ BeamSet buildBeams(const Scene& scene, const BeamOptions& o, const ReceiverDista
       // The tessellation condition for this scatterer and light.
       if (!receiverDistance) continue;
       std::size_t checked = 0, failed = 0;
+      float worst = 0.f;
       for (std::size_t i = first; i < out.beams.size(); ++i) {
         Beam& b = out.beams[i];
         const float sigma = b.fluxSigma.w;
@@ -293,11 +296,14 @@ BeamSet buildBeams(const Scene& scene, const BeamOptions& o, const ReceiverDista
         const float ratio = edge / dist / sigma;
         ++checked;
         if (ratio > o.maxTriangleSigma) ++failed;
-        out.worstTriangleSigma = std::max(out.worstTriangleSigma, ratio);
+        worst = std::max(worst, ratio);
       }
+      out.worstTriangleSigma = std::max(out.worstTriangleSigma, worst);
       out.tessellationChecked += checked;
       out.tessellationFailed += failed;
-      if (o.specularFallback && checked > 0 && float(failed) > kFallbackFraction * float(checked)) {
+      const bool fallback = o.specularFallback && checked > 0 && float(failed) > kFallbackFraction * float(checked);
+      if (checked > 0) out.scatterers.push_back({mi, li, mesh.name, checked, failed, worst, fallback});
+      if (fallback) {
         ++out.specularFallbacks;
         for (std::size_t i = first; i < out.beams.size(); ++i) {
           if (out.beams[i].fluxSigma.w > 0.f) --out.glossy;

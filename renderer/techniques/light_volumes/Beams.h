@@ -71,6 +71,15 @@ struct BeamSet {
   // (edge / distance) / sigma, and the scatterers (mesh x light) that fell back to specular beams.
   std::size_t tessellationChecked = 0, tessellationFailed = 0, specularFallbacks = 0;
   float worstTriangleSigma = 0.f;
+  // The same per scatterer (mesh x light) with glossy beams checked, in scene order.
+  struct Scatterer {
+    std::size_t mesh = 0, light = 0;
+    std::string meshName;
+    std::size_t checked = 0, failed = 0;
+    float worstTriangleSigma = 0.f;
+    bool specularFallback = false;
+  };
+  std::vector<Scatterer> scatterers;
   glm::dvec3 flux{0.0};  // sum of the scattered beams' flux (W)
 };
 

@@ -134,6 +134,8 @@ TEST(LightVolumes, CulledAndLinearTraversalsGiveTheSameGlossyImage) {
   EXPECT_EQ(c.at("beams_glossy"), 512.0);
   EXPECT_EQ(c.at("tessellation_failed"), 0.0) << "0.0375 m facets 1.2 m from the floor, sigma ~0.12";
   EXPECT_EQ(c.at("tessellation_specular_fallbacks"), 0.0);
+  EXPECT_EQ(c.at("tessellation/1:plate/light0/specular_fallback"), 0.0);
+  EXPECT_EQ(c.count("tessellation/0:floor/light0/checked"), 0u) << "the floor is no scatterer";
 }
 
 TEST(LightVolumes, CoarseGlossyScattererFallsBackToSpecularBeams) {
@@ -145,6 +147,11 @@ TEST(LightVolumes, CoarseGlossyScattererFallsBackToSpecularBeams) {
   EXPECT_GT(c.at("tessellation_worst_triangle_sigma"), 2.0);
   EXPECT_EQ(c.at("tessellation_specular_fallbacks"), 1.0);
   EXPECT_EQ(c.at("beams_glossy"), 0.0);
+  // The same per scatterer: mesh 1 ("plate") under light 0.
+  EXPECT_EQ(c.at("tessellation/1:plate/light0/checked"), c.at("tessellation_checked"));
+  EXPECT_EQ(c.at("tessellation/1:plate/light0/failed"), c.at("tessellation_failed"));
+  EXPECT_EQ(c.at("tessellation/1:plate/light0/worst_triangle_sigma"), c.at("tessellation_worst_triangle_sigma"));
+  EXPECT_EQ(c.at("tessellation/1:plate/light0/specular_fallback"), 1.0);
 }
 
 TEST(LightVolumes, PathsThroughTheGlossyPlateAreCountedOnceWithPhotonGi) {
