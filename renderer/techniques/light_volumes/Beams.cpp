@@ -30,7 +30,6 @@ glm::vec4 v4(const glm::vec3& v, float w) { return {v.x, v.y, v.z, w}; }
 // reference's lobe (normalised by its albedo) does.
 float planeGain(float sigma) { return 1.f + (8.f / 3.f) * sigma * sigma; }
 
-
 constexpr int kAlbedoMu = 33, kAlbedoStrata = 64;
 using AlbedoRow = std::array<glm::vec2, kAlbedoMu>;
 
