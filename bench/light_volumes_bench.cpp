@@ -1,19 +1,26 @@
 // light_volumes (issue 15): GPU time of the gathering against the beam count for the linear traversal
-// (the paper's loop over every beam) and the culled one (BVH over the beams' cones), and the error
-// against the reference light tracer.
-//   build/bench/light_volumes_bench [size=256] [max_linear_beams=5120] [lt_paths_per_pixel=64] [error]
-// ("error": only the error runs).
-// Scenes (a Lambertian floor, albedo 0.5, seen from above by an orthographic camera):
-//   ring   the paper's cardioid (Fig. 2): a half ring of mirror (radius 0.5 m, 0.2 m tall, roughness
-//          0, R = 0.9) lit by a point light over its open side; facets x rows x 2 triangles from 40 x 1
-//          (80 beams) to 1280 x 32 (81920 beams).
-//   plate  a glossy plate (0.6 m, roughness 0.3, 24 x 24 x 2) 1.2 m above the floor, lit from below.
-// Output, one line per run:
-//   ring beams=<B> traversal=<linear|bvh> gpu_ms=<ms, the pass's GPU time, beams cached, median of 3>
-//   equal-image check: relative L1 of bvh against linear at the same beam count
-//   error: relative L1 and energy ratio of the light_volumes AOV against the light tracer's image of
-//   the paths with exactly two scattering events (L S D E, L G D E: the only ones in these scenes that
-//   end on the floor with two events), and the light tracer's time.
+// (the paper's loop over every beam) and the culled one (BVH over the beams' cones), the error against
+// the reference light tracer, and the comparison with caustic triangles and photon splatting.
+//   build/bench/light_volumes_bench timing <width> <height> [max_linear_beams=5120] [max_bvh_beams=81920] [frames=3]
+//   build/bench/light_volumes_bench compare [size=128] [lt_paths_per_pixel=256] [scene name prefix]
+// Scenes (a Lambertian floor, albedo 0.5, seen from straight above by an orthographic camera that sits
+// below every scatterer, so that the light tracer's camera connections see the floor directly):
+//   ring    the paper's cardioid (Fig. 2): a half ring of mirror (radius 0.5 m, 0.2 m tall, roughness
+//           0, R = 0.9) lit by a point light over its open side; facets x rows x 2 triangles from 40 x 1
+//           (80 beams) to 1280 x 32 (81920 beams).
+//   water   the paper's Fig. 3: a wavy water surface (ior 1.33, roughness 0, 20 x 20 x 2 triangles,
+//           1 m square, waves of 2 cm) 0.5 m over the floor under a point light.
+//   window  a frosted window (thin glass pane, ior 1.5, 0.4 m, 32 x 32 x 2) 0.8 m over the floor under
+//           a point light, roughness 0.1 / 0.2 / 0.3 / 0.4 (sigma ~ 0.016 / 0.06 / 0.14 / 0.25 rad).
+//   plate   a glossy metal plate (0.6 m, roughness 0.3, R = 0.9, 24 x 24 x 2) 1.2 m above the floor,
+//           lit from below by a spot (the scene of tests/unit/light_volumes CalibrationTest).
+// timing: one line per run: beams, traversal, the pass's GPU ms (beams cached, median of `frames`),
+//   setup and BVH ms, and the relative L1 of bvh against linear at the same beam count.
+// compare: per scene, the light_volumes AOV, the caustics AOV (caustic triangles and their splat
+//   mode; mirror and smooth glass only) and photon_gi's indirect AOV (max_bounces 2) against the light
+//   tracer's image of the paths with exactly two scattering events (L S D E, L G D E: the only ones in
+//   these scenes that end on the floor with two events): relative L1, energy ratio, GPU ms of the pass
+//   (caches warm, median of 3), and the light tracer's own noise floor.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -79,19 +86,81 @@ Scene ringScene(int facets, int rows) {
 Scene plateScene() {
   testing::SceneBuilder b;
   const int floor = b.material(testing::lambertian(glm::vec3(0.5f)));
-  b.quad(glm::vec3(0.f), {1.5f, 0, 0}, {0, 0, -1.5f}, floor, "floor");
-  b.gridY({0.f, 1.2f, 0.f}, 0.3f, 24, false, b.material(metal(0.3f, 0.9f)), "plate");
+  b.quad(glm::vec3(0.f), {3.f, 0, 0}, {0, 0, -3.f}, floor, "floor");
+  const glm::vec3 light(-0.3f, 0.4f, 0.f), centre(0.f, 1.2f, 0.f);
+  b.gridY(centre, 0.3f, 24, false, b.material(metal(0.3f, 0.9f)), "plate");
   // A spot light pointing up at the plate: the floor gets no direct light, only what the plate sends.
-  b.spotLight({-0.5f, 0.6f, 0.f}, {0.45f, 1.f, 0.f}, 2.f, 0.5f, 0.7f);
-  b.topDownOrtho(1.f, 1.f);
+  b.spotLight(light, centre - light, 3.f, 0.7f, 0.8f);
+  b.topDownOrtho(1.f, 2.f);
   return b.build("bench:light_volumes:plate");
 }
 
-api::RenderRequest request(int size, const std::string& traversal) {
+Material glass(float roughness, float ior) {
+  Material m = testing::lambertian(glm::vec3(1.f));
+  m.transmissionFactor = 1.f;
+  m.roughnessFactor = roughness;
+  m.ior = ior;
+  m.doubleSided = true;
+  return m;
+}
+
+// A height field y = y0 + h(x, z) over [-half, half]^2 with n x n x 2 triangles, normals from the
+// analytic gradient (facing +y).
+template <class H, class G>
+MeshInstance heightField(float y0, float half, int n, H h, G grad, int material, const std::string& name) {
+  MeshInstance m;
+  m.name = name;
+  m.material = material;
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j <= n; ++j) {
+      const float x = -half + 2.f * half * i / n, z = -half + 2.f * half * j / n;
+      m.positions.push_back({x, y0 + h(x, z), z});
+      const glm::vec2 g = grad(x, z);
+      m.normals.push_back(glm::normalize(glm::vec3(-g.x, 1.f, -g.y)));
+    }
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const std::uint32_t p = i * (n + 1) + j, q = p + n + 1;
+      // counter-clockwise seen from +y
+      m.indices.insert(m.indices.end(), {p, p + 1, q, q, p + 1, q + 1});
+    }
+  for (auto& p : m.positions) m.bounds.extend(p);
+  return m;
+}
+
+Scene waterScene() {
+  testing::SceneBuilder b;
+  const int floor = b.material(testing::lambertian(glm::vec3(0.5f)));
+  b.quad(glm::vec3(0.f), {1.5f, 0, 0}, {0, 0, -1.5f}, floor, "floor");
+  const float a = 0.02f, k = 2.f * 3.14159265f / 0.5f;  // 2 cm waves of 0.5 m wavelength
+  b.scene().meshes.push_back(heightField(
+      0.5f, 0.5f, 20, [&](float x, float z) { return a * std::sin(k * x) * std::cos(0.8f * k * z); },
+      [&](float x, float z) {
+        return glm::vec2(a * k * std::cos(k * x) * std::cos(0.8f * k * z), -a * 0.8f * k * std::sin(k * x) * std::sin(0.8f * k * z));
+      },
+      b.material(glass(0.f, 1.33f)), "water"));
+  b.pointLight({0.2f, 1.5f, 0.1f}, 4.f);
+  b.topDownOrtho(0.4f, 0.8f);
+  return b.build("bench:light_volumes:water");
+}
+
+Scene windowScene(float roughness) {
+  testing::SceneBuilder b;
+  const int floor = b.material(testing::lambertian(glm::vec3(0.5f)));
+  b.quad(glm::vec3(0.f), {2.f, 0, 0}, {0, 0, -2.f}, floor, "floor");
+  b.gridY({0.f, 0.8f, 0.f}, 0.2f, 32, true, b.material(glass(roughness, 1.5f)), "window");
+  b.pointLight({-0.3f, 1.6f, 0.f}, 4.f);
+  b.topDownOrtho(0.6f, 0.8f);
+  return b.build("bench:light_volumes:window:" + std::to_string(roughness));
+}
+
+api::RenderRequest request(int width, int height, const std::string& traversal) {
   api::RenderRequest r;
-  r.width = r.height = size;
+  r.width = width;
+  r.height = height;
   r.passes["light_volumes"] = {{"traversal", traversal}};
   r.disabledPasses.insert("photon_gi");
+  r.disabledPasses.insert("caustics");
   r.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty", "light_volumes"}, false}};
   return r;
 }
@@ -108,30 +177,43 @@ const api::PassStats& passOf(const RenderOutput& out, const std::string& name) {
 }
 
 struct Timed {
-  double gpuMs = 0.0;
+  double gpuMs = 0.0, firstCpuMs = 0.0;
   Image image;
-  double beams = 0.0, segments = 0.0, setupMs = 0.0, bvhMs = 0.0;
+  double beams = 0.0, segments = 0.0, setupMs = 0.0, bvhMs = 0.0, fallbacks = 0.0;
 };
 
-Timed timed(const Scene& scene, int size, const std::string& traversal) {
+// The pass `pass` of `r` on `scene`: a first frame (which builds and caches the pass's derived data),
+// then `frames` frames; the median of their GPU ms and the first of their images (AOV `aov`).
+Timed timedPass(const Scene& scene, const api::RenderRequest& r, const std::string& pass, const std::string& aov,
+                int frames) {
   Timed t;
-  const RenderOutput first = renderer().render(scene, request(size, traversal));  // builds and caches the beams
-  const auto& p0 = passOf(first, "light_volumes");
-  t.setupMs = p0.counters.at("setup_ms");
-  t.bvhMs = p0.counters.at("bvh_ms");
+  const RenderOutput first = renderer().render(scene, r);
+  const auto& p0 = passOf(first, pass);
+  t.firstCpuMs = p0.cpuMs;
+  if (pass == "light_volumes") {
+    t.setupMs = p0.counters.at("setup_ms");
+    t.bvhMs = p0.counters.at("bvh_ms");
+  }
   std::vector<double> ms;
-  for (int k = 0; k < 3; ++k) {
-    const RenderOutput out = renderer().render(scene, request(size, traversal));
-    ms.push_back(passOf(out, "light_volumes").gpuMs);
+  for (int k = 0; k < frames; ++k) {
+    const RenderOutput out = renderer().render(scene, r);
+    ms.push_back(passOf(out, pass).gpuMs);
     if (k == 0) {
-      t.image = aovOf(out, "light_volumes");
-      t.beams = passOf(out, "light_volumes").counters.at("beams");
-      t.segments = passOf(out, "light_volumes").counters.at("bvh_segments");
+      t.image = aovOf(out, aov);
+      if (pass == "light_volumes") {
+        t.beams = passOf(out, pass).counters.at("beams");
+        t.segments = passOf(out, pass).counters.at("bvh_segments");
+        t.fallbacks = passOf(out, pass).counters.at("tessellation_specular_fallbacks");
+      }
     }
   }
   std::sort(ms.begin(), ms.end());
-  t.gpuMs = ms[1];
+  t.gpuMs = ms[ms.size() / 2];
   return t;
+}
+
+Timed timed(const Scene& scene, int width, int height, const std::string& traversal, int frames) {
+  return timedPass(scene, request(width, height, traversal), "light_volumes", "light_volumes", frames);
 }
 
 double relativeL1(const Image& a, const Image& b) {
@@ -163,44 +245,103 @@ Image lightTraced(const Scene& scene, int size, int pathsPerPixel, double& ms, s
   return img;
 }
 
-void error(const char* name, const Scene& scene, int size, int ltPaths) {
-  const Timed lv = timed(scene, size, "bvh");
-  double ltMs = 0.0;
+void timing(int width, int height, int maxLinear, int maxBvh, int frames) {
+  const int grid[][2] = {{40, 1}, {80, 2}, {160, 4}, {320, 8}, {640, 16}, {1280, 32}};
+  for (const auto& g : grid) {
+    if (2 * g[0] * g[1] > maxBvh) break;
+    const Scene scene = ringScene(g[0], g[1]);
+    const Timed bvh = timed(scene, width, height, "bvh", frames);
+    std::printf("ring %dx%d beams=%.0f traversal=bvh gpu_ms=%.2f segments=%.0f setup_ms=%.1f bvh_ms=%.1f\n", width,
+                height, bvh.beams, bvh.gpuMs, bvh.segments, bvh.setupMs, bvh.bvhMs);
+    std::fflush(stdout);
+    if (bvh.beams <= maxLinear) {
+      const Timed lin = timed(scene, width, height, "linear", frames);
+      std::printf("ring %dx%d beams=%.0f traversal=linear gpu_ms=%.2f relL1(bvh vs linear)=%.2e\n", width, height,
+                  lin.beams, lin.gpuMs, relativeL1(bvh.image, lin.image));
+      std::fflush(stdout);
+    }
+  }
+}
+
+// One scene of the comparison: every technique that applies against the light tracer.
+void compare(const char* name, const Scene& scene, int size, int ltPaths, bool specular) {
+  double ltMs = 0.0, ms2 = 0.0;
   const Image ref = lightTraced(scene, size, ltPaths, ltMs);
   // The light tracer's own noise: the relative L1 between two seeds (their difference has sqrt(2) times
   // the noise of one, so one image's noise floor is this / sqrt(2)).
-  double ms2 = 0.0;
   const Image ref2 = lightTraced(scene, size, ltPaths, ms2, 2);
-  std::printf("%s error: beams=%.0f gpu_ms=%.2f relL1=%.4f energy=%.4f (light tracer %d paths/pixel, %.0f ms; "
-              "its noise floor relL1=%.4f)\n",
-              name, lv.beams, lv.gpuMs, relativeL1(lv.image, ref), total(lv.image) / total(ref), ltPaths, ltMs,
+  std::printf("| %s | light tracer, %d paths/pixel | %.0f (CPU) | 0 | %.3f (noise floor) | 1 |\n", name, ltPaths, ltMs,
               relativeL1(ref2, ref) / std::sqrt(2.0));
+  auto row = [&](const std::string& method, const Timed& t, const std::string& detail) {
+    std::printf("| %s | %s | %.1f | %.0f | %.3f | %.3f |\n", name, (method + detail).c_str(), t.gpuMs, t.firstCpuMs,
+                relativeL1(t.image, ref), total(t.image) / total(ref));
+    std::fflush(stdout);
+  };
+  {
+    const Timed lv = timed(scene, size, size, "bvh", 3);
+    char d[96];
+    std::snprintf(d, sizeof d, " (%.0f beams%s)", lv.beams, lv.fallbacks > 0 ? ", specular fallback" : "");
+    row("light_volumes", lv, d);
+  }
+  if (specular) {
+    for (int P : {64, 128, 256}) {
+      api::RenderRequest r;
+      r.width = r.height = size;
+      r.disabledPasses = {"photon_gi", "light_volumes"};
+      r.passes["caustics"] = {{"photon_resolution", P}};
+      r.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty", "caustics"}, false}};
+      row("caustics", timedPass(scene, r, "caustics", "caustics", 3), " (triangles, P " + std::to_string(P) + ")");
+      r.passes["caustics"] = {{"photon_resolution", P}, {"method", "splat"}};
+      row("caustics", timedPass(scene, r, "caustics", "caustics", 3), " (splat, P " + std::to_string(P) + ")");
+    }
+  }
+  if (specular) {
+    // The photon tracer ends paths at Dirac-delta lobes: photon_gi has no L S D E light to splat.
+    std::printf("| %s | photon_gi | - | - | - | 0 (ends photon paths at Dirac lobes) |\n", name);
+    return;
+  }
+  auto photons = [&](int count, const std::string& method) {
+    api::RenderRequest r;
+    r.width = r.height = size;
+    r.disabledPasses = {"caustics", "light_volumes"};
+    r.passes["photon_gi"] = {{"photons", count}, {"max_bounces", 2}, {"method", method}};
+    r.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty", "indirect"}, false}};
+    row("photon_gi", timedPass(scene, r, "photon_gi", "indirect", 3),
+        " (" + method + ", " + std::to_string(count / 1000) + "k photons)");
+  };
+  for (int count : {50000, 250000, 1000000}) photons(count, "gather");
+  photons(250000, "splat");
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  const int size = argc > 1 ? std::atoi(argv[1]) : 256;
-  const int maxLinear = argc > 2 ? std::atoi(argv[2]) : 5120;
-  const int ltPaths = argc > 3 ? std::atoi(argv[3]) : 64;
-  std::printf("GL_RENDERER %s, %dx%d\n", renderer().device().renderer.c_str(), size, size);
-  const bool timing = !(argc > 4 && std::string(argv[4]) == "error");
-  const int grid[][2] = {{40, 1}, {80, 2}, {160, 4}, {320, 8}, {640, 16}, {1280, 32}};
-  for (const auto& g : grid) {
-    if (!timing) break;
-    const Scene scene = ringScene(g[0], g[1]);
-    const Timed bvh = timed(scene, size, "bvh");
-    std::printf("ring beams=%.0f traversal=bvh gpu_ms=%.2f segments=%.0f setup_ms=%.1f bvh_ms=%.1f\n", bvh.beams,
-                bvh.gpuMs, bvh.segments, bvh.setupMs, bvh.bvhMs);
-    if (bvh.beams <= maxLinear) {
-      const Timed lin = timed(scene, size, "linear");
-      std::printf("ring beams=%.0f traversal=linear gpu_ms=%.2f relL1(bvh vs linear)=%.2e\n", lin.beams, lin.gpuMs,
-                  relativeL1(bvh.image, lin.image));
-    }
-    std::fflush(stdout);
+  const std::string mode = argc > 1 ? argv[1] : "compare";
+  auto arg = [&](int i, int fallback) { return argc > i ? std::atoi(argv[i]) : fallback; };
+  std::printf("GL_RENDERER %s\n", renderer().device().renderer.c_str());
+  if (mode == "timing") {
+    timing(arg(2, 256), arg(3, 256), arg(4, 5120), arg(5, 81920), arg(6, 3));
+    return 0;
   }
-  error("ring", ringScene(40, 1), size, ltPaths);
-  error("ring", ringScene(320, 8), size, ltPaths);
-  error("plate", plateScene(), size, ltPaths);
+  if (mode != "compare") {
+    std::fprintf(stderr, "usage: %s timing <w> <h> [max_linear] [max_bvh] [frames] | compare [size] [paths]\n", argv[0]);
+    return 2;
+  }
+  const int size = arg(2, 128), paths = arg(3, 256);
+  const std::string only = argc > 4 ? argv[4] : "";  // run only the scenes whose name starts with this
+  auto wanted = [&](const char* name) { return std::string(name).rfind(only, 0) == 0; };
+  std::printf("%dx%d; ms = the pass's GPU ms, caches warm (median of 3); first-frame CPU ms includes building "
+              "beams, photon images or photon maps\n\n",
+              size, size);
+  std::printf("| scene | method | ms | first-frame CPU ms | relL1 | energy |\n|---|---|---|---|---|---|\n");
+  if (wanted("ring (80)")) compare("ring (80)", ringScene(40, 1), size, paths, true);
+  if (wanted("ring (5120)")) compare("ring (5120)", ringScene(320, 8), size, paths, true);
+  if (wanted("water")) compare("water", waterScene(), size, paths, true);
+  for (float r : {0.1f, 0.2f, 0.3f, 0.4f}) {
+    char name[48];
+    std::snprintf(name, sizeof name, "window r %.1f", r);
+    if (wanted(name)) compare(name, windowScene(r), size, paths, false);
+  }
+  if (wanted("plate")) compare("plate", plateScene(), size, paths, false);
   return 0;
 }

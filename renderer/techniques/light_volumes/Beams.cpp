@@ -1,7 +1,11 @@
 #include "renderer/techniques/light_volumes/Beams.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <map>
+#include <mutex>
+#include <random>
 
 #include "renderer/raytracing/Bsdf.h"
 #include "renderer/raytracing/Lights.h"
@@ -18,8 +22,64 @@ bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y
 
 glm::vec4 v4(const glm::vec3& v, float w) { return {v.x, v.y, v.z, w}; }
 
+// The gathering lays the Gaussian rho over the flat angular domain (|X| = phi) and spreads each beam
+// over its flux plane, so on a receiver plane perpendicular to the beam at distance d a point at angle
+// phi lies at x = d tan(phi): the beam delivers 2 pi int rho(phi) tan(phi) sec^2(phi) dphi
+// = 1 + (4/3) E[phi^2] + O(sigma^4) = 1 + (8/3) sigma^2 of its flux (measured before: ~1 + 3.3 sigma^2
+// on the bench's plates). Dividing the flux by it makes the whole glossy beam deliver Phi, as the
+// reference's lobe (normalised by its albedo) does.
+float planeGain(float sigma) { return 1.f + (8.f / 3.f) * sigma * sigma; }
+
+constexpr int kAlbedoMu = 33, kAlbedoStrata = 64;
+using AlbedoRow = std::array<glm::vec2, kAlbedoMu>;
+
+// (A, B) of ggxReflectionAlbedo at mu: VNDF sampling of h about wo (the direction towards the light)
+// makes f cos / pdf = F G2 / G1 (Heitz 2018, eq. 19), so A is the mean of G2 / G1 over the reflected
+// directions above the horizon and B the mean of G2 / G1 (1 - wo.h)^5.
+glm::vec2 albedoAt(float mu, float alpha) {
+  mu = std::clamp(mu, 1e-4f, 1.f);
+  const glm::vec3 wo(std::sqrt(1.f - mu * mu), 0.f, mu);
+  const float g1 = rt::smithG1(mu, alpha);
+  double a = 0.0, b = 0.0;
+  // Jittered strata with a fixed seed: the strata's midpoints alone are biased by ~0.7% (the map from
+  // the unit square to h is singular at the disk's rim, where wi crosses the horizon).
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<float> jitter(0.f, 1.f);
+  for (int i = 0; i < kAlbedoStrata; ++i)
+    for (int j = 0; j < kAlbedoStrata; ++j) {
+      const glm::vec2 u((i + jitter(rng)) / kAlbedoStrata, (j + jitter(rng)) / kAlbedoStrata);
+      const glm::vec3 h = rt::sampleGgxVndf(wo, alpha, u);
+      const glm::vec3 wi = rt::reflect(wo, h);
+      if (wi.z <= 0.f) continue;
+      const double w = rt::smithG2HeightCorrelated(wo.z, wi.z, alpha) / g1;
+      a += w;
+      b += w * rt::schlickWeight(glm::dot(wo, h));
+    }
+  const double n = double(kAlbedoStrata) * kAlbedoStrata;
+  return {float(a / n), float(b / n)};
+}
+
+const AlbedoRow& albedoRow(float alpha) {
+  static std::mutex mutex;
+  static std::map<float, AlbedoRow> rows;  // a few entries: one per distinct roughness of the scene
+  const std::lock_guard<std::mutex> lock(mutex);
+  auto it = rows.find(alpha);
+  if (it != rows.end()) return it->second;
+  AlbedoRow row;
+  for (int k = 0; k < kAlbedoMu; ++k) row[k] = albedoAt(float(k) / (kAlbedoMu - 1), alpha);
+  return rows.emplace(alpha, row).first->second;
+}
 
 }  // namespace
+
+glm::vec2 ggxReflectionAlbedo(float mu, float alpha) {
+  mu = std::clamp(mu, 0.f, 1.f);
+  if (!(alpha > 0.f)) return {1.f, rt::schlickWeight(mu)};
+  const AlbedoRow& row = albedoRow(alpha);
+  const float x = mu * (kAlbedoMu - 1);
+  const int k = std::min(int(x), kAlbedoMu - 2);
+  return glm::mix(row[k], row[k + 1], x - float(k));
+}
 
 float solidAngle(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
   const float la = glm::length(a), lb = glm::length(b), lc = glm::length(c);
@@ -137,7 +197,8 @@ bool appendTriangleBeams(const Light& light, const TriangleInput& t, const BeamO
     b.dirA = v4(d[0], 0.f);
     b.dirB = v4(d[1], 0.f);
     b.dirC = v4(d[2], 0.f);
-    b.fluxSigma = v4(phi, sigma);
+    // A glossy beam's flux is divided by its Gaussian's gain on a receiver plane (planeGain).
+    b.fluxSigma = v4(phi / planeGain(sigma), sigma);
     b.plane = v4(planeN, -glm::dot(planeN, t.p[0]));
     // The clamp: A_0 is the triangle's cross-section perpendicular to the mean direction.
     const glm::vec3 N = glm::normalize(d[0] + d[1] + d[2]);
@@ -151,9 +212,15 @@ bool appendTriangleBeams(const Light& light, const TriangleInput& t, const BeamO
   // Reflection: metal (conductor Fresnel, Schlick with f0 = baseColor), the opaque dielectric's
   // specular layer and, for transmissive materials, the exact dielectric Fresnel (Bsdf.h).
   {
-    const glm::vec3 weight = metal * rt::schlickFresnel(base, cosIn) +
-                             glm::vec3((1.f - metal) * (1.f - trans) * rt::schlickFresnel(rt::f0FromIor(m.ior), cosIn)) +
-                             glm::vec3((1.f - metal) * trans * rt::fresnelDielectric(cosIn, eta));
+    // Glossy: the lobe's directional albedo (Schlick over the microfacets and the Smith loss), not
+    // Fresnel at the mean normal. The transmissive dielectric keeps its exact Fresnel at cos theta_i
+    // times the Smith loss A.
+    const glm::vec2 ab = m.roughnessFactor > 0.f ? ggxReflectionAlbedo(cosIn, rt::alphaFromRoughness(m.roughnessFactor))
+                                                 : glm::vec2(1.f, rt::schlickWeight(cosIn));
+    auto schlickAlbedo = [&](const glm::vec3& f0) { return f0 * (ab.x - ab.y) + glm::vec3(ab.y); };
+    const glm::vec3 weight = metal * schlickAlbedo(base) +
+                             (1.f - metal) * (1.f - trans) * schlickAlbedo(glm::vec3(rt::f0FromIor(m.ior))) +
+                             glm::vec3((1.f - metal) * trans * rt::fresnelDielectric(cosIn, eta) * ab.x);
     if (!t.refract && rt::maxComponent(weight) > 0.f) {
       glm::vec3 d[3];
       for (int k = 0; k < 3; ++k) d[k] = rt::reflect(-w[k], n[k]);
@@ -175,7 +242,10 @@ bool appendTriangleBeams(const Light& light, const TriangleInput& t, const BeamO
       ++out.tirDropped;
     } else {
       const glm::vec3 weight = (1.f - metal) * trans * (1.f - rt::fresnelDielectric(cosIn, eta)) * base;
-      const float sigma = sigmaFromRoughness(m.roughnessFactor, cosIn, o.sigmaScale);
+      // A microfacet tilted by theta_h turns the reflected ray by 2 theta_h but the refracted one by
+      // theta_h |eta - 1| / eta (small angles at normal incidence; Walter et al. 2007's half vector
+      // h ~ eta wi + wo): the transmitted lobe is narrower by |eta - 1| / (2 eta), 1/6 for glass.
+      const float sigma = sigmaFromRoughness(m.roughnessFactor, cosIn, o.sigmaScale) * std::abs(eta - 1.f) / (2.f * eta);
       push(d, flux * weight, sigma, -nLit, false);
       ++out.scattered;
       out.glossy += sigma > 0.f ? 1 : 0;
@@ -195,8 +265,10 @@ bool appendTriangleBeams(const Light& light, const TriangleInput& t, const BeamO
 
 BeamSet buildBeams(const Scene& scene, const BeamOptions& o, const ReceiverDistance& receiverDistance) {
   BeamSet out;
-  for (const Light& light : scene.lights) {
-    for (const MeshInstance& mesh : scene.meshes) {
+  for (std::size_t li = 0; li < scene.lights.size(); ++li) {
+    const Light& light = scene.lights[li];
+    for (std::size_t mi = 0; mi < scene.meshes.size(); ++mi) {
+      const MeshInstance& mesh = scene.meshes[mi];
       const Material& mat = scene.material(mesh.material);
       if (!mat.scattersNarrowLobe()) continue;
       const std::size_t first = out.beams.size();
@@ -221,6 +293,7 @@ BeamSet buildBeams(const Scene& scene, const BeamOptions& o, const ReceiverDista
       // The tessellation condition for this scatterer and light.
       if (!receiverDistance) continue;
       std::size_t checked = 0, failed = 0;
+      float worst = 0.f;
       for (std::size_t i = first; i < out.beams.size(); ++i) {
         Beam& b = out.beams[i];
         const float sigma = b.fluxSigma.w;
@@ -234,15 +307,19 @@ BeamSet buildBeams(const Scene& scene, const BeamOptions& o, const ReceiverDista
         const float ratio = edge / dist / sigma;
         ++checked;
         if (ratio > o.maxTriangleSigma) ++failed;
-        out.worstTriangleSigma = std::max(out.worstTriangleSigma, ratio);
+        worst = std::max(worst, ratio);
       }
+      out.worstTriangleSigma = std::max(out.worstTriangleSigma, worst);
       out.tessellationChecked += checked;
       out.tessellationFailed += failed;
-      if (o.specularFallback && checked > 0 && float(failed) > kFallbackFraction * float(checked)) {
+      const bool fallback = o.specularFallback && checked > 0 && float(failed) > kFallbackFraction * float(checked);
+      if (checked > 0) out.scatterers.push_back({mi, li, mesh.name, checked, failed, worst, fallback});
+      if (fallback) {
         ++out.specularFallbacks;
         for (std::size_t i = first; i < out.beams.size(); ++i) {
           if (out.beams[i].fluxSigma.w > 0.f) --out.glossy;
-          out.beams[i].fluxSigma.w = 0.f;
+          const glm::vec3 phi = glm::vec3(out.beams[i].fluxSigma) * planeGain(out.beams[i].fluxSigma.w);
+          out.beams[i].fluxSigma = v4(phi, 0.f);
           out.cones[i] = beamCone(out.beams[i], o.cullSigmas);
         }
       }

@@ -40,8 +40,14 @@ static_assert(sizeof(BeamBvhNode) == 48, "std430 BeamBvhNode is 3 x vec4");
 
 enum class Split { Paper = glsl::kLvSplitPaper, TwoD = glsl::kLvSplit2d };
 
+// The roughness fit sigma = kSigmaScaleFit alpha sqrt(cos theta_i) (notes A8), calibrated against the
+// reference BSDF's GGX lobe: the scale that minimises the L1 distance between the normalised lobe
+// D V cos(theta_o) and the Gaussian, summed over roughness 0.1..0.5 and theta_i 0..60 degrees
+// (tests/unit/light_volumes: SigmaFitIsTheL1BestGaussianOfTheReferenceLobe; docs/TECHNIQUES.md).
+constexpr float kSigmaScaleFit = 1.58f;
+
 struct BeamOptions {
-  float sigmaScale = 1.1f;        // sigma = sigmaScale * alpha * sqrt(cos theta_i), alpha = roughness^2 (notes A8)
+  float sigmaScale = kSigmaScaleFit;  // sigma = sigmaScale * alpha * sqrt(cos theta_i), alpha = roughness^2
   bool negativeBeams = false;     // build a shadow beam of -Phi per scatterer triangle (§3.1)
   float maxConcentration = 1e4f;  // irradiance clamp: Phi / A_perp <= maxConcentration * Phi / A_0
   float maxTriangleSigma = 0.5f;  // tessellation condition: triangle edge / receiver distance <= this * sigma
@@ -65,6 +71,15 @@ struct BeamSet {
   // (edge / distance) / sigma, and the scatterers (mesh x light) that fell back to specular beams.
   std::size_t tessellationChecked = 0, tessellationFailed = 0, specularFallbacks = 0;
   float worstTriangleSigma = 0.f;
+  // The same per scatterer (mesh x light) with glossy beams checked, in scene order.
+  struct Scatterer {
+    std::size_t mesh = 0, light = 0;
+    std::string meshName;
+    std::size_t checked = 0, failed = 0;
+    float worstTriangleSigma = 0.f;
+    bool specularFallback = false;
+  };
+  std::vector<Scatterer> scatterers;
   glm::dvec3 flux{0.0};  // sum of the scattered beams' flux (W)
 };
 
@@ -76,6 +91,15 @@ float solidAngle(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c);
 // cos theta_i (notes A8): sigma = scale * alpha * sqrt(cos theta_i), alpha = roughness^2; 0 for
 // roughness 0 (a Dirac lobe).
 float sigmaFromRoughness(float roughness, float cosIncidence, float scale);
+
+// The directional albedo of the reference's GGX reflection lobe (Bsdf.h: D V, height-correlated Smith)
+// at cos theta_i = mu, split for Schlick's Fresnel: albedo(f0) = f0 (A - B) + B, with
+// A = integral of D V cos(theta_o) and B = the same weighted by (1 - v.h)^5 (as in split-sum tables).
+// A glossy beam carries flux x albedo: the Gaussian lobe integrates to 1, so the Smith masking
+// loss (1 - A, 1% at roughness 0.3, 9% at 0.5 under normal incidence) must be in the flux. For
+// alpha -> 0 it is (1, (1 - mu)^5): Schlick at the mirror direction. Tabulated in mu per alpha on
+// first use (jittered stratified VNDF sampling, 64 x 64 samples at 33 values of mu, fixed seed), linear in between.
+glm::vec2 ggxReflectionAlbedo(float mu, float alpha);
 
 // Beams of every scatterer (Material::scattersNarrowLobe()) for every light of the scene.
 BeamSet buildBeams(const Scene& scene, const BeamOptions& options, const ReceiverDistance& receiverDistance = {});

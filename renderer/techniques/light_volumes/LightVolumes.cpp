@@ -17,6 +17,7 @@ double msSince(Clock::time_point t) { return std::chrono::duration<double, std::
 
 // Beams per dispatch of the linear traversal (llvmpipe's loop limit is 65535 iterations).
 constexpr int kLinearSlice = 16384;
+constexpr std::size_t kReportedScatterers = 16;
 constexpr GLuint kBindingBeams = 8, kBindingCones = 9, kBindingNodes = 10, kBindingPrims = 11;
 
 bool hasScatterer(const Scene& scene) {
@@ -75,7 +76,7 @@ std::vector<int> LightVolumesPass::shadowMapExclusions(const Scene& scene, const
 
 void LightVolumesPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
   light_volumes::BeamOptions o;
-  o.sigmaScale = params.get<float>("sigma_scale", 1.1f);
+  o.sigmaScale = params.get<float>("sigma_scale", light_volumes::kSigmaScaleFit);
   o.negativeBeams = params.get<std::string>("shadows", "shadow_map") == "negative_beams";
   o.maxConcentration = params.get<float>("max_concentration", 1e4f);
   o.maxTriangleSigma = params.get<float>("max_triangle_sigma", 0.5f);
@@ -197,6 +198,17 @@ void LightVolumesPass::execute(PassContext& ctx) {
   s["tessellation_failed"] = static_cast<double>(b.tessellationFailed);
   s["tessellation_worst_triangle_sigma"] = b.worstTriangleSigma;
   s["tessellation_specular_fallbacks"] = static_cast<double>(b.specularFallbacks);
+  // The condition per scatterer, "tessellation/<mesh index>:<mesh name>/light<index>/...", for the
+  // first kReportedScatterers (the totals above count them all).
+  for (std::size_t k = 0; k < std::min(b.scatterers.size(), kReportedScatterers); ++k) {
+    const auto& r = b.scatterers[k];
+    const std::string key = "tessellation/" + std::to_string(r.mesh) + ":" + r.meshName + "/light" +
+                            std::to_string(r.light) + "/";
+    s[key + "checked"] = static_cast<double>(r.checked);
+    s[key + "failed"] = static_cast<double>(r.failed);
+    s[key + "worst_triangle_sigma"] = r.worstTriangleSigma;
+    s[key + "specular_fallback"] = r.specularFallback ? 1.0 : 0.0;
+  }
   s["beam_flux"] = b.flux.x + b.flux.y + b.flux.z;
   s["setup_ms"] = built_ ? c.setupMs : 0.0;
   s["bvh_ms"] = built_ ? c.bvhMs : 0.0;

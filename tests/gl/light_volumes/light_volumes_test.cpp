@@ -132,12 +132,14 @@ TEST(LightVolumes, CulledAndLinearTraversalsGiveTheSameGlossyImage) {
   EXPECT_EQ(testing::cacheEvent(bvh, "light_volumes_beams"), 1);
   const auto& c = pass(bvh, "light_volumes")->counters;
   EXPECT_EQ(c.at("beams_glossy"), 512.0);
-  EXPECT_EQ(c.at("tessellation_failed"), 0.0) << "0.0375 m facets 1.2 m from the floor, sigma ~0.1";
+  EXPECT_EQ(c.at("tessellation_failed"), 0.0) << "0.0375 m facets 1.2 m from the floor, sigma ~0.12";
   EXPECT_EQ(c.at("tessellation_specular_fallbacks"), 0.0);
+  EXPECT_EQ(c.at("tessellation/1:plate/light0/specular_fallback"), 0.0);
+  EXPECT_EQ(c.count("tessellation/0:floor/light0/checked"), 0u) << "the floor is no scatterer";
 }
 
 TEST(LightVolumes, CoarseGlossyScattererFallsBackToSpecularBeams) {
-  // 2 x 2 x 2 facets of 0.3 m at 1.2 m (0.25 rad against sigma ~0.1): the condition fails and the
+  // 2 x 2 x 2 facets of 0.3 m at 1.2 m (0.25 rad against sigma ~0.12): the condition fails and the
   // scatterer gets specular beams (stats say so).
   const RenderOutput out = renderer().render(glossyScene(2), request(32));
   const auto& c = pass(out, "light_volumes")->counters;
@@ -145,6 +147,11 @@ TEST(LightVolumes, CoarseGlossyScattererFallsBackToSpecularBeams) {
   EXPECT_GT(c.at("tessellation_worst_triangle_sigma"), 2.0);
   EXPECT_EQ(c.at("tessellation_specular_fallbacks"), 1.0);
   EXPECT_EQ(c.at("beams_glossy"), 0.0);
+  // The same per scatterer: mesh 1 ("plate") under light 0.
+  EXPECT_EQ(c.at("tessellation/1:plate/light0/checked"), c.at("tessellation_checked"));
+  EXPECT_EQ(c.at("tessellation/1:plate/light0/failed"), c.at("tessellation_failed"));
+  EXPECT_EQ(c.at("tessellation/1:plate/light0/worst_triangle_sigma"), c.at("tessellation_worst_triangle_sigma"));
+  EXPECT_EQ(c.at("tessellation/1:plate/light0/specular_fallback"), 1.0);
 }
 
 TEST(LightVolumes, PathsThroughTheGlossyPlateAreCountedOnceWithPhotonGi) {
