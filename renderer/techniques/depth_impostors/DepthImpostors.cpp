@@ -46,8 +46,10 @@ void DepthImpostorsPass::prepare(const Scene& scene, const Params& params, Frame
   const glm::vec3 forward = -glm::normalize(glm::vec3(view.camera.world[2]));
   const bool ortho = view.camera.projection == ProjectionType::Orthographic;
 
-  // Blocks: the medium and b only (a sweep over the other knots, the camera or the light reuses them).
-  const std::string blockKey = view.mediaKey + "|b=" + std::to_string(particlesPerBlock_);
+  // Blocks: the medium, b and the sky (the blocks' source holds albedo * ambient) only: a sweep over the
+  // other knots, the camera or the light reuses them.
+  const std::string blockKey = view.mediaKey + "|b=" + std::to_string(particlesPerBlock_) + "|ambient=" +
+                               nlohmann::json::array({view.ambient.x, view.ambient.y, view.ambient.z}).dump();
   const impostors::BlockSet& blocks = res.cached<impostors::BlockSet>("depth_impostors.blocks", blockKey, [&] {
     std::vector<int> systemOf;
     const auto particles =
