@@ -1,11 +1,17 @@
 // Camera pass (thesis 6.1.3): every visible non-specular receiver x looks up, per generator, the
-// caustic cube map in the direction v = x - c_G. The distance map's environment layer is the shadow
-// map: only when |v| matches the stored distance (within visibility_tolerance texels) does x receive
-// the caustic. The cube holds irradiance per receiver area, so the radiance added is f_r(wi, wo) E
-// with no further cosine; wi points from x towards c_G (so glossy receivers get a direction).
+// caustic cube map in the direction v = x - c_G. Visibility: x receives the caustic only when |v|
+// matches the mean distance of the receivers the photons were deposited on in that direction
+// (deposit.frag's alpha, within visibility_tolerance texels of the caustic cube). The thesis tests
+// |v| against the distance map's environment layer instead (the distance map as a shadow map); that
+// fails when another primitive of the same glass object, or a second generator, lies between c_G and
+// the receiver (it is the nearest surface in the environment layer), and it lets a caustic deposited
+// on a receiver hidden from c_G leak onto the surface that hides it. The cube holds irradiance per
+// receiver area, so the radiance added is f_r(wi, wo) E with no further cosine; wi points from x
+// towards c_G (so glossy receivers get a direction).
 #define LDM_TRACING
 #include "common/brdf.glsl"
 #include "specular/ldm.glsl"
+#include "caustics/cube.glsl"
 
 layout(binding = 0) uniform sampler2D t_position;
 layout(binding = 1) uniform sampler2D t_normal;
@@ -16,7 +22,7 @@ layout(binding = 5) uniform sampler2D t_geoNormal;
 layout(binding = kUnitCausticCube) uniform samplerCubeArray t_caustics;
 
 uniform int u_generators;
-uniform float u_visibilityTolerance;  // texels of the distance map
+uniform float u_visibilityTolerance;  // texels of the caustic cube
 uniform vec3 u_eye;
 uniform vec3 u_viewForward;
 uniform int u_orthographic;
@@ -43,16 +49,15 @@ void main() {
     vec3 v = x - objects[k].referenceRadius.xyz;
     float dist = length(v);
     if (!(dist > 0.0)) continue;
-    // Environment layer (l = 2) of generator k: the closest non-generator surface seen from c_G.
-    float stored = texture(t_ldmGeometry, vec4(v, float(k * u_layers + 2))).z;
-    if (stored <= 0.0) continue;
     vec3 wi = -v / dist;
     float NdotL = dot(n, wi);
     if (NdotL <= 0.0) continue;
-    float tol = u_visibilityTolerance * 2.0 * dist / u_cubeResolution / max(NdotL, 0.2);
-    if (abs(dist - stored) > tol) continue;
-    vec3 E = texture(t_caustics, vec4(v, float(k))).rgb;
-    L += gltfBrdfCos(n, wo, wi, mp) / NdotL * E;
+    vec4 deposit = texture(t_caustics, vec4(v, float(k)));
+    float deposited = depositDistance(deposit);
+    if (!(deposited > 0.0)) continue;
+    float tol = u_visibilityTolerance * 2.0 * dist / u_causticResolution / max(NdotL, 0.2);
+    if (abs(dist - deposited) > tol) continue;
+    L += gltfBrdfCos(n, wo, wi, mp) / NdotL * deposit.rgb;
   }
   if (any(isnan(L)) || any(isinf(L))) L = vec3(0.0);
   o_caustics = vec4(L, 1.0);

@@ -373,6 +373,7 @@ void CausticsPass::execute(PassContext& ctx) {
     bindMaps(prog);
     prog.set("u_generators", G);
     prog.set("u_visibilityTolerance", visibilityTolerance_);
+    prog.set("u_causticResolution", static_cast<float>(C));
     prog.set("u_eye", &ctx.view.eye[0], 3);
     const glm::vec3 forward = -glm::normalize(glm::vec3(ctx.view.camera.world[2]));
     prog.set("u_viewForward", &forward[0], 3);

@@ -63,12 +63,24 @@ void expectFinite(const Image& img) {
 // A white Lambertian floor (y = 0, 6 x 6) under a glass slab (ior, thickness t, top at y = top, side
 // `side`), lit by a directional light of irradiance E travelling along `dir`. The camera looks
 // straight down from below the slab (orthographic, half extent `half`), so it sees the floor only.
+// `primitives`: the slab is one mesh primitive (1), its top face and the other five faces (2), or six
+// quads (6), each primitive a generator of its own with its own reference point.
 Scene slabScene(float ior, float t, float top, float side, glm::vec3 dir, float E, const std::string& digest,
-                bool withSlab = true) {
+                bool withSlab = true, int primitives = 1) {
   testing::SceneBuilder b;
   const int white = b.material(testing::lambertian());
   b.quad({0, 0, 0}, {0, 0, 3}, {3, 0, 0}, white, "floor");
-  if (withSlab) b.solidBox({-0.5f * side, top - t, -0.5f * side}, {0.5f * side, top, 0.5f * side}, b.material(testing::glass(ior)), "slab");
+  const glm::vec3 lo(-0.5f * side, top - t, -0.5f * side), hi(0.5f * side, top, 0.5f * side);
+  if (withSlab && primitives == 1) b.solidBox(lo, hi, b.material(testing::glass(ior)), "slab");
+  if (withSlab && primitives > 1) {
+    const std::size_t first = b.scene().meshes.size();
+    b.box(lo, hi, b.material(testing::glass(ior)), "slab");  // +x -x +y -y +z -z
+    if (primitives == 2) {
+      auto& meshes = b.scene().meshes;
+      std::rotate(meshes.begin() + first + 2, meshes.begin() + first + 3, meshes.end());  // +y last
+      b.merge(first, 5, "slab-sides-and-bottom");
+    }
+  }
   b.directionalLight(dir, E);
   b.topDownOrtho(0.5f * (top - t), 1.5f);
   return b.build(digest);
@@ -139,9 +151,11 @@ TEST(Caustics, PhotonFluxIsLightPowerThroughGeneratorTimesFresnelProducts) {
 // stay opaque in the shadow maps) and the caustic brings back E (1 - F)^2 = 0.9216 E, so beauty is
 // 0.9216 E / pi on a white Lambertian floor; outside it is E / pi from direct alone and the caustic
 // is 0: nothing is counted twice.
-TEST(Caustics, GlassSlabTransmitsFresnelSquaredAtNormalIncidence) {
+void expectSlabTransmitsFresnelSquaredAtNormalIncidence(int primitives) {
+  SCOPED_TRACE(std::to_string(primitives) + " primitives");
   const float E = 2.f;
-  Scene scene = slabScene(1.5f, 0.2f, 1.2f, 1.f, {0, -1, 0}, E, "caustics-slab");
+  Scene scene = slabScene(1.5f, 0.2f, 1.2f, 1.f, {0, -1, 0}, E, "caustics-slab-" + std::to_string(primitives), true,
+                          primitives);
   const int n = 64;
   const float half = 1.5f;
   RenderOutput out = renderer().render(scene, request(n));
@@ -169,6 +183,17 @@ TEST(Caustics, GlassSlabTransmitsFresnelSquaredAtNormalIncidence) {
     }
   EXPECT_GT(in, 200);
   EXPECT_GT(outside, 1000);
+}
+TEST(Caustics, GlassSlabTransmitsFresnelSquaredAtNormalIncidence) { expectSlabTransmitsFresnelSquaredAtNormalIncidence(1); }
+
+// A generator made of several primitives (each its own specular object with its own reference point
+// and maps): the photons entering the top face are traced on through the other primitive's maps, and
+// the receivers under the slab lie behind that other primitive as seen from the top face's reference
+// point. The caustic must still be there, with the same closed form: the slab as its top face plus
+// the other five faces, and as six quads.
+TEST(Caustics, GlassSlabOfSeveralPrimitivesKeepsItsCaustic) {
+  expectSlabTransmitsFresnelSquaredAtNormalIncidence(2);
+  expectSlabTransmitsFresnelSquaredAtNormalIncidence(6);
 }
 
 // The slab at 30 degrees (oracle 3): the transmitted light keeps its direction (parallel faces), so
