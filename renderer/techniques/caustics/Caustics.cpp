@@ -144,6 +144,7 @@ void CausticsPass::prepare(const Scene& scene, const Params& params, FrameResour
   splatRadius_ = std::clamp(params.get<float>("splat_radius", 0.02f), 1e-4f, 10.f);
   energyCheck_ = params.get<bool>("energy_check", false);
   fresnelReflection_ = params.get<bool>("fresnel_reflection", true);
+  footprintFilter_ = params.get<bool>("footprint_filter", true);
 
   generators_ = SpecularPass::specularMeshes(scene);
   pairs_.clear();
@@ -182,8 +183,10 @@ void CausticsPass::prepare(const Scene& scene, const Params& params, FrameResour
 
   const int C = cubeResolution_;
   const int cubes = std::max<int>(1, static_cast<int>(generators_.size()));
-  gl::Texture& cube = res.texture("caustics_cube", GL_TEXTURE_CUBE_MAP_ARRAY, GL_RGBA32F, C, C, 6 * cubes);
-  cube.setFilter(GL_LINEAR, GL_LINEAR);
+  int levels = 1;
+  while ((C >> levels) > 0) ++levels;  // down to 1 x 1
+  gl::Texture& cube = res.texture("caustics_cube", GL_TEXTURE_CUBE_MAP_ARRAY, GL_RGBA32F, C, C, 6 * cubes, levels);
+  cube.setFilter(GL_LINEAR_MIPMAP_LINEAR, GL_LINEAR);
   gl::Framebuffer& cubeFb = res.framebuffer("caustics_cube");
   cubeFb.attach(GL_COLOR_ATTACHMENT0, cube);  // layered: the geometry shaders pick gl_Layer
   cubeFb.setDrawBuffers({GL_COLOR_ATTACHMENT0});
@@ -352,6 +355,10 @@ void CausticsPass::execute(PassContext& ctx) {
     counters["deposited_power"] = deposited;
   }
 
+  // The mip chain for the camera pass's footprint filter: box-filtered levels keep each region's power
+  // (irradiance and the alpha depth weight average alike, so the mean deposit depth stays a ratio).
+  if (footprintFilter_ && !pairs_.empty()) cube.generateMipmaps();
+
   // (4) Camera pass: caustics AOV, and beauty += caustics when this pass owns LS+DE (a request that
   // names light_volumes gives the class to it: then the AOV is written but not added, counted once).
   const bool owns = res.ownsLightPath("caustics", "LS+DE");
@@ -374,6 +381,10 @@ void CausticsPass::execute(PassContext& ctx) {
     prog.set("u_generators", G);
     prog.set("u_visibilityTolerance", visibilityTolerance_);
     prog.set("u_causticResolution", static_cast<float>(C));
+    prog.set("u_maxLod", footprintFilter_ ? static_cast<float>(cube.levels() - 1) : 0.f);
+    // A pixel's area on the plane at unit view depth (perspective) or its area (orthographic):
+    // (2 / (P00 W)) (2 / (P11 H)) for either projection.
+    prog.set("u_pixelArea", 4.f / (ctx.view.proj[0][0] * ctx.view.proj[1][1] * ctx.view.width * ctx.view.height));
     prog.set("u_eye", &ctx.view.eye[0], 3);
     const glm::vec3 forward = -glm::normalize(glm::vec3(ctx.view.camera.world[2]));
     prog.set("u_viewForward", &forward[0], 3);
@@ -394,6 +405,7 @@ void CausticsPass::execute(PassContext& ctx) {
   counters["triangles"] = method_ == Method::Triangles ? 2.0 * (P - 1) * (P - 1) * pairs_.size() : 0.0;
   counters["splats"] = method_ == Method::Splat ? double(P) * P * pairs_.size() : 0.0;
   counters["area_weight"] = areaWeight_;
+  counters["footprint_filter"] = footprintFilter_ ? 1.0 : 0.0;
 }
 
 }  // namespace radiant

@@ -59,7 +59,7 @@ private:
   Method method_ = Method::Triangles;
   int photonResolution_ = 128, cubeResolution_ = 256, maxDepth_ = 4, linearSteps_ = 32, secantSteps_ = 4;
   float areaWeight_ = 1.f / 3.f, visibilityTolerance_ = 2.f, splatRadius_ = 0.02f;
-  bool energyCheck_ = false, fresnelReflection_ = true;
+  bool energyCheck_ = false, fresnelReflection_ = true, footprintFilter_ = true;
   std::vector<std::size_t> generators_;  // mesh index per generator (= specular object index)
   std::vector<Pair> pairs_;
   int skippedPairs_ = 0;  // lights inside (or too close to) a generator's bounds
