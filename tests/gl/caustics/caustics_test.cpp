@@ -672,5 +672,61 @@ TEST(Caustics, FocusAgreesWithTheLightTracerAtTwoCubeResolutions) {
   EXPECT_NEAR(ours[1].centre / ours[0].centre, 1.0, 0.03);
 }
 
+// A caustic seen in a mirror (the secondary lookup, LS+DS+E). Neither reference renderer samples these
+// paths (the path tracer cannot reach the light through the slab, the light tracer cannot connect to
+// the camera through the mirror), so the oracle is the closed form: the slab at normal incidence puts
+// 0.9216 E / pi on the white floor under it (tested directly above and against the light tracer), and a
+// flat mirror of F0 = 0.9 seen at 45 degrees shows it times Schlick's F(cos 45) = 0.900216. The camera
+// (orthographic, along (1, -1, 0)) sees only the vertical mirror at x = 1.5, whose reflection shows the
+// floor at |x| < 0.22, |z| < 0.15, inside the plateau; the direct light there is the slab's shadow and
+// the mirror is edge-on to the light, so beauty is the secondary lookup alone (2% per pixel, the
+// slab's 1% plus the maps' reflected rays at nearest texels). With specular_lookup false beauty is 0.
+TEST(Caustics, CausticSeenInAMirrorIsTheMirrorsFresnelTimesTheCaustic) {
+  const float E = 2.f, f0 = 0.9f;
+  testing::SceneBuilder b;
+  b.quad({0, 0, 0}, {0, 0, 3}, {3, 0, 0}, b.material(testing::lambertian()), "floor");
+  b.solidBox({-0.5f, 1.0f, -0.5f}, {0.5f, 1.2f, 0.5f}, b.material(testing::glass(1.5f)), "slab");
+  b.quad({1.5f, 1.5f, 0}, {0, 0, 0.6f}, {0, 0.6f, 0}, b.material(testing::mirror(glm::vec3(f0))), "mirror");  // normal -x
+  b.directionalLight({0, -1, 0}, E);
+  const glm::vec3 d = glm::normalize(glm::vec3(1, -1, 0));
+  b.scene().camera = testing::orthoCamera(glm::vec3(1.5f, 1.5f, 0) - 2.f * d, d, {1, 1, 0}, 0.15f, 6.f);
+  Scene scene = b.build("caustics-in-mirror");
+  const int n = 32;
+  api::RenderRequest req = request(n, {{"cube_resolution", 512}});
+  req.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty", "direct", "specular", "caustics"}, false}};
+  RenderOutput on = renderer().render(scene, req);
+  EXPECT_EQ(on.stats.lightPaths.at("LS+DS+E"), "caustics");
+  EXPECT_EQ(counter(on, "caustics", "specular_lookup"), 1.0);
+  const Image& beauty = findAov(on, "beauty");
+  expectFinite(beauty);
+  const double F = f0 + (1.0 - f0) * std::pow(1.0 - std::sqrt(0.5), 5.0);
+  const double expected = F * 0.9216 * E / kPi;
+  double sum = 0.0, maxDirect = 0.0, maxSpecular = 0.0, maxCaustics = 0.0;
+  int off = 0;
+  for (int py = 0; py < n; ++py)
+    for (int px = 0; px < n; ++px) {
+      const double v = beauty.at(px, py)[1];
+      sum += v;
+      if (std::abs(v - expected) > 0.02 * expected) ++off;
+      maxDirect = std::max<double>(maxDirect, findAov(on, "direct").at(px, py)[1]);
+      maxSpecular = std::max<double>(maxSpecular, findAov(on, "specular").at(px, py)[1]);
+      maxCaustics = std::max<double>(maxCaustics, findAov(on, "caustics").at(px, py)[1]);
+    }
+  std::printf("mirror: beauty mean %.5f (expected %.5f), %d of %d pixels off by > 2%%; max direct %.2g, specular %.2g, "
+              "caustics AOV %.2g\n", sum / (n * n), expected, off, n * n, maxDirect, maxSpecular, maxCaustics);
+  EXPECT_EQ(off, 0);
+  EXPECT_NEAR(sum / (n * n), expected, 0.01 * expected);
+  EXPECT_LT(maxDirect + maxSpecular, 1e-3 * expected);
+  EXPECT_EQ(maxCaustics, 0.0);  // the AOV stays L S+ D E: the camera sees no diffuse surface
+  req.passes["caustics"]["specular_lookup"] = false;
+  RenderOutput without = renderer().render(scene, req);
+  const Image& dark = findAov(without, "beauty");
+  EXPECT_EQ(counter(without, "caustics", "specular_lookup"), 0.0);
+  double maxDark = 0.0;
+  for (int py = 0; py < n; ++py)
+    for (int px = 0; px < n; ++px) maxDark = std::max<double>(maxDark, dark.at(px, py)[1]);
+  EXPECT_LT(maxDark, 1e-3 * expected);
+}
+
 }  // namespace
 }  // namespace radiant
