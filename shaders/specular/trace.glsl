@@ -12,24 +12,14 @@
 #ifndef RADIANT_SPECULAR_TRACE
 #define RADIANT_SPECULAR_TRACE
 
+#include "common/brdf.glsl"  // fresnelDielectric
+
 #ifndef MAX_STACK
 #define MAX_STACK 10  // max_depth (<= 8) pending siblings + the current ray, see below
 #endif
 
 uniform int u_maxDepth;
 uniform float u_minWeight;  // branches whose path weight falls below this are dropped
-
-// Exact unpolarised Fresnel reflectance, eta = n_t / n_i, cosI >= 0; 1 under total internal
-// reflection (renderer/reference/Brdf.h fresnelDielectric, the same equations).
-float fresnelDielectric(float cosI, float eta) {
-  cosI = clamp(cosI, 0.0, 1.0);
-  float sin2T = (1.0 - cosI * cosI) / (eta * eta);
-  if (sin2T >= 1.0) return 1.0;
-  float cosT = sqrt(max(0.0, 1.0 - sin2T));
-  float rs = (cosI - eta * cosT) / (cosI + eta * cosT);
-  float rp = (eta * cosI - cosT) / (eta * cosI + cosT);
-  return 0.5 * (rs * rs + rp * rp);
-}
 
 vec3 schlick(vec3 f0, float cosTheta) {
   float m = clamp(1.0 - cosTheta, 0.0, 1.0);
