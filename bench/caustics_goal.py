@@ -8,7 +8,8 @@ its time? Same procedure as bench/photon_gi_goal.py (whose helpers it uses), one
   1. ground truth: the reference at --truth-spp (seed 99; path tracer + light-traced caustics);
   2. the reference at 256 spp (seed 5): its time (the reference pass) and RMSE;
   3. frames with photons cached (a first render from another camera traces them), scored on beauty:
-     the default frame (caustics on), the same with caustics off, and caustics at P 256 / C 512.
+     the default frame (caustics on), the same with caustics off, without the secondary lookup (the
+     reference has no L S+ D S+ E paths), and caustics at P 256 / C 512.
 Prints a Markdown table for docs/PERFORMANCE.md. Python standard library only.
 """
 import argparse
@@ -39,6 +40,8 @@ def main():
     other_camera = {"position": [0.25, 0.55, 1.7], "target": [0.0, 0.45, 0.0], "up": [0, 1, 0], "yfov_deg": 42}
     settings = [("default frame (photon_gi + specular + caustics)", {}),
                 ("default frame, caustics off", False),
+                ("default frame, caustics without specular_lookup (no LS+DS+E, like the reference)",
+                 {"specular_lookup": False}),
                 ("default frame, caustics P 256, C 512", {"photon_resolution": 256, "cube_resolution": 512}),
                 ("default frame, caustics splat r 0.02", {"method": "splat", "splat_radius": 0.02})]
     for label, caustics in settings:

@@ -1,11 +1,13 @@
 // Camera pass (thesis 6.1.3): every visible non-specular receiver x looks up, per generator, the
-// caustic cube map in the direction v = x - c_G. The distance map's environment layer is the shadow
-// map: only when |v| matches the stored distance (within visibility_tolerance texels) does x receive
-// the caustic. The cube holds irradiance per receiver area, so the radiance added is f_r(wi, wo) E
-// with no further cosine; wi points from x towards c_G (so glossy receivers get a direction).
+// caustic cube map in the direction x - c_G (caustics/lookup.glsl: visibility by the cube's deposit
+// depth, footprint filter). The cube holds irradiance per receiver area, so the radiance added is
+// f_r(wi, wo) E with no further cosine; wi points from x towards c_G (so glossy receivers get a
+// direction).
 #define LDM_TRACING
 #include "common/brdf.glsl"
 #include "specular/ldm.glsl"
+#include "caustics/cube.glsl"
+#include "caustics/lookup.glsl"
 
 layout(binding = 0) uniform sampler2D t_position;
 layout(binding = 1) uniform sampler2D t_normal;
@@ -13,13 +15,10 @@ layout(binding = 2) uniform sampler2D t_albedo;
 layout(binding = 3) uniform sampler2D t_material;
 layout(binding = 4) uniform sampler2D t_emission;
 layout(binding = 5) uniform sampler2D t_geoNormal;
-layout(binding = kUnitCausticCube) uniform samplerCubeArray t_caustics;
-
-uniform int u_generators;
-uniform float u_visibilityTolerance;  // texels of the distance map
 uniform vec3 u_eye;
 uniform vec3 u_viewForward;
 uniform int u_orthographic;
+uniform float u_pixelArea;  // a pixel's area at unit view depth (perspective) or its area (orthographic)
 
 layout(location = 0) out vec4 o_caustics;
 layout(location = 1) out vec4 o_beauty;
@@ -38,21 +37,21 @@ void main() {
   vec4 mat = texelFetch(t_material, px, 0);
   MaterialParams mp = materialParams(texelFetch(t_albedo, px, 0).rgb, mat.x, mat.y, mat.w,
                                      texelFetch(t_emission, px, 0).a);
+  // The pixel's area on the receiver: Omega_pixel d^2 / cos_n = u_pixelArea z^2 cos(theta) / cos_n for
+  // a perspective camera (Omega_pixel = u_pixelArea cos^3(theta), z the view depth), u_pixelArea / cos_n
+  // for an orthographic one. The cosines are floored at 0.2 like the visibility tolerance's.
+  float cosView = max(abs(dot(n, wo)), 0.2);
+  float pixelArea = u_pixelArea / cosView;
+  if (u_orthographic == 0) {
+    float z = max(dot(x - u_eye, u_viewForward), 1e-30);
+    pixelArea *= z * z * z / max(length(x - u_eye), 1e-30);
+  }
   vec3 L = vec3(0.0);
   for (int k = 0; k < u_generators; ++k) {
-    vec3 v = x - objects[k].referenceRadius.xyz;
-    float dist = length(v);
-    if (!(dist > 0.0)) continue;
-    // Environment layer (l = 2) of generator k: the closest non-generator surface seen from c_G.
-    float stored = texture(t_ldmGeometry, vec4(v, float(k * u_layers + 2))).z;
-    if (stored <= 0.0) continue;
-    vec3 wi = -v / dist;
-    float NdotL = dot(n, wi);
-    if (NdotL <= 0.0) continue;
-    float tol = u_visibilityTolerance * 2.0 * dist / u_cubeResolution / max(NdotL, 0.2);
-    if (abs(dist - stored) > tol) continue;
-    vec3 E = texture(t_caustics, vec4(v, float(k))).rgb;
-    L += gltfBrdfCos(n, wo, wi, mp) / NdotL * E;
+    vec3 wi;
+    float NdotL;
+    vec3 E = causticIrradiance(k, x, n, pixelArea, wi, NdotL);
+    if (NdotL > 0.0 && any(greaterThan(E, vec3(0.0)))) L += gltfBrdfCos(n, wo, wi, mp) / NdotL * E;
   }
   if (any(isnan(L)) || any(isinf(L))) L = vec3(0.0);
   o_caustics = vec4(L, 1.0);

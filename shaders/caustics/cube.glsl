@@ -61,4 +61,10 @@ float texelSolidAngle(vec2 uv) {
   float r2 = 1.0 + dot(uv, uv);
   return s * s / (r2 * sqrt(r2));
 }
+// Mean distance from c_G of the receivers deposited into a caustic cube texel (deposit.frag), 0 where
+// nothing was deposited.
+float depositDistance(vec4 texel) {
+  float w = texel.r + texel.g + texel.b;
+  return w > 0.0 ? texel.a / w : 0.0;
+}
 #endif

@@ -1,7 +1,8 @@
 // Diagnostics (caustics.energy_check): the power the caustic cube map of one generator deposits on
-// the receivers its distance map sees, sum over texels of E Omega_texel d^2 / cos (thesis oracle:
-// with area weight 1/3 it equals the photons' power, with 1/2 two thirds of it). d and the receiver
-// normal come from the environment layer; per work group partial sums.
+// its receivers, sum over texels of E Omega_texel d^2 / cos (thesis oracle: with area weight 1/3 it
+// equals the photons' power, with 1/2 two thirds of it). d is the texel's deposit distance
+// (deposit.frag), the receiver normal comes from the environment layer (exact for receivers that
+// c_G sees); per work group partial sums.
 layout(local_size_x = 8, local_size_y = 8) in;
 #define LDM_TRACING
 #include "specular/ldm.glsl"
@@ -24,9 +25,10 @@ void main() {
       vec2 st = (vec2(id.xy) + 0.5) / float(C) * 2.0 - 1.0;
       vec3 dir = normalize(faceDirection(id.z, st));
       vec4 geo = texture(t_ldmGeometry, vec4(dir, float(u_generator * u_layers + 2)));
-      if (geo.z > 0.0) {
+      float d = depositDistance(imageLoad(i_caustics, ivec3(id.xy, 6 * u_generator + id.z)));
+      if (geo.z > 0.0 && d > 0.0) {
         float cosR = max(abs(dot(octDecode(geo.xy), dir)), 1e-3);
-        sum = vec4(E * texelSolidAngle(st) * geo.z * geo.z / cosR, 1.0);
+        sum = vec4(E * texelSolidAngle(st) * d * d / cosR, 1.0);
       }
     }
   }

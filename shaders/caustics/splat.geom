@@ -9,6 +9,7 @@ layout(triangle_strip, max_vertices = 24) out;
 flat in ivec2 v_texel[];
 out vec3 g_irradiance;
 out vec2 g_disk;
+out vec3 g_position;
 uniform float u_splatRadius;
 
 void main() {
@@ -24,13 +25,17 @@ void main() {
   const vec2 corners[4] = vec2[4](vec2(-1, -1), vec2(1, -1), vec2(-1, 1), vec2(1, 1));
   vec4 q[4];
   for (int f = 0; f < 6; ++f) {
-    for (int i = 0; i < 4; ++i)
-      q[i] = u_faceViewProj[f] * vec4(p + u_splatRadius * (corners[i].x * a + corners[i].y * b), 1.0);
+    vec3 corner[4];
+    for (int i = 0; i < 4; ++i) {
+      corner[i] = p + u_splatRadius * (corners[i].x * a + corners[i].y * b);
+      q[i] = u_faceViewProj[f] * vec4(corner[i], 1.0);
+    }
     if (outsideFace(q, 4)) continue;
     for (int i = 0; i < 4; ++i) {
       gl_Layer = u_cubeLayer + f;
       g_irradiance = E;
       g_disk = corners[i];
+      g_position = corner[i];
       gl_Position = q[i];
       EmitVertex();
     }

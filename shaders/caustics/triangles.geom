@@ -27,6 +27,7 @@ layout(triangle_strip, max_vertices = 18) out;  // 6 faces x 3, or 4 texel quads
 flat in ivec2 v_texel[];
 out vec3 g_irradiance;
 out vec2 g_disk;
+out vec3 g_position;
 
 layout(binding = 3) uniform sampler2D t_vertex;  // rgb I_v, a sum A_t (area.comp)
 uniform float u_areaWeight;
@@ -84,6 +85,7 @@ void main() {
         gl_Layer = u_cubeLayer + face;
         g_irradiance = E;
         g_disk = vec2(0.0);
+        g_position = mid;
         gl_Position = vec4(centre + corners[i] * h, 0.5, 1.0);
         EmitVertex();
       }
@@ -98,6 +100,7 @@ void main() {
       gl_Layer = u_cubeLayer + f;
       g_irradiance = V[i].rgb;
       g_disk = vec2(0.0);
+      g_position = p[i];
       gl_Position = q[i];
       EmitVertex();
     }

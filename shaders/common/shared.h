@@ -66,7 +66,8 @@ RADIANT_CONST int kUnitAoEmission = 21;   // ambient_occlusion resolve: the emis
 RADIANT_CONST int kUnitGbufferLayers = 22;    // direct: the G-buffer's gbuffer_layers (KHR_materials_clearcoat, sheen)
 RADIANT_CONST int kUnitGbufferSpecular = 23;  // direct: the G-buffer's gbuffer_specular (KHR_materials_specular)
 RADIANT_CONST int kUnitCausticCube = 24;  // caustics: the caustic cube maps (irradiance per receiver area)
-RADIANT_CONST int kUnitCount = 25;        // units used; GL 4.5 guarantees 16, every driver we run has 32
+RADIANT_CONST int kUnitLdmAlbedo = 25;  // specular: the maps' diffuse albedo (read by caustics at specular's secondary hits)
+RADIANT_CONST int kUnitCount = 26;        // units used; GL 4.5 guarantees 16, every driver we run has 32
 
 // Shader storage bindings of the scene buffers.
 RADIANT_CONST int kBindingMaterials = 0;

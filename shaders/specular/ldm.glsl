@@ -12,6 +12,8 @@
 //                  the reference point (0 = empty texel, no surface), w = specular object index + 1
 //                  of the surface (0 for diffuse): a ray leaving a mirror or refractor continues in the
 //                  maps of the object it hit.
+//   t_ldmAlbedo:   rgb = diffuse albedo (1 - metallic)(1 - transmission) baseColor of a lit non-specular
+//                  surface, 0 elsewhere (RGBA8; read by the caustics pass at the secondary hits).
 //   t_ldmDistance:   the distance again (R32F), sampled with linear filtering for the search: the
 //                  secant steps then converge on a piecewise-linear surface instead of the staircase
 //                  of nearest texels. Empty texels hold kEmptyDistance, so a blend with an empty

@@ -22,6 +22,7 @@ layout(binding = kUnitPeel) uniform sampler2D t_peel;  // previous layer of this
 layout(location = 0) out vec4 o_material;
 layout(location = 1) out vec4 o_geometry;
 layout(location = 2) out float o_distance;  // cleared to kEmptyDistance
+layout(location = 3) out vec4 o_albedo;     // rgb diffuse albedo of a non-specular, lit surface, else 0
 
 void main() {
   if (u_faceMode == 0 && !gl_FrontFacing) discard;
@@ -43,9 +44,12 @@ void main() {
   vec3 n = dot(v_normal, v_normal) > 1e-30 ? normalize(v_normal) : faceNormal;
 
   MaterialParams p = decodeMaterial(m, v_uv0, v_uv1);
+  o_albedo = vec4(0.0);
   if (u_objectCode > 0) {
     o_material = specularTexel(p.baseColor.rgb, p.surface.x, p.surface.z, p.surface.w);
   } else {
+    // The Lambertian part of the glTF BRDF (what the caustics pass lights at the maps' texels).
+    if (!materialUnlit(m)) o_albedo = vec4(p.baseColor.rgb * (1.0 - p.surface.x) * (1.0 - p.surface.z), 1.0);
     // Two-sided shading towards the viewer of the map, the reference point (view-dependent terms
     // are therefore evaluated for that viewer: the usual distance-map approximation).
     vec3 wo = dist > 1e-30 ? -toP / dist : n;

@@ -1,19 +1,12 @@
 // The specular pass proper: rasterises each specular object (the first hit, thesis ch. 5: "the first
 // point is identified by rasterization"), keeps the fragment the G-buffer sees, and traces the
-// reflected and refracted rays through the layered distance maps, iterating Algorithm 3 with an
-// explicit, bounded stack instead of recursion:
-//   RayTrace(x, R) = radiance of the closest diffuse hit, or 0 when max_depth is reached, or
-//                    F RayTrace(x, Rl) + (1 - F) T RayTrace(x, Rf) at a mirror or refractor.
+// reflected and refracted rays through the layered distance maps (Algorithm 3, specular/trace.glsl).
 // Writes the radiance arriving through the traced paths, already weighted by Fresnel and colour:
 // the `specular` AOV, which compose.frag adds to beauty.
 #define LDM_TRACING
 #include "common/scene.glsl"
 #include "specular/ldm.glsl"
 #include "common/environment.glsl"
-
-#ifndef MAX_STACK
-#define MAX_STACK 10  // max_depth (<= 8) pending siblings + the current ray, see below
-#endif
 
 in vec3 v_position;
 
@@ -30,74 +23,16 @@ uniform int u_orthographic;
 uniform vec3 u_background;  // radiance where a ray leaves the scene (the sky), as `direct` uses
 uniform int u_hasEnvironment;  // 1: a ray leaving the scene sees the environment map instead
 layout(binding = kUnitEnvironment) uniform sampler2D t_environment;
-uniform int u_maxDepth;
-uniform float u_minWeight;  // branches whose path weight falls below this are dropped
 
 layout(location = 0) out vec4 o_specular;
 
-// Exact unpolarised Fresnel reflectance, eta = n_t / n_i, cosI >= 0; 1 under total internal
-// reflection (renderer/reference/Brdf.h fresnelDielectric, the same equations).
-float fresnelDielectric(float cosI, float eta) {
-  cosI = clamp(cosI, 0.0, 1.0);
-  float sin2T = (1.0 - cosI * cosI) / (eta * eta);
-  if (sin2T >= 1.0) return 1.0;
-  float cosT = sqrt(max(0.0, 1.0 - sin2T));
-  float rs = (cosI - eta * cosT) / (cosI + eta * cosT);
-  float rp = (eta * cosI - cosT) / (eta * cosI + cosT);
-  return 0.5 * (rs * rs + rp * rp);
+// A ray that leaves the scene sees the sky in its direction; a diffuse hit its stored radiance.
+vec3 missRadiance(vec3 dir) {
+  return u_hasEnvironment != 0 ? environmentRadiance(t_environment, dir) : u_background;
 }
+vec3 diffuseHitRadiance(vec3 hit, vec3 rayDir, vec3 dir, float cube, vec4 texel) { return texel.rgb; }
 
-vec3 schlick(vec3 f0, float cosTheta) {
-  float m = clamp(1.0 - cosTheta, 0.0, 1.0);
-  float m2 = m * m;
-  return f0 + (1.0 - f0) * (m2 * m2 * m);
-}
-
-struct Ray {
-  vec3 origin;
-  vec3 dir;
-  vec3 weight;
-  int depth;   // specular interactions on the path so far (the one that spawned this ray included)
-  int object;  // whose layered distance map the ray is traced in: the object it leaves
-};
-
-Ray stack[MAX_STACK];
-int sp = 0;
-
-void push(vec3 origin, vec3 dir, vec3 weight, int depth, int object) {
-  if (max(weight.r, max(weight.g, weight.b)) < u_minWeight || sp >= MAX_STACK) return;
-  stack[sp] = Ray(origin, dir, weight, depth, object);
-  ++sp;
-}
-
-// The two children of an ideal specular interaction at p. R: incoming unit direction; n: the
-// surface normal as modelled (either side); texel: specularTexel(); the rays leave in `object`'s map.
-void scatter(vec3 p, vec3 R, vec3 n, vec4 texel, vec3 weight, int depth, int object, bool entering) {
-  // Unit vectors throughout: the G-buffer normal is stored at half precision, and the search's shell
-  // clipping (ldm.glsl) assumes |R| = 1.
-  n = normalize(n);
-  vec3 nn = dot(n, R) > 0.0 ? -n : n;  // faces the incoming ray
-  float cosI = clamp(-dot(R, nn), 0.0, 1.0);
-  // Self-intersection offset: the maps are sampled at nearest texels, so the surface at the origin is
-  // known only to about half a texel; step off it by that (scaled by the object's size).
-  float eps = objects[object].referenceRadius.w * (1e-3 + 0.5 / u_cubeResolution);
-  vec3 rl = normalize(reflect(R, nn));
-  if (texel.a < 0.0) {
-    // Mirror: Schlick with F0 = the stored colour (glTF conductor Fresnel, as the reference).
-    push(p + nn * eps, rl, weight * schlick(texel.rgb, cosI), depth, object);
-    return;
-  }
-  float ior = texel.a;
-  float eta = entering ? ior : 1.0 / ior;  // n_t / n_i
-  float F = fresnelDielectric(cosI, eta);
-  push(p + nn * eps, rl, weight * F, depth, object);
-  if (F < 1.0) {
-    vec3 rf = refract(R, nn, 1.0 / eta);  // GLSL's eta is n_i / n_t
-    if (dot(rf, rf) > 0.0)
-      // Radiance crossing an interface scales by 1 / eta^2 (Veach 1997, 5.2), as in the reference.
-      push(p - nn * eps, normalize(rf), weight * (1.0 - F) * texel.rgb / (eta * eta), depth, object);
-  }
-}
+#include "specular/trace.glsl"
 
 void main() {
   ivec2 px = ivec2(gl_FragCoord.xy);
@@ -113,42 +48,9 @@ void main() {
   float ior = texelFetch(t_emission, px, 0).a;
   vec3 R = u_orthographic != 0 ? u_viewForward : normalize(p - u_eye);
 
-  sp = 0;
   // The G-buffer normal faces the viewer; whether the ray enters or leaves the object is the face's
   // orientation (a camera inside a glass object sees its back faces).
-  scatter(p, R, n, specularTexel(albedo, mat.x, mat.w, ior), vec3(1.0), 1, u_object, gl_FrontFacing);
-
-  vec3 L = vec3(0.0);
-  int traced = 0;
-  // Each pop pushes at most two children and the walk is depth-first, so at most one pending sibling
-  // per depth level waits on the stack: MAX_STACK >= max_depth + 1 bounds it, and the loop ends after
-  // at most 2^(max_depth + 1) - 2 rays.
-  while (sp > 0) {
-    --sp;
-    Ray r = stack[sp];
-    ++traced;
-    float d;
-    int layer;
-    if (!traceLayers(r.object, r.origin, r.dir, d, layer)) {
-      // No surface in any layer: the ray leaves the scene and sees the sky in its direction.
-      L += r.weight * (u_hasEnvironment != 0 ? environmentRadiance(t_environment, r.dir) : u_background);
-      continue;
-    }
-    vec3 hit = r.origin + r.dir * d;
-    vec3 dir = hit - objects[r.object].referenceRadius.xyz;
-    if (dot(dir, dir) < 1e-30) dir = r.dir;
-    float cube = float(r.object * u_layers + layer);
-    vec4 texel = texture(t_ldmMaterial, vec4(dir, cube));
-    vec4 geo = texture(t_ldmGeometry, vec4(dir, cube));
-    int code = int(geo.w + 0.5);
-    if (texel.a == 0.0 || code == 0) {
-      L += r.weight * texel.rgb;  // diffuse: its reflected radiance
-      continue;
-    }
-    if (r.depth >= u_maxDepth) continue;  // Algorithm 3: max ray depth reached -> zero
-    vec3 hn = octDecode(geo.xy);
-    // Entering a refractor when arriving against its outward normal.
-    scatter(hit, r.dir, hn, texel, r.weight, r.depth + 1, code - 1, dot(hn, r.dir) < 0.0);
-  }
+  int traced;
+  vec3 L = traceSpecularTree(p, R, n, specularTexel(albedo, mat.x, mat.w, ior), u_object, gl_FrontFacing, traced);
   o_specular = vec4(L, float(traced));
 }

@@ -80,9 +80,15 @@ public:
   SceneBuilder& solidBox(glm::vec3 lo, glm::vec3 hi, int mat, const std::string& name = "solid") {
     const std::size_t first = scene_.meshes.size();
     box(lo, hi, mat, name);
+    return merge(first, scene_.meshes.size() - first, name);
+  }
+
+  // Merges the `count` meshes from index `first` on into one MeshInstance (the first one's material)
+  // at index `first`: one primitive made of several, e.g. five faces of a box.
+  SceneBuilder& merge(std::size_t first, std::size_t count, const std::string& name) {
     MeshInstance merged = std::move(scene_.meshes[first]);
     merged.name = name;
-    for (std::size_t i = first + 1; i < scene_.meshes.size(); ++i) {
+    for (std::size_t i = first + 1; i < first + count; ++i) {
       const auto base = static_cast<std::uint32_t>(merged.positions.size());
       const MeshInstance& q = scene_.meshes[i];
       merged.positions.insert(merged.positions.end(), q.positions.begin(), q.positions.end());
@@ -91,8 +97,9 @@ public:
       for (std::uint32_t idx : q.indices) merged.indices.push_back(base + idx);
       merged.bounds.extend(q.bounds);
     }
-    scene_.meshes.resize(first);
-    scene_.meshes.push_back(std::move(merged));
+    scene_.meshes.erase(scene_.meshes.begin() + static_cast<std::ptrdiff_t>(first + 1),
+                        scene_.meshes.begin() + static_cast<std::ptrdiff_t>(first + count));
+    scene_.meshes[first] = std::move(merged);
     return *this;
   }
 

@@ -50,6 +50,8 @@ bool boundsMayBeVisible(const Bounds& b, const glm::mat4& viewProj) {
 }
 
 constexpr int kGroup = 8;
+// The secondary lookup's tree drops branches below this path weight (the specular pass's bound).
+constexpr float kMinBranchWeight = 1e-3f;
 constexpr float kMaxLightTan = 11.4f;  // tan(85 degrees)  // work-group side of area.comp and energy.comp
 
 }  // namespace
@@ -63,7 +65,7 @@ const TechniqueInfo& CausticsPass::info() const {
       {"caustics"},
       true,
       true,
-      {"LS+DE"}};
+      {"LS+DE", "LS+DS+E"}};
   return i;
 }
 
@@ -119,15 +121,16 @@ std::string CausticsPass::skipReason(const Scene& scene) {
 Requirements CausticsPass::requirements(const Scene& scene, const api::RenderRequest& request) const {
   std::string why = skipReason(scene);
   if (!why.empty()) return Requirements::skip(why);
-  // The camera must see a receiver: a mesh that is neither specular nor unlit inside the view frustum.
+  // The camera must see a receiver (a mesh that is neither specular nor unlit inside the view
+  // frustum), or a mirror or refractor that may show one (the secondary lookup).
   const FrameView view = makeFrameView(scene, request);
   bool receiver = false;
   for (const MeshInstance& m : scene.meshes) {
     const Material& mat = scene.material(m.material);
-    if (mat.isSpecular() || mat.unlit || m.triangleCount() == 0) continue;
+    if (mat.unlit || m.triangleCount() == 0) continue;
     receiver = receiver || boundsMayBeVisible(m.bounds, view.viewProj);
   }
-  if (!receiver) return Requirements::skip("the camera sees no diffuse or glossy receiver");
+  if (!receiver) return Requirements::skip("the camera sees no diffuse or glossy receiver, nor a mirror or refractor");
   return Requirements::ok();
 }
 
@@ -144,6 +147,8 @@ void CausticsPass::prepare(const Scene& scene, const Params& params, FrameResour
   splatRadius_ = std::clamp(params.get<float>("splat_radius", 0.02f), 1e-4f, 10.f);
   energyCheck_ = params.get<bool>("energy_check", false);
   fresnelReflection_ = params.get<bool>("fresnel_reflection", true);
+  footprintFilter_ = params.get<bool>("footprint_filter", true);
+  specularLookup_ = params.get<bool>("specular_lookup", true);
 
   generators_ = SpecularPass::specularMeshes(scene);
   pairs_.clear();
@@ -182,8 +187,10 @@ void CausticsPass::prepare(const Scene& scene, const Params& params, FrameResour
 
   const int C = cubeResolution_;
   const int cubes = std::max<int>(1, static_cast<int>(generators_.size()));
-  gl::Texture& cube = res.texture("caustics_cube", GL_TEXTURE_CUBE_MAP_ARRAY, GL_RGBA32F, C, C, 6 * cubes);
-  cube.setFilter(GL_LINEAR, GL_LINEAR);
+  int levels = 1;
+  while ((C >> levels) > 0) ++levels;  // down to 1 x 1
+  gl::Texture& cube = res.texture("caustics_cube", GL_TEXTURE_CUBE_MAP_ARRAY, GL_RGBA32F, C, C, 6 * cubes, levels);
+  cube.setFilter(GL_LINEAR_MIPMAP_LINEAR, GL_LINEAR);
   gl::Framebuffer& cubeFb = res.framebuffer("caustics_cube");
   cubeFb.attach(GL_COLOR_ATTACHMENT0, cube);  // layered: the geometry shaders pick gl_Layer
   cubeFb.setDrawBuffers({GL_COLOR_ATTACHMENT0});
@@ -197,6 +204,10 @@ void CausticsPass::prepare(const Scene& scene, const Params& params, FrameResour
   fb.attach(GL_COLOR_ATTACHMENT1, res.texture("beauty", GL_TEXTURE_2D, GL_RGBA32F, w, h));
   fb.setDrawBuffers({GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1});
   fb.checkComplete("CausticsPass::prepare");
+  gl::Framebuffer& secondary = res.framebuffer("caustics_secondary");
+  secondary.attach(GL_COLOR_ATTACHMENT0, res.texture("beauty", GL_TEXTURE_2D, GL_RGBA32F, w, h));
+  secondary.setDrawBuffers({GL_COLOR_ATTACHMENT0});
+  secondary.checkComplete("CausticsPass::prepare (secondary)");
   declareDirectLightingResources(res);
 }
 
@@ -212,6 +223,7 @@ void CausticsPass::execute(PassContext& ctx) {
   const int ldmResolution = ldmGeometry.width();
   const int layers = G > 0 ? std::max(3, ldmGeometry.depth() / (6 * G)) : 3;
   auto bindMaps = [&](const gl::Program& prog) {
+    res.texture("specular_ldm_albedo").bindUnit(gpu::kUnitLdmAlbedo);
     ldmMaterial.bindUnit(gpu::kUnitLdmMaterial);
     ldmGeometry.bindUnit(gpu::kUnitLdmGeometry);
     ldmDistance.bindUnit(gpu::kUnitLdmDistance);
@@ -352,9 +364,29 @@ void CausticsPass::execute(PassContext& ctx) {
     counters["deposited_power"] = deposited;
   }
 
+  // The mip chain for the camera pass's footprint filter: box-filtered levels keep each region's power
+  // (irradiance and the alpha depth weight average alike, so the mean deposit depth stays a ratio).
+  if (footprintFilter_ && !pairs_.empty()) cube.generateMipmaps();
+
   // (4) Camera pass: caustics AOV, and beauty += caustics when this pass owns LS+DE (a request that
   // names light_volumes gives the class to it: then the AOV is written but not added, counted once).
   const bool owns = res.ownsLightPath("caustics", "LS+DE");
+  const float pixelArea = 4.f / (ctx.view.proj[0][0] * ctx.view.proj[1][1] * ctx.view.width * ctx.view.height);
+  const float maxLod = footprintFilter_ ? static_cast<float>(cube.levels() - 1) : 0.f;
+  const glm::vec3 forward = -glm::normalize(glm::vec3(ctx.view.camera.world[2]));
+  const int orthographic = ctx.view.camera.projection == ProjectionType::Orthographic ? 1 : 0;
+  auto setLookup = [&](const gl::Program& prog) {
+    prog.set("u_generators", G);
+    prog.set("u_visibilityTolerance", visibilityTolerance_);
+    prog.set("u_causticResolution", static_cast<float>(C));
+    prog.set("u_maxLod", maxLod);
+    // A pixel's area on the plane at unit view depth (perspective) or its area (orthographic):
+    // (2 / (P00 W)) (2 / (P11 H)) for either projection.
+    prog.set("u_pixelArea", pixelArea);
+    prog.set("u_eye", &ctx.view.eye[0], 3);
+    prog.set("u_viewForward", &forward[0], 3);
+    prog.set("u_orthographic", orthographic);
+  };
   gl::Framebuffer& fb = res.framebuffer("caustics");
   fb.bind();
   glViewport(0, 0, ctx.view.width, ctx.view.height);
@@ -371,12 +403,7 @@ void CausticsPass::execute(PassContext& ctx) {
     const gl::Program& prog = ctx.shaders.program({"common/fullscreen.vert", "caustics/camera.frag"});
     prog.use();
     bindMaps(prog);
-    prog.set("u_generators", G);
-    prog.set("u_visibilityTolerance", visibilityTolerance_);
-    prog.set("u_eye", &ctx.view.eye[0], 3);
-    const glm::vec3 forward = -glm::normalize(glm::vec3(ctx.view.camera.world[2]));
-    prog.set("u_viewForward", &forward[0], 3);
-    prog.set("u_orthographic", ctx.view.camera.projection == ProjectionType::Orthographic ? 1 : 0);
+    setLookup(prog);
     glDrawArrays(GL_TRIANGLES, 0, 3);
   }
   glDisablei(GL_BLEND, 1);
@@ -384,6 +411,40 @@ void CausticsPass::execute(PassContext& ctx) {
   res.markWritten("caustics");
   if (owns) res.markWritten("beauty");
   counters["adds_to_beauty"] = owns ? 1.0 : 0.0;
+
+  // (5) The caustics seen in mirrors and through glass (LS+DS+E): the specular objects rasterised from
+  // the camera, their trees traced through the maps, the cubes looked up at the non-specular hits;
+  // into beauty only (the caustics AOV stays exactly LS+DE, the reference's caustics class).
+  const bool secondary = specularLookup_ && !pairs_.empty() && res.ownsLightPath("caustics", "LS+DS+E");
+  if (secondary) {
+    res.framebuffer("caustics_secondary").bind();
+    glViewport(0, 0, ctx.view.width, ctx.view.height);
+    glDisable(GL_DEPTH_TEST);  // the G-buffer test keeps one fragment per pixel (secondary.frag)
+    glDisable(GL_CULL_FACE);
+    glEnable(GL_BLEND);
+    glBlendEquation(GL_FUNC_ADD);
+    glBlendFunc(GL_ONE, GL_ONE);
+    const char* inputs[] = {"gbuffer_position", "normal", "albedo", "material", "emission"};
+    for (GLuint i = 0; i < std::size(inputs); ++i) res.texture(inputs[i]).bindUnit(i);
+    cube.bindUnit(gpu::kUnitCausticCube);
+    const gl::Program& prog = ctx.shaders.program({"specular/map.vert", "caustics/secondary.frag"});
+    prog.use();
+    bindMaps(prog);
+    setLookup(prog);
+    prog.setMat4("u_viewProj", &ctx.view.viewProj[0][0]);
+    prog.set("u_maxDepth", maxDepth_);
+    prog.set("u_minWeight", kMinBranchWeight);
+    const GLint objectLoc = prog.uniformLocation("u_object");
+    ctx.gpu.drawMeshes(prog, false, [&](std::size_t mesh) {
+      const auto it = std::find(generators_.begin(), generators_.end(), mesh);
+      if (it == generators_.end()) return false;
+      glProgramUniform1i(prog.id(), objectLoc, static_cast<int>(it - generators_.begin()));
+      return true;
+    });
+    glDisable(GL_BLEND);
+    res.markWritten("beauty");
+  }
+  counters["specular_lookup"] = secondary ? 1.0 : 0.0;
 
   counters["generators"] = G;
   counters["pairs"] = static_cast<double>(pairs_.size());  // (light, generator, branch) hit images
@@ -393,6 +454,7 @@ void CausticsPass::execute(PassContext& ctx) {
   counters["triangles"] = method_ == Method::Triangles ? 2.0 * (P - 1) * (P - 1) * pairs_.size() : 0.0;
   counters["splats"] = method_ == Method::Splat ? double(P) * P * pairs_.size() : 0.0;
   counters["area_weight"] = areaWeight_;
+  counters["footprint_filter"] = footprintFilter_ ? 1.0 : 0.0;
 }
 
 }  // namespace radiant

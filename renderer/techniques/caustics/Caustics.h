@@ -12,7 +12,9 @@
 // areas and irradiance I = dPhi / dA (area.comp); (3) 2 P^2 caustic triangles, or the splat
 // baseline's disks, added into the generator's cube (triangles.geom / splat.geom); then (4) one camera
 // pass over the G-buffer adds f_r E where the distance map says the receiver is visible from c_G
-// (camera.frag), into the `caustics` AOV and beauty.
+// (camera.frag), into the `caustics` AOV and beauty; and (5) the caustics seen in mirrors and through
+// glass (LS+DS+E): the specular objects' rays traced as the specular pass does, the cubes looked up at
+// their non-specular hits (secondary.frag), into beauty only.
 //
 // Generators stay opaque in the shadow maps: the direct pass leaves them black shadows and this pass
 // brings the transmitted light back, so no light is counted twice.
@@ -59,7 +61,7 @@ private:
   Method method_ = Method::Triangles;
   int photonResolution_ = 128, cubeResolution_ = 256, maxDepth_ = 4, linearSteps_ = 32, secantSteps_ = 4;
   float areaWeight_ = 1.f / 3.f, visibilityTolerance_ = 2.f, splatRadius_ = 0.02f;
-  bool energyCheck_ = false, fresnelReflection_ = true;
+  bool energyCheck_ = false, fresnelReflection_ = true, footprintFilter_ = true, specularLookup_ = true;
   std::vector<std::size_t> generators_;  // mesh index per generator (= specular object index)
   std::vector<Pair> pairs_;
   int skippedPairs_ = 0;  // lights inside (or too close to) a generator's bounds

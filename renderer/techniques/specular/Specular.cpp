@@ -95,6 +95,8 @@ void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResour
   geometry.setFilter(GL_NEAREST, GL_NEAREST);
   gl::Texture& distance = res.texture("specular_ldm_distance", GL_TEXTURE_CUBE_MAP_ARRAY, GL_R32F, resolution_,
                                       resolution_, 6 * cubes);
+  res.texture("specular_ldm_albedo", GL_TEXTURE_CUBE_MAP_ARRAY, GL_RGBA8, resolution_, resolution_, 6 * cubes)
+      .setFilter(GL_NEAREST, GL_NEAREST);
   distance.setFilter(GL_LINEAR, GL_LINEAR);
   res.texture("specular_ldm_depth", GL_TEXTURE_2D, GL_DEPTH_COMPONENT32F, resolution_, resolution_);
   gl::Texture& peel = res.texture("specular_ldm_peel", GL_TEXTURE_2D, GL_RGBA32F, resolution_, resolution_);
@@ -141,6 +143,7 @@ void SpecularPass::execute(PassContext& ctx) {
   gl::Texture& material = res.texture("specular_ldm_material");
   gl::Texture& geometry = res.texture("specular_ldm_geometry");
   gl::Texture& distance = res.texture("specular_ldm_distance");
+  gl::Texture& albedo = res.texture("specular_ldm_albedo");
 
   ctx.stats.counters["objects"] = objectCount;
   ctx.stats.counters["maps_rendered"] = 0;
@@ -184,12 +187,14 @@ void SpecularPass::execute(PassContext& ctx) {
           fb.attach(GL_COLOR_ATTACHMENT0, material, 0, layerFace);
           fb.attach(GL_COLOR_ATTACHMENT1, geometry, 0, layerFace);
           fb.attach(GL_COLOR_ATTACHMENT2, distance, 0, layerFace);
-          fb.setDrawBuffers({GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2});
+          fb.attach(GL_COLOR_ATTACHMENT3, albedo, 0, layerFace);
+          fb.setDrawBuffers({GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2, GL_COLOR_ATTACHMENT3});
           fb.checkComplete("SpecularPass::execute (maps)");
           fb.bind();
           glClearNamedFramebufferfv(fb.id(), GL_COLOR, 0, zero);
           glClearNamedFramebufferfv(fb.id(), GL_COLOR, 1, zero);
           glClearNamedFramebufferfv(fb.id(), GL_COLOR, 2, empty);
+          glClearNamedFramebufferfv(fb.id(), GL_COLOR, 3, zero);
           glClearNamedFramebufferfv(fb.id(), GL_DEPTH, 0, &depthClear);
           const glm::mat4 vp = ShadowMapsPass::cubeFaceViewProj(ref, f, znear);
           prog.setMat4("u_viewProj", &vp[0][0]);

@@ -34,7 +34,7 @@ public:
   static glm::vec3 referencePoint(const MeshInstance& mesh) { return mesh.bounds.center(); }
   // The specular objects in map order (object k's cubes are k * layers + l of the cube arrays): every
   // mesh with triangles whose material isSpecular(), in mesh order. The caustics pass reads the maps
-  // (the frame resources specular_ldm_material / _geometry / _distance, specular_objects,
+  // (the frame resources specular_ldm_material / _geometry / _distance / _albedo, specular_objects,
   // specular_minmax) through the internal output "specular_maps".
   static std::vector<std::size_t> specularMeshes(const Scene& scene);
 

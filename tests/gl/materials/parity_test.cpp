@@ -780,6 +780,7 @@ TEST_F(ParityTest, SamplerUnitsAreUniqueAcrossTheFramesPrograms) {
       {"specular/map.vert", "caustics/photon.frag"},      {"common/fullscreen.vert", "caustics/camera.frag"},
       {"caustics/grid.vert", "caustics/triangles.geom", "caustics/deposit.frag"},
       {"caustics/grid.vert", "caustics/splat.geom", "caustics/deposit.frag"},
+      {"specular/map.vert", "caustics/secondary.frag"},
   };
   std::map<int, std::string> sharedUnitOwner;  // unit >= 6 -> sampler name
   int samplers = 0;
