@@ -130,15 +130,7 @@ void DepthImpostorsPass::execute(PassContext& ctx) {
   ctx.gpu.lights.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingLights);
   const gl::Program& prog = ctx.shaders.program({"depth_impostors/gather.vert", "depth_impostors/gather.frag"});
   prog.use();
-  prog.setMat4("u_view", &view.view[0][0]);
-  prog.setMat4("u_proj", &view.proj[0][0]);
-  prog.setMat4("u_invViewProj", &view.invViewProj[0][0]);
-  prog.set("u_znear", view.camera.znear);
-  prog.set("u_orthographic", view.camera.projection == ProjectionType::Orthographic ? 1 : 0);
-  prog.set("u_hasDepth", hasDepth ? 1 : 0);
-  const float targetSize[2] = {static_cast<float>(view.width), static_cast<float>(view.height)};
-  prog.set("u_targetSize", targetSize, 2);
-  glProgramUniform2i(prog.id(), prog.uniformLocation("u_fullSize"), view.width, view.height);
+  setMediaCameraUniforms(prog, view, hasDepth, view.width, view.height);
   prog.set("u_axisMode", viewAxis_.mode);
   prog.set("u_axis", &viewAxis_.axis.x, 3);
   prog.set("u_res", set.layout().res);

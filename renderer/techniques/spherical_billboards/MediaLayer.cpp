@@ -24,6 +24,18 @@ void beginMediaLayer(const gl::Framebuffer& target, int w, int h) {
   glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE_MINUS_SRC_ALPHA);
 }
 
+void setMediaCameraUniforms(const gl::Program& prog, const FrameView& view, bool hasDepth, int targetW, int targetH) {
+  prog.setMat4("u_view", &view.view[0][0]);
+  prog.setMat4("u_proj", &view.proj[0][0]);
+  prog.setMat4("u_invViewProj", &view.invViewProj[0][0]);
+  prog.set("u_znear", view.camera.znear);
+  prog.set("u_orthographic", view.camera.projection == ProjectionType::Orthographic ? 1 : 0);
+  prog.set("u_hasDepth", hasDepth ? 1 : 0);
+  const float targetSize[2] = {static_cast<float>(targetW), static_cast<float>(targetH)};
+  prog.set("u_targetSize", targetSize, 2);
+  glProgramUniform2i(prog.id(), prog.uniformLocation("u_fullSize"), view.width, view.height);
+}
+
 void declareMediaLayer(FrameResources& res, int w, int h) {
   gl::Texture& media = res.texture("media", GL_TEXTURE_2D, GL_RGBA32F, w, h);
   media.setFilter(GL_NEAREST, GL_NEAREST);

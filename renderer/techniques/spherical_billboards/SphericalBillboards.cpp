@@ -123,15 +123,7 @@ void SphericalBillboardsPass::execute(PassContext& ctx) {
   ctx.gpu.lights.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingLights);
   const gl::Program& prog = ctx.shaders.program({"spherical_billboards/particle.vert", "spherical_billboards/particle.frag"});
   prog.use();
-  prog.setMat4("u_view", &view.view[0][0]);
-  prog.setMat4("u_proj", &view.proj[0][0]);
-  prog.setMat4("u_invViewProj", &view.invViewProj[0][0]);
-  prog.set("u_znear", view.camera.znear);
-  prog.set("u_orthographic", view.camera.projection == ProjectionType::Orthographic ? 1 : 0);
-  prog.set("u_hasDepth", hasDepth ? 1 : 0);
-  const float targetSize[2] = {static_cast<float>(tw), static_cast<float>(th)};
-  prog.set("u_targetSize", targetSize, 2);
-  glProgramUniform2i(prog.id(), prog.uniformLocation("u_fullSize"), view.width, view.height);
+  setMediaCameraUniforms(prog, view, hasDepth, tw, th);
   prog.set("u_method", method_);
   prog.set("u_chord", chord_);
   prog.set("u_softScale", softScale_);
