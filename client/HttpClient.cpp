@@ -6,6 +6,22 @@
 
 namespace radiant::client {
 
+std::string problemType(const HttpResponse& r) {
+  const nlohmann::json problem = nlohmann::json::parse(r.body, nullptr, false);
+  const std::string type = problem.is_object() ? problem.value("type", "") : "";
+  return type.substr(type.rfind('/') == std::string::npos ? 0 : type.rfind('/') + 1);
+}
+
+FleetRetry fleetRetry(const HttpResponse& r) {
+  if (r.status < 400) return FleetRetry::None;
+  const std::string type = problemType(r);
+  if (r.status == 502 && type == "daemon-unavailable") return FleetRetry::Again;  // the proxy's own answer
+  if (r.header("x-radiant-daemon").empty()) return FleetRetry::None;               // a lone daemon
+  if (r.status == 502 || r.status == 504 || (r.status == 503 && type == "shutting-down")) return FleetRetry::Again;
+  if (r.status == 404 && type == "unknown-scene") return FleetRetry::Reupload;
+  return FleetRetry::None;
+}
+
 ServerError::ServerError(int status, nlohmann::json problem)
     : std::runtime_error(problem.value("detail", "HTTP " + std::to_string(status))),
       status(status),

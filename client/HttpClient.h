@@ -42,6 +42,18 @@ using Headers = std::map<std::string, std::string>;
 inline constexpr const char* kSceneHeader = "X-Radiant-Scene";
 inline Headers sceneHeader(const std::string& digest) { return digest.empty() ? Headers{} : Headers{{kSceneHeader, digest}}; }
 
+// The last path segment of a problem+json answer's `type` ("queue-full"), or "" for another body.
+std::string problemType(const HttpResponse& r);
+
+// What a failed POST /v1/renders asks of a client behind a proxy in front of several daemons
+// (docs/DEPLOYMENT.md). Again: the proxy lost the daemon on the way (502 daemon-unavailable, a
+// daemon's 504) or the render reached a draining daemon (503 shutting-down); the proxy marks it down
+// and the next try lands on another. Reupload: the render reached a daemon that inherited the scene's
+// share of the hash but not the scene (404 unknown-scene). None: an answer to keep. Answers of a lone
+// daemon (no X-Radiant-Daemon header, not the proxy's own 502) are always None.
+enum class FleetRetry { None, Again, Reupload };
+FleetRetry fleetRetry(const HttpResponse& r);
+
 class HttpClient {
 public:
   // baseUrl: "http://host:port" (no TLS: put a proxy in front). token: "" = no Authorization header.

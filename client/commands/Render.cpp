@@ -278,6 +278,9 @@ nlohmann::json buildRequest(const RenderOptions& o, const HttpClient& http, bool
   return request;
 }
 
+// A render through a proxy is sent this often before its failure is reported (a second apart).
+constexpr int kRenderFleetTries = 10;
+
 int runRender(const GlobalOptions& g, const RenderOptions& o) {
   std::string packNote;
   const std::string sceneBytes = o.sceneFile.empty() ? "" : sceneFileBytes(o.sceneFile, &packNote);
@@ -299,7 +302,25 @@ int runRender(const GlobalOptions& g, const RenderOptions& o) {
   std::string digest = request["scene"].is_object() && request["scene"].contains("digest") && request["scene"]["digest"].is_string()
                            ? request["scene"]["digest"].get<std::string>() : "";
   if (!api::isSceneDigest(digest)) digest.clear();  // the daemon names a bad digest at /scene/digest
-  HttpResponse r = http.post("/v1/renders", request.dump(), "application/json", sceneHeader(digest));
+  // Behind a proxy (docs/DEPLOYMENT.md) a render whose daemon is lost on the way is sent again (the
+  // proxy has marked that daemon down, so it lands on another), and the scene is uploaded again where
+  // the next daemon lacks it. A lone daemon's answers are kept as they are (client::fleetRetry).
+  const std::string body = request.dump();
+  auto submit = [&] {
+    for (int attempt = 1;; ++attempt) {
+      HttpResponse answer = http.post("/v1/renders", body, "application/json", sceneHeader(digest));
+      const FleetRetry retry = attempt < kRenderFleetTries ? fleetRetry(answer) : FleetRetry::None;
+      if (retry == FleetRetry::None || (retry == FleetRetry::Reupload && sceneBytes.empty())) return answer;
+      if (!o.quiet)
+        std::cerr << "render: " << (retry == FleetRetry::Reupload ? "the daemon behind the proxy lacks the scene; uploading it again"
+                                                                    : "the proxy lost the daemon (" + std::to_string(answer.status) +
+                                                                          "); sending the render again")
+                  << "\n";
+      if (retry == FleetRetry::Reupload) ensureSceneUploaded(http, sceneBytes, o.sceneFile, !o.quiet);
+      else std::this_thread::sleep_for(std::chrono::seconds(1));
+    }
+  };
+  HttpResponse r = submit();
   HttpClient::expectOk(r);
   nlohmann::json result = r.json();
   if (async) {
@@ -350,7 +371,15 @@ int runRender(const GlobalOptions& g, const RenderOptions& o) {
   if (!o.outDir.empty()) std::filesystem::create_directories(o.outDir);
   std::vector<std::size_t> sizes;
   for (std::size_t i = 0; i < paths.size(); ++i) {
-    const HttpResponse frame = http.get(result["frames"][i]["url"].get<std::string>());
+    HttpResponse frame = http.get(result["frames"][i]["url"].get<std::string>());
+    // The daemon holding a synchronous render's frames was lost after rendering: render it again.
+    for (int again = 1; !async && fleetRetry(frame) == FleetRetry::Again && again < kRenderFleetTries; ++again) {
+      if (!o.quiet) std::cerr << "render: the proxy lost the daemon holding the frames; rendering again\n";
+      r = submit();
+      HttpClient::expectOk(r);
+      result = r.json();
+      frame = http.get(result["frames"][i]["url"].get<std::string>());
+    }
     HttpClient::expectOk(frame);
     writeFile(paths[i], frame.body);
     sizes.push_back(frame.body.size());

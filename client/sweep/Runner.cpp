@@ -54,12 +54,6 @@ struct Rendered {
 // Renders through a proxy are retried this often (a second apart) before the server counts as gone.
 constexpr int kFleetRetries = 60;
 
-std::string problemType(const HttpResponse& r) {
-  const json problem = json::parse(r.body, nullptr, false);
-  const std::string type = problem.is_object() ? problem.value("type", "") : "";
-  return type.substr(type.rfind('/') == std::string::npos ? 0 : type.rfind('/') + 1);
-}
-
 std::string isoNow() {
   const std::time_t t = std::time(nullptr);
   char buf[32];
@@ -345,14 +339,13 @@ private:
           continue;
         }
         if (s.fleet && retries < kFleetRetries) {
-          // The proxy lost the daemon on the way (502/504), or the render reached a draining one: the
-          // proxy marks it down and the next try lands on another.
-          if (r.status == 502 || r.status == 504 || (r.status == 503 && type == "shutting-down")) {
+          const FleetRetry retry = fleetRetry(r);
+          if (retry == FleetRetry::Again) {
             ++retries;
             pause(1);
             continue;
           }
-          if (r.status == 404 && type == "unknown-scene" && !p.sceneFile.empty()) {
+          if (retry == FleetRetry::Reupload && !p.sceneFile.empty()) {
             ++retries;
             upload(s, p, true);
             continue;

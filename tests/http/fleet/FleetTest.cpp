@@ -448,3 +448,58 @@ TEST_F(Fleet, ZFailoverADaemonKilledMidSweepLosesNoPoint) {
             << " points on it in all; " << reuploads << " scene re-uploads; nginx passed " << passedOn
             << " requests on to another daemon and answered 502 to " << badGateway << "\n";
 }
+
+// A single `radiant render` through the proxy survives the loss of its daemon in the middle of the
+// render: the proxy answers 502, the client sends the render again, the next daemon on the ring lacks
+// the scene (404 unknown-scene), the client uploads it there, and the frame is the one the same request
+// gives on a daemon directly.
+TEST_F(Fleet, SingleRenderSurvivesItsDaemonDyingMidRender) {
+  const fs::path& d = *dir_;
+  const std::string scene = sceneVariant(40);
+  const std::string digest = radiant::api::sceneDigest(scene);
+  std::ofstream(d / "rf.gltf", std::ios::binary) << scene;
+  auto c = proxy();
+  auto put = c.Put("/v1/scenes", {{"X-Radiant-Scene", digest}}, scene, "model/gltf+json");
+  ASSERT_TRUE(put);
+  ASSERT_EQ(put->status / 100, 2) << put->body;
+  const std::string owner = put->get_header_value("X-Radiant-Daemon");
+  ASSERT_GE(indexOf(owner), 0) << owner;
+  Daemon* victim = daemons_[indexOf(owner)];
+  // Long enough to be killed in the middle of: the reference at 48x48 takes seconds on llvmpipe.
+  const json options = {{"width", 48},
+                        {"height", 48},
+                        {"passes", {{"photon_gi", false}, {"reference", {{"spp", 256}, {"max_bounces", 3}}}}}};
+  std::ofstream(d / "rf.json") << options.dump();
+  const std::vector<std::string> args = {RADIANT_CLIENT_PATH, "--server", proxyUrl(), "render", (d / "rf.gltf").string(),
+                                         "--request", (d / "rf.json").string(), "-o", (d / "rf.png").string()};
+  const pid_t client = spawn(args, d / "rf.out", d / "rf.err");
+  bool rendering = false;
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (!rendering && std::chrono::steady_clock::now() < end) {
+    auto m = victim->client().Get("/metrics");
+    rendering = m && m->body.find("\nradiant_jobs_active 1") != std::string::npos;
+    if (!rendering) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_TRUE(rendering) << "the render never started on " << owner << ": " << slurp(d / "rf.err");
+  victim->signal(SIGKILL);
+  victim->wait();
+  ASSERT_EQ(waitExit(client, std::chrono::seconds(300)), 0) << slurp(d / "rf.err");
+  const std::string err = slurp(d / "rf.err");
+  EXPECT_NE(err.find("sending the render again"), std::string::npos) << err;
+  EXPECT_NE(err.find("uploading it again"), std::string::npos) << err;
+  // The same request (the client's own, from --dry-run) on a surviving daemon, directly.
+  std::vector<std::string> dry = args;
+  dry.push_back("--dry-run");
+  ASSERT_EQ(waitExit(spawn(dry, d / "rf-dry.out", d / "rf-dry.err"), std::chrono::seconds(60)), 0) << slurp(d / "rf-dry.err");
+  const json request = json::parse(slurp(d / "rf-dry.out"));
+  Daemon* survivor = daemons_[(indexOf(owner) + 1) % 3];
+  auto direct = survivor->client();
+  direct.set_read_timeout(300, 0);
+  ASSERT_EQ(direct.Put("/v1/scenes", scene, "model/gltf+json")->status / 100, 2);
+  auto r = direct.Post("/v1/renders", request.dump(), "application/json");
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  auto frame = direct.Get(json::parse(r->body)["frames"][0]["url"].get<std::string>());
+  ASSERT_TRUE(frame);
+  EXPECT_TRUE(frame->body == slurp(d / "rf.png")) << "the failed-over frame differs from the direct render";
+}

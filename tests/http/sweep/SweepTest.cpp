@@ -319,7 +319,7 @@ TEST_F(SweepAgainstDaemon, BenchScoresEachTechniqueOnTheGroundTruthsInfoServes) 
   EXPECT_TRUE(truths["specular"]["specular"].is_null());  // the reference has no specular-only mode
 
   const auto dir = scratch("bench-spec");
-  ProcResult r = radiant(dir, {"--server", daemon_->url(), "bench", "--quick", "--dry-run", "-o", (dir / "b").string()});
+  ProcResult r = runRadiant(dir, {"--server", daemon_->url(), "bench", "--quick", "--dry-run", "-o", (dir / "b").string()});
   ASSERT_EQ(r.code, 0) << r.err;
   std::ifstream in(dir / "b" / "bench.spec.json");
   const json spec = json::parse(in);
