@@ -116,17 +116,18 @@ TEST_F(ClientHttp, RenderWritesEveryOutputOfAMultiOutputRequest) {
   EXPECT_EQ(client(daemon_->url(), "render --request multi.json -o a.exr -o b.exr", d).code, 2) << "5 outputs, 2 files";
 }
 
-// A reference render long enough to show progress (a few seconds on llvmpipe's machine). The daemon
-// caches a reference by its sample count among other things, so each run asks for another.
+// A reference render long enough to show progress, which starts after 1 s: several seconds on
+// llvmpipe even on a quiet machine (at 48x48 and 500 spp the second run took under a second in CI).
+// The daemon caches a reference by its sample count among other things, so each run asks for another.
 std::string slowRender(int spp) {
-  return "render --builtin cornell_box --size 48x48 --pass reference --aov reference --set reference.spp=" +
+  return "render --builtin cornell_box --size 64x64 --pass reference --aov reference --set reference.spp=" +
          std::to_string(spp) + " -o slow.exr --async";
 }
 
 TEST_F(ClientHttp, ProgressBarOnAPseudoTerminalAndPlainLinesWithout) {
   const fs::path& d = *dir_;
   // `script` runs the client on a new pseudo-terminal and copies what it draws to stdout.
-  const std::string inner = "RADIANT_SERVER='" + daemon_->url() + "' '" RADIANT_CLIENT_PATH "' " + slowRender(512);
+  const std::string inner = "RADIANT_SERVER='" + daemon_->url() + "' '" RADIANT_CLIENT_PATH "' " + slowRender(1536);
   const std::string cmd = "cd '" + d.string() + "' && script -q -e -c \"" + inner + "\" /dev/null > tty.txt 2>&1";
   const int status = std::system(cmd.c_str());
   ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << testing::slurp(d / "tty.txt");
@@ -138,7 +139,7 @@ TEST_F(ClientHttp, ProgressBarOnAPseudoTerminalAndPlainLinesWithout) {
   EXPECT_TRUE(fs::exists(d / "slow.exr"));
 
   // Without a terminal: whole lines, no carriage returns.
-  const ProcessRun r = client(daemon_->url(), slowRender(500), d);
+  const ProcessRun r = client(daemon_->url(), slowRender(1500), d);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(r.err.find('\r'), std::string::npos) << r.err;
   std::smatch m;
