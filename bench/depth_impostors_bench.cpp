@@ -18,12 +18,15 @@
 #include <vector>
 
 #include "api/Validate.h"
+#include "bench/BenchSupport.h"
 #include "renderer/Renderer.h"
 #include "renderer/scene/Scene.h"
 
 namespace {
 
 using namespace radiant;
+using bench::aovOf;
+using bench::relativeRmse;
 using nlohmann::json;
 
 json cloud(int n, int seed) {
@@ -31,19 +34,6 @@ json cloud(int n, int seed) {
   const double tau = 10.0 * std::pow(1.0 + r, 3) / (n * r * r * r);  // optical diameter 20
   return {{"kind", "cloud"}, {"tau", tau}, {"albedo", {0.9, 0.9, 0.9}}, {"seed", seed},
           {"generator", {{"count", n}, {"extent", {1, 1, 1}}, {"radius", r}}}};
-}
-
-const Image& aovOf(const RenderOutput& out, const std::string& name) {
-  for (const auto& a : out.aovs)
-    if (a.aov == name) return a;
-  std::fprintf(stderr, "missing aov %s\n", name.c_str());
-  std::exit(1);
-}
-
-double relativeRmse(const Image& a, const Image& ref) {
-  double s = 0, m = 0;
-  for (std::size_t i = 0; i < a.pixels.size(); ++i) s += std::pow(a.pixels[i] - ref.pixels[i], 2), m += ref.pixels[i];
-  return std::sqrt(s / a.pixels.size()) / std::max(m / a.pixels.size(), 1e-12);
 }
 
 struct Timing {

@@ -20,20 +20,16 @@
 #include <vector>
 
 #include "api/Validate.h"
+#include "bench/BenchSupport.h"
 #include "renderer/Renderer.h"
 #include "renderer/techniques/Registry.h"
 
 namespace {
 
 using namespace radiant;
+using bench::aovOf;
+using bench::relativeRmse;
 using nlohmann::json;
-
-const Image& aovOf(const RenderOutput& out, const std::string& name) {
-  for (const auto& a : out.aovs)
-    if (a.aov == name) return a;
-  std::fprintf(stderr, "missing aov %s\n", name.c_str());
-  std::exit(1);
-}
 
 const api::PassStats& passOf(const RenderOutput& out, const std::string& name) {
   for (const auto& p : out.stats.passes)

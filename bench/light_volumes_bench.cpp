@@ -30,6 +30,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/BenchSupport.h"
 #include "renderer/Renderer.h"
 #include "renderer/raytracing/RayScene.h"
 #include "renderer/reference/LightTracer.h"
@@ -38,6 +39,8 @@
 namespace {
 
 using namespace radiant;
+using bench::aovOf;
+using bench::relativeRmse;
 
 Renderer& renderer() {
   static std::unique_ptr<Renderer> r = std::make_unique<Renderer>();
@@ -165,11 +168,6 @@ api::RenderRequest request(int width, int height, const std::string& traversal) 
   return r;
 }
 
-const Image& aovOf(const RenderOutput& out, const std::string& name) {
-  for (const auto& a : out.aovs)
-    if (a.aov == name) return a;
-  throw std::runtime_error("missing aov " + name);
-}
 const api::PassStats& passOf(const RenderOutput& out, const std::string& name) {
   for (const auto& p : out.stats.passes)
     if (p.name == name) return p;

@@ -13,20 +13,16 @@
 #include <vector>
 
 #include "api/Validate.h"
+#include "bench/BenchSupport.h"
 #include "renderer/Renderer.h"
 #include "renderer/scene/BuiltinScenes.h"
 
 namespace {
 
 using namespace radiant;
+using bench::aovOf;
+using bench::relativeRmse;
 using nlohmann::json;
-
-const Image& aovOf(const RenderOutput& out, const std::string& name) {
-  for (const auto& a : out.aovs)
-    if (a.aov == name) return a;
-  std::fprintf(stderr, "missing aov %s\n", name.c_str());
-  std::exit(1);
-}
 
 struct Timing {
   double gpuMs, cpuMs, overdraw;
@@ -46,12 +42,6 @@ Timing timePass(Renderer& r, const Scene& scene, const json& body, int repeats) 
   std::sort(gpu.begin(), gpu.end());
   std::sort(cpu.begin(), cpu.end());
   return {gpu[gpu.size() / 2], cpu[cpu.size() / 2], overdraw};
-}
-
-double relativeRmse(const Image& a, const Image& ref) {
-  double s = 0, m = 0;
-  for (std::size_t i = 0; i < a.pixels.size(); ++i) s += std::pow(a.pixels[i] - ref.pixels[i], 2), m += ref.pixels[i];
-  return std::sqrt(s / a.pixels.size()) / std::max(m / a.pixels.size(), 1e-12);
 }
 
 }  // namespace
