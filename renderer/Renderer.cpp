@@ -68,6 +68,9 @@ std::size_t sanitize(std::vector<float>& v) {
   return bad;
 }
 
+// The seed of every ground truth compare() renders (see there).
+constexpr std::uint64_t kGroundTruthSeed = 0x6A09E667F3BCC909ull;
+
 // Scores the compared AOV against the ground truth; adds stats.metrics and the "error" and
 // "reference" AOVs.
 void compare(FrameResources& resources, const Scene& scene, const FrameView& view, const api::RenderRequest& request,
@@ -128,7 +131,16 @@ void compare(FrameResources& resources, const Scene& scene, const FrameView& vie
     r.maxBounces = truth.reference.contains("max_bounces") ? r.maxBounces : c.maxBounces;
     bool hit = false;
     const auto t0 = Clock::now();
-    reference = referenceImage(resources, scene, view, r, &hit);
+    // The ground truth draws its own random numbers. With the frame's seed, sample s of pixel p would
+    // be the same path in the truth as in a `reference` pass of the frame (rt::Sampler hashes
+    // (pixel, sample, seed)), so a reference scored against itself would share its first spp samples
+    // with the truth and report too small an error (zero at equal spp: the cache returned the frame's
+    // own image). One fixed seed, far from the small seeds requests use, is independent of the frame's
+    // and of refinement's batches (seed, seed + 1, ...), and every seed of a sweep or a refinement is
+    // scored against the same, cached, truth.
+    FrameView truthView = view;
+    truthView.seed = kGroundTruthSeed;
+    reference = referenceImage(resources, scene, truthView, r, &hit);
     if (!view.media.empty() && r.aov != "media" && r.aov != "media_transmittance")
       out.stats.warnings.push_back("the reference path tracer renders no participating media: compare.aov " + c.aov +
                                    " is scored without the frame's particle systems (compare.aov media scores them)");

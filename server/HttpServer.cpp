@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "api/Aovs.h"
+#include "api/Base64.h"
 #include "api/JsonLimits.h"
 #include "api/Presets.h"
 #include "api/Sha256.h"
@@ -132,28 +133,12 @@ std::string statusTitle(int status) {
 }
 
 std::string base64Decode(const std::string& in, const std::string& pointer) {
-  static const std::string kAlphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  out.reserve(in.size() * 3 / 4);
-  unsigned buffer = 0;
-  int bits = 0;
-  std::size_t i = 0;
-  for (; i < in.size(); ++i) {
-    const char c = in[i];
-    if (c == '=') break;
-    if (c == '\n' || c == '\r') continue;
-    const auto v = kAlphabet.find(c);
-    if (v == std::string::npos)
-      throw api::ApiError(422, "invalid-value", "Invalid value",
-                          pointer + ": not base64 (character " + std::to_string(i) + ")", pointer);
-    buffer = (buffer << 6) | static_cast<unsigned>(v);
-    bits += 6;
-    if (bits >= 8) {
-      bits -= 8;
-      out.push_back(static_cast<char>((buffer >> bits) & 0xff));
-    }
-  }
-  return out;
+  std::size_t bad = 0;
+  std::optional<std::string> bytes = api::base64Decode(in, &bad);
+  if (!bytes)
+    throw api::ApiError(422, "invalid-value", "Invalid value",
+                        pointer + ": not base64 (character " + std::to_string(bad) + ")", pointer);
+  return std::move(*bytes);
 }
 
 json deviceJson(const DeviceInfo& d) {

@@ -332,9 +332,9 @@ void RenderService::renderLoop() {
     RenderOutput output;
     bool recreate = false;
     try {
-      FrameInputs inputs{job->compareTarget.get(), job->environment.get()};
       Job* raw = job.get();
-      inputs.progress = [raw](double f) { raw->renderProgress.store(f); };
+      FrameInputs inputs{job->compareTarget.get(), job->environment.get(),
+                         [raw](double f) { raw->renderProgress.store(f); }};
       output = job->request.refine ? refine(*backend, job, inputs)
                                    : backend->render(*job->scene, job->request, &job->cancel, inputs);
     } catch (const api::ApiError& e) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "api/Base64.h"
 #include "renderer/io/ImageIO.h"
 
 namespace radiant::client::report {
@@ -38,19 +39,6 @@ Thumbnail readThumbnail(const std::filesystem::path& file, const std::string& ao
   return t;
 }
 
-std::string base64(std::string_view bytes) {
-  static constexpr char kDigits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  out.reserve((bytes.size() + 2) / 3 * 4);
-  for (std::size_t i = 0; i < bytes.size(); i += 3) {
-    const std::size_t n = std::min<std::size_t>(3, bytes.size() - i);
-    unsigned v = 0;
-    for (std::size_t k = 0; k < 3; ++k) v = v << 8 | (k < n ? static_cast<unsigned char>(bytes[i + k]) : 0u);
-    for (std::size_t k = 0; k < 4; ++k) out += k <= n ? kDigits[(v >> (18 - 6 * k)) & 63] : '=';
-  }
-  return out;
-}
-
-std::string pngDataUri(const std::string& png) { return "data:image/png;base64," + base64(png); }
+std::string pngDataUri(const std::string& png) { return "data:image/png;base64," + api::base64Encode(png); }
 
 }  // namespace radiant::client::report

@@ -8,6 +8,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "api/Base64.h"
+
 namespace radiant {
 namespace {
 
@@ -40,23 +42,11 @@ std::string decodeDataUri(const std::string& uri, const std::string& pointer) {
   const auto comma = uri.find(',');
   if (comma == std::string::npos || comma < 7 || uri.compare(comma - 7, 7, ";base64") != 0)
     throw PackError(pointer, "data URI refused: only base64 data URIs are supported");
-  static const std::string kAlphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  unsigned buffer = 0;
-  int bits = 0;
-  for (std::size_t i = comma + 1; i < uri.size(); ++i) {
-    const char c = uri[i];
-    if (c == '=') break;
-    const auto v = kAlphabet.find(c);
-    if (v == std::string::npos) throw PackError(pointer, "data URI is not valid base64 (byte " + std::to_string(i) + ")");
-    buffer = (buffer << 6) | unsigned(v);
-    bits += 6;
-    if (bits >= 8) {
-      bits -= 8;
-      out.push_back(char((buffer >> bits) & 0xff));
-    }
-  }
-  return out;
+  std::size_t bad = 0;
+  std::optional<std::string> bytes = api::base64Decode(std::string_view(uri).substr(comma + 1), &bad);
+  if (!bytes)
+    throw PackError(pointer, "data URI is not valid base64 (byte " + std::to_string(comma + 1 + bad) + ")");
+  return std::move(*bytes);
 }
 
 std::uint32_t le32(const char* p) {

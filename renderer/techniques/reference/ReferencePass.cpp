@@ -151,6 +151,15 @@ const TechniqueInfo& ReferencePass::info() const {
   return i;
 }
 
+GroundTruth ReferencePass::groundTruth(const Params& params, const std::string& aov) const {
+  if (aov != "reference") return {};
+  nlohmann::json truth = params.json();
+  // The compare block sets the truth's samples; its bounce range is the pass's own (max_bounces stays).
+  truth.erase("spp");
+  truth.erase("light_paths_per_pixel");
+  return {truth};
+}
+
 Requirements ReferencePass::requirements(const Scene& scene, const api::RenderRequest& request) const {
   const SceneFeatures f = mediaFeatures(scene.features, request.media);
   return f.triangles > 0 || f.hasMedia() ? Requirements::ok()

@@ -42,6 +42,11 @@ const Image& referenceImage(FrameResources& resources, const Scene& scene, const
 class ReferencePass final : public Technique {
 public:
   const TechniqueInfo& info() const override;
+  // The reference AOV's ground truth is the reference itself in the same mode (aov, bounce range,
+  // caustics, AO definition, media mode) at the compare block's spp and with its own seed
+  // (renderer/Renderer.cpp, compare()): `compare: {"aov": "reference", "spp": 1024}` scores a 64-spp
+  // reference pass against an independent 1024-spp one.
+  GroundTruth groundTruth(const Params& params, const std::string& aov) const override;
   Requirements requirements(const Scene&, const api::RenderRequest&) const override;
   void prepare(const Scene&, const Params&, FrameResources&) override;
   void execute(PassContext&) override;

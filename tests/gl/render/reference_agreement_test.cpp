@@ -89,6 +89,37 @@ TEST(ReferenceAgreement, CornellBoxDirectMatchesReferenceDirectOnly) {
   EXPECT_TRUE(again.stats.metrics["reference_cached"].get<bool>());
 }
 
+TEST(ReferenceAgreement, AReferencePassIsScoredAgainstAnIndependentReference) {
+  // compare.aov "reference" scores the reference pass against the reference in the same mode at the
+  // compare block's spp, with its own seed. For an unbiased estimator with per-pixel variance s^2,
+  // independent N-spp images differ by E[MSE] = 2 s^2 / N, and an N-spp image differs from an M-spp one
+  // by s^2 (1/N + 1/M). With the frame's own seed the truth would share its first N samples (rt::Sampler
+  // hashes pixel, sample and seed): MSE 0 at M = N (the cache returned the frame's own image) and
+  // s^2 (1/N - 1/M) otherwise. So MSE(4 vs 4) / MSE(4 vs 64) is 2 / (1 + 1/16) = 1.88 when independent,
+  // 0 when shared. Direct light only (max_bounces 1), 64 x 64 pixels: the ratio of two MSEs over 4096
+  // pixels is within +-25% of 1.88 (the bounds below).
+  Scene scene = loadBuiltinScene("cornell_box");
+  api::RenderRequest req;
+  req.width = req.height = 64;
+  req.passes["reference"] = {{"spp", 4}, {"max_bounces", 1}};
+  req.disabledPasses.insert("photon_gi");
+  req.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"reference"}, false}};
+  auto mse = [&](int truthSpp) {
+    req.compare = api::CompareSpec{"reference", "reference", truthSpp, 8};
+    const RenderOutput out = renderer().render(scene, req);
+    EXPECT_EQ(out.stats.metrics.at("reference_mode"), "beauty");
+    EXPECT_EQ(out.stats.metrics.at("max_bounces"), 1);  // the pass's own bounce range, not compare's 8
+    const double rmse = out.stats.metrics.at("rmse").get<double>();
+    return rmse * rmse;
+  };
+  const double equal = mse(4), converged = mse(64);
+  std::printf("MSE 4 vs 4 spp %.6g, 4 vs 64 spp %.6g, ratio %.3f (independent: 1.88)\n", equal, converged,
+              equal / converged);
+  ASSERT_GT(converged, 0.0);
+  EXPECT_GT(equal / converged, 1.88 * 0.75);
+  EXPECT_LT(equal / converged, 1.88 * 1.25);
+}
+
 TEST(ReferenceAgreement, IdenticalImagesGiveZeroError) {
   // Comparing a frame with itself (an uploaded target equal to the frame) gives RMSE 0, SSIM 1 and a
   // PSNR of null (infinite), not a crash.

@@ -374,7 +374,9 @@ TEST(LayeredBsdf, ReciprocityAndTheCoatsStatedAsymmetry) {
     coat.specularWeight = 0.f;
     const float ratio = coat.coatWeight(a) / coat.coatWeight(c);
     const float fa = coat.eval(a, c).x, fc = coat.eval(c, a).x;
-    if (fc > 1e-6f) ASSERT_NEAR(fa / fc, ratio, 1e-4f * ratio) << i;
+    if (fc > 1e-6f) {
+      ASSERT_NEAR(fa / fc, ratio, 1e-4f * ratio) << i;
+    }
   }
 }
 
@@ -454,8 +456,9 @@ TEST(LayeredBsdf, NeverNaN) {
     ASSERT_TRUE(std::isfinite(f.x + f.y + f.z) && f.x >= 0.f && f.y >= 0.f && f.z >= 0.f) << i;
     ASSERT_TRUE(std::isfinite(p) && p >= 0.f) << i;
     GltfBsdf::Sample s;
-    if (b.sample(wo, U(rng), U(rng), {U(rng), U(rng)}, s))
+    if (b.sample(wo, U(rng), U(rng), {U(rng), U(rng)}, s)) {
       ASSERT_TRUE(std::isfinite(s.weight.x + s.weight.y + s.weight.z) && s.weight.x >= 0.f) << i;
+    }
   }
 }
 
