@@ -61,6 +61,41 @@ json chosenSubset(const json& params, const json& point) {
   return out;
 }
 
+// The server's caps (RequestLimits, radiantd --max-samples / --max-photons / --max-particles) that a
+// front point's parameters exceed, as {param: {"wanted", "limit", "flag"}}; a parameter the request
+// gives itself wins over the point and was capped by validation already. Empty when the point fits.
+json capsExceeded(const std::string& technique, const json& point, const std::set<std::string>& explicitKeys,
+                  const RequestLimits* limits) {
+  json out = json::object();
+  const TechniqueSchema* schema = limits ? findTechnique(technique) : nullptr;
+  if (!schema) return out;
+  for (const auto& [k, v] : point.items()) {
+    if (explicitKeys.count(k) || !v.is_number_integer() || !schema->params.contains(k)) continue;
+    const json& p = schema->params[k];
+    if (!p.contains("x-cost")) continue;
+    const auto cap = costLimit(p["x-cost"].get<std::string>(), *limits);
+    if (cap && v.get<long long>() > cap->max)
+      out[k] = {{"wanted", v}, {"limit", cap->max}, {"flag", std::string("radiantd ") + cap->flag}};
+  }
+  return out;
+}
+
+// A point whose every capped parameter is lowered to its cap: what runs when no point of the front
+// fits the caps (its error was not measured).
+json clampedToCaps(const json& point, const json& exceeded) {
+  json p = point;
+  for (const auto& [k, c] : exceeded.items()) p[k] = c["limit"];
+  return p;
+}
+
+std::string describeCaps(const json& exceeded) {
+  std::string s;
+  for (const auto& [k, c] : exceeded.items())
+    s += (s.empty() ? "" : ", ") + k + " " + c["wanted"].dump() + " is above this server's limit " + c["limit"].dump() +
+         " (" + c["flag"].get<std::string>() + ")";
+  return s;
+}
+
 }  // namespace
 
 double passCostMs(const PassStats& pass) {
@@ -113,7 +148,7 @@ int PresetTable::presetIndex(const std::string& technique, const std::string& qu
 }
 
 BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std::string>& planned,
-                                 const RenderRequest& request) {
+                                 const RenderRequest& request, const RequestLimits* limits) {
   BudgetChoice c;
   for (const auto& t : planned) c.params[t] = paramsOf(request, t);
   c.active = !request.quality.empty() || request.timeBudgetMs > 0;
@@ -151,19 +186,53 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
     if (!given.empty()) entry["explicit"] = given;
     const json& front = table.front(t);
     if (!request.quality.empty() && !front.empty()) {
-      const int i = table.presetIndex(t, request.quality);
-      if (i >= 0 && i < int(front.size())) {
-        c.params[t] = techniqueParams(t, merged(c.params[t], front[i]["params"], given));
-        entry["params"] = chosenSubset(c.params[t], front[i]["params"]);
-        entry["point"] = i;
-        entry["predicted_error"] = errorBlock(t, front[i], overridden(front[i]["params"], given));
+      const int preset = table.presetIndex(t, request.quality);
+      if (preset >= 0 && preset < int(front.size())) {
+        // Under the server's caps: the preset's point if it fits, else the most accurate cheaper point
+        // that does (the front is ordered by cost and error), else the cheapest point lowered to the caps.
+        int i = preset;
+        while (i >= 0 && !capsExceeded(t, front[i]["params"], given, limits).empty()) --i;
+        json point = front[std::max(i, 0)]["params"];
+        if (i != preset) {
+          const json exceeded = capsExceeded(t, front[preset]["params"], given, limits);
+          entry["capped"] = {{"limits", exceeded}, {"preset_point", preset}, {"clamped", i < 0}};
+          if (i < 0) point = clampedToCaps(point, capsExceeded(t, point, given, limits));
+          c.warnings.push_back("quality " + request.quality + ": " + t + " runs " +
+                               (i < 0 ? "its cheapest front point lowered to the server's caps"
+                                      : "front point " + std::to_string(i)) +
+                               " instead of the preset's point " + std::to_string(preset) + ": " + describeCaps(exceeded));
+        }
+        c.params[t] = techniqueParams(t, merged(c.params[t], point, given));
+        entry["params"] = chosenSubset(c.params[t], point);
+        entry["point"] = std::max(i, 0);
+        entry["predicted_error"] =
+            i < 0 ? json(nullptr) : errorBlock(t, front[i], overridden(front[i]["params"], given));
       }
     } else if (request.timeBudgetMs > 0 && !front.empty() && table.hasModel(t)) {
+      // Only the points within the server's caps are candidates; when none is, the cheapest point
+      // lowered to the caps (error unmeasured: NaN here, null in the stats).
       std::vector<Candidate> all;
+      json excluded = json::array(), exceededAll = json::object();
       for (std::size_t i = 0; i < front.size(); ++i) {
+        const json exceeded = capsExceeded(t, front[i]["params"], given, limits);
+        if (!exceeded.empty()) {
+          excluded.push_back(i);
+          exceededAll.update(exceeded);
+          continue;
+        }
         json p = techniqueParams(t, merged(c.params[t], front[i]["params"], given));
         const double ms = table.predictMs(t, p, pixels);
         all.push_back({std::move(p), ms, front[i]["error"].get<double>(), int(i)});
+      }
+      if (!excluded.empty()) {
+        entry["capped"] = {{"limits", exceededAll}, {"excluded_points", excluded}, {"clamped", all.empty()}};
+        c.warnings.push_back("time_budget_ms: " + t + " chooses among " + std::to_string(all.size()) + " of its " +
+                             std::to_string(front.size()) + " front points: " + describeCaps(exceededAll));
+      }
+      if (all.empty()) {
+        json p = techniqueParams(t, merged(c.params[t], clampedToCaps(front[0]["params"], capsExceeded(t, front[0]["params"], given, limits)), given));
+        const double ms = table.predictMs(t, p, pixels);
+        all.push_back({std::move(p), ms, std::numeric_limits<double>::quiet_NaN(), -1});
       }
       // The front at this frame's pixel count: by predicted cost, then only points that lower the error.
       std::stable_sort(all.begin(), all.end(), [](const Candidate& a, const Candidate& b) { return a.ms < b.ms; });
@@ -211,13 +280,14 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
     }
     for (const auto& [t, list] : candidates) {
       const Candidate& k = list[at[t]];
-      const json& point = table.front(t)[k.point];
+      const json& point = table.front(t)[std::max(k.point, 0)];
       c.params[t] = k.params;
       json& entry = techniques[t];
       entry["params"] = chosenSubset(k.params, point["params"]);
-      entry["point"] = k.point;
+      entry["point"] = std::max(k.point, 0);
       entry["predicted_ms"] = k.ms;
-      entry["predicted_error"] = errorBlock(t, point, overridden(point["params"], explicitOf(t)));
+      entry["predicted_error"] =
+          k.point < 0 ? json(nullptr) : errorBlock(t, point, overridden(point["params"], explicitOf(t)));
     }
   }
   double total = table.predictOverheadMs(pixels);

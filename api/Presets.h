@@ -22,6 +22,7 @@
 #include <nlohmann/json.hpp>
 
 #include "api/Types.h"
+#include "api/Validate.h"  // RequestLimits
 
 namespace radiant::api {
 
@@ -68,8 +69,15 @@ struct BudgetChoice {
 // budget, the upgrade with the largest ln(error ratio) per ms is taken. The sequence of upgrades does
 // not depend on the budget (the first upgrade that does not fit ends it), so a larger budget never
 // gives a technique a larger predicted error.
+//
+// Server caps (`limits`, the daemon's RequestLimits; null = none): a front point whose "x-cost"
+// parameters exceed a cap is never chosen. A preset then takes the most accurate cheaper point that
+// fits, a budget chooses among the points that fit; when none fits, the cheapest point runs with its
+// capped parameters lowered to the caps (predicted_error null). stats.techniques[t].capped says which
+// limits excluded what ({"limits": {param: {wanted, limit, flag}}, "preset_point" | "excluded_points",
+// "clamped"}), and a warning says it in words.
 BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std::string>& planned,
-                                 const RenderRequest& request);
+                                 const RenderRequest& request, const RequestLimits* limits = nullptr);
 
 // Adds measured_ms per technique (passCostMs) and for the frame (`frameMs`: the render up to readback,
 // without a compare block's reference) to choice.stats.

@@ -444,11 +444,6 @@ RenderRequest parseRenderRequest(const json& body, const RequestLimits& limits) 
       throw ApiError(422, "invalid-value", "Invalid value",
                      "/refine: progressive refinement needs \"async\": true (poll the job for the current frame)",
                      "/refine");
-    if (r.compare)
-      throw ApiError(422, "invalid-value", "Invalid value",
-                     "/refine: not together with compare (the compare block would score one batch, not the mean); "
-                     "score the finished frame against an uploaded image instead",
-                     "/refine");
   }
   std::size_t particles = 0;
   for (std::size_t i = 0; i < v["media"].size(); ++i) {

@@ -171,6 +171,7 @@ void compare(FrameResources& resources, const Scene& scene, const FrameView& vie
   m["mean_abs"] = e.meanAbs;
   m["max_abs"] = e.maxAbs;
   out.stats.metrics = m;
+  out.compareReference = reference;
   Image err = metrics::errorMap(*test, reference);
   err.aov = "error";
   out.aovs.push_back(std::move(err));
@@ -382,7 +383,7 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     // without them, the request's own.
     std::vector<std::string> planned;
     for (Technique* t : plan.passes) planned.push_back(t->info().name);
-    api::BudgetChoice choice = api::chooseConfiguration(api::PresetTable::builtin(), planned, request);
+    api::BudgetChoice choice = api::chooseConfiguration(api::PresetTable::builtin(), planned, request, inputs.limits);
     for (auto& w : choice.warnings) stats.warnings.push_back(std::move(w));
     std::set<int> shadowMapExclusions;  // meshes whose shadows a pass supplies itself (light_volumes)
     for (std::size_t i = 0; i < plan.passes.size(); ++i) {

@@ -13,10 +13,17 @@
 #include "renderer/scene/Scene.h"
 
 namespace radiant {
+namespace api {
+struct RequestLimits;  // api/Validate.h
+}
 
 struct RenderOutput {
   std::vector<Image> aovs;  // every AOV the request's outputs name (and "beauty" always)
   api::FrameStats stats;
+  // With request.compare: the ground truth the compared AOV was scored against, with its channels
+  // (the "reference" AOV may be the frame's own reference pass instead). A refining job scores the
+  // batches' mean against it (server/Refinement.h). Empty without compare.
+  Image compareReference;
 };
 
 // Images a request refers to by digest, resolved by the caller (the server's image store).
@@ -27,6 +34,9 @@ struct FrameInputs {
   // light-tracer waves, photon tracing), in pass-count units, then 1 after readback. Never decreases.
   // May be called from the renderer's worker threads: keep it cheap and thread-safe (store an atomic).
   std::function<void(double)> progress;
+  // The server's caps (radiantd --max-samples, --max-photons, ...): quality presets and time budgets
+  // choose only configurations within them (api::chooseConfiguration). Null = the schema's own bounds.
+  const api::RequestLimits* limits = nullptr;
 };
 
 struct TechniqueDescription {

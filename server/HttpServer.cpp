@@ -774,6 +774,8 @@ struct HttpServer::Impl {
         res.set_header("X-Radiant-Estimated-Rmse",
                        std::isfinite(snap->estimatedRmse) ? std::to_string(snap->estimatedRmse) : std::string("null"));
         res.set_header("X-Radiant-Elapsed-Ms", std::to_string(snap->elapsedMs));
+        // With a compare block: the current mean's RMSE against the ground truth (server/Refinement.h).
+        if (snap->metrics.is_object()) res.set_header("X-Radiant-Rmse", snap->metrics["rmse"].dump());
         res.status = 200;
         res.set_content(bytes, spec.format == api::ImageFormat::Exr ? "image/x-exr" : "image/png");
         return;

@@ -2,6 +2,8 @@
 
 #include <stdexcept>
 
+#include "renderer/metrics/Metrics.h"
+
 namespace radiant::server {
 
 void BatchMean::add(const std::vector<Image>& aovs) {
@@ -53,6 +55,20 @@ double BatchMean::estimatedRmse(const std::string& aov) const {
     return sum_[i].empty() ? 0.0 : std::sqrt(acc / double(sum_[i].size()));
   }
   return std::numeric_limits<double>::quiet_NaN();
+}
+
+nlohmann::json scoreMean(const nlohmann::json& batchMetrics, const Image& mean, const Image& reference,
+                         float exposureEV, int batches) {
+  const metrics::ImageMetrics e = metrics::compareImages(mean, reference, exposureEV);
+  nlohmann::json m = batchMetrics;
+  m["rmse"] = e.rmse;
+  m["rel_mse"] = e.relMse;
+  m["psnr"] = e.psnr ? nlohmann::json(*e.psnr) : nlohmann::json(nullptr);
+  m["ssim"] = e.ssim;
+  m["mean_abs"] = e.meanAbs;
+  m["max_abs"] = e.maxAbs;
+  m["batches"] = batches;
+  return m;
 }
 
 }  // namespace radiant::server

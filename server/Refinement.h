@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "renderer/Image.h"
 
 namespace radiant::server {
@@ -31,12 +33,21 @@ private:
   int n_ = 0;
 };
 
-// What GET /v1/renders/{id} shows of a refining job: the mean so far and its estimated error.
+// A refining job with a compare block scores the batches' mean, not one batch: `batchMetrics` (a
+// batch's stats.metrics: against, aov, reference mode, spp, ...) with its numbers (rmse, rel_mse, psnr,
+// ssim, mean_abs, max_abs) recomputed for `mean` (the compared AOV's mean) against `reference` (the
+// ground truth the batch was scored against, RenderOutput::compareReference), plus "batches".
+nlohmann::json scoreMean(const nlohmann::json& batchMetrics, const Image& mean, const Image& reference,
+                         float exposureEV, int batches);
+
+// What GET /v1/renders/{id} shows of a refining job: the mean so far and its estimated error; with a
+// compare block also the mean's true error against the ground truth (scoreMean; null otherwise).
 struct RefineSnapshot {
   std::vector<Image> mean;
   int batches = 0;
   double estimatedRmse = std::numeric_limits<double>::quiet_NaN();
   double elapsedMs = 0;
+  nlohmann::json metrics;
 };
 
 }  // namespace radiant::server

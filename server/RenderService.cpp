@@ -1,6 +1,7 @@
 #include "server/RenderService.h"
 
 #include "api/JsonLimits.h"
+#include "renderer/metrics/Metrics.h"
 
 #include <algorithm>
 #include <cmath>
@@ -140,7 +141,8 @@ json RenderService::describe(const Job& job) {
     const RefineSnapshot& c = *job.current;
     j["refinement"] = {{"batches", c.batches}, {"elapsed_ms", c.elapsedMs},
                        {"estimated_rmse", std::isfinite(c.estimatedRmse) ? json(c.estimatedRmse) : json(nullptr)},
-                       {"current", "/v1/renders/" + job.id + "?current=exr"}};
+                       {"estimate_kind", "noise_only"}, {"current", "/v1/renders/" + job.id + "?current=exr"}};
+    if (c.metrics.is_object()) j["refinement"]["metrics"] = c.metrics;  // the current mean against the ground truth
   }
   j["progress"] = progress;
   j["timings"] = {{"queue_ms", job.queueMs}, {"render_ms", job.renderMs}, {"encode_ms", job.encodeMs}};
@@ -173,6 +175,15 @@ RenderOutput RenderService::refine(RenderBackend& backend, const std::shared_ptr
   const auto start = Clock::now();
   double slowestBatchMs = 0;
   std::string stop = "max_batches";
+  // compare: the mean is scored, after every batch, against the ground truth of the first batch's
+  // compare block (server/Refinement.h, scoreMean). The frame's own "reference" AOV (an output, or the
+  // compared AOV) is averaged like any other; the compare block's is the ground truth, added at the end.
+  const std::optional<api::CompareSpec> compare = job->request.compare;
+  bool frameHasReference = compare && compare->aov == "reference";
+  for (const auto& o : job->request.outputs)
+    frameHasReference = frameHasReference || std::count(o.aovs.begin(), o.aovs.end(), "reference");
+  Image truth;
+  json batchMetrics;
   constexpr std::uint64_t kMaxSeed = 9007199254740991ull;  // the schema's bound (2^53 - 1)
   for (int k = 0; k < spec.maxBatches; ++k) {
     // Progress: the larger of the batches' and the time limit's fraction.
@@ -188,11 +199,23 @@ RenderOutput RenderService::refine(RenderBackend& backend, const std::shared_ptr
     const auto t0 = Clock::now();
     last = backend.render(*job->scene, batch, &job->cancel, in);
     slowestBatchMs = std::max(slowestBatchMs, msBetween(t0, Clock::now()));
+    if (compare) {
+      // Every batch runs the compare block (its ground truth is rendered once, then cached), so that
+      // each reads back the compared AOV; the batch's own error map and ground truth are not averaged.
+      if (k == 0) {
+        truth = last.compareReference;
+        batchMetrics = last.stats.metrics;
+      }
+      std::erase_if(last.aovs, [&](const Image& i) { return i.aov == "error" || (i.aov == "reference" && !frameHasReference); });
+    }
     acc.add(last.aovs);
     auto snap = std::make_shared<RefineSnapshot>();
     snap->mean = acc.mean();
     snap->batches = acc.batches();
     snap->estimatedRmse = acc.estimatedRmse(spec.aov);
+    if (compare && !truth.pixels.empty())
+      for (const Image& m : snap->mean)
+        if (m.aov == compare->aov) snap->metrics = scoreMean(batchMetrics, m, truth, job->request.exposure, snap->batches);
     snap->elapsedMs = msBetween(start, Clock::now());
     const double estimate = snap->estimatedRmse;
     const double elapsed = snap->elapsedMs;
@@ -216,11 +239,41 @@ RenderOutput RenderService::refine(RenderBackend& backend, const std::shared_ptr
   RenderOutput out;
   out.aovs = acc.mean();
   out.stats = std::move(last.stats);  // the last batch's passes and counters
+  if (compare && !truth.pixels.empty()) {
+    // The mean's scores, error map and ground truth, as a compare block gives them for one frame.
+    std::shared_ptr<const RefineSnapshot> now;
+    {
+      std::lock_guard lock(mutex_);
+      now = job->current;
+    }
+    out.stats.metrics = now->metrics;
+    for (const Image& m : out.aovs)
+      if (m.aov == compare->aov) {
+        Image err = metrics::errorMap(m, truth);
+        err.aov = "error";
+        out.aovs.push_back(std::move(err));
+        break;
+      }
+    if (!frameHasReference) {
+      out.aovs.push_back(truth);
+      out.aovs.back().aov = "reference";
+    }
+    out.compareReference = std::move(truth);
+  }
   const double estimate = acc.estimatedRmse(spec.aov);
   out.stats.refinement = {{"batches", acc.batches()}, {"aov", spec.aov}, {"stopped_by", stop},
                           {"elapsed_ms", msBetween(start, Clock::now())},
                           {"estimated_rmse", std::isfinite(estimate) ? json(estimate) : json(nullptr)},
-                          {"seeds", {job->request.seed, batch.seed}}};
+                          {"seeds", {job->request.seed, batch.seed}},
+                          // The estimate is the batches' variance only (server/Refinement.h): a biased
+                          // pass (photon_gi's kernel) has a larger true error.
+                          {"estimate_kind", "noise_only"}};
+  // Scored against a ground truth on the refined AOV: the error splits as bias^2 + noise^2, so the part
+  // the noise estimate does not explain (the bias, plus the ground truth's own noise) is measured.
+  if (out.stats.metrics.is_object() && out.stats.metrics.value("aov", "") == spec.aov && std::isfinite(estimate)) {
+    const double rmse = out.stats.metrics["rmse"].get<double>();
+    out.stats.refinement["bias_rmse"] = std::sqrt(std::max(0.0, rmse * rmse - estimate * estimate));
+  }
   out.stats.renderMs = msBetween(start, Clock::now());
   return out;
 }
@@ -333,8 +386,9 @@ void RenderService::renderLoop() {
     bool recreate = false;
     try {
       Job* raw = job.get();
+      // The caps: presets and budgets choose within this daemon's limits.
       FrameInputs inputs{job->compareTarget.get(), job->environment.get(),
-                         [raw](double f) { raw->renderProgress.store(f); }};
+                         [raw](double f) { raw->renderProgress.store(f); }, &config_.limits};
       output = job->request.refine ? refine(*backend, job, inputs)
                                    : backend->render(*job->scene, job->request, &job->cancel, inputs);
     } catch (const api::ApiError& e) {

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <set>
 #include <thread>
+#include <tuple>
 
 #include <unistd.h>
 
@@ -296,6 +297,13 @@ int runRender(const GlobalOptions& g, const RenderOptions& o) {
   nlohmann::json request = buildRequest(o, http, true, sceneBytes);
   const std::vector<std::string> paths = planOutputs(o, request);
   const bool async = request.value("async", false);
+  // A synchronous render is sent as an async job and polled, so that it shows its progress as --async
+  // does; it keeps a synchronous render's semantics (the client waits for the frames, and behind a proxy
+  // a render whose daemon is lost is rendered again). The daemon describes a finished job with the same
+  // JSON as a synchronous answer. --quiet shows no progress, so it sends the request as it is.
+  const bool poll = async || !o.quiet;
+  nlohmann::json sent = request;
+  if (poll) sent["async"] = true;
 
   const auto t0 = std::chrono::steady_clock::now();
   // A scene by digest routes to the daemon holding it when a proxy is in front (docs/DEPLOYMENT.md).
@@ -305,7 +313,7 @@ int runRender(const GlobalOptions& g, const RenderOptions& o) {
   // Behind a proxy (docs/DEPLOYMENT.md) a render whose daemon is lost on the way is sent again (the
   // proxy has marked that daemon down, so it lands on another), and the scene is uploaded again where
   // the next daemon lacks it. A lone daemon's answers are kept as they are (client::fleetRetry).
-  const std::string body = request.dump();
+  const std::string body = sent.dump();
   auto submit = [&] {
     for (int attempt = 1;; ++attempt) {
       HttpResponse answer = http.post("/v1/renders", body, "application/json", sceneHeader(digest));
@@ -320,13 +328,13 @@ int runRender(const GlobalOptions& g, const RenderOptions& o) {
       else std::this_thread::sleep_for(std::chrono::seconds(1));
     }
   };
-  HttpResponse r = submit();
-  HttpClient::expectOk(r);
-  nlohmann::json result = r.json();
-  if (async) {
-    const std::string location = r.header("location").empty() ? "/v1/renders/" + result.value("id", "") : r.header("location");
-    // Progress once the render has lasted a second: on a terminal a bar redrawn in place, with the
-    // time left at the rate so far; otherwise (a log, a pipe) a plain line per 10 % or change of state.
+  // Polls a submitted job until it is done: its JSON, or nullopt when a synchronous render's daemon was
+  // lost behind a proxy (the caller sends the render again). Progress once the render has lasted a
+  // second: on a terminal a bar redrawn in place, with the time left at the rate so far; otherwise (a
+  // log, a pipe) a plain line per 10 % or change of state.
+  auto waitForJob = [&](const HttpResponse& submitted, nlohmann::json result) -> std::optional<nlohmann::json> {
+    const std::string location =
+        submitted.header("location").empty() ? "/v1/renders/" + result.value("id", "") : submitted.header("location");
     const bool tty = isatty(STDERR_FILENO) && !o.quiet;
     bool shown = false;
     std::string lastLine;
@@ -360,10 +368,34 @@ int runRender(const GlobalOptions& g, const RenderOptions& o) {
         shown = true;
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(200));
-      result = HttpClient::expectOk(http.get(location)).json();
+      const HttpResponse answer = http.get(location);
+      if (!async && fleetRetry(answer) == FleetRetry::Again) {
+        if (tty && shown) std::cerr << "\n";
+        return std::nullopt;
+      }
+      result = HttpClient::expectOk(answer).json();
     }
     if (shown) std::cerr << (tty ? "\r" : "") << result.value("id", "") << ": done 100%" << (tty ? "          " : "") << "\n";
-  }
+    return result;
+  };
+  // One render to its end: submitted, and polled unless --quiet sends it synchronously.
+  auto run = [&]() -> std::pair<HttpResponse, nlohmann::json> {
+    for (int attempt = 1;; ++attempt) {
+      HttpResponse r = submit();
+      HttpClient::expectOk(r);
+      nlohmann::json result = r.json();
+      if (!poll) return {r, result};
+      if (std::optional<nlohmann::json> done = waitForJob(r, result)) return {r, *done};
+      if (attempt >= kRenderFleetTries)
+        throw ServerError(502, {{"title", "Daemon lost"},
+                                {"detail", "the proxy lost the daemon of render " + result.value("id", "") + " " +
+                                               std::to_string(attempt) + " times"}});
+      if (!o.quiet) std::cerr << "render: the proxy lost the daemon (502) while it rendered; sending the render again\n";
+    }
+  };
+  HttpResponse r;
+  nlohmann::json result;
+  std::tie(r, result) = run();
   if (!result.contains("frames") || !result["frames"].is_array() || result["frames"].size() < paths.size())
     throw ServerError(r.status, {{"title", "No frames"},
                                  {"detail", "the server returned " + std::to_string(result.value("frames", nlohmann::json::array()).size()) +
@@ -375,9 +407,7 @@ int runRender(const GlobalOptions& g, const RenderOptions& o) {
     // The daemon holding a synchronous render's frames was lost after rendering: render it again.
     for (int again = 1; !async && fleetRetry(frame) == FleetRetry::Again && again < kRenderFleetTries; ++again) {
       if (!o.quiet) std::cerr << "render: the proxy lost the daemon holding the frames; rendering again\n";
-      r = submit();
-      HttpClient::expectOk(r);
-      result = r.json();
+      std::tie(r, result) = run();
       frame = http.get(result["frames"][i]["url"].get<std::string>());
     }
     HttpClient::expectOk(frame);
@@ -447,7 +477,9 @@ void addRenderCommand(CLI::App& root, const GlobalOptions& g, Action& action) {
                        ->type_name("N");
   c->add_flag("--float", o->fullFloat, "32-bit float EXR channels (default: half)");
   c->add_option("--stats", o->statsFile, "write the request, stats, timings and frames as JSON")->type_name("FILE");
-  c->add_flag("--async", o->async, "submit as an async job and poll it (a progress bar on a terminal)");
+  c->add_flag("--async", o->async,
+              "send the request as an async job (behind a proxy its URLs die with its daemon; without --async a lost "
+              "render is sent again). Either way the client polls it and shows progress unless -q");
   c->add_flag("-q,--quiet", o->quiet, "print nothing but errors");
   c->add_option("--compare", o->compareSpp, "score beauty against the reference path tracer at SPP samples (stats.metrics)")
       ->type_name("SPP")

@@ -100,6 +100,8 @@ struct BenchOptions {
   bool quick = false, service = false, noReport = false, dryRun = false;
   int requests = 20, size = 256, throughputN = 40, pngCompression = 1;
   std::string scene = "cornell_box";
+  CLI::Option* sceneGiven = nullptr;
+  std::vector<std::string> techniques;  // the suite: only these (empty = every implemented one)
   sweep::RunOptions run;
 };
 
@@ -334,14 +336,20 @@ int runBench(const GlobalOptions& g, BenchOptions bo) {
   json sceneNames = json::array();
   for (const auto& b : scenes.value("builtins", json::array())) {
     const std::string name = b.value("name", "");
-    if (!quick || name == "cornell_box" || name == "ao_creases" || name == "cornell_mirror") sceneNames.push_back(name);
+    if (bo.sceneGiven && bo.sceneGiven->count() ? name == scene
+                                                 : !quick || name == "cornell_box" || name == "ao_creases" || name == "cornell_mirror")
+      sceneNames.push_back(name);
   }
+  if (sceneNames.empty() && bo.sceneGiven && bo.sceneGiven->count())
+    throw UsageError("bench: the server has no built-in scene \"" + scene + "\" (radiant scenes lists them)");
   static const std::set<std::string> support{"gbuffer", "shadow_maps", "tonemap", "reference"};
   const std::vector<int> sizes = quick ? std::vector<int>{32, 64} : std::vector<int>{128, 256};
   json sweeps = json::array();
   for (const auto& t : info.value("techniques", json::array())) {
     const std::string name = t.value("name", "");
     if (support.count(name) || !t.value("available", true)) continue;
+    if (!bo.techniques.empty() && std::find(bo.techniques.begin(), bo.techniques.end(), name) == bo.techniques.end())
+      continue;
     const Preset preset = presetFor(name, quick);
     json axes{{"scene.builtin", sceneNames}};
     const json fitted = fitToSchema(preset.axes, t.value("params", json::object()), name);
@@ -362,7 +370,9 @@ int runBench(const GlobalOptions& g, BenchOptions bo) {
                       {"warmup", 1},
                       {"compare", compare}});
   }
-  if (sweeps.empty()) throw UsageError("bench: the server implements no technique to measure");
+  if (sweeps.empty())
+    throw UsageError(bo.techniques.empty() ? "bench: the server implements no technique to measure"
+                                           : "bench: the server implements none of the --technique names (radiant info lists them)");
   fs::create_directories(dir);
   const fs::path specFile = dir / "bench.spec.json";
   writeFile(specFile.string(), json{{"sweeps", sweeps}}.dump(2) + "\n");
@@ -440,7 +450,11 @@ void addSweepCommands(CLI::App& root, const GlobalOptions& g, Action& action) {
   b->add_option("--inflight", bo->run.inflight, "requests in flight per server")->type_name("N")->check(CLI::Range(1, 64));
   b->add_option("--requests", bo->requests, "--service: sequential requests (default 20)")->type_name("N")->check(CLI::Range(1, 10000));
   b->add_option("--size", bo->size, "--service: frame size in pixels (default 256)")->type_name("PX")->check(CLI::Range(1, 4096));
-  b->add_option("--scene", bo->scene, "--service: the built-in scene (default cornell_box)")->type_name("NAME");
+  bo->sceneGiven = b->add_option("--scene", bo->scene,
+                                 "the suite: only this built-in scene; --service: the built-in scene (default cornell_box)")
+                       ->type_name("NAME");
+  repeated(b->add_option("--technique", bo->techniques, "the suite: only this technique (repeatable; default every one)"))
+      ->type_name("NAME");
   b->add_option("--throughput", bo->throughputN, "--service: back-to-back requests per throughput run (default 40)")
       ->type_name("N")
       ->check(CLI::Range(1, 100000));

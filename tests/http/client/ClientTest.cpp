@@ -1,8 +1,8 @@
 // The real `radiant` client against the real radiantd (llvmpipe) on an ephemeral loopback port:
 // - `render` writes every output of a multi-output request (-o repeated, --out-dir), and each file
 //   holds exactly the AOV it names, compared pixel by pixel with the same AOV of a multi-layer EXR;
-// - an async render that lasts more than a second draws a bar with an ETA on a pseudo-terminal
-//   (`script` gives it one), and prints plain lines when stderr is a file.
+// - a render (synchronous or --async) that lasts more than a second draws a bar with an ETA on a
+//   pseudo-terminal (`script` gives it one), and prints plain lines when stderr is a file.
 #include <sys/wait.h>
 
 #include <algorithm>
@@ -119,15 +119,18 @@ TEST_F(ClientHttp, RenderWritesEveryOutputOfAMultiOutputRequest) {
 // A reference render long enough to show progress, which starts after 1 s: several seconds on
 // llvmpipe even on a quiet machine (at 48x48 and 500 spp the second run took under a second in CI).
 // The daemon caches a reference by its sample count among other things, so each run asks for another.
-std::string slowRender(int spp) {
+// Without --async the client submits an async job under the hood and polls it the same way, keeping the
+// synchronous semantics (the request it reports, --stats, is still synchronous).
+std::string slowRender(int spp, bool async) {
   return "render --builtin cornell_box --size 64x64 --pass reference --aov reference --set reference.spp=" +
-         std::to_string(spp) + " -o slow.exr --async";
+         std::to_string(spp) + " -o slow.exr --stats slow.json" + (async ? " --async" : "");
 }
 
 TEST_F(ClientHttp, ProgressBarOnAPseudoTerminalAndPlainLinesWithout) {
   const fs::path& d = *dir_;
   // `script` runs the client on a new pseudo-terminal and copies what it draws to stdout.
-  const std::string inner = "RADIANT_SERVER='" + daemon_->url() + "' '" RADIANT_CLIENT_PATH "' " + slowRender(1536);
+  // A synchronous render (no --async) on the terminal.
+  const std::string inner = "RADIANT_SERVER='" + daemon_->url() + "' '" RADIANT_CLIENT_PATH "' " + slowRender(1536, false);
   const std::string cmd = "cd '" + d.string() + "' && script -q -e -c \"" + inner + "\" /dev/null > tty.txt 2>&1";
   const int status = std::system(cmd.c_str());
   ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << testing::slurp(d / "tty.txt");
@@ -137,14 +140,25 @@ TEST_F(ClientHttp, ProgressBarOnAPseudoTerminalAndPlainLinesWithout) {
   EXPECT_TRUE(std::regex_search(tty, std::regex(R"(\[#+\.*\] \d+% ETA \d+ s)"))) << tty;
   EXPECT_NE(tty.find(": done 100%"), std::string::npos) << tty;
   EXPECT_TRUE(fs::exists(d / "slow.exr"));
+  EXPECT_EQ(json::parse(testing::slurp(d / "slow.json"))["request"]["async"], false) << "still a synchronous render";
+  EXPECT_NE(tty.find("wrote slow.exr"), std::string::npos) << tty;
 
-  // Without a terminal: whole lines, no carriage returns.
-  const ProcessRun r = client(daemon_->url(), slowRender(1500), d);
-  ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_EQ(r.err.find('\r'), std::string::npos) << r.err;
-  std::smatch m;
-  EXPECT_TRUE(std::regex_search(r.err, m, std::regex(R"((^|\n)r-[^\n]*: running \d+%( ETA \d+ s)?\n)"))) << r.err;
-  EXPECT_NE(r.err.find(": done 100%\n"), std::string::npos) << r.err;
+  // Without a terminal: whole lines, no carriage returns; synchronous and async alike.
+  for (const bool async : {false, true}) {
+    const ProcessRun r = client(daemon_->url(), slowRender(async ? 1500 : 1520, async), d);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(r.err.find('\r'), std::string::npos) << r.err;
+    std::smatch m;
+    EXPECT_TRUE(std::regex_search(r.err, m, std::regex(R"((^|\n)r-[^\n]*: running \d+%( ETA \d+ s)?\n)"))) << async << r.err;
+    EXPECT_NE(r.err.find(": done 100%\n"), std::string::npos) << r.err;
+    EXPECT_NE(r.out.find("wrote slow.exr"), std::string::npos) << r.out;
+    EXPECT_EQ(json::parse(testing::slurp(d / "slow.json"))["request"]["async"], async);
+  }
+  // --quiet: a plain synchronous request, nothing on stderr.
+  const ProcessRun q = client(daemon_->url(), "render --builtin cornell_box --size 16x16 -o quiet.exr -q", d);
+  ASSERT_EQ(q.code, 0) << q.err;
+  EXPECT_EQ(q.err, "");
+  EXPECT_TRUE(fs::exists(d / "quiet.exr"));
 }
 
 }  // namespace

@@ -4,8 +4,9 @@
 //  - a larger time_budget_ms never gives a larger predicted or measured error, the predicted cost fits
 //    the budget, and the measured frame time fits it in most runs (the rate is printed and asserted
 //    loosely: the machine is shared, timings are never asserted tightly);
+//  - a daemon's caps (--max-photons) bound what a preset or budget picks;
 //  - progressive refinement of the reference: the estimated error of the batches' mean tracks its true
-//    error against a high-spp ground truth within a factor.
+//    error against a high-spp ground truth within a factor; with a compare block the mean is scored.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -26,9 +27,12 @@ namespace fs = std::filesystem;
 struct RealDaemon {
   fs::path dir;
   testing::Daemon daemon;
-  explicit RealDaemon(const std::string& name)
-      : dir(testing::scratch(name)),
-        daemon(RADIANTD_PATH, {"--port", "0", "--request-timeout", "600"}, {}, dir / "stderr.log") {}
+  explicit RealDaemon(const std::string& name, std::vector<std::string> flags = {})
+      : dir(testing::scratch(name)), daemon(RADIANTD_PATH, withPort(std::move(flags)), {}, dir / "stderr.log") {}
+  static std::vector<std::string> withPort(std::vector<std::string> flags) {
+    flags.insert(flags.begin(), {"--port", "0", "--request-timeout", "600"});
+    return flags;
+  }
   bool ready() { return daemon.port() > 0 && daemon.waitReady(std::chrono::seconds(120)); }
   json render(const json& body) {
     auto c = daemon.client();
@@ -158,6 +162,64 @@ TEST(Budgets, LargerBudgetsNeverGiveLargerErrorsAndMostRunsFit) {
   EXPECT_GE(fits, 2);
 }
 
+// A daemon capped below the table's dearer photon_gi points (radiantd --max-photons): the preset and
+// the budget run the best point within the cap, the pass traces that many photons, and the stats say
+// what the cap excluded. An explicit request above the cap is still refused (422, the field named).
+TEST(Budgets, PresetsAndBudgetsStayWithinTheDaemonsCaps) {
+  const json& front = tableEntry("photon_gi")["front"];
+  ASSERT_TRUE(front.is_array() && front.size() >= 3);
+  // The cap: between the front's second and third photon counts, so that exactly the points with at
+  // most the second's photons fit.
+  const long long cap = (front[1]["params"]["photons"].get<long long>() + front[2]["params"]["photons"].get<long long>()) / 2;
+  int best = -1;  // the most accurate point within the cap (fronts are sorted by cost, error falling)
+  for (std::size_t i = 0; i < front.size(); ++i)
+    if (front[i]["params"]["photons"].get<long long>() <= cap) best = int(i);
+  ASSERT_GE(best, 1);
+  const int finalPoint = tableEntry("photon_gi")["presets"]["final"];
+  ASSERT_GT(front[finalPoint]["params"]["photons"].get<long long>(), cap) << "the cap must bind on the final preset";
+  RealDaemon d("caps", {"--max-photons", std::to_string(cap)});
+  ASSERT_TRUE(d.ready()) << testing::slurp(d.dir / "stderr.log");
+  auto photonGiPass = [](const json& r) {
+    for (const auto& p : r["stats"]["passes"])
+      if (p["name"] == "photon_gi") return p;
+    return json();
+  };
+  // Most accurate preset first: the preset's point is above the cap, so the best point within it runs.
+  for (const char* q : {"reference", "final"}) {
+    json body = cornell(32, 0);
+    body["quality"] = q;
+    const json r = d.render(body);
+    ASSERT_FALSE(r.contains("http_status")) << r.dump();
+    const json& chosen = r["stats"]["budget"]["techniques"]["photon_gi"];
+    EXPECT_EQ(chosen["point"], best) << q;
+    EXPECT_EQ(chosen["params"], front[best]["params"]) << q;
+    EXPECT_DOUBLE_EQ(chosen["predicted_error"]["value"].get<double>(), front[best]["error"].get<double>()) << q;
+    EXPECT_EQ(chosen["capped"]["limits"]["photons"]["limit"], cap) << q;
+    EXPECT_EQ(chosen["capped"]["limits"]["photons"]["flag"], "radiantd --max-photons");
+    EXPECT_EQ(chosen["capped"]["preset_point"], tableEntry("photon_gi")["presets"][q]) << q;
+    EXPECT_EQ(photonGiPass(r)["counters"]["photons"], front[best]["params"]["photons"]) << "the pass ran the capped point";
+    EXPECT_NE(r["stats"]["warnings"].dump().find("--max-photons"), std::string::npos) << r["stats"]["warnings"].dump();
+  }
+  // A budget large enough for the whole front: the best point within the cap, the others excluded.
+  json body = cornell(32, 0);
+  body["time_budget_ms"] = 1e7;
+  const json r = d.render(body);
+  ASSERT_FALSE(r.contains("http_status")) << r.dump();
+  const json& chosen = r["stats"]["budget"]["techniques"]["photon_gi"];
+  EXPECT_EQ(chosen["point"], best);
+  EXPECT_EQ(photonGiPass(r)["counters"]["photons"], front[best]["params"]["photons"]);
+  EXPECT_EQ(chosen["capped"]["excluded_points"].size(), front.size() - best - 1);
+  // The request's own photons above the cap: refused, naming the field, and the daemon keeps serving.
+  body = cornell(32, 0);
+  body["quality"] = "draft";
+  body["passes"] = {{"photon_gi", {{"photons", cap + 1}}}};
+  const json refused = d.render(body);
+  EXPECT_EQ(refused["http_status"], 422) << refused.dump();
+  EXPECT_EQ(refused["pointer"], "/passes/photon_gi/photons");
+  body["passes"] = {{"photon_gi", {{"photons", cap}}}};
+  EXPECT_EQ(photonGiPass(d.render(body))["counters"]["photons"], cap);
+}
+
 double rmse(const Image& a, const Image& b) {
   double s = 0;
   for (std::size_t i = 0; i < a.pixels.size(); ++i) s += (double(a.pixels[i]) - b.pixels[i]) * (double(a.pixels[i]) - b.pixels[i]);
@@ -222,6 +284,77 @@ TEST(Refinement, TheEstimatedErrorOfTheReferenceTracksItsTrueError) {
     EXPECT_LT(midEstimate / midTrue, 1.5);
     EXPECT_LT(estimate, midEstimate);  // more batches, less error
   }
+}
+
+// A refining job with a compare block scores the batches' mean, not one batch: stats.metrics of the
+// finished job, and the current mean's RMSE while it refines, equal the RMSE the test computes from the
+// frames themselves against the ground truth the job returns. photon_gi's error then splits as
+// bias^2 + noise^2 / batches: the mean's squared error minus its estimated noise is the bias (plus the
+// ground truth's own noise), and one batch's squared error is that plus batches x the mean's noise.
+TEST(Refinement, ACompareBlockScoresTheMeanAgainstTheGroundTruth) {
+  RealDaemon d("refine-compare");
+  ASSERT_TRUE(d.ready()) << testing::slurp(d.dir / "stderr.log");
+  const int size = 32, batches = 8;
+  json base = cornell(size, 0);
+  base["outputs"] = {{{"format", "exr"}, {"half", false}, {"aovs", {"indirect"}}}};
+  base["passes"] = {{"photon_gi", {{"photons", 20000}}}};
+  base["compare"] = {{"aov", "indirect"}, {"spp", 256}};
+  // One batch alone (the job's first seed), scored by an ordinary compare block.
+  const json one = d.render(base);
+  ASSERT_FALSE(one.contains("http_status")) << one.dump();
+  const double oneBatchRmse = one["stats"]["metrics"]["rmse"];
+
+  json body = base;
+  body["async"] = true;
+  body["refine"] = {{"max_batches", batches}, {"aov", "indirect"}};
+  auto c = d.daemon.client();
+  auto r = c.Post("/v1/renders", body.dump(), "application/json");
+  ASSERT_EQ(r->status, 202) << r->body;
+  const std::string location = r->get_header_value("Location");
+  json state = json::object();
+  double midRmse = -1;
+  int midBatches = 0;
+  for (int i = 0; i < 6000 && state.value("state", "") != "done" && state.value("state", "") != "failed"; ++i) {
+    state = json::parse(c.Get(location.c_str())->body);
+    if (!midBatches && state.contains("refinement") && state["refinement"]["batches"].get<int>() >= 2 &&
+        state["state"] == "running") {
+      auto cur = c.Get((location + "?current=exr").c_str());
+      ASSERT_EQ(cur->status, 200);
+      midBatches = std::stoi(cur->get_header_value("X-Radiant-Batches"));
+      midRmse = std::stod(cur->get_header_value("X-Radiant-Rmse"));
+      io::writeFile((d.dir / "current.exr").string(), cur->body);
+      EXPECT_TRUE(state["refinement"]["metrics"]["rmse"].is_number()) << state.dump();
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ASSERT_EQ(state["state"], "done") << state.dump();
+  const json& m = state["stats"]["metrics"];
+  ASSERT_TRUE(m.is_object()) << state["stats"].dump();
+  EXPECT_EQ(m["batches"], batches);
+  EXPECT_EQ(m["aov"], "indirect");
+  const fs::path frame = d.dir / "mean.exr";
+  io::writeFile(frame.string(), c.Get(state["frames"][0]["url"].get<std::string>().c_str())->body);
+  const Image mean = io::readImage(frame.string(), "indirect"), truth = io::readImage(frame.string(), "reference");
+  // The reported score is the mean's (float EXR: the same numbers up to rounding).
+  const double meanRmse = m["rmse"];
+  EXPECT_NEAR(rmse(mean, truth), meanRmse, 1e-5 * meanRmse);
+  if (midBatches >= 2) {
+    const Image current = io::readImage((d.dir / "current.exr").string(), "indirect");
+    EXPECT_NEAR(rmse(current, truth), midRmse, 1e-5 * midRmse) << "after " << midBatches << " batches";
+  }
+  // bias^2 + noise^2: the mean's noise is the estimate; one batch has `batches` times its variance.
+  const double estimate = state["stats"]["refinement"]["estimated_rmse"];
+  const double bias2 = meanRmse * meanRmse - estimate * estimate;
+  const double predictedOne = std::sqrt(bias2 + batches * estimate * estimate);
+  std::printf("photon_gi indirect, %d batches of 20000 photons: one batch rmse %.5f, mean %.5f, estimated noise of "
+              "the mean %.5f, so bias %.5f and one batch predicted %.5f\n",
+              batches, oneBatchRmse, meanRmse, estimate, std::sqrt(std::max(0.0, bias2)), predictedOne);
+  EXPECT_EQ(state["stats"]["refinement"]["estimate_kind"], "noise_only");
+  EXPECT_NEAR(state["stats"]["refinement"]["bias_rmse"].get<double>(), std::sqrt(std::max(0.0, bias2)), 1e-9);
+  EXPECT_LT(meanRmse, oneBatchRmse);
+  EXPECT_GT(bias2, 0.0) << "the kernel's bias: the mean's error exceeds its noise";
+  // The estimate is itself noisy (7 degrees of freedom per pixel channel): within 25 %.
+  EXPECT_NEAR(predictedOne, oneBatchRmse, 0.25 * oneBatchRmse);
 }
 
 }  // namespace

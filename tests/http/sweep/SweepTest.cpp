@@ -870,3 +870,86 @@ TEST_F(SweepAgainstDaemon, ReportShowsTheParetoPointsFramesErrorMapsAndReference
   }
   fs::remove_all(dir);
 }
+
+// `radiant bench` end to end on a tiny configuration (--quick, one technique, one scene: 4 AO methods
+// x 2 sizes): the HTML it writes pictures, per section (scene and size), exactly each method's Pareto
+// points of the results file; the pictures are those points' frames, error maps and reference, and the
+// numbers beside them are the results file's.
+TEST_F(SweepAgainstDaemon, BenchReportShowsEachSectionsParetoPointsFramesAndTheirNumbers) {
+  const auto dir = scratch("bench-thumbs");
+  ProcResult r = runRadiant(dir,
+                            {"--server", daemon_->url(), "bench", "--quick", "--technique", "ambient_occlusion", "--scene",
+                             "ao_creases", "-q", "-o", (dir / "b").string()},
+                            std::chrono::seconds(280));
+  ASSERT_EQ(r.code, 0) << r.err << r.out;
+  const auto recs = records(dir / "b" / "results.jsonl");
+  ASSERT_EQ(recs.size(), 8u) << "4 methods x sizes 32 and 64";
+  // The front of each section, from the results file (the report's sections: technique x scene x size).
+  std::set<std::string> frontIds;
+  std::map<int, std::vector<json>> bySize;
+  for (const auto& rec : recs) {
+    EXPECT_EQ(rec["technique"], "ambient_occlusion");
+    EXPECT_EQ(rec["request"]["scene"]["builtin"], "ao_creases");
+    bySize[rec["request"]["width"].get<int>()].push_back(rec);
+  }
+  ASSERT_EQ(bySize.size(), 2u);
+  for (const auto& [size, group] : bySize)
+    for (const json* rec : paretoFront(group)) frontIds.insert((*rec)["point_id"].get<std::string>());
+
+  const std::string page = slurp(dir / "b" / "report.html");
+  EXPECT_EQ(page.find("src=\"http"), std::string::npos) << "one offline file";
+  // Per thumbnail figure: the header cells' numbers and the frames, in the same order.
+  const std::regex imgRe(R"re(<img class="thumb" data-point="([0-9a-f]+)" data-kind="(\w+)" alt="[^"]*" width="128" src="data:image/png;base64,([A-Za-z0-9+/=]+)">)re");
+  const std::regex headRe(R"re(<th>[^<]*<br><span class="n" data-key="frame_gpu_ms.median">([^<]+)</span> ms, rmse <span class="n" data-key="metric">([^<]+)</span></th>)re");
+  std::map<std::string, std::map<std::string, radiant::Image>> shown;  // kind -> point -> image
+  std::set<std::string> pictured;
+  int figures = 0;
+  for (std::size_t at = 0; (at = page.find("<figure id=\"thumbs-", at)) != std::string::npos; ++figures) {
+    const std::size_t end = page.find("</figure>", at);
+    ASSERT_NE(end, std::string::npos);
+    const std::string fig = page.substr(at, end - at);
+    at = end;
+    std::vector<std::pair<std::string, std::string>> heads;
+    for (auto it = std::sregex_iterator(fig.begin(), fig.end(), headRe); it != std::sregex_iterator(); ++it)
+      heads.push_back({(*it)[1], (*it)[2]});
+    std::vector<std::string> frames;
+    for (auto it = std::sregex_iterator(fig.begin(), fig.end(), imgRe); it != std::sregex_iterator(); ++it) {
+      shown[(*it)[2]][(*it)[1]] = radiant::io::decodeImage(base64Decode((*it)[3]));
+      if ((*it)[2] == "frame") frames.push_back((*it)[1]);
+    }
+    ASSERT_EQ(heads.size(), frames.size());
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+      pictured.insert(frames[i]);
+      const auto rec = std::find_if(recs.begin(), recs.end(), [&](const json& j) { return j["point_id"] == frames[i]; });
+      ASSERT_NE(rec, recs.end()) << frames[i];
+      EXPECT_TRUE(showsNumber(heads[i].first, (*rec)["frame_gpu_ms"]["median"])) << frames[i];
+      EXPECT_TRUE(showsNumber(heads[i].second, (*rec)["metrics"]["rmse"])) << frames[i];
+    }
+  }
+  EXPECT_EQ(figures, 2) << "one thumbnail figure per section (size)";
+  EXPECT_EQ(pictured, frontIds);
+
+  // The pictures are the frames': each pictured point rendered again here with its compare block, as a
+  // float EXR (the sizes are at most 64 px, so a thumbnail is the frame itself).
+  httplib::Client http("127.0.0.1", daemon_->port());
+  http.set_read_timeout(120, 0);
+  for (const auto& rec : recs) {
+    const std::string id = rec["point_id"];
+    if (!pictured.count(id)) continue;
+    json request = rec["request"];
+    request["outputs"] = {{{"format", "exr"}, {"aovs", {"ao"}}, {"half", false}}};
+    auto res = http.Post("/v1/renders", request.dump(), "application/json");
+    ASSERT_TRUE(res && res->status == 200) << (res ? res->body : "no answer");
+    auto frame = http.Get(json::parse(res->body)["frames"][0]["url"].get<std::string>().c_str());
+    ASSERT_TRUE(frame && frame->status == 200);
+    const radiant::Image ao = radiant::io::decodeImage(frame->body, "ao");
+    ASSERT_EQ(ao.width, rec["request"]["width"].get<int>());
+    EXPECT_LE(radiant::testing::maxAbsDifference(shown["frame"][id], displayed(ao)), 1.0 / 255) << id;
+    if (shown["reference"].count(id)) {
+      const radiant::Image reference = radiant::io::decodeImage(frame->body, "reference");
+      EXPECT_LE(radiant::testing::maxAbsDifference(shown["reference"][id], displayed(reference)), 1.0 / 255) << id;
+    }
+  }
+  EXPECT_GE(shown["reference"].size(), 2u) << "a reference per section at least";
+  fs::remove_all(dir);
+}
