@@ -3,6 +3,9 @@
 //
 // Textures, framebuffers and buffers are declared by name in a technique's prepare(): a declaration
 // with the same spec as last frame returns the same object, so steady-state frames allocate nothing.
+// The Renderer declares the planned passes' AOV outputs, beauty and the environment map before any
+// pass (renderer/frame/FrameAllocation.h); passes look those up by name, as their TechniqueInfo
+// declares (beginPass below).
 // Derived data (shadow maps, BVHs, cube maps, photon maps) is cached under a key together with the
 // digest of exactly the inputs it depends on; every lookup is logged as a cache hit or miss. Each key
 // keeps the derived data of its `derivedCapacity` most recently used digests (renders alternating
@@ -84,7 +87,7 @@ public:
   // outputs, the AOV table's resources and the frame resources (environment_map); the Renderer sets
   // them once. It opens a scope around each pass's prepare() and execute(): inside it, a pass may touch
   // a shared resource (texture(), markWritten()) only as its `access` declares, and execute() may
-  // allocate nothing (a texture or buffer declared with a new spec there throws). A breach is a
+  // allocate nothing (a texture, buffer or framebuffer created there throws). A breach is a
   // programmer error: std::logic_error naming the pass, the resource and what it declared. Names that
   // are not shared (a pass's own intermediate targets) are the pass's business.
   enum class Phase { Prepare, Execute };
