@@ -101,6 +101,9 @@ std::optional<CostLimit> costLimit(std::string_view cost, const RequestLimits& l
   if (cost == "samples") return CostLimit{limits.maxSamples, "--max-samples"};
   if (cost == "photons") return CostLimit{limits.maxPhotons, "--max-photons"};
   if (cost == "particles") return CostLimit{static_cast<long long>(limits.maxParticles), "--max-particles"};
+  if (cost == "resolution") return CostLimit{limits.maxMapResolution, "--max-map-resolution"};
+  if (cost == "nodes") return CostLimit{limits.maxNetworkNodes, "--max-network-nodes"};
+  if (cost == "iterations") return CostLimit{limits.maxIterations, "--max-iterations"};
   if (cost == "none") return std::nullopt;
   throw std::logic_error("schema: unknown x-cost \"" + std::string(cost) + "\"");
 }

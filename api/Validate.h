@@ -48,6 +48,16 @@ struct RequestLimits {
   std::uint64_t maxOutputBytes = 0;
   // Particles of all request media systems together (radiantd --max-particles).
   std::size_t maxParticles = 65536;
+  // Texels per side of any map or grid a pass allocates (x-cost "resolution": shadow_map_size, the
+  // cube_resolution of specular, caustics and env_diffuse, photon/impostor/slice resolutions; memory and
+  // fill grow with its square) (radiantd --max-map-resolution).
+  int maxMapResolution = 4096;
+  // Illumination-network nodes (x-cost "nodes": memory and work per iteration grow with nodes x
+  // directions) (radiantd --max-network-nodes).
+  int maxNetworkNodes = 65536;
+  // Iterations of an iterative solver in one request (x-cost "iterations": illumination_network's
+  // passes over every node and direction) (radiantd --max-iterations).
+  int maxIterations = 1024;
 };
 
 // The limit an "x-cost" kind is capped by, and the radiantd flag that sets it; nullopt for "none".

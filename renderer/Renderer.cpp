@@ -11,6 +11,7 @@
 #include "api/Aovs.h"
 #include "api/Presets.h"
 #include "api/Validate.h"
+#include "renderer/frame/FrameAllocation.h"
 #include "renderer/frame/FramePlanner.h"
 #include "renderer/frame/FrameResources.h"
 #include "renderer/frame/FrameView.h"
@@ -375,6 +376,12 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
 
     im.resources.beginFrame(gpu, view, &stats.cache);
     im.resources.setLightPathOwners(plan.lightPaths);
+    // Declared resources (renderer/frame/FrameAllocation.h): the Renderer allocates the planned passes'
+    // AOV outputs, beauty and the environment map; each pass then touches the shared resources only as
+    // its TechniqueInfo declares (declaredAccess, checked by FrameResources in the pass scopes below).
+    im.resources.setSharedResources(sharedResources(all));
+    allocateDeclaredOutputs(im.resources, plan.passes);
+    declareEnvironmentMap(im.resources, view);
     im.profiler.beginFrame();
     // PassStats must not move while the profiler holds pointers to them.
     stats.passes.resize(plan.passes.size());
@@ -395,7 +402,9 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     im.resources.setShadowMapExclusions(std::move(shadowMapExclusions));
     for (std::size_t i = 0; i < plan.passes.size(); ++i) {
       Technique* t = plan.passes[i];
+      im.resources.beginPass(t->info().name, declaredAccess(t->info()), FrameResources::Phase::Prepare);
       t->prepare(scene, params[i], im.resources);
+      im.resources.endPass();
       gl::checkError(("prepare " + t->info().name).c_str());
     }
     // Frame progress: monotone, and reported in order although a pass's callback may come from several
@@ -419,7 +428,7 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
       gl::DebugGroup group(t->info().name);
       PassContext ctx{scene, gpu, view, params[i], im.resources, im.shaders, stats.passes[i]};
       ctx.progress = [&, i](double f) { report(0.95 * (static_cast<double>(i) + std::clamp(f, 0.0, 1.0)) / passCount); };
-      im.resources.beginPass();
+      im.resources.beginPass(t->info().name, declaredAccess(t->info()), FrameResources::Phase::Execute);
       {
         GpuProfiler::Scope scope(im.profiler, stats.passes[i]);
         t->execute(ctx);
@@ -428,6 +437,7 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
       if (const std::string bad = undeclaredWrite(t->info(), im.resources.passWrites()); !bad.empty())
         throw std::logic_error("Renderer: pass " + t->info().name + " wrote '" + bad +
                                "', which its TechniqueInfo does not declare");
+      im.resources.endPass();
       gl::checkError(("execute " + t->info().name).c_str());
     }
 

@@ -26,6 +26,10 @@ std::string usage() {
                             per pixel, compare.spp) (default 65536)
   --max-photons N           largest photon count of any pass (x-cost "photons") (default 4000000)
   --max-particles N         particles of a request's media systems together (default 65536)
+  --max-map-resolution N    texels per side of any map or grid a pass allocates (x-cost "resolution":
+                            shadow_map_size, cube_resolution, ...) (default 4096)
+  --max-network-nodes N     illumination_network nodes (x-cost "nodes") (default 65536)
+  --max-iterations N        iterations of an iterative pass (x-cost "iterations") (default 1024)
   --max-queue N             jobs waiting behind the running one before 503 (default 16)
   --request-timeout S       seconds from submission to encoded frames (default 300)
   --frame-ttl S             seconds frames and finished jobs are kept (default 600)
@@ -104,6 +108,9 @@ void apply(ServerConfig& c, const std::string& name, const std::string& v, std::
   else if (name == "max-samples") c.limits.maxSamples = static_cast<int>(toInt(flag, v, 1, 65536));
   else if (name == "max-photons") c.limits.maxPhotons = toInt(flag, v, 1, 4000000);
   else if (name == "max-particles") c.limits.maxParticles = static_cast<std::size_t>(toInt(flag, v, 1, 1048576));
+  else if (name == "max-map-resolution") c.limits.maxMapResolution = static_cast<int>(toInt(flag, v, 1, 4096));
+  else if (name == "max-network-nodes") c.limits.maxNetworkNodes = static_cast<int>(toInt(flag, v, 1, 65536));
+  else if (name == "max-iterations") c.limits.maxIterations = static_cast<int>(toInt(flag, v, 0, 1024));
   else if (name == "max-queue") c.maxQueue = static_cast<int>(toInt(flag, v, 1, 10000));
   else if (name == "request-timeout") c.requestTimeoutS = toDouble(flag, v);
   else if (name == "frame-ttl") c.frameTtlS = toDouble(flag, v);

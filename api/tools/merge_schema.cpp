@@ -56,9 +56,11 @@ json normaliseParam(const std::string& file, const std::string& name, const json
     fail(file, "params." + name + " is a " + type + " without both minimum and maximum (or an enum)");
   // What a parameter costs (api/Validate.h, costLimit): the server limit that caps it.
   if (out.contains("x-cost")) {
-    static const std::set<std::string> kCosts{"samples", "photons", "particles", "none"};
+    static const std::set<std::string> kCosts{"samples", "photons", "particles", "resolution", "nodes", "iterations",
+                                              "none"};
     if (!out["x-cost"].is_string() || !kCosts.count(out["x-cost"].get<std::string>()))
-      fail(file, "params." + name + ".x-cost must be one of samples, photons, particles, none");
+      fail(file, "params." + name +
+                     ".x-cost must be one of samples, photons, particles, resolution, nodes, iterations, none");
     if (type != "integer") fail(file, "params." + name + " has an x-cost but is not an integer");
   }
   const json& d = out["default"];

@@ -13,6 +13,25 @@ bool isFrameAov(const std::string& aov) {
   return a && a->blend == api::AovBlend::Accumulate;
 }
 
+std::vector<ResourceAccess> declaredAccess(const TechniqueInfo& info) {
+  std::vector<ResourceAccess> out;
+  for (const auto& in : info.inputs) out.push_back({in, Access::Read});
+  for (const auto& in : info.optionalInputs) out.push_back({in, Access::Read});
+  for (const auto& o : info.outputs) out.push_back({o, Access::Write});
+  if (info.addsToBeauty)
+    for (const api::AovInfo& a : api::aovTable())
+      if (a.blend == api::AovBlend::Accumulate) out.push_back({a.resource, Access::Accumulate});
+  return out;
+}
+
+std::set<std::string> sharedResources(const std::vector<Technique*>& techniques) {
+  std::set<std::string> names{kEnvironmentMap};
+  for (const Technique* t : techniques) names.insert(t->info().outputs.begin(), t->info().outputs.end());
+  for (const api::AovInfo& a : api::aovTable())
+    if (!a.resource.empty()) names.insert(a.resource);
+  return names;
+}
+
 std::string undeclaredWrite(const TechniqueInfo& info, const std::set<std::string>& written) {
   for (const std::string& name : written) {
     if (std::find(info.outputs.begin(), info.outputs.end(), name) != info.outputs.end()) continue;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "api/Types.h"
+#include "renderer/frame/FrameResources.h"
 #include "renderer/frame/Technique.h"
 
 namespace radiant {
@@ -24,6 +25,18 @@ struct FramePlan {
 
 // AOVs that are not a technique's output but exist in every frame (the AOV table's accumulate AOVs).
 bool isFrameAov(const std::string& aov);
+
+// The frame resource that holds the request's environment map (renderer/frame/FrameAllocation.h): the
+// Renderer declares and uploads it, passes that show the environment read it (an optional input).
+inline constexpr const char* kEnvironmentMap = "environment_map";
+
+// What a pass declares it touches, from its TechniqueInfo: inputs and optional inputs Read, outputs
+// Write, and the accumulate AOVs (beauty) Accumulate when it addsToBeauty. FrameResources enforces it.
+std::vector<ResourceAccess> declaredAccess(const TechniqueInfo& info);
+
+// The names passes exchange, whose access FrameResources checks: every technique's outputs, every AOV
+// table resource and the frame resources.
+std::set<std::string> sharedResources(const std::vector<Technique*>& techniques);
 
 // The first of `written` (what a pass marked written) that its info does not declare: neither one of
 // its outputs nor, when it addsToBeauty, an accumulate AOV. "" when every write is declared. The

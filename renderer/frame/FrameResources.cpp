@@ -1,5 +1,6 @@
 #include "renderer/frame/FrameResources.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <stdexcept>
 
@@ -15,10 +16,53 @@ std::string hex(GLenum v) {
 }
 }  // namespace
 
+const char* toString(Access access) {
+  switch (access) {
+    case Access::Read: return "Read";
+    case Access::Write: return "Write";
+    default: return "Accumulate";
+  }
+}
+
+void FrameResources::beginPass(std::string pass, std::vector<ResourceAccess> access, Phase phase) {
+  pass_ = std::move(pass);
+  access_ = std::move(access);
+  phase_ = phase;
+  inPass_ = true;
+  if (phase == Phase::Execute) passWrites_.clear();
+}
+
+void FrameResources::checkAccess(const std::string& name, bool write) const {
+  if (!inPass_) return;
+  if (!write && !shared_.count(name)) return;
+  const auto it = std::find_if(access_.begin(), access_.end(), [&](const ResourceAccess& a) { return a.name == name; });
+  std::string declared;
+  for (const ResourceAccess& a : access_) declared += (declared.empty() ? "" : ", ") + a.name + ":" + toString(a.access);
+  if (it == access_.end())
+    throw std::logic_error("FrameResources: pass " + pass_ + (write ? " wrote '" : " used '") + name +
+                           "', which its TechniqueInfo does not declare (it declares " +
+                           (declared.empty() ? std::string("nothing") : declared) + ")");
+  if (write && it->access == Access::Read)
+    throw std::logic_error("FrameResources: pass " + pass_ + " wrote '" + name + "', which it declares Read only");
+}
+
+void FrameResources::checkNoAllocation(const std::string& what, const std::string& name) const {
+  if (inPass_ && phase_ == Phase::Execute)
+    throw std::logic_error("FrameResources: pass " + pass_ + " allocated " + what + " '" + name +
+                           "' in execute(); declare it in prepare()");
+}
+
+void FrameResources::markWritten(const std::string& name) {
+  checkAccess(name, true);
+  written_.insert(name);
+  passWrites_.insert(name);
+}
+
 void FrameResources::beginFrame(const GpuScene& gpu, const FrameView& view, std::vector<api::CacheEvent>* cacheLog) {
   gpu_ = &gpu;
   view_ = &view;
   cacheLog_ = cacheLog;
+  endPass();  // a pass that threw last frame left its scope open
   written_.clear();
   declaredThisFrame_.clear();
 }
@@ -28,6 +72,7 @@ const std::string& FrameResources::sceneKey() const { return gpu_->sceneKey; }
 gl::Texture& FrameResources::texture(const std::string& name, GLenum target, GLenum internalFormat, int width,
                                      int height, int depth, int levels) {
   const TextureSpec spec{target, internalFormat, width, height, depth, levels};
+  checkAccess(name, false);
   for (const api::AovInfo& a : api::aovTable()) {
     if (a.resource != name) continue;
     const GLenum declared = a.format == api::AovFormat::R32F      ? GL_R32F
@@ -46,13 +91,15 @@ gl::Texture& FrameResources::texture(const std::string& name, GLenum target, GLe
   if (it != textures_.end() && declaredThisFrame_.count(name))
     throw std::logic_error("FrameResources: texture '" + name +
                            "' re-declared with another size or format in the same frame (it would lose what earlier "
-                           "passes wrote into it)");
+                           "passes wrote into it)" + (inPass_ ? " by pass " + pass_ : std::string()));
+  checkNoAllocation("texture", name);
   declaredThisFrame_.insert(name);
   gl::Texture t(name, target, internalFormat, width, height, depth, levels);
   return textures_.insert_or_assign(name, std::make_pair(spec, std::move(t))).first->second.second;
 }
 
 gl::Texture& FrameResources::texture(const std::string& name) {
+  checkAccess(name, false);
   auto it = textures_.find(name);
   if (it == textures_.end()) throw std::logic_error("FrameResources: texture '" + name + "' was never declared");
   return it->second.second;
@@ -60,13 +107,17 @@ gl::Texture& FrameResources::texture(const std::string& name) {
 
 gl::Framebuffer& FrameResources::framebuffer(const std::string& name) {
   auto it = framebuffers_.find(name);
-  if (it == framebuffers_.end()) it = framebuffers_.emplace(name, gl::Framebuffer(name)).first;
+  if (it == framebuffers_.end()) {
+    checkNoAllocation("framebuffer", name);
+    it = framebuffers_.emplace(name, gl::Framebuffer(name)).first;
+  }
   return it->second;
 }
 
 gl::Buffer& FrameResources::buffer(const std::string& name, std::size_t bytes, GLbitfield flags) {
   auto it = buffers_.find(name);
   if (it != buffers_.end() && it->second.size() == bytes) return it->second;
+  checkNoAllocation("buffer", name);
   return buffers_.insert_or_assign(name, gl::Buffer(name, bytes, nullptr, flags)).first->second;
 }
 

@@ -3,6 +3,9 @@
 //
 // Textures, framebuffers and buffers are declared by name in a technique's prepare(): a declaration
 // with the same spec as last frame returns the same object, so steady-state frames allocate nothing.
+// The Renderer declares the planned passes' AOV outputs, beauty and the environment map before any
+// pass (renderer/frame/FrameAllocation.h); passes look those up by name, as their TechniqueInfo
+// declares (beginPass below).
 // Derived data (shadow maps, BVHs, cube maps, photon maps) is cached under a key together with the
 // digest of exactly the inputs it depends on; every lookup is logged as a cache hit or miss. Each key
 // keeps the derived data of its `derivedCapacity` most recently used digests (renders alternating
@@ -23,6 +26,16 @@ namespace radiant {
 
 class GpuScene;
 struct FrameView;
+
+// How a pass uses a shared resource (Falcor's RenderPassReflection, Filament's FrameGraph): Read (one of
+// its inputs or optional inputs), Write (an output it overwrites), Accumulate (adds into an accumulate
+// AOV: beauty). FramePlanner's declaredAccess() derives a pass's list from its TechniqueInfo.
+enum class Access { Read, Write, Accumulate };
+struct ResourceAccess {
+  std::string name;
+  Access access;
+};
+const char* toString(Access access);
 
 class FrameResources {
 public:
@@ -65,15 +78,24 @@ public:
   void setShadowMapExclusions(std::set<int> meshes) { shadowMapExclusions_ = std::move(meshes); }
   const std::set<int>& shadowMapExclusions() const { return shadowMapExclusions_; }
 
-  // Outputs written this frame (the planner and readback consult it).
-  void markWritten(const std::string& name) {
-    written_.insert(name);
-    passWrites_.insert(name);
-  }
+  // Outputs written this frame (the planner and readback consult it). Inside a pass scope, marking a
+  // resource the pass did not declare Write or Accumulate throws std::logic_error.
+  void markWritten(const std::string& name);
   bool written(const std::string& name) const { return written_.count(name) != 0; }
-  // What the current pass marked written (the Renderer calls beginPass() before each execute() and
-  // checks these against the pass's declared outputs).
-  void beginPass() { passWrites_.clear(); }
+
+  // Declared resource access. The shared resources are the names passes exchange: every technique's
+  // outputs, the AOV table's resources and the frame resources (environment_map); the Renderer sets
+  // them once. It opens a scope around each pass's prepare() and execute(): inside it, a pass may touch
+  // a shared resource (texture(), markWritten()) only as its `access` declares, and execute() may
+  // allocate nothing (a texture, buffer or framebuffer created there throws). A breach is a
+  // programmer error: std::logic_error naming the pass, the resource and what it declared. Names that
+  // are not shared (a pass's own intermediate targets) are the pass's business.
+  enum class Phase { Prepare, Execute };
+  void setSharedResources(std::set<std::string> names) { shared_ = std::move(names); }
+  bool isShared(const std::string& name) const { return shared_.count(name) != 0; }
+  void beginPass(std::string pass, std::vector<ResourceAccess> access, Phase phase);
+  void endPass() { pass_.clear(); inPass_ = false; }
+  // What the current pass marked written (the Renderer checks these against its declared outputs).
   const std::set<std::string>& passWrites() const { return passWrites_; }
 
   // Cached derived data: returns the entry under `key` if it was built from `inputsDigest`, else
@@ -127,6 +149,14 @@ private:
   std::set<int> shadowMapExclusions_;
   std::set<std::string> declaredThisFrame_;
   std::set<std::string> passWrites_;
+  // The current pass scope (beginPass / endPass).
+  void checkAccess(const std::string& name, bool write) const;
+  void checkNoAllocation(const std::string& what, const std::string& name) const;
+  std::set<std::string> shared_;
+  bool inPass_ = false;
+  std::string pass_;
+  std::vector<ResourceAccess> access_;
+  Phase phase_ = Phase::Prepare;
 };
 
 }  // namespace radiant

@@ -118,49 +118,67 @@ bool SceneLights::sampleLe(Sampler& sampler, Emission& out) const {
   if (!(total_ > 0.f)) return false;
   const float uSelect = sampler.next();
   const glm::vec2 u1 = sampler.next2();
-  glm::vec2 u2 = sampler.next2();
+  const glm::vec2 u2 = sampler.next2();
   const int i = findInterval(emitterCdf_.data(), static_cast<int>(emitters_.size()), uSelect * total_);
   const float pSelect = (emitterCdf_[i + 1] - emitterCdf_[i]) / total_;
   if (!(pSelect > 0.f)) return false;
-  const Emitter& e = emitters_[i];
+  LeSample s;
+  if (!sampleLe(i, u1, u2, s)) return false;
   out = Emission{};
   out.light = i;
-  const Scene& scene = rays_.scene();
+  out.ray = s.ray;
+  out.flux = s.L * (s.cosine / (s.pdfPos * s.pdfDir * pSelect));
+  const Emitter& e = emitters_[i];
+  if (e.kind == Kind::Punctual && rays_.scene().lights[e.index].type != LightType::Directional)
+    out.windowRange = rays_.scene().lights[e.index].range;
+  return maxComponent(out.flux) > 0.f;
+}
+
+bool SceneLights::sampleLe(int i, glm::vec2 u1, glm::vec2 u2, LeSample& out) const {
+  const Emitter& e = emitters_.at(i);
+  out = LeSample{};
+  const float diskPdf = 1.f / (kPi * radius_ * radius_);
   switch (e.kind) {
     case Kind::Punctual: {
-      const Light& l = scene.lights[e.index];
+      const Light& l = rays_.scene().lights[e.index];
       const glm::vec3 I = l.color * l.intensity;
       if (l.type == LightType::Directional) {
         // Parallel rays through a disk of the bounding sphere's radius, perpendicular to the beam.
+        if (!(glm::length(l.direction) > 0.f)) return false;
         const glm::vec3 d = glm::normalize(l.direction);
         glm::vec3 t, b;
         planeOf(d, t, b);
         const glm::vec2 disk = sampleConcentricDisk(u1) * radius_;
         out.ray = Ray{center_ - 1.01f * radius_ * d + disk.x * t + disk.y * b, d, 0.f, kInf};
-        out.flux = I * (kPi * radius_ * radius_) / pSelect;
-        return true;
+        out.L = I;
+        out.pdfPos = diskPdf;
+        out.pdfDir = 1.f;
+        return maxComponent(I) > 0.f;
       }
-      out.windowRange = l.range;
+      out.pdfPos = 1.f;
       if (l.type == LightType::Point) {
         out.ray = Ray{l.position, sampleUniformSphere(u1), 0.f, kInf};
-        out.flux = I * (4.f * kPi) / pSelect;
-        return true;
+        out.L = I;
+        out.pdfDir = uniformSpherePdf();
+        return maxComponent(I) > 0.f;
       }
+      if (!(glm::length(l.direction) > 0.f)) return false;
       const glm::vec3 axis = glm::normalize(l.direction);
       const float cosOuter = std::cos(l.outerConeAngle);
       const glm::vec3 local = sampleUniformCone(u1, cosOuter);
       const ShadingFrame f = ShadingFrame::fromNormal(axis);
       out.ray = Ray{l.position, glm::normalize(f.toWorld(local)), 0.f, kInf};
-      out.flux = I * spotFalloff(l, local.z) * (2.f * kPi * (1.f - cosOuter)) / pSelect;
-      return maxComponent(out.flux) > 0.f;
+      out.L = I * spotFalloff(l, local.z);
+      out.pdfDir = 1.f / (2.f * kPi * (1.f - cosOuter));
+      return maxComponent(out.L) > 0.f;
     }
     case Kind::Triangle: {
       // A point uniform by area, a direction cosine-weighted about the emitting side (Stürzlinger &
       // Bastos say "uniform" for diffuse emitters; for a Lambertian emitter the flux leaves
-      // cosine-distributed, which this samples exactly): flux = Le pi A sides / pSelect.
+      // cosine-distributed, which this samples exactly): flux = Le pi A sides.
       const TriangleLight& tl = rays_.triangleLights()[e.index];
       const Material& mat = rays_.materialOf(tl.mesh);
-      SurfaceHit p = rays_.pointOn(tl.mesh, tl.prim, sampleUniformTriangle(u1));
+      const SurfaceHit p = rays_.pointOn(tl.mesh, tl.prim, sampleUniformTriangle(u1));
       glm::vec3 n = p.ng;
       float sides = 1.f;
       if (mat.doubleSided) {
@@ -168,11 +186,14 @@ bool SceneLights::sampleLe(Sampler& sampler, Emission& out) const {
         if (u2.x < 0.5f) n = -n;
         u2.x = u2.x < 0.5f ? 2.f * u2.x : 2.f * u2.x - 1.f;
       }
-      const glm::vec3 dir = glm::normalize(ShadingFrame::fromNormal(n).toWorld(sampleCosineHemisphere(u2)));
-      const glm::vec3 Le = rays_.emissionAt(p, -dir);
+      const glm::vec3 local = sampleCosineHemisphere(u2);
+      const glm::vec3 dir = glm::normalize(ShadingFrame::fromNormal(n).toWorld(local));
       out.ray = Ray{RayScene::offsetOrigin(p.p, p.ng, p.offsetScale, dir), dir, 0.f, kInf};
-      out.flux = Le * (kPi * tl.area * sides) / pSelect;
-      return maxComponent(out.flux) > 0.f;
+      out.L = rays_.emissionAt(p, -dir);
+      out.cosine = std::abs(glm::dot(n, dir));
+      out.pdfPos = 1.f / tl.area;
+      out.pdfDir = cosineHemispherePdf(out.cosine) / sides;
+      return out.pdfDir > 0.f && tl.area > 0.f && maxComponent(out.L) > 0.f;
     }
     case Kind::Environment: {
       float pdf = 0.f;
@@ -182,11 +203,56 @@ bool SceneLights::sampleLe(Sampler& sampler, Emission& out) const {
       planeOf(wi, t, b);
       const glm::vec2 disk = sampleConcentricDisk(u2) * radius_;
       out.ray = Ray{center_ + 1.01f * radius_ * wi + disk.x * t + disk.y * b, -wi, 0.f, kInf};
-      out.flux = environment_.radiance(wi) * (kPi * radius_ * radius_) / (pdf * pSelect);
-      return maxComponent(out.flux) > 0.f;
+      out.L = environment_.radiance(wi);
+      out.pdfPos = diskPdf;
+      out.pdfDir = pdf;
+      return maxComponent(out.L) > 0.f;
     }
   }
   return false;
+}
+
+void SceneLights::pdfLe(int i, const Ray& ray, float& pdfPos, float& pdfDir) const {
+  const Emitter& e = emitters_.at(i);
+  pdfPos = pdfDir = 0.f;
+  // The bounding disk across `axis`: the origin's distance from the line through the centre.
+  auto onDisk = [&](const glm::vec3& axis) {
+    const glm::vec3 r = ray.org - center_;
+    const glm::vec3 across = r - glm::dot(r, axis) * axis;
+    return glm::dot(across, across) <= radius_ * radius_ * (1.f + 1e-4f);
+  };
+  switch (e.kind) {
+    case Kind::Punctual: {
+      const Light& l = rays_.scene().lights[e.index];
+      if (!(glm::length(l.direction) > 0.f) && l.type != LightType::Point) return;
+      if (l.type == LightType::Directional) {
+        if (onDisk(glm::normalize(l.direction))) pdfPos = 1.f / (kPi * radius_ * radius_);
+        return;  // pdfDir: a delta
+      }
+      if (l.type == LightType::Point) {
+        pdfDir = uniformSpherePdf();
+        return;
+      }
+      const float cosOuter = std::cos(l.outerConeAngle);
+      if (glm::dot(glm::normalize(l.direction), ray.dir) >= cosOuter) pdfDir = 1.f / (2.f * kPi * (1.f - cosOuter));
+      return;
+    }
+    case Kind::Triangle: {
+      const TriangleLight& tl = rays_.triangleLights()[e.index];
+      const Material& mat = rays_.materialOf(tl.mesh);
+      const glm::vec3 ng = rays_.pointOn(tl.mesh, tl.prim, glm::vec2(1.f / 3.f)).ng;
+      const float c = glm::dot(ng, ray.dir);
+      pdfPos = tl.area > 0.f ? 1.f / tl.area : 0.f;
+      pdfDir = mat.doubleSided ? cosineHemispherePdf(std::abs(c)) / 2.f : cosineHemispherePdf(c);
+      return;
+    }
+    case Kind::Environment: {
+      const glm::vec3 wi = -ray.dir;
+      if (onDisk(wi)) pdfPos = 1.f / (kPi * radius_ * radius_);
+      pdfDir = environment_.pdf(wi);
+      return;
+    }
+  }
 }
 
 }  // namespace radiant::rt

@@ -179,6 +179,22 @@ inline std::shared_ptr<const EnvironmentDistribution> EnvironmentDistribution::b
 }
 
 
+// One emission sample of one emitter (pbrt-v4 Light::SampleLe): the ray leaving it, what it carries
+// along the ray and the densities it was drawn with.
+// - L: the emitted radiance for an area emitter (triangle, environment); the intensity I(w) (W/sr) of
+//   a point or spot light; the irradiance E normal to the beam (lux) of a directional light.
+// - pdfPos: density of the origin over the emitting area (m^-2); 1 for point and spot lights (a delta
+//   in position).
+// - pdfDir: density of the direction over solid angle (sr^-1); 1 for a directional light (a delta in
+//   direction).
+// - cosine: |n . dir| at a triangle's emitting side, 1 otherwise.
+// The flux of the sample is L cosine / (pdfPos pdfDir); its mean over samples is the emitter's power.
+struct LeSample {
+  Ray ray;
+  glm::vec3 L{0.f};
+  float pdfPos = 0.f, pdfDir = 0.f, cosine = 1.f;
+};
+
 // A photon (or light-tracing particle) leaving an emitter: the ray and its flux, already divided by
 // the probability of choosing this emitter and this ray, so the mean over N emissions of
 // flux / N ... sums to the emitted power.
@@ -217,8 +233,32 @@ public:
   float trianglePdf(const SurfaceHit& hit, const glm::vec3& dir) const;
 
   // Emission of one particle (eq. 1 of Stürzlinger & Bastos: m_i proportional to Phi_i, each photon
-  // carrying Phi / m). False when nothing emits.
+  // carrying Phi / m): an emitter chosen in proportion to its power, then sampleLe(emitter). False when
+  // nothing emits.
   bool sampleLe(Sampler& sampler, Emission& out) const;
+
+  // Emission of emitter `i` (an emitters() index) from two uniform pairs (pbrt-v4 SampleLe):
+  // - point: direction uniform on the sphere (u1); spot: uniform in the outer cone (u1);
+  // - directional: origin uniform on the disk of the scene's bounding sphere across the beam (u1);
+  // - triangle: origin uniform by area (u1), side (double-sided: u2.x < 1/2 is the back) and direction
+  //   cosine-weighted about that side's normal (u2);
+  // - environment: direction towards the sky by the map's importance (u1, EnvironmentLight::sample),
+  //   origin uniform on the bounding disk across it (u2), travelling inwards.
+  // False when the sample carries nothing (outside a spot's falloff, a zero-pdf direction).
+  bool sampleLe(int i, glm::vec2 u1, glm::vec2 u2, LeSample& out) const;
+  // The densities sampleLe(i) draws `ray` with (pbrt-v4 PDF_Le), for rays of the emitter's support
+  // (a triangle's: origin on it): pdfPos over area, pdfDir over solid angle; 0 for the delta parts
+  // (the position of a point or spot light, the direction of a directional light), which no other
+  // strategy can hit, and 0 outside the support (beyond a spot's cone or the disk, behind a one-sided
+  // triangle).
+  void pdfLe(int i, const Ray& ray, float& pdfPos, float& pdfDir) const;
+  // Radiant flux of emitter i (W, per channel): point 4 pi I, spot punctualPower, directional
+  // E pi r^2 and environment pi r^2 \int L dw over the bounding disk of radius r, triangle
+  // pi A L (twice for double-sided).
+  const glm::vec3& power(int i) const { return emitters_.at(i).power; }
+  // The disk directional light and the environment emit through (the scene's bounding sphere).
+  glm::vec3 center() const { return center_; }
+  float radius() const { return radius_; }
 
 private:
   const RayScene& rays_;

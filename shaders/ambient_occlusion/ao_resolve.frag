@@ -4,7 +4,7 @@
 // term to beauty: L^r = a L^a O (thesis eq. 4.1 with L^in = L^a mu), where a is the diffuse albedo
 // baseColor (1 - metallic) (1 - transmission) times the material's baked occlusion. For an environment
 // map L^a becomes E(n) / pi, its SH irradiance by the shading normal, and the glTF Fresnel weight of the
-// diffuse base multiplies it (renderer/techniques/direct/ImageBasedLighting.h; 1 - ~1e-3 head-on).
+// diffuse base multiplies it (renderer/shading/ImageBasedLighting.h; 1 - ~1e-3 head-on).
 // Metals have no diffuse lobe: their response to the environment is specular, which the direct pass
 // adds (split-sum), unoccluded.
 #include "common/shared.h"

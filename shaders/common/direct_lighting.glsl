@@ -1,6 +1,6 @@
 // Direct lighting of a surface point by every punctual light, with PCF shadow maps: the code the
 // `direct` pass runs per pixel and that other passes (environment cube maps, ...) run per fragment.
-// C++ side: renderer/techniques/direct/DirectLighting.h binds what this needs.
+// C++ side: renderer/shading/DirectLighting.h binds what this needs.
 #ifndef RADIANT_COMMON_DIRECT_LIGHTING
 #define RADIANT_COMMON_DIRECT_LIGHTING
 #include "common/brdf.glsl"

@@ -1,5 +1,5 @@
 // Image-based lighting, split-sum (Karis 2013) and SH irradiance (Ramamoorthi and Hanrahan 2001):
-// the GLSL half of renderer/techniques/direct/ImageBasedLighting.h, which documents the equations.
+// the GLSL half of renderer/shading/ImageBasedLighting.h, which documents the equations.
 #ifndef RADIANT_COMMON_IBL
 #define RADIANT_COMMON_IBL
 #include "common/constants.glsl"

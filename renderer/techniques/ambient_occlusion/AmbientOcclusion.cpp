@@ -10,7 +10,7 @@
 
 #include "renderer/frame/GpuTypes.h"
 #include "renderer/frame/PassContext.h"
-#include "renderer/techniques/direct/ImageBasedLighting.h"
+#include "renderer/shading/ImageBasedLighting.h"
 
 namespace radiant {
 namespace ao {
@@ -270,10 +270,10 @@ void AmbientOcclusionPass::prepare(const Scene&, const Params& params, FrameReso
   estimate.setDrawBuffers({GL_COLOR_ATTACHMENT0});
   estimate.checkComplete("AmbientOcclusionPass::prepare (estimate)");
 
-  gl::Texture& out = res.texture("ao", GL_TEXTURE_2D, GL_R32F, w, h);
+  gl::Texture& out = res.texture("ao");
   out.setFilter(GL_NEAREST, GL_NEAREST);
-  // Same spec as DirectPass declares, so this is the same texture.
-  gl::Texture& beauty = res.texture("beauty", GL_TEXTURE_2D, GL_RGBA32F, w, h);
+  // Declared outputs and beauty: allocated by the Renderer (renderer/frame/FrameAllocation.h).
+  gl::Texture& beauty = res.texture("beauty");
   gl::Framebuffer& resolve = res.framebuffer("ao_resolve");
   resolve.attach(GL_COLOR_ATTACHMENT0, out);
   resolve.attach(GL_COLOR_ATTACHMENT1, beauty);

@@ -8,9 +8,9 @@
 
 #include "renderer/frame/GpuTypes.h"
 #include "renderer/frame/PassContext.h"
-#include "renderer/techniques/direct/DirectLighting.h"
-#include "renderer/techniques/shadow_maps/ShadowMaps.h"
-#include "renderer/techniques/specular/Specular.h"
+#include "renderer/shading/DirectLighting.h"
+#include "renderer/shading/CubeFaces.h"
+#include "renderer/shading/SpecularObjects.h"
 
 namespace radiant {
 namespace {
@@ -108,12 +108,12 @@ bool CausticsPass::lightCamera(const Light& light, const Bounds& bounds, LightCa
 
 std::string CausticsPass::skipReason(const Scene& scene) {
   if (scene.features.lightCount() == 0) return "no point, spot or directional light";
-  const std::vector<std::size_t> generators = SpecularPass::specularMeshes(scene);
+  const std::vector<std::size_t> generators = specularMeshes(scene);
   if (generators.empty()) return "no specular material (mirror or refractor) in the scene";
   bool seen = false;
   for (const Light& l : scene.lights)
     for (std::size_t g : generators)
-      seen = seen || lightReaches(l, SpecularPass::referencePoint(scene.meshes[g]), scene.meshes[g].bounds.radius());
+      seen = seen || lightReaches(l, specularReferencePoint(scene.meshes[g]), scene.meshes[g].bounds.radius());
   if (!seen) return "no specular material in view of a light";
   return "";
 }
@@ -150,13 +150,13 @@ void CausticsPass::prepare(const Scene& scene, const Params& params, FrameResour
   footprintFilter_ = params.get<bool>("footprint_filter", true);
   specularLookup_ = params.get<bool>("specular_lookup", true);
 
-  generators_ = SpecularPass::specularMeshes(scene);
+  generators_ = specularMeshes(scene);
   pairs_.clear();
   skippedPairs_ = 0;
   for (std::size_t li = 0; li < scene.lights.size(); ++li)
     for (std::size_t g = 0; g < generators_.size(); ++g) {
       const MeshInstance& m = scene.meshes[generators_[g]];
-      const glm::vec3 c = SpecularPass::referencePoint(m);
+      const glm::vec3 c = specularReferencePoint(m);
       if (!lightReaches(scene.lights[li], c, m.bounds.radius())) continue;
       Pair p{static_cast<int>(li), static_cast<int>(g), {}};
       if (!lightCamera(scene.lights[li], m.bounds, p.camera)) {
@@ -198,14 +198,14 @@ void CausticsPass::prepare(const Scene& scene, const Params& params, FrameResour
   const int cubeGroups = ((C + kGroup - 1) / kGroup) * ((C + kGroup - 1) / kGroup) * 6;
   res.buffer("caustics_deposit_sums", static_cast<std::size_t>(cubeGroups) * sizeof(glm::vec4));
 
-  const int w = res.view().width, h = res.view().height;
+  // Its output and beauty: allocated by the Renderer (renderer/frame/FrameAllocation.h).
   gl::Framebuffer& fb = res.framebuffer("caustics");
-  fb.attach(GL_COLOR_ATTACHMENT0, res.texture("caustics", GL_TEXTURE_2D, GL_RGBA32F, w, h));
-  fb.attach(GL_COLOR_ATTACHMENT1, res.texture("beauty", GL_TEXTURE_2D, GL_RGBA32F, w, h));
+  fb.attach(GL_COLOR_ATTACHMENT0, res.texture("caustics"));
+  fb.attach(GL_COLOR_ATTACHMENT1, res.texture("beauty"));
   fb.setDrawBuffers({GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1});
   fb.checkComplete("CausticsPass::prepare");
   gl::Framebuffer& secondary = res.framebuffer("caustics_secondary");
-  secondary.attach(GL_COLOR_ATTACHMENT0, res.texture("beauty", GL_TEXTURE_2D, GL_RGBA32F, w, h));
+  secondary.attach(GL_COLOR_ATTACHMENT0, res.texture("beauty"));
   secondary.setDrawBuffers({GL_COLOR_ATTACHMENT0});
   secondary.checkComplete("CausticsPass::prepare (secondary)");
   declareDirectLightingResources(res);
@@ -244,7 +244,7 @@ void CausticsPass::execute(PassContext& ctx) {
   // Face transforms around the origin: hit positions are relative to the reference point.
   std::vector<glm::mat4> faces(6);
   const float sceneRadius = std::max(ctx.scene.features.bounds.radius(), 1e-6f);
-  for (int f = 0; f < 6; ++f) faces[f] = ShadowMapsPass::cubeFaceViewProj(glm::vec3(0.f), f, sceneRadius * 1e-6f);
+  for (int f = 0; f < 6; ++f) faces[f] = cubeFaceViewProj(glm::vec3(0.f), f, sceneRadius * 1e-6f);
 
   gl::Framebuffer& photonFb = res.framebuffer("caustics_photons");
   gl::Texture& hit = res.texture("caustics_hit");

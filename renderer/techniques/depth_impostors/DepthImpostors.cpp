@@ -6,8 +6,7 @@
 #include "renderer/frame/FrameResources.h"
 #include "renderer/frame/FrameView.h"
 #include "renderer/frame/PassContext.h"
-#include "renderer/techniques/spherical_billboards/MediaLayer.h"
-#include "renderer/techniques/spherical_billboards/SphericalBillboards.h"
+#include "renderer/shading/MediaLayer.h"
 
 namespace radiant {
 
@@ -53,7 +52,7 @@ void DepthImpostorsPass::prepare(const Scene& scene, const Params& params, Frame
   const impostors::BlockSet& blocks = res.cached<impostors::BlockSet>("depth_impostors.blocks", blockKey, [&] {
     std::vector<int> systemOf;
     const auto particles =
-        SphericalBillboardsPass::gpuParticles(view.media, view.ambient, view.eye, forward, ortho, false, &systemOf);
+        mediaParticles(view.media, view.ambient, view.eye, forward, ortho, false, &systemOf);
     return std::make_unique<impostors::BlockSet>(impostors::buildBlocks(particles, systemOf, particlesPerBlock_));
   });
   const impostors::AtlasLayout layout = impostors::atlasLayout(static_cast<int>(blocks.blocks.size()), requestedRes_);

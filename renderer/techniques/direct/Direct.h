@@ -16,7 +16,6 @@ public:
 private:
   int pcfRadius_ = 1;
   bool imageBasedLighting_ = true;
-  const Image* environmentUpload_ = nullptr;  // the map to upload in execute() (null: texture current)
 };
 
 }  // namespace radiant

@@ -11,8 +11,8 @@
 
 #include "renderer/frame/FrameView.h"
 #include "renderer/frame/PassContext.h"
-#include "renderer/techniques/direct/DirectLighting.h"
-#include "renderer/techniques/shadow_maps/ShadowMaps.h"
+#include "renderer/shading/DirectLighting.h"
+#include "renderer/shading/CubeFaces.h"
 
 namespace radiant {
 namespace {
@@ -133,12 +133,12 @@ void EnvDiffusePass::prepare(const Scene& scene, const Params& params, FrameReso
     receivers_.push_back(std::move(st));
   }
 
-  const int w = res.view().width, h = res.view().height;
+  // Its output and beauty: allocated by the Renderer (renderer/frame/FrameAllocation.h).
   gl::Framebuffer& fb = res.framebuffer("env_diffuse");
-  gl::Texture& indirect = res.texture("indirect_diffuse", GL_TEXTURE_2D, GL_RGBA32F, w, h);
+  gl::Texture& indirect = res.texture("indirect_diffuse");
   indirect.setFilter(GL_NEAREST, GL_NEAREST);
   fb.attach(GL_COLOR_ATTACHMENT0, indirect);
-  fb.attach(GL_COLOR_ATTACHMENT1, res.texture("beauty", GL_TEXTURE_2D, GL_RGBA32F, w, h));
+  fb.attach(GL_COLOR_ATTACHMENT1, res.texture("beauty"));
   fb.setDrawBuffers({GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1});
   fb.checkComplete("EnvDiffusePass::prepare");
 }
@@ -200,7 +200,7 @@ void EnvDiffusePass::buildCubeMaps(PassContext& ctx, const ReceiverState& st) {
       glClearNamedFramebufferfv(fb.id(), GL_COLOR, 0, sky);
       glClearNamedFramebufferfv(fb.id(), GL_COLOR, 1, far);
       glClearNamedFramebufferfv(fb.id(), GL_DEPTH, 0, &depthClear);
-      const glm::mat4 viewProj = ShadowMapsPass::cubeFaceViewProj(r.referencePoint, face, znear);
+      const glm::mat4 viewProj = cubeFaceViewProj(r.referencePoint, face, znear);
       cube.setMat4("u_viewProj", glm::value_ptr(viewProj));
       ctx.gpu.drawMeshes(cube, true, [&](std::size_t i) { return own.count(static_cast<int>(i)) == 0; });
     }

@@ -7,7 +7,7 @@
 
 #include "renderer/frame/PassContext.h"
 #include "renderer/raytracing/ParticleMedium.h"
-#include "renderer/techniques/spherical_billboards/MediaLayer.h"
+#include "renderer/shading/MediaLayer.h"
 
 namespace radiant {
 

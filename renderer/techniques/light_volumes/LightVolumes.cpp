@@ -120,9 +120,9 @@ void LightVolumesPass::prepare(const Scene& scene, const Params& params, FrameRe
   res.buffer("light_volumes_cones", bytesOf(cache.beams.cones));
   res.buffer("light_volumes_nodes", bytesOf(cache.bvh.nodes));
   res.buffer("light_volumes_prims", bytesOf(cache.bvh.primitives));
-  const int w = res.view().width, h = res.view().height;
-  res.texture("light_volumes", GL_TEXTURE_2D, GL_RGBA32F, w, h).setFilter(GL_NEAREST, GL_NEAREST);
-  res.texture("beauty", GL_TEXTURE_2D, GL_RGBA32F, w, h);
+  // Declared outputs: allocated by the Renderer (renderer/frame/FrameAllocation.h).
+  res.texture("light_volumes").setFilter(GL_NEAREST, GL_NEAREST);
+  res.texture("beauty");
 }
 
 void LightVolumesPass::execute(PassContext& ctx) {

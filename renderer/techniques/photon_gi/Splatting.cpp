@@ -127,11 +127,11 @@ void declareSplatResources(FrameResources& res, const SplatGrid& grid, const Spl
   splatFb.attach(GL_COLOR_ATTACHMENT0, accum);
   splatFb.setDrawBuffers({GL_COLOR_ATTACHMENT0});
   splatFb.checkComplete("photon_gi::declareSplatResources");
-  gl::Texture& indirect = res.texture("indirect", GL_TEXTURE_2D, GL_RGBA32F, w, h);
+  gl::Texture& indirect = res.texture("indirect");
   indirect.setFilter(GL_NEAREST, GL_NEAREST);
   gl::Framebuffer& resolveFb = res.framebuffer("photon_gi_resolve");
   resolveFb.attach(GL_COLOR_ATTACHMENT0, indirect);
-  resolveFb.attach(GL_COLOR_ATTACHMENT1, res.texture("beauty", GL_TEXTURE_2D, GL_RGBA32F, w, h));
+  resolveFb.attach(GL_COLOR_ATTACHMENT1, res.texture("beauty"));
   resolveFb.setDrawBuffers({GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1});
   resolveFb.checkComplete("photon_gi::declareSplatResources");
 }

@@ -182,7 +182,7 @@ ReferenceRequest referenceRequestFrom(const Params& params) {
 
 void ReferencePass::prepare(const Scene&, const Params& params, FrameResources& res) {
   request_ = referenceRequestFrom(params);
-  res.texture("reference", GL_TEXTURE_2D, GL_RGBA32F, res.view().width, res.view().height);
+  res.texture("reference");  // a declared output: allocated by the Renderer
 }
 
 void ReferencePass::execute(PassContext& ctx) {

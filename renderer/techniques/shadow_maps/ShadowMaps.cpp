@@ -7,6 +7,7 @@
 
 #include "renderer/frame/FrameView.h"
 #include "renderer/frame/PassContext.h"
+#include "renderer/shading/CubeFaces.h"
 
 namespace radiant {
 namespace {
@@ -35,14 +36,6 @@ Requirements ShadowMapsPass::requirements(const Scene& scene, const api::RenderR
   if (f.lightCount() == 0) return Requirements::skip("the scene has no punctual lights");
   if (f.triangles == 0) return Requirements::skip("the scene has no triangles to cast shadows");
   return Requirements::ok();
-}
-
-glm::mat4 ShadowMapsPass::cubeFaceViewProj(const glm::vec3& p, int face, float znear) {
-  // GL cube map face orientation (GL 4.5 spec table 8.19): the up vectors make a lookAt camera's
-  // image match the face's (s,t) layout when rendered with the lower-left origin.
-  static const glm::vec3 dirs[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-  static const glm::vec3 ups[6] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
-  return reversedZPerspective(glm::half_pi<float>(), 1.f, znear) * glm::lookAt(p, p + dirs[face], ups[face]);
 }
 
 void ShadowMapsPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {

@@ -4,6 +4,7 @@
 
 #include "renderer/frame/GpuTypes.h"
 #include "renderer/frame/Technique.h"
+#include "renderer/shading/CubeFaces.h"
 
 namespace radiant {
 
@@ -21,7 +22,9 @@ public:
   void execute(PassContext&) override;
 
   // World -> light clip transforms for one face / map; exposed for tests.
-  static glm::mat4 cubeFaceViewProj(const glm::vec3& lightPos, int face, float znear);
+  static glm::mat4 cubeFaceViewProj(const glm::vec3& lightPos, int face, float znear) {
+    return radiant::cubeFaceViewProj(lightPos, face, znear);  // renderer/shading/CubeFaces.h
+  }
 
 private:
   bool mapsValid_ = false;

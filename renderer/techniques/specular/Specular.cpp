@@ -9,8 +9,9 @@
 
 #include "renderer/frame/GpuTypes.h"
 #include "renderer/frame/PassContext.h"
-#include "renderer/techniques/direct/DirectLighting.h"
-#include "renderer/techniques/shadow_maps/ShadowMaps.h"
+#include "renderer/shading/CubeFaces.h"
+#include "renderer/shading/DirectLighting.h"
+#include "renderer/shading/SpecularObjects.h"
 
 namespace radiant {
 namespace {
@@ -38,13 +39,6 @@ const TechniqueInfo& SpecularPass::info() const {
       true,
       {"LS+E", "LDS+E"}};
   return i;
-}
-
-std::vector<std::size_t> SpecularPass::specularMeshes(const Scene& scene) {
-  std::vector<std::size_t> out;
-  for (std::size_t i = 0; i < scene.meshes.size(); ++i)
-    if (scene.material(scene.meshes[i].material).isSpecular() && scene.meshes[i].triangleCount() > 0) out.push_back(i);
-  return out;
 }
 
 Requirements SpecularPass::requirements(const Scene& scene, const api::RenderRequest&) const {
@@ -105,7 +99,7 @@ void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResour
   res.buffer("specular_objects", std::max<std::size_t>(1, objects_.size()) * sizeof(GpuObject));
   res.buffer("specular_minmax", static_cast<std::size_t>(cubes) * 2 * sizeof(std::uint32_t));
 
-  gl::Texture& specular = res.texture("specular", GL_TEXTURE_2D, GL_RGBA32F, w, h);
+  gl::Texture& specular = res.texture("specular");
   gl::Texture& depth = res.texture("specular_depth", GL_TEXTURE_2D, GL_DEPTH_COMPONENT32F, w, h);
   gl::Framebuffer& fb = res.framebuffer("specular");
   fb.attach(GL_COLOR_ATTACHMENT0, specular);
@@ -113,7 +107,7 @@ void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResour
   fb.setDrawBuffers({GL_COLOR_ATTACHMENT0});
   fb.checkComplete("SpecularPass::prepare");
   gl::Framebuffer& compose = res.framebuffer("specular_compose");
-  compose.attach(GL_COLOR_ATTACHMENT0, res.texture("beauty", GL_TEXTURE_2D, GL_RGBA32F, w, h));
+  compose.attach(GL_COLOR_ATTACHMENT0, res.texture("beauty"));
   compose.setDrawBuffers({GL_COLOR_ATTACHMENT0});
   compose.checkComplete("SpecularPass::prepare");
   declareDirectLightingResources(res);
@@ -196,7 +190,7 @@ void SpecularPass::execute(PassContext& ctx) {
           glClearNamedFramebufferfv(fb.id(), GL_COLOR, 2, empty);
           glClearNamedFramebufferfv(fb.id(), GL_COLOR, 3, zero);
           glClearNamedFramebufferfv(fb.id(), GL_DEPTH, 0, &depthClear);
-          const glm::mat4 vp = ShadowMapsPass::cubeFaceViewProj(ref, f, znear);
+          const glm::mat4 vp = cubeFaceViewProj(ref, f, znear);
           prog.setMat4("u_viewProj", &vp[0][0]);
           prog.set("u_faceMode", l == 0 ? 0 : l == 1 ? 1 : 2);
           prog.set("u_peel", l >= 3 ? 1 : 0);

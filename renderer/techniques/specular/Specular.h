@@ -13,6 +13,7 @@
 #include <glm/glm.hpp>
 
 #include "renderer/frame/Technique.h"
+#include "renderer/shading/SpecularObjects.h"
 
 namespace radiant {
 
@@ -30,13 +31,11 @@ public:
   };
   static_assert(sizeof(GpuObject) == 32, "std430 SpecularObject must be 32 bytes");
 
-  // The reference point of an object (thesis 5.1: the centre of its cube maps): its bounds' centre.
-  static glm::vec3 referencePoint(const MeshInstance& mesh) { return mesh.bounds.center(); }
-  // The specular objects in map order (object k's cubes are k * layers + l of the cube arrays): every
-  // mesh with triangles whose material isSpecular(), in mesh order. The caustics pass reads the maps
-  // (the frame resources specular_ldm_material / _geometry / _distance / _albedo, specular_objects,
-  // specular_minmax) through the internal output "specular_maps".
-  static std::vector<std::size_t> specularMeshes(const Scene& scene);
+  // The specular objects and their reference points: renderer/shading/SpecularObjects.h (shared with
+  // caustics). The caustics pass reads the maps (the frame resources specular_ldm_material / _geometry
+  // / _distance / _albedo, specular_objects, specular_minmax) through the internal output "specular_maps".
+  static glm::vec3 referencePoint(const MeshInstance& mesh) { return specularReferencePoint(mesh); }
+  static std::vector<std::size_t> specularMeshes(const Scene& scene) { return radiant::specularMeshes(scene); }
 
 private:
   struct Object {

@@ -6,7 +6,7 @@
 
 #include "renderer/frame/PassContext.h"
 #include "renderer/raytracing/Media.h"
-#include "renderer/techniques/spherical_billboards/MediaLayer.h"
+#include "renderer/shading/MediaLayer.h"
 
 namespace radiant {
 
@@ -29,40 +29,6 @@ Requirements SphericalBillboardsPass::requirements(const Scene& scene, const api
   return mediaRequirements(scene, request);
 }
 
-std::vector<gpu::MediaParticle> SphericalBillboardsPass::gpuParticles(const std::vector<api::ParticleSystem>& media,
-                                                                     glm::vec3 ambient, glm::vec3 eye,
-                                                                     glm::vec3 forward, bool orthographic, bool sort,
-                                                                     std::vector<int>* systemOf) {
-  std::vector<gpu::MediaParticle> out;
-  std::vector<float> key;
-  if (systemOf) systemOf->clear();
-  for (const api::ParticleSystem& s : media) {
-    const int profile = s.profile == api::DensityProfile::Thesis        ? gpu::kProfileThesis
-                        : s.profile == api::DensityProfile::LinearExact ? gpu::kProfileLinearExact
-                                                                        : gpu::kProfileConstant;
-    const int phase = s.phase == api::PhaseModel::HenyeyGreenstein ? gpu::kPhaseHenyeyGreenstein
-                      : s.phase == api::PhaseModel::CornetteShanks ? gpu::kPhaseCornetteShanks
-                                                                   : gpu::kPhaseIsotropic;
-    for (const api::Particle& p : s.particles) {
-      if (!(p.tau > 0.f)) continue;
-      // (1 - a) L_e + a L_ambient: a uniform sky integrates the phase function to 1.
-      const glm::vec3 emitted = s.emits() ? s.emissionScale * rt::blackbodyRgb(p.temperature) : glm::vec3(0.f);
-      const glm::vec3 source = (1.f - p.albedo) * emitted + p.albedo * ambient;
-      out.push_back({glm::vec4(p.position, p.radius), glm::vec4(source, p.tau), glm::vec4(p.albedo, s.g),
-                     glm::ivec4(profile, phase, 0, 0)});
-      key.push_back(orthographic ? glm::dot(p.position - eye, forward) : glm::length(p.position - eye));
-      if (systemOf) systemOf->push_back(static_cast<int>(&s - media.data()));
-    }
-  }
-  if (!sort || systemOf) return out;  // systemOf: unsorted, so that it stays parallel
-  std::vector<std::size_t> order(out.size());
-  std::iota(order.begin(), order.end(), std::size_t(0));
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key[a] > key[b]; });
-  std::vector<gpu::MediaParticle> sorted(out.size());
-  for (std::size_t i = 0; i < order.size(); ++i) sorted[i] = out[order[i]];
-  return sorted;
-}
-
 void SphericalBillboardsPass::prepare(const Scene&, const Params& params, FrameResources& res) {
   const FrameView& view = res.view();
   const std::string method = params.get<std::string>("method", "spherical");
@@ -73,7 +39,7 @@ void SphericalBillboardsPass::prepare(const Scene&, const Params& params, FrameR
   depthAware_ = params.get<std::string>("upsampling", "depth_aware") == "depth_aware";
   const glm::vec3 forward = -glm::normalize(glm::vec3(view.camera.world[2]));
   const bool ortho = view.camera.projection == ProjectionType::Orthographic;
-  particles_ = gpuParticles(view.media, view.ambient, view.eye, forward, ortho, params.get<bool>("sort", true));
+  particles_ = mediaParticles(view.media, view.ambient, view.eye, forward, ortho, params.get<bool>("sort", true));
 
   // Overdraw estimate: covered pixels of every particle's disc over the image (the cost driver, 7.3).
   const float pixelsPerUnit = ortho ? 0.5f * view.height / view.camera.ymag

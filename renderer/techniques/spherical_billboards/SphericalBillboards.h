@@ -18,6 +18,7 @@
 #include "renderer/frame/GpuTypes.h"
 #include "renderer/gl/Gl.h"
 #include "renderer/frame/Technique.h"
+#include "renderer/shading/MediaLayer.h"
 
 namespace radiant {
 
@@ -35,7 +36,9 @@ public:
   static std::vector<gpu::MediaParticle> gpuParticles(const std::vector<api::ParticleSystem>& media,
                                                       glm::vec3 ambient, glm::vec3 eye, glm::vec3 forward,
                                                       bool orthographic, bool sort,
-                                                      std::vector<int>* systemOf = nullptr);
+                                                      std::vector<int>* systemOf = nullptr) {
+    return mediaParticles(media, ambient, eye, forward, orthographic, sort, systemOf);  // renderer/shading/MediaLayer.h
+  }
 
 private:
   std::vector<gpu::MediaParticle> particles_;

@@ -5,8 +5,8 @@
 
 #include "renderer/frame/GpuTypes.h"
 #include "renderer/frame/PassContext.h"
-#include "renderer/techniques/direct/DirectLighting.h"
-#include "renderer/techniques/direct/ImageBasedLighting.h"
+#include "renderer/shading/DirectLighting.h"
+#include "renderer/shading/ImageBasedLighting.h"
 
 namespace radiant {
 
@@ -32,7 +32,7 @@ void TransparencyPass::prepare(const Scene&, const Params& params, FrameResource
   pcfRadius_ = params.get<int>("pcf_radius", 1);
   const int w = res.view().width, h = res.view().height;
   gl::Framebuffer& fb = res.framebuffer("transparency");
-  fb.attach(GL_COLOR_ATTACHMENT0, res.texture("beauty", GL_TEXTURE_2D, GL_RGBA32F, w, h));
+  fb.attach(GL_COLOR_ATTACHMENT0, res.texture("beauty"));
   fb.attach(GL_DEPTH_ATTACHMENT, res.texture("depth_buffer", GL_TEXTURE_2D, GL_DEPTH_COMPONENT32F, w, h));
   fb.setDrawBuffers({GL_COLOR_ATTACHMENT0});
   fb.checkComplete("TransparencyPass::prepare");

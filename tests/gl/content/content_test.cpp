@@ -10,7 +10,7 @@
 #include "renderer/scene/GltfLoader.h"
 #include "renderer/raytracing/Bsdf.h"
 #include "renderer/scene/StudioEnvironment.h"
-#include "renderer/techniques/direct/ImageBasedLighting.h"
+#include "renderer/shading/ImageBasedLighting.h"
 #include "tests/support/RenderTestSupport.h"
 #include "tests/support/SceneBuilder.h"
 #include "tests/unit/scene/GltfTestBuilder.h"

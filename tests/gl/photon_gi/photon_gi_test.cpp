@@ -44,6 +44,9 @@ public:
     r.width = r.height = size;
     view_ = makeFrameView(scene_, r);
     res_.beginFrame(*gpu_, view_, nullptr);
+    // What the Renderer allocates before any pass (renderer/frame/FrameAllocation.h): the declared outputs.
+    res_.texture("indirect", GL_TEXTURE_2D, GL_RGBA32F, size, size);
+    res_.texture("beauty", GL_TEXTURE_2D, GL_RGBA32F, size, size);
     api::PassStats stats;
     Params params;
     gbuffer_.prepare(scene_, params, res_);

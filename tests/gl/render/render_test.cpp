@@ -14,9 +14,11 @@
 
 #include "api/Aovs.h"
 #include "renderer/Renderer.h"
+#include "renderer/frame/FramePlanner.h"
 #include "renderer/frame/FrameResources.h"
 #include "renderer/io/ImageIO.h"
 #include "tests/support/Expect.h"
+#include "tests/support/ImageDifference.h"
 #include "tests/support/RenderTestSupport.h"
 #include "tests/support/SceneBuilder.h"
 
@@ -337,6 +339,81 @@ TEST(AovTable, FrameResourcesRefuseAnAovInAnotherFormatOrRespecifiedWithinAFrame
   // Resources that are no AOV's are free to change.
   res.texture("scratch", GL_TEXTURE_2D, GL_RGBA16F, 8, 8);
   res.texture("scratch", GL_TEXTURE_2D, GL_RGBA16F, 8, 8);
+}
+
+// Declared resource access (FrameResources::beginPass, FramePlanner's declaredAccess): inside a pass a
+// shared resource is touched only as the pass's TechniqueInfo declares, nothing is allocated in
+// execute(), and a pass cannot re-declare beauty in another spec (which would drop the light earlier
+// passes accumulated in it). Each breach is a std::logic_error naming the pass and the resource.
+TEST(AovTable, APassThatTouchesAnUndeclaredResourceFails) {
+  renderer();  // a current GL context
+  gl::ShaderLibrary shaders;
+  FrameResources res(shaders);
+  res.setSharedResources({"beauty", "direct", "ao", "specular", kEnvironmentMap});
+  // What the Renderer allocates before any pass (allocateDeclaredOutputs).
+  res.texture("beauty", GL_TEXTURE_2D, GL_RGBA32F, 8, 8);
+  res.texture("direct", GL_TEXTURE_2D, GL_RGBA32F, 8, 8);
+  const TechniqueInfo ao{"ambient_occlusion", "", {}, {"direct"}, {"ao"}, /*addsToBeauty=*/false, false};
+  res.beginPass(ao.name, declaredAccess(ao), FrameResources::Phase::Prepare);
+  res.texture("ao", GL_TEXTURE_2D, GL_R32F, 8, 8);         // its output
+  res.texture("direct");                                   // its optional input
+  res.texture("ao_scratch", GL_TEXTURE_2D, GL_R32F, 4, 4);  // its own intermediate: not shared
+  const std::string used = testing::thrownMessage<std::logic_error>([&] { res.texture("beauty"); });
+  EXPECT_NE(used.find("pass ambient_occlusion used 'beauty'"), std::string::npos) << used;
+  EXPECT_NE(used.find("direct:Read"), std::string::npos) << used;  // and says what it did declare
+  res.endPass();
+
+  res.beginPass(ao.name, declaredAccess(ao), FrameResources::Phase::Execute);
+  res.texture("ao");
+  res.markWritten("ao");
+  const std::string readOnly = testing::thrownMessage<std::logic_error>([&] { res.markWritten("direct"); });
+  EXPECT_NE(readOnly.find("declares Read only"), std::string::npos) << readOnly;
+  const std::string undeclared = testing::thrownMessage<std::logic_error>([&] { res.markWritten("specular"); });
+  EXPECT_NE(undeclared.find("pass ambient_occlusion wrote 'specular'"), std::string::npos) << undeclared;
+  const std::string allocated = testing::thrownMessage<std::logic_error>(
+      [&] { res.texture("ao_blurred", GL_TEXTURE_2D, GL_R32F, 8, 8); });
+  EXPECT_NE(allocated.find("in execute()"), std::string::npos) << allocated;
+  const std::string buffer = testing::thrownMessage<std::logic_error>([&] { res.buffer("ao_samples", 64); });
+  EXPECT_NE(buffer.find("in execute()"), std::string::npos) << buffer;
+  EXPECT_EQ(res.passWrites(), (std::set<std::string>{"ao"}));
+  res.endPass();
+
+  // A pass that adds to beauty sees the Renderer's beauty; asking for another size throws and keeps it.
+  const TechniqueInfo caustics{"caustics", "", {}, {}, {"caustics"}, /*addsToBeauty=*/true, false};
+  res.beginPass(caustics.name, declaredAccess(caustics), FrameResources::Phase::Prepare);
+  const GLuint beautyId = res.texture("beauty").id();
+  const std::string resized = testing::thrownMessage<std::logic_error>(
+      [&] { res.texture("beauty", GL_TEXTURE_2D, GL_RGBA32F, 16, 16); });
+  EXPECT_NE(resized.find("by pass caustics"), std::string::npos) << resized;
+  res.endPass();
+  EXPECT_EQ(res.texture("beauty").id(), beautyId);
+  EXPECT_EQ(res.texture("beauty").width(), 8);
+  // Outside a pass scope (the Renderer, readback) nothing is checked.
+  EXPECT_NO_THROW(res.texture("specular", GL_TEXTURE_2D, GL_RGBA32F, 8, 8));
+}
+
+// The Renderer allocates the planned passes' declared outputs and uploads the environment map as a frame
+// resource once per map: a second frame with the same map is a cache hit, and the direct pass (which
+// reads it, declared) shows the same sky in both.
+TEST(AovTable, TheEnvironmentMapIsAFrameResourceUploadedOncePerMap) {
+  Scene scene = planeScene().topDownOrtho(5.f, 1.f).build("env-frame-resource");
+  Image env = Image::make("environment", 8, 4, 3);
+  for (std::size_t i = 0; i < env.pixels.size(); ++i) env.pixels[i] = 0.25f + 0.01f * static_cast<float>(i % 7);
+  api::RenderRequest req = request(16, {"beauty"});
+  req.environment = "sha256:env-frame-resource";
+  FrameInputs inputs;
+  inputs.environment = &env;
+  auto envEvents = [](const RenderOutput& out) {
+    std::vector<bool> hits;
+    for (const auto& e : out.stats.cache)
+      if (e.what == "environment_map") hits.push_back(e.hit);
+    return hits;
+  };
+  const RenderOutput first = renderer().render(scene, req, nullptr, inputs);
+  const RenderOutput second = renderer().render(scene, req, nullptr, inputs);
+  EXPECT_EQ(envEvents(first), std::vector<bool>{false});
+  EXPECT_EQ(envEvents(second), std::vector<bool>{true});
+  EXPECT_EQ(testing::maxAbsDifference(aov(first, "beauty"), aov(second, "beauty")), 0.f);
 }
 
 TEST(AovTable, MaterialAovCarriesTransmission) {

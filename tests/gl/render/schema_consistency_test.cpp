@@ -154,6 +154,39 @@ TEST(SchemaConsistency, UndeclaredWritesAreFound) {
   EXPECT_EQ(undeclaredWrite(info, {}), "");
 }
 
+// Declared access (FramePlanner's declaredAccess, enforced by FrameResources in each pass scope): every
+// Read names a resource some technique writes or a frame resource the Renderer provides; Accumulate is
+// beauty, for exactly the passes that add to it; the environment map is read, never written, by passes.
+TEST(SchemaConsistency, EveryDeclaredReadHasAWriterAndOnlyBeautyAccumulates) {
+  std::vector<std::unique_ptr<Technique>> all = createTechniques();
+  std::vector<Technique*> ptrs;
+  std::set<std::string> written{"beauty", kEnvironmentMap};
+  for (auto& t : all) {
+    ptrs.push_back(t.get());
+    written.insert(t->info().outputs.begin(), t->info().outputs.end());
+  }
+  bool directReadsEnvironment = false;
+  for (auto& t : all) {
+    const TechniqueInfo& info = t->info();
+    int accumulates = 0;
+    for (const ResourceAccess& a : declaredAccess(info)) {
+      if (a.access == Access::Read) EXPECT_TRUE(written.count(a.name)) << info.name << " reads " << a.name;
+      if (a.access == Access::Write) EXPECT_NE(a.name, kEnvironmentMap) << info.name;
+      if (a.access == Access::Accumulate) {
+        EXPECT_EQ(a.name, "beauty") << info.name;
+        ++accumulates;
+      }
+      directReadsEnvironment |= info.name == "direct" && a.name == kEnvironmentMap && a.access == Access::Read;
+    }
+    EXPECT_EQ(accumulates, info.addsToBeauty ? 1 : 0) << info.name;
+  }
+  EXPECT_TRUE(directReadsEnvironment);
+  const std::set<std::string> shared = sharedResources(ptrs);
+  for (const char* name : {"beauty", kEnvironmentMap, "gbuffer_position", "media", "specular_maps", "shadow_maps"})
+    EXPECT_TRUE(shared.count(name)) << name;
+  EXPECT_FALSE(shared.count("ao_raw"));  // a pass's own intermediate target
+}
+
 // Each technique declares what scores its AOVs (Technique::groundTruth); the compare block only asks.
 TEST(SchemaConsistency, TechniquesDeclareTheirGroundTruth) {
   std::map<std::string, std::unique_ptr<Technique>> byName;

@@ -2,7 +2,9 @@
 // and the server's caps key on that declaration, not on parameter names.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <regex>
+#include <vector>
 #include <set>
 
 #include "api/Validate.h"
@@ -62,6 +64,9 @@ RequestLimits limitsWith(const std::string& kind, long long max) {
   if (kind == "samples") l.maxSamples = static_cast<int>(max);
   else if (kind == "photons") l.maxPhotons = max;
   else if (kind == "particles") l.maxParticles = static_cast<std::size_t>(max);
+  else if (kind == "resolution") l.maxMapResolution = static_cast<int>(max);
+  else if (kind == "nodes") l.maxNetworkNodes = static_cast<int>(max);
+  else if (kind == "iterations") l.maxIterations = static_cast<int>(max);
   return l;
 }
 
@@ -78,6 +83,16 @@ TEST(CostLimits, TheSchemaDeclaresEveryKnownCostKnob) {
       {"/passes/photon_gi/ppm_base_photons", "none"},
       {"/compare/spp", "samples"},
       {"/media/*/generator/count", "particles"},
+      // Sizes of maps and grids: texels per side (memory and fill grow with the square).
+      {"/passes/shadow_maps/shadow_map_size", "resolution"},
+      {"/passes/specular/cube_resolution", "resolution"},
+      {"/passes/caustics/cube_resolution", "resolution"},
+      {"/passes/caustics/photon_resolution", "resolution"},
+      {"/passes/env_diffuse/cube_resolution", "resolution"},
+      {"/passes/depth_impostors/impostor_resolution", "resolution"},
+      {"/passes/depth_impostors/slice_resolution", "resolution"},
+      {"/passes/illumination_network/nodes", "nodes"},
+      {"/passes/illumination_network/iterations", "iterations"},
   };
   for (const auto& [pointer, kind] : expected) {
     ASSERT_TRUE(found.count(pointer)) << pointer << " declares no x-cost";
@@ -85,41 +100,66 @@ TEST(CostLimits, TheSchemaDeclaresEveryKnownCostKnob) {
   }
 }
 
-// Every x-cost knob, one above its cap (and within the schema's range): 422 limit-exceeded naming exactly
-// that field and the flag that raises the cap; at the cap it is accepted.
+// The schema of the knob at a costParameters() pointer.
+const json& knobSchema(const json& schema, const std::string& pointer) {
+  std::string sp;
+  for (std::size_t i = 1, j; i <= pointer.size(); i = j + 1) {
+    j = pointer.find('/', i);
+    if (j == std::string::npos) j = pointer.size();
+    const std::string token = pointer.substr(i, j - i);
+    sp += token == "*" ? "/items" : "/properties/" + token;
+  }
+  return schema[json::json_pointer(sp)];
+}
+long long smallestValue(const json& knob) {
+  if (knob.contains("enum")) {
+    const auto v = knob.at("enum").get<std::vector<long long>>();
+    return *std::min_element(v.begin(), v.end());
+  }
+  return knob.value("minimum", 0LL);
+}
+
+// Every x-cost knob, one above its cap (and within the schema's range; for an enumerated knob, the next
+// allowed value): 422 limit-exceeded naming exactly that field and the flag that raises the cap; at the
+// cap it is accepted. The knobs of the same kind beside it (a named pass gets every default, and those
+// are capped too) are set to their smallest values, and the cap is at least those.
 TEST(CostLimits, AnOverCapValueOfEveryCostKnobIsA422NamingIt) {
   const json& schema = renderRequestSchema();
   int checked = 0;
   for (const auto& [pointer, kind] : costParameters(schema)) {
     const auto limit = costLimit(kind, RequestLimits{});
     if (!limit) continue;  // "none": not capped
-    // The knob's own schema, for its range.
-    std::string sp;
-    for (std::size_t i = 1, j; i <= pointer.size(); i = j + 1) {
-      j = pointer.find('/', i);
-      if (j == std::string::npos) j = pointer.size();
-      const std::string token = pointer.substr(i, j - i);
-      sp += token == "*" ? "/items" : "/properties/" + token;
-    }
-    const json& knob = schema[json::json_pointer(sp)];
-    const long long lo = knob.value("minimum", 0LL), hi = knob.value("maximum", 1LL << 40);
-    // The cap: just above the minimum, but not below the defaults of the knobs of the same kind beside
-    // it (a named pass gets every default, and those are capped too: reference.spp's 64 beside
-    // light_paths_per_pixel).
-    long long cap = std::max(lo, 1LL) + 1;
+    SCOPED_TRACE(pointer);
+    const json& knob = knobSchema(schema, pointer);
+    std::vector<std::pair<std::string, long long>> siblings;
+    long long floor = std::max(knob.value("minimum", 0LL), 1LL) + 1;
     const std::string parent = pointer.substr(0, pointer.rfind('/'));
     for (const auto& [other, otherKind] : costParameters(schema))
       if (otherKind == kind && other != pointer && other.substr(0, other.rfind('/')) == parent) {
-        std::string op = sp.substr(0, sp.rfind('/')) + "/" + other.substr(other.rfind('/') + 1);
-        cap = std::max(cap, schema[json::json_pointer(op)].value("default", 0LL));
+        siblings.emplace_back(other, smallestValue(knobSchema(schema, other)));
+        floor = std::max(floor, siblings.back().second);
       }
-    ASSERT_LT(cap, hi) << pointer;
-    SCOPED_TRACE(pointer);
+    long long cap = floor, over = floor + 1;
+    if (knob.contains("enum")) {
+      std::vector<long long> values = knob.at("enum").get<std::vector<long long>>();
+      std::sort(values.begin(), values.end());
+      const auto at = std::lower_bound(values.begin(), values.end(), floor);
+      ASSERT_TRUE(at != values.end() && at + 1 != values.end());
+      cap = *at;
+      over = *(at + 1);
+    } else {
+      ASSERT_LT(cap, knob.value("maximum", 1LL << 40));
+    }
+    auto body = [&](long long value) {
+      json b = requestWith(pointer, value);
+      for (const auto& [other, smallest] : siblings) b[json::json_pointer(firstItem(other))] = smallest;
+      return b;
+    };
     const RequestLimits limits = limitsWith(kind, cap);
-    EXPECT_NO_THROW(parseRenderRequest(requestWith(pointer, cap), limits));
+    EXPECT_NO_THROW(parseRenderRequest(body(cap), limits));
     try {
-      parseRenderRequest(requestWith(pointer, cap + 1), limits);
-      ADD_FAILURE() << "no error for " << pointer << " = " << cap + 1 << " above a cap of " << cap;
+      parseRenderRequest(body(over), limits);
+      ADD_FAILURE() << "no error for " << pointer << " = " << over << " above a cap of " << cap;
     } catch (const ApiError& e) {
       EXPECT_EQ(e.status, 422);
       EXPECT_EQ(e.type, "limit-exceeded");
@@ -128,7 +168,7 @@ TEST(CostLimits, AnOverCapValueOfEveryCostKnobIsA422NamingIt) {
     }
     ++checked;
   }
-  EXPECT_GE(checked, 6);
+  EXPECT_GE(checked, 15);
 }
 
 TEST(CostLimits, ACostLikeParameterWithoutXCostFails) {
@@ -154,4 +194,8 @@ TEST(CostLimits, UnknownCostKindIsAProgrammerError) {
   EXPECT_THROW(costLimit("beams", RequestLimits{}), std::logic_error);
   EXPECT_FALSE(costLimit("none", RequestLimits{}).has_value());
   EXPECT_EQ(costLimit("photons", RequestLimits{})->max, 4000000);
+  // The defaults are the schema's own maxima: a server without flags refuses nothing the schema allows.
+  EXPECT_EQ(costLimit("resolution", RequestLimits{})->max, 4096);
+  EXPECT_EQ(costLimit("nodes", RequestLimits{})->max, 65536);
+  EXPECT_EQ(costLimit("iterations", RequestLimits{})->max, 1024);
 }

@@ -1,4 +1,9 @@
-#include "renderer/techniques/spherical_billboards/MediaLayer.h"
+#include "renderer/shading/MediaLayer.h"
+
+#include <algorithm>
+#include <numeric>
+
+#include "renderer/raytracing/Media.h"
 
 #include "renderer/frame/FrameView.h"
 
@@ -37,14 +42,14 @@ void setMediaCameraUniforms(const gl::Program& prog, const FrameView& view, bool
 }
 
 void declareMediaLayer(FrameResources& res, int w, int h) {
-  gl::Texture& media = res.texture("media", GL_TEXTURE_2D, GL_RGBA32F, w, h);
+  gl::Texture& media = res.texture("media");
   media.setFilter(GL_NEAREST, GL_NEAREST);
   gl::Framebuffer& fb = res.framebuffer("media");
   fb.attach(GL_COLOR_ATTACHMENT0, media);
   fb.setDrawBuffers({GL_COLOR_ATTACHMENT0});
   fb.checkComplete("declareMediaLayer");
   gl::Framebuffer& compose = res.framebuffer("media_compose");
-  compose.attach(GL_COLOR_ATTACHMENT0, res.texture("beauty", GL_TEXTURE_2D, GL_RGBA32F, w, h));
+  compose.attach(GL_COLOR_ATTACHMENT0, res.texture("beauty"));
   compose.setDrawBuffers({GL_COLOR_ATTACHMENT0});
   compose.checkComplete("declareMediaLayer (compose)");
 }
@@ -69,6 +74,39 @@ void composeMediaIntoBeauty(PassContext& ctx) {
   glDisable(GL_BLEND);
   glDepthMask(GL_TRUE);
   res.markWritten("beauty");
+}
+
+std::vector<gpu::MediaParticle> mediaParticles(const std::vector<api::ParticleSystem>& media, glm::vec3 ambient,
+                                               glm::vec3 eye, glm::vec3 forward, bool orthographic, bool sort,
+                                               std::vector<int>* systemOf) {
+  std::vector<gpu::MediaParticle> out;
+  std::vector<float> key;
+  if (systemOf) systemOf->clear();
+  for (const api::ParticleSystem& s : media) {
+    const int profile = s.profile == api::DensityProfile::Thesis        ? gpu::kProfileThesis
+                        : s.profile == api::DensityProfile::LinearExact ? gpu::kProfileLinearExact
+                                                                        : gpu::kProfileConstant;
+    const int phase = s.phase == api::PhaseModel::HenyeyGreenstein ? gpu::kPhaseHenyeyGreenstein
+                      : s.phase == api::PhaseModel::CornetteShanks ? gpu::kPhaseCornetteShanks
+                                                                   : gpu::kPhaseIsotropic;
+    for (const api::Particle& p : s.particles) {
+      if (!(p.tau > 0.f)) continue;
+      // (1 - a) L_e + a L_ambient: a uniform sky integrates the phase function to 1.
+      const glm::vec3 emitted = s.emits() ? s.emissionScale * rt::blackbodyRgb(p.temperature) : glm::vec3(0.f);
+      const glm::vec3 source = (1.f - p.albedo) * emitted + p.albedo * ambient;
+      out.push_back({glm::vec4(p.position, p.radius), glm::vec4(source, p.tau), glm::vec4(p.albedo, s.g),
+                     glm::ivec4(profile, phase, 0, 0)});
+      key.push_back(orthographic ? glm::dot(p.position - eye, forward) : glm::length(p.position - eye));
+      if (systemOf) systemOf->push_back(static_cast<int>(&s - media.data()));
+    }
+  }
+  if (!sort || systemOf) return out;  // systemOf: unsorted, so that it stays parallel
+  std::vector<std::size_t> order(out.size());
+  std::iota(order.begin(), order.end(), std::size_t(0));
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key[a] > key[b]; });
+  std::vector<gpu::MediaParticle> sorted(out.size());
+  for (std::size_t i = 0; i < order.size(); ++i) sorted[i] = out[order[i]];
+  return sorted;
 }
 
 }  // namespace radiant

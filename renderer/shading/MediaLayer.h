@@ -2,13 +2,25 @@
 // The media layer every media technique writes and composes (spherical_billboards, depth_impostors;
 // illumination_network; one of them per frame, FramePlanner): the "media" target (RGBA32F: RGB premultiplied radiance,
 // A transmittance) and its composition into beauty, beauty = beauty * T + C (thesis 7.2.3).
+#include <vector>
+
 #include "renderer/frame/FrameResources.h"
+#include "renderer/frame/GpuTypes.h"
 #include "renderer/frame/PassContext.h"
 #include "renderer/frame/Technique.h"
 
 namespace radiant {
 
 struct FrameView;
+
+// The frame's particles as the media shaders read them (std430 gpu::MediaParticle): position and
+// radius, the source term (1 - albedo) L_e + albedo L_ambient and optical depth, albedo and phase
+// parameter, density profile and phase model; sorted back to front for the view from `eye` (forward:
+// the view direction, the sort key of orthographic cameras) when `sort` (else in the systems' order).
+// `systemOf` (when given; the particles are then unsorted) receives each particle's index in `media`.
+std::vector<gpu::MediaParticle> mediaParticles(const std::vector<api::ParticleSystem>& media, glm::vec3 ambient,
+                                               glm::vec3 eye, glm::vec3 forward, bool orthographic, bool sort,
+                                               std::vector<int>* systemOf = nullptr);
 
 // Run when the frame has particles (the scene's or the request's), else skip with the reason.
 Requirements mediaRequirements(const Scene& scene, const api::RenderRequest& request);

@@ -1,4 +1,4 @@
-#include "renderer/techniques/direct/ImageBasedLighting.h"
+#include "renderer/shading/ImageBasedLighting.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "renderer/techniques/direct/DirectLighting.h"
+#include "renderer/shading/DirectLighting.h"
 
 namespace radiant {
 

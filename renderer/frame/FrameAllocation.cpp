@@ -1,0 +1,58 @@
+#include "renderer/frame/FrameAllocation.h"
+
+#include <algorithm>
+#include <string>
+
+#include "api/Aovs.h"
+#include "renderer/frame/FramePlanner.h"
+
+namespace radiant {
+namespace {
+GLenum glFormat(api::AovFormat f) {
+  switch (f) {
+    case api::AovFormat::R32F: return GL_R32F;
+    case api::AovFormat::Rgba16F: return GL_RGBA16F;
+    default: return GL_RGBA32F;
+  }
+}
+struct EnvironmentMapEntry {};  // marks the environment_map texture as holding the keyed map
+}  // namespace
+
+void allocateDeclaredOutputs(FrameResources& res, const std::vector<Technique*>& passes) {
+  const int w = res.view().width, h = res.view().height;
+  for (const api::AovInfo& a : api::aovTable()) {
+    if (a.resource.empty()) continue;
+    bool declared = a.blend == api::AovBlend::Accumulate;  // beauty exists in every frame
+    for (const Technique* t : passes) {
+      const auto& outs = t->info().outputs;
+      declared = declared || std::find(outs.begin(), outs.end(), a.name) != outs.end() ||
+                 std::find(outs.begin(), outs.end(), a.resource) != outs.end();
+    }
+    if (declared) res.texture(a.resource, GL_TEXTURE_2D, glFormat(a.format), w, h);
+  }
+}
+
+void declareEnvironmentMap(FrameResources& res, const FrameView& view) {
+  if (!view.environment) {
+    // Keep a previous frame's map (the shaders do not sample it: u_hasEnvironment = 0).
+    if (!res.hasTexture(kEnvironmentMap)) res.texture(kEnvironmentMap, GL_TEXTURE_2D, GL_RGBA32F, 1, 1);
+    return;
+  }
+  const Image& env = *view.environment;
+  gl::Texture& t = res.texture(kEnvironmentMap, GL_TEXTURE_2D, GL_RGBA32F, env.width, env.height);
+  t.setFilter(GL_NEAREST, GL_NEAREST);
+  bool built = false;
+  res.cached<EnvironmentMapEntry>(kEnvironmentMap, view.environmentKey + "|" + std::to_string(env.width) + "x" +
+                                                       std::to_string(env.height), [&] {
+    built = true;
+    return std::make_unique<EnvironmentMapEntry>();
+  });
+  if (!built) return;
+  std::vector<float> rgba(static_cast<std::size_t>(env.width) * env.height * 4, 0.f);
+  for (std::size_t p = 0; p < static_cast<std::size_t>(env.width) * env.height; ++p)
+    for (int c = 0; c < 3; ++c) rgba[p * 4 + c] = env.pixels[p * env.channels + std::min(c, env.channels - 1)];
+  // Rows in image order (row 0 = up): texel row v * height is image row v * height.
+  t.upload(0, 0, 0, 0, env.width, env.height, 1, GL_RGBA, GL_FLOAT, rgba.data());
+}
+
+}  // namespace radiant
