@@ -34,21 +34,41 @@ gpu::Material toGpuMaterial(const Material& m) {
   g.texturesB = glm::ivec4(uvSet(m.emissiveTexture), m.doubleSided ? 1 : 0, uvSet(m.transmissionTexture), 0);
   g.flags = glm::ivec4(m.unlit ? 1 : 0, m.isSpecular() ? 1 : 0, 0, 0);
   // KHR_texture_transform: the same rows TextureRef::transformUv applies on the CPU, slot by slot.
-  const TextureRef* slots[gpu::kSlotCount] = {};
+  const auto slots = materialTextureSlots(m);
+  for (int s = 0; s < gpu::kSlotCount; ++s) {
+    g.uvTransform[2 * s] = glm::vec4(slots[s]->uvRow0, 0.f);
+    g.uvTransform[2 * s + 1] = glm::vec4(slots[s]->uvRow1, 0.f);
+  }
+  g.clearcoat = glm::vec4(m.clearcoatFactor, m.clearcoatRoughnessFactor, m.clearcoatNormalTexture.scale, 0.f);
+  g.sheen = glm::vec4(m.sheenColorFactor, m.sheenRoughnessFactor);
+  g.specular = glm::vec4(m.specularColorFactor, m.specularFactor);
+  g.texturesC = glm::ivec4(uvSet(m.clearcoatTexture), uvSet(m.clearcoatRoughnessTexture),
+                           uvSet(m.clearcoatNormalTexture), uvSet(m.sheenColorTexture));
+  g.texturesD = glm::ivec4(uvSet(m.sheenRoughnessTexture), uvSet(m.specularTexture), uvSet(m.specularColorTexture), 0);
+  return g;
+}
+
+std::array<const TextureRef*, gpu::kSlotCount> materialTextureSlots(const Material& m) {
+  std::array<const TextureRef*, gpu::kSlotCount> slots{};
   slots[gpu::kSlotBaseColor] = &m.baseColorTexture;
   slots[gpu::kSlotMetallicRoughness] = &m.metallicRoughnessTexture;
   slots[gpu::kSlotNormal] = &m.normalTexture;
   slots[gpu::kSlotOcclusion] = &m.occlusionTexture;
   slots[gpu::kSlotEmissive] = &m.emissiveTexture;
   slots[gpu::kSlotTransmission] = &m.transmissionTexture;
-  for (int s = 0; s < gpu::kSlotCount; ++s) {
-    g.uvTransform[2 * s] = glm::vec4(slots[s]->uvRow0, 0.f);
-    g.uvTransform[2 * s + 1] = glm::vec4(slots[s]->uvRow1, 0.f);
-  }
-  g.clearcoat = glm::vec4(m.clearcoatFactor, m.clearcoatRoughnessFactor, 0.f, 0.f);
-  g.sheen = glm::vec4(m.sheenColorFactor, m.sheenRoughnessFactor);
-  g.specular = glm::vec4(m.specularColorFactor, m.specularFactor);
-  return g;
+  slots[gpu::kSlotClearcoat] = &m.clearcoatTexture;
+  slots[gpu::kSlotClearcoatRoughness] = &m.clearcoatRoughnessTexture;
+  slots[gpu::kSlotClearcoatNormal] = &m.clearcoatNormalTexture;
+  slots[gpu::kSlotSheenColor] = &m.sheenColorTexture;
+  slots[gpu::kSlotSheenRoughness] = &m.sheenRoughnessTexture;
+  slots[gpu::kSlotSpecular] = &m.specularTexture;
+  slots[gpu::kSlotSpecularColor] = &m.specularColorTexture;
+  return slots;
+}
+
+bool materialSlotIsSrgb(int slot) {
+  return slot == gpu::kSlotBaseColor || slot == gpu::kSlotEmissive || slot == gpu::kSlotSheenColor ||
+         slot == gpu::kSlotSpecularColor;
 }
 
 namespace {
@@ -128,12 +148,8 @@ GpuScene::GpuScene(const Scene& scene) : sceneKey(nextSceneKey(scene)) {
     g.vao.elements(g.indices);
     g.material = mi.material >= 0 && mi.material < defaultMaterial ? mi.material : defaultMaterial;
     const Material& m = scene.material(mi.material);
-    g.textures[gpu::kSlotBaseColor] = gpuTexture(m.baseColorTexture, true);
-    g.textures[gpu::kSlotMetallicRoughness] = gpuTexture(m.metallicRoughnessTexture, false);
-    g.textures[gpu::kSlotNormal] = gpuTexture(m.normalTexture, false);
-    g.textures[gpu::kSlotOcclusion] = gpuTexture(m.occlusionTexture, false);
-    g.textures[gpu::kSlotEmissive] = gpuTexture(m.emissiveTexture, true);
-    g.textures[gpu::kSlotTransmission] = gpuTexture(m.transmissionTexture, false);
+    const auto slots = materialTextureSlots(m);
+    for (int s = 0; s < gpu::kSlotCount; ++s) g.textures[s] = gpuTexture(*slots[s], materialSlotIsSrgb(s));
     triangles += mi.triangleCount();
     meshes.push_back(std::move(g));
   }
@@ -155,7 +171,7 @@ void GpuScene::bindSceneBuffers() const {
 void GpuScene::bindMaterialTextures(std::size_t meshIndex) const {
   const GpuMesh& m = meshes[meshIndex];
   for (int s = 0; s < gpu::kSlotCount; ++s)
-    if (m.textures[s] >= 0) textures[m.textures[s]].bindUnit(gpu::kUnitMaterial0 + s);
+    if (m.textures[s] >= 0) textures[m.textures[s]].bindUnit(gpu::materialTextureUnit(s));
 }
 
 void GpuScene::draw(const gl::Program& program, bool withTextures) const {

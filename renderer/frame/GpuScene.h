@@ -30,6 +30,10 @@ struct GpuMesh {
 // parity test feeds the GPU exactly what a render does.
 gpu::Light toGpuLight(const Light& light);
 gpu::Material toGpuMaterial(const Material& material);
+// The material's TextureRef of each slot (gpu::kSlot*), and whether a slot holds sRGB colour (base
+// colour, emissive, sheen colour, specular colour) rather than data.
+std::array<const TextureRef*, gpu::kSlotCount> materialTextureSlots(const Material& material);
+bool materialSlotIsSrgb(int slot);
 
 class GpuScene {
 public:
@@ -51,7 +55,7 @@ public:
 
   // Binds the materials, lights and sheen-albedo buffers at their shared.h bindings.
   void bindSceneBuffers() const;
-  // Binds mesh `meshIndex`'s material textures to units kUnitMaterial0 + slot (what draw() does per mesh).
+  // Binds mesh `meshIndex`'s material textures to units gpu::materialTextureUnit(slot) (what draw() does per mesh).
   void bindMaterialTextures(std::size_t meshIndex) const;
 
   // Binds the materials buffer and, per draw, the mesh's textures; issues one draw per mesh.

@@ -15,7 +15,8 @@ using mat4 = glm::mat4;
 
 static_assert(sizeof(Light) == 64, "std430 Light must be 64 bytes");
 static_assert(sizeof(ShadowInfo) == 96, "std430 ShadowInfo must be 96 bytes");
-static_assert(sizeof(Material) == 112 + 32 * kSlotCount + 48, "std430 Material must be 352 bytes");
+static_assert(sizeof(Material) == 112 + 32 * kSlotCount + 80, "std430 Material must be 608 bytes");
+static_assert(offsetof(Material, texturesC) == 112 + 32 * kSlotCount + 48, "std430 Material: layer uv sets follow the layer factors");
 static_assert(offsetof(Material, clearcoat) == 112 + 32 * kSlotCount, "std430 Material: layer factors follow the uv rows");
 static_assert(offsetof(Material, texturesA) == 64 && offsetof(Material, texturesB) == 80,
               "std430 Material: texture slots follow the four factor vec4s");
@@ -26,7 +27,13 @@ static_assert(offsetof(MaterialParams, clearcoat) == 48 && offsetof(MaterialPara
               "std430 MaterialParams: the layers follow surface");
 static_assert(offsetof(MaterialParams, emission) == 16 && offsetof(MaterialParams, surface) == 32,
               "std430 MaterialParams: baseColor, emission, surface");
-static_assert(kUnitMaterial0 + kSlotCount <= kUnitEnvironment, "material texture units overlap the environment");
+static_assert(kUnitMaterial0 + kSlotLayer0 <= kUnitEnvironment, "material texture units overlap the environment");
+static_assert(kUnitLdmAlbedo < kUnitMaterialLayer0 && kUnitMaterialLayer0 + kSlotCount - kSlotLayer0 == kUnitCount,
+              "the layered extensions' material units are the last ones");
+// The unit material texture slot `slot` is bound to (GpuScene::bindMaterialTextures; material.glsl's bindings).
+constexpr int materialTextureUnit(int slot) {
+  return slot < kSlotLayer0 ? kUnitMaterial0 + slot : kUnitMaterialLayer0 + (slot - kSlotLayer0);
+}
 static_assert(kUnitShadow2D < kUnitMaterial0, "shadow units overlap the material units");
 static_assert(kUnitLdmDistance < kUnitIblDfg && kUnitIblDfg < kUnitIblPrefiltered &&
                   kUnitIblPrefiltered < kUnitAoEmission && kUnitAoEmission < kUnitCount,

@@ -284,26 +284,26 @@ Shading RayScene::shade(const SurfaceHit& hit, const glm::vec3& wo, TransportMod
   s.bsdf.eta = front ? s.bsdf.ior : 1.f / s.bsdf.ior;
   s.ngFacing = front ? hit.ng : -hit.ng;
 
-  // Shading normal: interpolated vertex normal, normal-mapped when a tangent frame exists.
+  // Shading normal: interpolated vertex normal, normal-mapped when a tangent frame exists
+  // (MaterialDecode.h's mapTangentNormal, as material.glsl's decodeShadingNormal).
   glm::vec3 ns = hit.ng;
-  glm::vec3 coat = s.ngFacing;  // KHR_materials_clearcoat: the interpolated normal, not normal-mapped
+  // KHR_materials_clearcoat: the interpolated normal, or its own clearcoatNormalTexture (decodeCoatNormal
+  // of material.glsl), never the base's normal map.
+  glm::vec3 coat = s.ngFacing;
   const std::uint32_t* i = &m.indices[static_cast<size_t>(hit.prim) * 3];
   if (m.normals.size() == m.positions.size()) {
     const glm::vec3 n = hit.b0 * m.normals[i[0]] + hit.b1 * m.normals[i[1]] + hit.b2 * m.normals[i[2]];
     if (glm::dot(n, n) > 0.f) ns = glm::normalize(n);
     coat = ns;
-    if (mat.normalTexture.valid() && m.tangents.size() == m.positions.size()) {
+    if (mat.hasNormalMap() && m.tangents.size() == m.positions.size()) {
       const glm::vec4 t4 = hit.b0 * m.tangents[i[0]] + hit.b1 * m.tangents[i[1]] + hit.b2 * m.tangents[i[2]];
-      glm::vec3 t = glm::vec3(t4) - ns * glm::dot(ns, glm::vec3(t4));
-      if (glm::dot(t, t) > 0.f) {
-        t = glm::normalize(t);
-        const glm::vec3 b = glm::cross(ns, t) * (m.tangents[i[0]].w < 0.f ? -1.f : 1.f);
-        glm::vec3 tn = glm::vec3(textureAt(mat.normalTexture, hit, false)) * 2.f - 1.f;
-        tn.x *= mat.normalTexture.scale;
-        tn.y *= mat.normalTexture.scale;
-        const glm::vec3 mapped = tn.x * t + tn.y * b + tn.z * ns;
-        if (glm::dot(mapped, mapped) > 0.f) ns = glm::normalize(mapped);
-      }
+      const glm::vec4 frame(glm::vec3(t4), m.tangents[i[0]].w);
+      const glm::vec3 interpolated = ns;
+      if (mat.normalTexture.valid())
+        ns = mapTangentNormal(textureAt(mat.normalTexture, hit, false), mat.normalTexture.scale, interpolated, frame);
+      if (mat.clearcoatNormalTexture.valid())
+        coat = mapTangentNormal(textureAt(mat.clearcoatNormalTexture, hit, false), mat.clearcoatNormalTexture.scale,
+                                interpolated, frame);
     }
     if (glm::dot(ns, hit.ng) < 0.f) ns = -ns;  // normals inconsistent with the winding
     if (!front) ns = -ns;

@@ -15,9 +15,9 @@ const std::vector<std::string>& supportedExtensions() {
       "KHR_materials_transmission",
       "KHR_materials_ior",
       "KHR_materials_emissive_strength",
-      "KHR_materials_clearcoat",  // factors; its textures are listed in stats.warnings
-      "KHR_materials_sheen",      // factors; its textures are listed in stats.warnings
-      "KHR_materials_specular",   // factors; its textures are listed in stats.warnings
+      "KHR_materials_clearcoat",  // factors and textures (coat normal map included)
+      "KHR_materials_sheen",      // factors and textures
+      "KHR_materials_specular",   // factors and textures
       "KHR_mesh_quantization",  // any component type is read and normalised
       "KHR_texture_transform",
       "KHR_materials_unlit",

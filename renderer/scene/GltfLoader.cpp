@@ -560,10 +560,14 @@ private:
     return r;
   }
 
-  TextureRef textureRef(const tinygltf::Value& info, const std::string& ptr) {
+  // A textureInfo object of an extension (tinygltf leaves these as JSON values): index, texCoord, the
+  // normal `scale` of a normalTextureInfo, and its KHR_texture_transform.
+  TextureRef textureRef(const tinygltf::Value& info, const std::string& ptr, bool srgb = false) {
     if (!info.IsObject() || !info.Has("index")) return {};
+    if (!info.Get("index").IsNumber()) throw SceneError(ptr + "/index", "a texture index must be a number");
     const int texCoord = info.Has("texCoord") ? info.Get("texCoord").GetNumberAsInt() : 0;
-    TextureRef r = textureRef(info.Get("index").GetNumberAsInt(), texCoord, 1.f, ptr, false);
+    const float scale = info.Has("scale") && info.Get("scale").IsNumber() ? float(info.Get("scale").GetNumberAsDouble()) : 1.f;
+    TextureRef r = textureRef(info.Get("index").GetNumberAsInt(), texCoord, scale, ptr, srgb);
     if (r.valid() && info.Has("extensions") && info.Get("extensions").Has("KHR_texture_transform"))
       gltf::applyTextureTransform(&info.Get("extensions").Get("KHR_texture_transform"), r, ptr);
     return r;
@@ -675,13 +679,11 @@ private:
       if (const auto* e = extension(g.extensions, "KHR_materials_ior")) mat.ior = number(*e, "ior", 1.5f);
       if (const auto* e = extension(g.extensions, "KHR_materials_emissive_strength"))
         mat.emissiveStrength = number(*e, "emissiveStrength", 1.f);
-      // The layered extensions: their factors are rendered; their textures are not read yet, and a
-      // material that has one says so in stats.warnings rather than losing it silently.
-      auto ignoredTextures = [&](const tinygltf::Value& e, const char* ext,
-                                 std::initializer_list<const char*> names) {
-        for (const char* t : names)
-          if (e.Has(t)) scene_.warnings.push_back(ep + ext + "/" + t + ": ignored (textures of " + ext +
-                                                  " are not supported yet; its factor is used)");
+      // The layered extensions: factors and textures (the channels each texture contributes are in
+      // MaterialDecode.h). sheenColorTexture and specularColorTexture hold sRGB colour (the extensions'
+      // specs); the others are data.
+      auto layerTexture = [&](const tinygltf::Value& e, const char* ext, const char* key, bool srgb) {
+        return e.Has(key) ? textureRef(e.Get(key), ep + ext + "/" + key, srgb) : TextureRef{};
       };
       auto color3 = [](const tinygltf::Value& e, const char* key, glm::vec3 fallback) {
         if (!e.Has(key)) return fallback;
@@ -692,20 +694,26 @@ private:
         return c;
       };
       if (const auto* e = extension(g.extensions, "KHR_materials_clearcoat")) {
+        const char* x = "KHR_materials_clearcoat";
         mat.clearcoatFactor = std::clamp(number(*e, "clearcoatFactor", 0.f), 0.f, 1.f);
         mat.clearcoatRoughnessFactor = std::clamp(number(*e, "clearcoatRoughnessFactor", 0.f), 0.f, 1.f);
-        ignoredTextures(*e, "KHR_materials_clearcoat",
-                        {"clearcoatTexture", "clearcoatRoughnessTexture", "clearcoatNormalTexture"});
+        mat.clearcoatTexture = layerTexture(*e, x, "clearcoatTexture", false);
+        mat.clearcoatRoughnessTexture = layerTexture(*e, x, "clearcoatRoughnessTexture", false);
+        mat.clearcoatNormalTexture = layerTexture(*e, x, "clearcoatNormalTexture", false);
       }
       if (const auto* e = extension(g.extensions, "KHR_materials_sheen")) {
+        const char* x = "KHR_materials_sheen";
         mat.sheenColorFactor = glm::clamp(color3(*e, "sheenColorFactor", glm::vec3(0.f)), 0.f, 1.f);
         mat.sheenRoughnessFactor = std::clamp(number(*e, "sheenRoughnessFactor", 0.f), 0.f, 1.f);
-        ignoredTextures(*e, "KHR_materials_sheen", {"sheenColorTexture", "sheenRoughnessTexture"});
+        mat.sheenColorTexture = layerTexture(*e, x, "sheenColorTexture", true);
+        mat.sheenRoughnessTexture = layerTexture(*e, x, "sheenRoughnessTexture", false);
       }
       if (const auto* e = extension(g.extensions, "KHR_materials_specular")) {
+        const char* x = "KHR_materials_specular";
         mat.specularFactor = std::clamp(number(*e, "specularFactor", 1.f), 0.f, 1.f);
         mat.specularColorFactor = glm::max(color3(*e, "specularColorFactor", glm::vec3(1.f)), 0.f);
-        ignoredTextures(*e, "KHR_materials_specular", {"specularTexture", "specularColorTexture"});
+        mat.specularTexture = layerTexture(*e, x, "specularTexture", false);
+        mat.specularColorTexture = layerTexture(*e, x, "specularColorTexture", true);
       }
       scene_.materials.push_back(std::move(mat));
     }
@@ -938,7 +946,7 @@ private:
     }
     const Material& mat = scene_.material(prim.material);
     std::vector<glm::vec4> tan;
-    if (const int a = attribute("TANGENT"); a >= 0 && mat.normalTexture.valid()) {
+    if (const int a = attribute("TANGENT"); a >= 0 && mat.hasNormalMap()) {
       tan = asVec4(readFloats(m_, a, TINYGLTF_TYPE_VEC4, where + " TANGENT", maxBytes_));
       sameCount(tan.size(), "TANGENT", a);
     }
@@ -999,7 +1007,7 @@ private:
     } else {
       nrm = areaWeightedNormals(pos, idx);
     }
-    if (mat.normalTexture.valid()) {
+    if (mat.hasNormalMap()) {
       if (!tan.empty()) {
         const float handedness = det < 0.f ? -1.f : 1.f;
         for (std::size_t i = 0; i < n; ++i) {
@@ -1011,7 +1019,9 @@ private:
         }
       } else {
         // Without the UV set the normal map uses, any frame perpendicular to the normal will do.
-        tan = generateTangents(pos, nrm, uv[mat.normalTexture.texCoord], idx);
+        // One frame per vertex serves both normal maps: the base's uv set when it has one, else the coat's.
+        const TextureRef& map = mat.normalTexture.valid() ? mat.normalTexture : mat.clearcoatNormalTexture;
+        tan = generateTangents(pos, nrm, uv[map.texCoord], idx);
       }
     }
     for (const auto& p : pos) mi.bounds.extend(p);

@@ -40,14 +40,42 @@ glm::vec3 decodeEmission(const Material& m, Texel&& texel) {
   return e;
 }
 
-// The layered extensions (factors only): KHR_materials_clearcoat, _sheen, _specular, clamped to their
-// ranges (decodeLayers() of material.glsl).
-inline void decodeLayers(const Material& m, gpu::MaterialParams& p) {
-  p.clearcoat = glm::vec4(std::clamp(m.clearcoatFactor, 0.f, 1.f), std::clamp(m.clearcoatRoughnessFactor, 0.f, 1.f),
-                          0.f, 0.f);
-  p.sheen = glm::vec4(glm::clamp(m.sheenColorFactor, 0.f, 1.f),
-                      std::clamp(m.sheenRoughnessFactor, gpu::kMinSheenRoughness, 1.f));
-  p.specular = glm::vec4(glm::max(m.specularColorFactor, 0.f), std::clamp(m.specularFactor, 0.f, 1.f));
+// The layered extensions, factor x texture channel as their specs define them, clamped to their
+// ranges (decodeLayerFactors() of material.glsl): KHR_materials_clearcoat (clearcoat = red of
+// clearcoatTexture, roughness = green of clearcoatRoughnessTexture), KHR_materials_sheen (colour = rgb
+// of sheenColorTexture, sRGB; roughness = alpha of sheenRoughnessTexture), KHR_materials_specular
+// (weight = alpha of specularTexture, colour = rgb of specularColorTexture, sRGB).
+template <class Texel>
+void decodeLayers(const Material& m, Texel&& texel, gpu::MaterialParams& p) {
+  float coat = m.clearcoatFactor, coatRoughness = m.clearcoatRoughnessFactor;
+  if (m.clearcoatTexture.valid()) coat *= texel(m.clearcoatTexture, false).r;
+  if (m.clearcoatRoughnessTexture.valid()) coatRoughness *= texel(m.clearcoatRoughnessTexture, false).g;
+  glm::vec3 sheenColor = m.sheenColorFactor;
+  float sheenRoughness = m.sheenRoughnessFactor;
+  if (m.sheenColorTexture.valid()) sheenColor *= glm::vec3(texel(m.sheenColorTexture, true));
+  if (m.sheenRoughnessTexture.valid()) sheenRoughness *= texel(m.sheenRoughnessTexture, false).a;
+  glm::vec3 specularColor = m.specularColorFactor;
+  float specular = m.specularFactor;
+  if (m.specularTexture.valid()) specular *= texel(m.specularTexture, false).a;
+  if (m.specularColorTexture.valid()) specularColor *= glm::vec3(texel(m.specularColorTexture, true));
+  p.clearcoat = glm::vec4(std::clamp(coat, 0.f, 1.f), std::clamp(coatRoughness, 0.f, 1.f), 0.f, 0.f);
+  p.sheen = glm::vec4(glm::clamp(sheenColor, 0.f, 1.f), std::clamp(sheenRoughness, gpu::kMinSheenRoughness, 1.f));
+  p.specular = glm::vec4(glm::max(specularColor, 0.f), std::clamp(specular, 0.f, 1.f));
+}
+
+// A tangent-space normal map's texel (2 texel - 1, xy times `scale`) in the frame of the interpolated
+// normal n (unit) and tangent t4 (xyz, w handedness): mapTangentNormal() of material.glsl. Returns n
+// when the tangent is degenerate or the mapped normal vanishes.
+inline glm::vec3 mapTangentNormal(const glm::vec4& texel, float scale, const glm::vec3& n, const glm::vec4& t4) {
+  glm::vec3 t = glm::vec3(t4) - n * glm::dot(n, glm::vec3(t4));
+  if (glm::dot(t, t) <= 0.f) return n;
+  t = glm::normalize(t);
+  const glm::vec3 b = glm::cross(n, t) * (t4.w < 0.f ? -1.f : 1.f);
+  glm::vec3 tn = glm::vec3(texel) * 2.f - 1.f;
+  tn.x *= scale;
+  tn.y *= scale;
+  const glm::vec3 mapped = tn.x * t + tn.y * b + tn.z * n;
+  return glm::dot(mapped, mapped) > 0.f ? glm::normalize(mapped) : n;
 }
 
 // What the BSDF reads (baseColor, surface), without the emission and occlusion lookups: the ray
@@ -70,7 +98,7 @@ gpu::MaterialParams decodeBsdfInputs(const Material& m, Texel&& texel) {
   p.emission = glm::vec4(0.f, 0.f, 0.f, 1.f);
   p.surface = glm::vec4(std::clamp(metallic, 0.f, 1.f), std::clamp(roughness, 0.f, 1.f),
                         std::clamp(transmission, 0.f, 1.f), ior);
-  decodeLayers(m, p);
+  decodeLayers(m, texel, p);
   return p;
 }
 

@@ -80,6 +80,10 @@ struct Material {
   glm::vec3 specularColorFactor{1.f};
   TextureRef baseColorTexture, metallicRoughnessTexture, normalTexture, occlusionTexture,
       emissiveTexture, transmissionTexture;
+  // The layered extensions' textures (their channels: MaterialDecode.h): KHR_materials_clearcoat
+  // (clearcoatNormalTexture.scale is its normal scale), KHR_materials_sheen, KHR_materials_specular.
+  TextureRef clearcoatTexture, clearcoatRoughnessTexture, clearcoatNormalTexture, sheenColorTexture,
+      sheenRoughnessTexture, specularTexture, specularColorTexture;
   bool doubleSided = false;
   bool unlit = false;  // KHR_materials_unlit: the surface shows its base colour, lit by nothing
   AlphaMode alphaMode = AlphaMode::Opaque;
@@ -90,6 +94,8 @@ struct Material {
   glm::vec3 emission() const { return emissiveFactor * emissiveStrength; }
   bool isEmissive() const { return emission() != glm::vec3(0.f) || emissiveTexture.valid(); }
   bool isTransmissive() const { return transmissionFactor > 0.f; }
+  // A tangent frame is needed for the base's or the clear coat's normal map.
+  bool hasNormalMap() const { return normalTexture.valid() || clearcoatNormalTexture.valid(); }
   bool isSpecular() const {
     if (unlit) return false;
     return (metallicFactor > 0.5f && roughnessFactor < kSpecularRoughness) || isTransmissive();

@@ -6,8 +6,12 @@
 // map L^a becomes E(n) / pi, its SH irradiance by the shading normal, and the glTF Fresnel weight of the
 // diffuse base multiplies it (renderer/shading/ImageBasedLighting.h; 1 - ~1e-3 head-on).
 // Metals have no diffuse lobe: their response to the environment is specular, which the direct pass
-// adds (split-sum), unoccluded.
+// adds (split-sum), unoccluded. The layers (KHR_materials_clearcoat, _sheen, _specular) attenuate the
+// diffuse base as the direct pass's split-sum does (ibl.glsl's layered iblDiffuseWeight); their own
+// reflections of the environment are the direct pass's.
 #include "common/shared.h"
+#include "common/brdf.glsl"
+#include "common/material.glsl"  // decodeLayers
 #include "common/ibl.glsl"
 
 in vec2 v_uv;
@@ -20,6 +24,8 @@ layout(binding = 4) uniform sampler2D t_material;  // metallic, roughness, occlu
 layout(binding = 5) uniform sampler2D t_geoNormal;
 layout(binding = kUnitAoEmission) uniform sampler2D t_emission;  // a = ior
 layout(binding = kUnitIblDfg) uniform sampler2D t_dfg;
+layout(binding = kUnitGbufferLayers) uniform usampler2D t_layers;    // common/material.glsl encodeLayers
+layout(binding = kUnitGbufferSpecular) uniform sampler2D t_specular;  // gbuffer_specular
 uniform vec3 u_eye;
 uniform vec3 u_viewForward;
 uniform int u_orthographic;
@@ -90,6 +96,9 @@ void main() {
   // sky), with the Fresnel weight glTF's fresnel_mix leaves the diffuse base (ImageBasedLighting.h).
   vec3 n = texelFetch(t_normal, px, 0).xyz;
   vec3 wo = u_orthographic != 0 ? -u_viewForward : normalize(u_eye - P.xyz);
-  float w = iblDiffuseWeight(t_dfg, max(dot(n, wo), 0.0), texelFetch(t_emission, px, 0).a);
+  MaterialParams p = materialParams(albedo, m.x, m.y, m.w, texelFetch(t_emission, px, 0).a);
+  p.specular = texelFetch(t_specular, px, 0);
+  vec3 nc = decodeLayers(texelFetch(t_layers, px, 0), p);
+  float w = iblDiffuseWeight(t_dfg, nc, wo, max(dot(n, wo), 0.0), p);
   o_beauty = vec4(iblIrradiance(n) * INV_PI * w * diffuseAlbedo * a, 0.0);
 }

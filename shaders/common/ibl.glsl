@@ -80,6 +80,19 @@ vec3 iblSpecular(sampler2D dfg, sampler2DArray map, vec3 n, vec3 nc, vec3 wo, Ma
   }
   return L;
 }
+
+// The diffuse base's weight under the layers, as the layered iblSpecular attenuates the base: glTF's
+// fresnel_mix with KHR_materials_specular's F0 and weight, 1 - w max3(F0s + (1 - F0s) Dp(mu)) (the
+// plain iblDiffuseWeight's (1 - f0)(1 - Dp) when w = 1 and F0s = f0 grey), times (1 - max3(c) E(mu))
+// under the sheen and (1 - cw(wo)) under the clear coat. The base's (1 - metallic)(1 - transmission)
+// and its colour are the caller's.
+float iblDiffuseWeight(sampler2D dfg, vec3 nc, vec3 wo, float mu, MaterialParams p) {
+  vec3 f0 = specularF0(p);
+  float w = 1.0 - p.specular.a * maxComponent(f0 + (1.0 - f0) * iblDfg(dfg, mu, 1.0).z);
+  if (materialHasSheen(p)) w *= max(0.0, 1.0 - maxComponent(p.sheen.rgb) * sheenAlbedo(mu, p.sheen.a));
+  if (p.clearcoat.x > 0.0) w *= 1.0 - coatWeight(p, nc, wo);
+  return w;
+}
 #endif
 
 // The diffuse weight glTF's fresnel_mix leaves the base: (1 - f0)(1 - Dp(mu)).

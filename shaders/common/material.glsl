@@ -3,7 +3,7 @@
 // cube maps, specular distance maps); renderer/scene/MaterialDecode.h is the C++ twin used by the
 // ray-tracing core, and tests/gl/materials/parity_test.cpp holds the two equal.
 //
-// The material textures are bound by GpuScene::bindMaterialTextures() at kUnitMaterial0 + slot.
+// The material textures are bound by GpuScene::bindMaterialTextures() at gpu::materialTextureUnit(slot).
 // MATERIAL_SAMPLE(sampler, uv) is texture(); a stage without implicit derivatives (compute) defines
 // it before the include, e.g. as textureLod(sampler, uv, 0.0).
 #ifndef RADIANT_COMMON_MATERIAL
@@ -21,6 +21,13 @@ layout(binding = kUnitMaterial0 + kSlotNormal) uniform sampler2D t_matNormal;
 layout(binding = kUnitMaterial0 + kSlotOcclusion) uniform sampler2D t_matOcclusion;
 layout(binding = kUnitMaterial0 + kSlotEmissive) uniform sampler2D t_matEmissive;
 layout(binding = kUnitMaterial0 + kSlotTransmission) uniform sampler2D t_matTransmission;
+layout(binding = kUnitMaterialLayer0 + kSlotClearcoat - kSlotLayer0) uniform sampler2D t_matClearcoat;
+layout(binding = kUnitMaterialLayer0 + kSlotClearcoatRoughness - kSlotLayer0) uniform sampler2D t_matClearcoatRoughness;
+layout(binding = kUnitMaterialLayer0 + kSlotClearcoatNormal - kSlotLayer0) uniform sampler2D t_matClearcoatNormal;
+layout(binding = kUnitMaterialLayer0 + kSlotSheenColor - kSlotLayer0) uniform sampler2D t_matSheenColor;
+layout(binding = kUnitMaterialLayer0 + kSlotSheenRoughness - kSlotLayer0) uniform sampler2D t_matSheenRoughness;
+layout(binding = kUnitMaterialLayer0 + kSlotSpecular - kSlotLayer0) uniform sampler2D t_matSpecular;
+layout(binding = kUnitMaterialLayer0 + kSlotSpecularColor - kSlotLayer0) uniform sampler2D t_matSpecularColor;
 
 vec2 materialUv(int set, vec2 uv0, vec2 uv1) { return set == 1 ? uv1 : uv0; }
 
@@ -56,6 +63,31 @@ vec3 decodeEmission(Material m, vec2 uv0, vec2 uv1) {
   return e;
 }
 
+// KHR_materials_clearcoat, _sheen, _specular: factor x texture channel, as their specs define them
+// (clearcoat = red of clearcoatTexture, coat roughness = green of clearcoatRoughnessTexture, sheen
+// colour = rgb of sheenColorTexture (sRGB), sheen roughness = alpha of sheenRoughnessTexture, specular
+// = alpha of specularTexture, specular colour = rgb of specularColorTexture (sRGB)), then clamped to
+// their ranges. MaterialDecode.h's decodeLayers is the C++ twin.
+void decodeLayerFactors(Material m, vec2 uv0, vec2 uv1, inout MaterialParams p) {
+  float coat = m.clearcoat.x, coatRoughness = m.clearcoat.y;
+  if (m.texturesC.x >= 0) coat *= MATERIAL_SAMPLE(t_matClearcoat, materialSlotUv(m, kSlotClearcoat, m.texturesC.x, uv0, uv1)).r;
+  if (m.texturesC.y >= 0)
+    coatRoughness *= MATERIAL_SAMPLE(t_matClearcoatRoughness, materialSlotUv(m, kSlotClearcoatRoughness, m.texturesC.y, uv0, uv1)).g;
+  vec3 sheenColor = m.sheen.rgb;
+  float sheenRoughness = m.sheen.a;
+  if (m.texturesC.w >= 0) sheenColor *= MATERIAL_SAMPLE(t_matSheenColor, materialSlotUv(m, kSlotSheenColor, m.texturesC.w, uv0, uv1)).rgb;
+  if (m.texturesD.x >= 0)
+    sheenRoughness *= MATERIAL_SAMPLE(t_matSheenRoughness, materialSlotUv(m, kSlotSheenRoughness, m.texturesD.x, uv0, uv1)).a;
+  vec3 specularColor = m.specular.rgb;
+  float specular = m.specular.a;
+  if (m.texturesD.y >= 0) specular *= MATERIAL_SAMPLE(t_matSpecular, materialSlotUv(m, kSlotSpecular, m.texturesD.y, uv0, uv1)).a;
+  if (m.texturesD.z >= 0)
+    specularColor *= MATERIAL_SAMPLE(t_matSpecularColor, materialSlotUv(m, kSlotSpecularColor, m.texturesD.z, uv0, uv1)).rgb;
+  p.clearcoat = vec4(clamp(coat, 0.0, 1.0), clamp(coatRoughness, 0.0, 1.0), 0.0, 0.0);
+  p.sheen = vec4(clamp(sheenColor, 0.0, 1.0), clamp(sheenRoughness, kMinSheenRoughness, 1.0));
+  p.specular = vec4(max(specularColor, vec3(0.0)), clamp(specular, 0.0, 1.0));
+}
+
 // The whole material at a point. glTF 3.9.2-3.9.3: metallic is the blue, roughness the green channel
 // of metallicRoughnessTexture; occlusion = 1 + strength (texel.r - 1); KHR_materials_transmission
 // reads the red channel of transmissionTexture.
@@ -77,10 +109,7 @@ MaterialParams decodeMaterial(Material m, vec2 uv0, vec2 uv1) {
   p.baseColor = vec4(clamp(base.rgb, 0.0, 1.0), base.a);
   p.emission = vec4(decodeEmission(m, uv0, uv1), occlusion);
   p.surface = vec4(clamp(metallic, 0.0, 1.0), clamp(roughness, 0.0, 1.0), clamp(transmission, 0.0, 1.0), ior);
-  // KHR_materials_clearcoat, _sheen, _specular (factors only), clamped to their ranges.
-  p.clearcoat = vec4(clamp(m.clearcoat.x, 0.0, 1.0), clamp(m.clearcoat.y, 0.0, 1.0), 0.0, 0.0);
-  p.sheen = vec4(clamp(m.sheen.rgb, 0.0, 1.0), clamp(m.sheen.a, kMinSheenRoughness, 1.0));
-  p.specular = vec4(max(m.specular.rgb, vec3(0.0)), clamp(m.specular.a, 0.0, 1.0));
+  decodeLayerFactors(m, uv0, uv1, p);
   return p;
 }
 
@@ -103,6 +132,14 @@ vec3 decodeLayers(uvec4 layers, inout MaterialParams p) {
   return octDecode(unpackSnorm2x16(layers.y));
 }
 
+// A tangent-space normal map's texel tn (2 texel - 1, xy scaled) in the frame of the interpolated vertex
+// normal n and tangent (xyz, w handedness).
+vec3 mapTangentNormal(vec3 tn, vec3 n, vec4 tangent) {
+  vec3 t = materialSafeNormalize(tangent.xyz - n * dot(n, tangent.xyz), vec3(1, 0, 0));
+  vec3 b = cross(n, t) * (tangent.w < 0.0 ? -1.0 : 1.0);
+  return materialSafeNormalize(t * tn.x + b * tn.y + n * tn.z, n);
+}
+
 // The normal-mapped shading normal (glTF 3.9.3): n is the interpolated vertex normal (on the front
 // side of the winding), tangent the interpolated vertex tangent (xyz, w handedness). The back face of a
 // double-sided surface sees the whole tangent frame reversed (t, b and n, as the glTF sample viewer
@@ -110,11 +147,21 @@ vec3 decodeLayers(uvec4 layers, inout MaterialParams p) {
 vec3 decodeShadingNormal(Material m, vec3 n, vec4 tangent, vec2 uv0, vec2 uv1, bool frontFacing) {
   vec3 mapped = n;
   if (m.texturesA.z >= 0) {
-    vec3 t = materialSafeNormalize(tangent.xyz - n * dot(n, tangent.xyz), vec3(1, 0, 0));
-    vec3 b = cross(n, t) * (tangent.w < 0.0 ? -1.0 : 1.0);
     vec3 tn = MATERIAL_SAMPLE(t_matNormal, materialSlotUv(m, kSlotNormal, m.texturesA.z, uv0, uv1)).xyz * 2.0 - 1.0;
     tn.xy *= m.scales.x;
-    mapped = materialSafeNormalize(t * tn.x + b * tn.y + n * tn.z, n);
+    mapped = mapTangentNormal(tn, n, tangent);
+  }
+  return frontFacing ? mapped : -mapped;
+}
+
+// KHR_materials_clearcoat: the coat's normal is the interpolated normal, or clearcoatNormalTexture
+// mapped as decodeShadingNormal maps normalTexture (its scale in m.clearcoat.z); never the base's map.
+vec3 decodeCoatNormal(Material m, vec3 n, vec4 tangent, vec2 uv0, vec2 uv1, bool frontFacing) {
+  vec3 mapped = n;
+  if (m.texturesC.z >= 0) {
+    vec3 tn = MATERIAL_SAMPLE(t_matClearcoatNormal, materialSlotUv(m, kSlotClearcoatNormal, m.texturesC.z, uv0, uv1)).xyz * 2.0 - 1.0;
+    tn.xy *= m.clearcoat.z;
+    mapped = mapTangentNormal(tn, n, tangent);
   }
   return frontFacing ? mapped : -mapped;
 }

@@ -46,7 +46,8 @@ RADIANT_CONST int kLobeSpecular = 16;
 // declares without overwriting another's input. Units 0-5 are a pass's own full-screen inputs.
 RADIANT_CONST int kUnitShadowCube = 6;
 RADIANT_CONST int kUnitShadow2D = 7;
-// Material textures: unit kUnitMaterial0 + slot (slots below).
+// Material textures: slot s < kSlotLayer0 at unit kUnitMaterial0 + s, the layered extensions' slots
+// at kUnitMaterialLayer0 + (s - kSlotLayer0) (materialTextureUnit() in GpuTypes.h; slots below).
 RADIANT_CONST int kUnitMaterial0 = 8;
 RADIANT_CONST int kSlotBaseColor = 0;
 RADIANT_CONST int kSlotMetallicRoughness = 1;
@@ -54,7 +55,16 @@ RADIANT_CONST int kSlotNormal = 2;
 RADIANT_CONST int kSlotOcclusion = 3;
 RADIANT_CONST int kSlotEmissive = 4;
 RADIANT_CONST int kSlotTransmission = 5;  // KHR_materials_transmission, red channel
-RADIANT_CONST int kSlotCount = 6;
+// The layered extensions' textures (channels as their specs say: material.glsl, MaterialDecode.h).
+RADIANT_CONST int kSlotLayer0 = 6;
+RADIANT_CONST int kSlotClearcoat = 6;           // KHR_materials_clearcoat: clearcoatTexture, red
+RADIANT_CONST int kSlotClearcoatRoughness = 7;  // clearcoatRoughnessTexture, green
+RADIANT_CONST int kSlotClearcoatNormal = 8;     // clearcoatNormalTexture (tangent space, like normalTexture)
+RADIANT_CONST int kSlotSheenColor = 9;          // KHR_materials_sheen: sheenColorTexture, rgb (sRGB)
+RADIANT_CONST int kSlotSheenRoughness = 10;     // sheenRoughnessTexture, alpha
+RADIANT_CONST int kSlotSpecular = 11;           // KHR_materials_specular: specularTexture, alpha
+RADIANT_CONST int kSlotSpecularColor = 12;      // specularColorTexture, rgb (sRGB)
+RADIANT_CONST int kSlotCount = 13;
 RADIANT_CONST int kUnitEnvironment = 14;  // equirect environment radiance (direct, specular)
 RADIANT_CONST int kUnitPeel = 15;         // specular: previous layer of a distance-map face
 RADIANT_CONST int kUnitLdmMaterial = 16;  // specular: layered distance maps
@@ -67,7 +77,11 @@ RADIANT_CONST int kUnitGbufferLayers = 22;    // direct: the G-buffer's gbuffer_
 RADIANT_CONST int kUnitGbufferSpecular = 23;  // direct: the G-buffer's gbuffer_specular (KHR_materials_specular)
 RADIANT_CONST int kUnitCausticCube = 24;  // caustics: the caustic cube maps (irradiance per receiver area)
 RADIANT_CONST int kUnitLdmAlbedo = 25;  // specular: the maps' diffuse albedo (read by caustics at specular's secondary hits)
-RADIANT_CONST int kUnitCount = 26;        // units used; GL 4.5 guarantees 16, every driver we run has 32
+RADIANT_CONST int kUnitMaterialLayer0 = 26;  // material slots kSlotLayer0.. (units 26-32)
+// Units used. A binding must be below GL_MAX_COMBINED_TEXTURE_IMAGE_UNITS (GL 4.5 guarantees 80); a
+// stage may read at most GL_MAX_TEXTURE_IMAGE_UNITS samplers (16 guaranteed, 32 on llvmpipe), which
+// material_parity_test checks per program.
+RADIANT_CONST int kUnitCount = 33;
 
 // Shader storage bindings of the scene buffers.
 RADIANT_CONST int kBindingMaterials = 0;
@@ -118,10 +132,13 @@ struct Material {
   // KHR_texture_transform per slot: rows 2 slot and 2 slot + 1 of uv' = M (u, v, 1) (xyz used, w 0);
   // identity rows for a slot without the extension.
   vec4 uvTransform[2 * kSlotCount];
-  // Layered extensions (factors; their textures are not read yet and are listed in stats.warnings).
-  vec4 clearcoat;  // KHR_materials_clearcoat: x clearcoatFactor, y clearcoatRoughnessFactor, zw unused
+  // Layered extensions: factors, and the uv set per texture slot (-1 = none).
+  vec4 clearcoat;  // KHR_materials_clearcoat: x clearcoatFactor, y clearcoatRoughnessFactor,
+                   // z clearcoatNormalTexture.scale, w unused
   vec4 sheen;      // KHR_materials_sheen: rgb sheenColorFactor, a sheenRoughnessFactor
   vec4 specular;   // KHR_materials_specular: rgb specularColorFactor, a specularFactor
+  ivec4 texturesC; // uv set of kSlotClearcoat, kSlotClearcoatRoughness, kSlotClearcoatNormal, kSlotSheenColor
+  ivec4 texturesD; // uv set of kSlotSheenRoughness, kSlotSpecular, kSlotSpecularColor; w unused
 };
 
 // The material decoded at a surface point (factors x textures): what the BRDF reads. gltfBrdfCos

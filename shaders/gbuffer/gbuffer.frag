@@ -32,7 +32,8 @@ void main() {
 
   vec3 faceNormal = materialSafeNormalize(cross(dFdx(v_position), dFdy(v_position)), vec3(0, 1, 0));
   vec3 n = materialSafeNormalize(v_normal, faceNormal);
-  vec3 coatNormal = gl_FrontFacing ? n : -n;  // KHR_materials_clearcoat: not normal-mapped
+  // KHR_materials_clearcoat: its own normal map (clearcoatNormalTexture) or none, never the base's.
+  vec3 coatNormal = decodeCoatNormal(m, n, v_tangent, v_uv0, v_uv1, gl_FrontFacing);
   n = decodeShadingNormal(m, n, v_tangent, v_uv0, v_uv1, gl_FrontFacing);
 
   // Geometric normal on the side the viewer sees: used for shadow normal-offset bias.

@@ -39,8 +39,8 @@ struct SplatSurface {
   vec3 n;      // shading normal
   vec3 ng;     // geometric normal facing the viewer
   vec3 wo;     // towards the eye
-  vec3 baseColor;
-  float metallic, roughness, transmission, ior;
+  vec3 nc;     // the clear coat's normal (KHR_materials_clearcoat)
+  MaterialParams p;  // the G-buffer's material with its layers (clear coat, sheen, specular)
 };
 
 // phi_j f_r k / h^2 of photon j at the surface s (0 when it fails the surface test).
@@ -56,19 +56,17 @@ vec3 photonContribution(GpuPhoton p, SplatSurface s) {
   vec3 wi = p.wi.xyz;
   float NdotL = dot(s.n, wi);
   if (NdotL <= 0.0) return vec3(0.0);
-  // gltfBrdfCos is f cos(theta_i); density estimation needs f alone (the photon flux per area already
-  // carries the cosine).
-  float metallic = s.metallic, roughness = s.roughness;
-  vec3 base = s.baseColor;
-  vec3 f;
-  if (roughness < u_minGlossyRoughness || p.normal.w > 0.5) {
-    // Too sharp to estimate from photons, or a glossy reflection another technique owns: keep the
-    // diffuse lobe (what a dielectric's base reflects) and leave the specular reflection out.
-    float r = (s.ior - 1.0) / (s.ior + 1.0);
-    f = (1.0 - metallic) * (1.0 - s.transmission) * (1.0 - r * r) * base * INV_PI;
-  } else {
-    f = gltfBrdfCos(s.n, s.wo, wi, base, metallic, roughness, s.transmission, s.ior) / NdotL;
-  }
+  // The layered glTF BSDF (common/brdf.glsl gltfBsdfCos, the reference's rt::GltfBsdf): the base under
+  // the sheen and the clear coat. gltfBsdfCos is f cos(theta_i); density estimation needs f alone (the
+  // photon flux per area already carries the cosine). A lobe too sharp to estimate from photons, or a
+  // glossy reflection another technique owns (normal.w), is left out by making it a Dirac lobe, which
+  // carries nothing towards a photon's direction: the base's specular (roughness 0 leaves the diffuse
+  // lobe with its Fresnel weight) and the coat's lobe (its (1 - Fc) attenuation of the base stays).
+  MaterialParams m = s.p;
+  bool diffuseOnly = p.normal.w > 0.5;
+  if (diffuseOnly || m.surface.y < u_minGlossyRoughness) m.surface.y = 0.0;
+  if (diffuseOnly || m.clearcoat.y < u_minGlossyRoughness) m.clearcoat.y = 0.0;
+  vec3 f = gltfBsdfCos(s.n, s.nc, s.wo, wi, m, m.surface.w) / NdotL;
   return p.power.rgb * f * (k / (h * h));
 }
 

@@ -1,12 +1,18 @@
 // The G-buffer surface at a pixel, for splatting and gathering.
 #ifndef RADIANT_PHOTON_GI_SURFACE
 #define RADIANT_PHOTON_GI_SURFACE
+#ifndef MATERIAL_SAMPLE
+#define MATERIAL_SAMPLE(sampler, uv) textureLod(sampler, uv, 0.0)  // compute stages have no derivatives
+#endif
+#include "common/material.glsl"  // decodeLayers (the G-buffer's layers target)
 layout(binding = 0) uniform sampler2D t_position;
 layout(binding = 1) uniform sampler2D t_normal;
 layout(binding = 2) uniform sampler2D t_albedo;
 layout(binding = 3) uniform sampler2D t_material;
 layout(binding = 4) uniform sampler2D t_emission;
 layout(binding = 6) uniform sampler2D t_geoNormal;
+layout(binding = kUnitGbufferLayers) uniform usampler2D t_layers;    // common/material.glsl encodeLayers
+layout(binding = kUnitGbufferSpecular) uniform sampler2D t_specular;  // gbuffer_specular
 
 uniform vec3 u_eye;
 uniform vec3 u_viewForward;
@@ -21,12 +27,13 @@ bool loadSurface(ivec2 px, out SplatSurface s) {
   s.n = normalize(N.xyz);
   s.ng = normalize(texelFetch(t_geoNormal, px, 0).xyz);
   s.wo = u_orthographic != 0 ? -u_viewForward : normalize(u_eye - P.xyz);
-  s.baseColor = texelFetch(t_albedo, px, 0).rgb;
   vec4 m = texelFetch(t_material, px, 0);
-  s.metallic = m.x;
-  s.roughness = m.y;
-  s.transmission = m.w;
-  s.ior = texelFetch(t_emission, px, 0).a;
+  s.p = materialParams(texelFetch(t_albedo, px, 0).rgb, m.x, m.y, m.w, texelFetch(t_emission, px, 0).a);
+  // The layers, read and bent towards the viewer as the direct pass does (direct.frag).
+  s.p.specular = texelFetch(t_specular, px, 0);
+  s.nc = decodeLayers(texelFetch(t_layers, px, 0), s.p);
+  float ncv = dot(s.nc, s.wo);
+  if (ncv < 1e-3) s.nc = normalize(s.nc + s.wo * (1e-3 - ncv));
   return true;
 }
 #endif

@@ -50,7 +50,7 @@ void main() {
       vec4 a = texelFetch(t_low, q, 0);
       vec3 L = a.rgb;
       if (u_renormalize != 0 && a.a > 0.0) L /= max(a.a, u_minKernelMass);
-      sum += wb * L * (s.baseColor + 0.02) / (o.baseColor + 0.02);
+      sum += wb * L * (s.p.baseColor.rgb + 0.02) / (o.p.baseColor.rgb + 0.02);
       wsum += wb;
     }
   if (wsum > 0.0) {

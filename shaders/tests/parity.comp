@@ -65,6 +65,7 @@ uniform int u_front;  // 0: the point is seen from the back of a double-sided su
 layout(std430, binding = 3) readonly buffer Cases { vec4 cases[]; };
 layout(std430, binding = 4) writeonly buffer Results { MaterialParams results[]; };
 layout(std430, binding = 5) writeonly buffer Normals { vec4 normals[]; };
+layout(std430, binding = 6) writeonly buffer CoatNormals { vec4 coatNormals[]; };  // KHR_materials_clearcoat
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= uint(u_count)) return;
@@ -73,5 +74,6 @@ void main() {
   Material m = materials[u_material];
   results[k] = decodeMaterial(m, c.xy, c.zw);
   normals[k] = vec4(decodeShadingNormal(m, normalize(u_normal), u_tangent, c.xy, c.zw, u_front != 0), 0.0);
+  coatNormals[k] = vec4(decodeCoatNormal(m, normalize(u_normal), u_tangent, c.xy, c.zw, u_front != 0), 0.0);
 }
 #endif

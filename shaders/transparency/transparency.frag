@@ -34,7 +34,7 @@ void main() {
   }
   vec3 faceNormal = materialSafeNormalize(cross(dFdx(v_position), dFdy(v_position)), vec3(0, 1, 0));
   vec3 n0 = materialSafeNormalize(v_normal, faceNormal);
-  vec3 nc = gl_FrontFacing ? n0 : -n0;
+  vec3 nc = decodeCoatNormal(m, n0, v_tangent, v_uv0, v_uv1, gl_FrontFacing);  // KHR_materials_clearcoat
   vec3 n = decodeShadingNormal(m, n0, v_tangent, v_uv0, v_uv1, gl_FrontFacing);
   vec3 wo = u_orthographic != 0 ? -u_viewForward : normalize(u_eye - v_position);
   vec3 ng = dot(faceNormal, wo) < 0.0 ? -faceNormal : faceNormal;
@@ -48,7 +48,7 @@ void main() {
     L += occlusion * iblSpecular(t_dfg, t_prefiltered, n, nc, wo, p);
     if (u_diffuseIbl != 0) {
       float mu = max(dot(n, wo), 0.0);
-      vec3 diffuse = (1.0 - p.surface.x) * (1.0 - p.surface.z) * iblDiffuseWeight(t_dfg, mu, p.surface.w) *
+      vec3 diffuse = (1.0 - p.surface.x) * (1.0 - p.surface.z) * iblDiffuseWeight(t_dfg, nc, wo, mu, p) *
                      p.baseColor.rgb * iblIrradiance(n) * INV_PI;
       L += occlusion * diffuse;
     }

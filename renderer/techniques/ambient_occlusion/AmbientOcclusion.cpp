@@ -221,7 +221,8 @@ const TechniqueInfo& AmbientOcclusionPass::info() const {
   static const TechniqueInfo i{
       "ambient_occlusion",
       "Screen-space ambient occlusion (volumetric, containment, crytek, gtao) applied to the ambient light",
-      {"gbuffer_position", "normal", "albedo", "material", "geometric_normal", "emission"},
+      {"gbuffer_position", "normal", "albedo", "material", "geometric_normal", "emission", "gbuffer_layers",
+       "gbuffer_specular"},
       {"direct"},  // runs after direct, which initialises beauty
       {"ao"},
       true,
@@ -355,6 +356,10 @@ void AmbientOcclusionPass::execute(PassContext& ctx) {
   rp.set("u_blur", blur_ ? 1 : 0);
   rp.set("u_radius", radius_);
   res.texture("emission").bindUnit(gpu::kUnitAoEmission);
+  // The layers attenuate the diffuse base (ao_resolve.frag); the sheen's table is an SSBO.
+  res.texture("gbuffer_layers").bindUnit(gpu::kUnitGbufferLayers);
+  res.texture("gbuffer_specular").bindUnit(gpu::kUnitGbufferSpecular);
+  ctx.gpu.sheenAlbedo.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingSheenAlbedo);
   ibl::bind(res, rp, gpu::kUnitIblDfg, -1);
   rp.set("u_eye", &view.eye[0], 3);
   rp.set("u_viewForward", &forward[0], 3);

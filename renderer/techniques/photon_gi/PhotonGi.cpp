@@ -48,7 +48,8 @@ const TechniqueInfo& PhotonGiPass::info() const {
   static const TechniqueInfo i{"photon_gi",
                                "Photon tracing (Embree) and view-dependent photon splatting (Stürzlinger & Bastos "
                                "1997): indirect light on every diffuse and glossy surface",
-                               {"gbuffer_position", "normal", "albedo", "material", "emission", "geometric_normal"},
+                               {"gbuffer_position", "normal", "albedo", "material", "emission", "geometric_normal",
+                                "gbuffer_layers", "gbuffer_specular"},
                                {"direct"},  // runs after direct, which initialises beauty
                                {"indirect"},
                                true,
@@ -206,6 +207,8 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
 }
 
 void PhotonGiPass::execute(PassContext& ctx) {
+  // The receivers' layered BSDF reads the sheen directional-albedo table (common/brdf.glsl).
+  ctx.gpu.sheenAlbedo.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingSheenAlbedo);
   photon_gi::splatAndResolve(ctx.resources, ctx.shaders, ctx.view, splat_, *grid_, upload_, true);
   // The GPU holds the splats now: the CPU copy would double the memory of every cached photon set. A
   // lost GL context clears the cache entry too (FrameResources::clear), so it is rebuilt, not re-uploaded.

@@ -6,6 +6,7 @@
 
 #include <glm/gtc/type_ptr.hpp>
 
+#include "renderer/frame/GpuTypes.h"
 #include "renderer/raytracing/Bsdf.h"
 
 namespace radiant::photon_gi {
@@ -149,6 +150,9 @@ void splatAndResolve(FrameResources& res, gl::ShaderLibrary& shaders, const Fram
   const char* inputs[] = {"gbuffer_position", "normal", "albedo", "material", "emission"};
   for (GLuint i = 0; i < std::size(inputs); ++i) res.texture(inputs[i]).bindUnit(i);
   res.texture("geometric_normal").bindUnit(6);
+  // The layers of the receiver's material (photon_gi/surface.glsl).
+  res.texture("gbuffer_layers").bindUnit(gpu::kUnitGbufferLayers);
+  res.texture("gbuffer_specular").bindUnit(gpu::kUnitGbufferSpecular);
   splats.bindBase(GL_SHADER_STORAGE_BUFFER, kSplatBinding);
   cells.bindBase(GL_SHADER_STORAGE_BUFFER, kCellBinding);
   const glm::vec3 forward = -glm::normalize(glm::vec3(view.camera.world[2]));

@@ -138,7 +138,8 @@ void ShadowMapsPass::execute(PassContext& ctx) {
     prog.set("u_lightPosition", &origin[0], 3);
     prog.set("u_lightDirection", &dir[0], 3);
     prog.set("u_orthographic", ortho ? 1 : 0);
-    ctx.gpu.drawMeshes(prog, false, [&](std::size_t m) { return !excluded_.count(static_cast<int>(m)); });
+    // With textures: MASK and BLEND materials' coverage comes from the base colour's alpha (shadow.frag).
+    ctx.gpu.drawMeshes(prog, true, [&](std::size_t m) { return !excluded_.count(static_cast<int>(m)); });
   }
   ctx.stats.counters["map_size"] = size_;
 }

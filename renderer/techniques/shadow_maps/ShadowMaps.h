@@ -11,7 +11,8 @@ namespace radiant {
 // Shadow maps for every punctual light: a cube map (6 x 90 degree faces) per point light, a
 // perspective 2D map per spot light (cone plus margin) and an orthographic 2D map per directional
 // light fitted to the scene bounds. Maps store the light's distance measure in R32F; the direct
-// pass filters them with PCF (see shaders/direct/direct.frag for the bias model).
+// pass filters them with PCF (see shaders/direct/direct.frag for the bias model). MASK texels below
+// the cutoff cast nothing, BLEND surfaces a dithered coverage alpha (shaders/shadow_maps/shadow.frag).
 // The maps depend only on the scene geometry, its lights and the map size, so they are cached under
 // that digest: a request that changes the camera or another pass's knobs reuses them.
 class ShadowMapsPass final : public Technique {

@@ -538,7 +538,7 @@ TEST_F(ParityTest, MaterialDecodingMatchesCpuOnRandomInputs) {
     }
     return r;
   };
-  int textured = 0, transformedSlots = 0;
+  int textured = 0, layerTextured = 0, transformedSlots = 0;
   std::vector<int> transformedMaterials;
   for (int i = 0; i < kMaterials; ++i) {
     Material m;
@@ -564,15 +564,26 @@ TEST_F(ParityTest, MaterialDecodingMatchesCpuOnRandomInputs) {
     m.occlusionTexture.scale = uniform(rng);
     m.emissiveTexture = maybeTexture(0.6f);
     m.transmissionTexture = maybeTexture(0.6f);
-    if (uniform(rng) < 0.7f) {
-      m.normalTexture.texture = kTextures + std::uniform_int_distribution<int>(0, kNormalTextures - 1)(rng);
-      m.normalTexture.texCoord = uniform(rng) < 0.3f ? 1 : 0;
-      m.normalTexture.scale = uniform(rng, 0.5f, 1.5f);
-    }
+    // The layered extensions' textures (KHR_materials_clearcoat, _sheen, _specular).
+    m.clearcoatTexture = maybeTexture(0.5f);
+    m.clearcoatRoughnessTexture = maybeTexture(0.5f);
+    m.sheenColorTexture = maybeTexture(0.5f);
+    m.sheenRoughnessTexture = maybeTexture(0.5f);
+    m.specularTexture = maybeTexture(0.5f);
+    m.specularColorTexture = maybeTexture(0.5f);
+    auto normalMap = [&](TextureRef& r) {
+      r.texture = kTextures + std::uniform_int_distribution<int>(0, kNormalTextures - 1)(rng);
+      r.texCoord = uniform(rng) < 0.3f ? 1 : 0;
+      r.scale = uniform(rng, 0.5f, 1.5f);
+    };
+    if (uniform(rng) < 0.7f) normalMap(m.normalTexture);
+    if (uniform(rng) < 0.5f) normalMap(m.clearcoatNormalTexture);
     m.doubleSided = true;
-    for (const TextureRef* r : {&m.baseColorTexture, &m.metallicRoughnessTexture, &m.occlusionTexture,
-                                &m.emissiveTexture, &m.transmissionTexture, &m.normalTexture})
-      textured += r->valid();
+    for (const TextureRef* r : materialTextureSlots(m)) textured += r->valid();
+    for (const TextureRef* r : {&m.clearcoatTexture, &m.clearcoatRoughnessTexture, &m.clearcoatNormalTexture,
+                                &m.sheenColorTexture, &m.sheenRoughnessTexture, &m.specularTexture,
+                                &m.specularColorTexture})
+      layerTextured += r->valid();
     // KHR_texture_transform on every slot of a third of the materials, with the loader's own rows
     // (gltf::textureTransformRows). The transforms map the 8x8 grid of texel centres onto itself (odd
     // integer scales, mirrors, quarter turns, offsets in eighths), so texel-centre points stay exact.
@@ -583,8 +594,8 @@ TEST_F(ParityTest, MaterialDecodingMatchesCpuOnRandomInputs) {
                                       {{-0.5f, 0.25f}, rt::kPi, {-1.f, 3.f}},
                                       {{0.125f, 0.f}, -0.5f * rt::kPi, {1.f, 5.f}}};
       int k = i / 3;
-      for (TextureRef* r : {&m.baseColorTexture, &m.metallicRoughnessTexture, &m.normalTexture, &m.occlusionTexture,
-                            &m.emissiveTexture, &m.transmissionTexture}) {
+      for (const TextureRef* slot : materialTextureSlots(m)) {
+        TextureRef* r = const_cast<TextureRef*>(slot);  // m is this loop's own, mutable Material
         const Transform& t = transforms[k++ % 4];
         gltf::textureTransformRows(t.offset, t.rotation, t.scale, r->uvRow0, r->uvRow1);
         // Exact rows: float cos(pi/2) is -4.4e-8, which would move a texel-centre lookup by ~2e-6 of a
@@ -613,7 +624,8 @@ TEST_F(ParityTest, MaterialDecodingMatchesCpuOnRandomInputs) {
     for (const auto& p : mesh.positions) mesh.bounds.extend(p);
     scene.meshes.push_back(mesh);
   }
-  EXPECT_GT(textured, 80);
+  EXPECT_GT(textured, 150);
+  EXPECT_GT(layerTextured, 80);
   EXPECT_GT(transformedSlots, 25);
   scene.features = computeFeatures(scene);
   const rt::RayScene rays(scene);
@@ -638,15 +650,17 @@ TEST_F(ParityTest, MaterialDecodingMatchesCpuOnRandomInputs) {
   }
   const Program* program = nullptr;
   std::vector<gpu::MaterialParams> gpu(cases.size());
-  std::vector<glm::vec4> gpuNormals(cases.size());
+  std::vector<glm::vec4> gpuNormals(cases.size()), gpuCoatNormals(cases.size());
   {
     program = &library_.program({"tests/parity.comp"}, {{"PARITY_MATERIAL", ""}});
     Buffer in("parity cases", cases.size() * sizeof(glm::vec4), cases.data(), 0);
     Buffer out("parity results", cases.size() * sizeof(gpu::MaterialParams));
     Buffer normals("parity normals", cases.size() * sizeof(glm::vec4));
+    Buffer coatNormals("parity coat normals", cases.size() * sizeof(glm::vec4));
     in.bindBase(GL_SHADER_STORAGE_BUFFER, kCasesBinding);
     out.bindBase(GL_SHADER_STORAGE_BUFFER, kResultsBinding);
     normals.bindBase(GL_SHADER_STORAGE_BUFFER, kResultsBinding + 1);
+    coatNormals.bindBase(GL_SHADER_STORAGE_BUFFER, kResultsBinding + 2);
     gpuScene.materials.bindBase(GL_SHADER_STORAGE_BUFFER, GpuScene::kMaterialBinding);
     program->use();
     for (int mi = 0; mi < kMaterials; ++mi) {
@@ -663,9 +677,11 @@ TEST_F(ParityTest, MaterialDecodingMatchesCpuOnRandomInputs) {
     gl::checkError("parity.comp PARITY_MATERIAL");
     out.download(gpu.data(), gpu.size() * sizeof(gpu::MaterialParams));
     normals.download(gpuNormals.data(), gpuNormals.size() * sizeof(glm::vec4));
+    coatNormals.download(gpuCoatNormals.data(), gpuCoatNormals.size() * sizeof(glm::vec4));
   }
 
-  int failures = 0, checked = 0, normalsCompared = 0, mappedNormalsCompared = 0, movedByTransform = 0,
+  int failures = 0, checked = 0, normalsCompared = 0, mappedNormalsCompared = 0, mappedCoatNormalsCompared = 0,
+      movedByTransform = 0,
       transformedCases = 0;
   struct Worst { int failures = 0; float relative = 0.f, absolute = 0.f; };
   std::map<std::string, Worst> byWhat;  // per quantity
@@ -694,8 +710,8 @@ TEST_F(ParityTest, MaterialDecodingMatchesCpuOnRandomInputs) {
       // The transform really moves the lookups: the same material with identity rows decodes to
       // something else at most points (so the GPU/CPU agreement below is not two decoders ignoring it).
       Material plain = m;
-      for (TextureRef* r : {&plain.baseColorTexture, &plain.metallicRoughnessTexture, &plain.normalTexture,
-                            &plain.occlusionTexture, &plain.emissiveTexture, &plain.transmissionTexture}) {
+      for (const TextureRef* slot : materialTextureSlots(plain)) {
+        TextureRef* r = const_cast<TextureRef*>(slot);
         r->uvRow0 = glm::vec3(1.f, 0.f, 0.f);
         r->uvRow1 = glm::vec3(0.f, 1.f, 0.f);
       }
@@ -703,7 +719,10 @@ TEST_F(ParityTest, MaterialDecodingMatchesCpuOnRandomInputs) {
           decodeMaterial(plain, [&](const TextureRef& ref, bool srgb) { return rays.textureAt(ref, hit, srgb); });
       const float moved = std::max({rt::maxComponent(glm::abs(glm::vec3(untransformed.baseColor - cpu.baseColor))),
                                     rt::maxComponent(glm::abs(glm::vec3(untransformed.emission - cpu.emission))),
-                                    rt::maxComponent(glm::abs(glm::vec3(untransformed.surface - cpu.surface)))});
+                                    rt::maxComponent(glm::abs(glm::vec3(untransformed.surface - cpu.surface))),
+                                    rt::maxComponent(glm::abs(glm::vec3(untransformed.clearcoat - cpu.clearcoat))),
+                                    rt::maxComponent(glm::abs(glm::vec3(untransformed.sheen - cpu.sheen))),
+                                    rt::maxComponent(glm::abs(glm::vec3(untransformed.specular - cpu.specular)))});
       ++transformedCases;
       movedByTransform += moved > 0.05f;
     }
@@ -720,9 +739,12 @@ TEST_F(ParityTest, MaterialDecodingMatchesCpuOnRandomInputs) {
       expectNear(i, ch < 3 ? "emission" : "occlusion", g.emission[ch], cpu.emission[ch],
                  ch < 3 ? srgbTol * emissionScale : linearTol);
       expectNear(i, "surface", g.surface[ch], cpu.surface[ch], linearTol);
-      expectNear(i, "clearcoat", g.clearcoat[ch], cpu.clearcoat[ch], 1e-6f);
-      expectNear(i, "sheen", g.sheen[ch], cpu.sheen[ch], 1e-6f);
-      expectNear(i, "specular", g.specular[ch], cpu.specular[ch], 1e-6f);
+      // The layers: factor x texel, linear data (clear coat, coat roughness, sheen roughness, specular
+      // weight) or sRGB colour (sheen and specular colour; the specular colour factor goes up to 3).
+      expectNear(i, "clearcoat", g.clearcoat[ch], cpu.clearcoat[ch], linearTol);
+      expectNear(i, ch < 3 ? "sheen.rgb" : "sheen.a", g.sheen[ch], cpu.sheen[ch], ch < 3 ? srgbTol : linearTol);
+      expectNear(i, ch < 3 ? "specular.rgb" : "specular.a", g.specular[ch], cpu.specular[ch],
+                 ch < 3 ? srgbTol * std::max(1.f, m.specularColorFactor[ch]) : linearTol);
     }
     // The ray-tracing core's own reading of the material is the decoder's, and its normal-mapped
     // shading normal is GLSL's decodeShadingNormal (2 texel - 1, times a normal scale up to 1.5, then
@@ -738,6 +760,15 @@ TEST_F(ParityTest, MaterialDecodingMatchesCpuOnRandomInputs) {
                    centre ? 1e-5f : 4.f / 128.f);
       ++normalsCompared;
       mappedNormalsCompared += m.normalTexture.valid();
+    }
+    // KHR_materials_clearcoat's normal: decodeCoatNormal == RayScene::shade's coat normal (its own map or
+    // the interpolated normal), with the same horizon exclusion.
+    const glm::vec3 coatWorld = sh.frame.toWorld(sh.bsdf.coatNormal);
+    if (glm::dot(glm::vec3(gpuCoatNormals[i]), wo) > 0.05f) {
+      for (int ch = 0; ch < 3; ++ch)
+        expectNear(i, m.clearcoatNormalTexture.valid() ? "coat normal (mapped)" : "coat normal", gpuCoatNormals[i][ch],
+                   coatWorld[ch], centre ? 1e-5f : 4.f / 128.f);
+      mappedCoatNormalsCompared += m.clearcoatNormalTexture.valid();
     }
     expectNear(i, "shade.baseColor.r", sh.bsdf.baseColor.r, cpu.baseColor.r, 0.f);
     expectNear(i, "shade.metallic", sh.bsdf.metallic, cpu.surface.x, 0.f);
@@ -759,6 +790,7 @@ TEST_F(ParityTest, MaterialDecodingMatchesCpuOnRandomInputs) {
   EXPECT_EQ(failures, 0) << "of " << checked << " comparisons";
   EXPECT_GT(normalsCompared, 9000);
   EXPECT_GT(mappedNormalsCompared, 5000);
+  EXPECT_GT(mappedCoatNormalsCompared, 3000);
   EXPECT_GT(transformedCases, 3000);
   EXPECT_GT(movedByTransform, transformedCases / 2);
 }
@@ -769,9 +801,12 @@ TEST_F(ParityTest, MaterialDecodingMatchesCpuOnRandomInputs) {
 // be both t_baseColor and t_environment.) Units 0-5 are each full-screen pass's own inputs.
 
 TEST_F(ParityTest, SamplerUnitsAreUniqueAcrossTheFramesPrograms) {
-  GLint maxUnits = 0;
-  glGetIntegerv(GL_MAX_TEXTURE_IMAGE_UNITS, &maxUnits);
-  EXPECT_GE(maxUnits, gpu::kUnitCount);
+  // A binding must be below the combined limit (GL 4.5 guarantees 80); a program's stage reads at most
+  // GL_MAX_TEXTURE_IMAGE_UNITS samplers (checked per program below, which bounds every stage).
+  GLint maxCombinedUnits = 0, maxStageSamplers = 0;
+  glGetIntegerv(GL_MAX_COMBINED_TEXTURE_IMAGE_UNITS, &maxCombinedUnits);
+  glGetIntegerv(GL_MAX_TEXTURE_IMAGE_UNITS, &maxStageSamplers);
+  EXPECT_GE(maxCombinedUnits, gpu::kUnitCount);
   const std::vector<std::vector<std::string>> programs = {
       {"gbuffer/gbuffer.vert", "gbuffer/gbuffer.frag"},   {"common/fullscreen.vert", "direct/direct.frag"},
       {"specular/map.vert", "specular/map.frag"},         {"specular/map.vert", "specular/specular.frag"},
@@ -781,6 +816,8 @@ TEST_F(ParityTest, SamplerUnitsAreUniqueAcrossTheFramesPrograms) {
       {"caustics/grid.vert", "caustics/triangles.geom", "caustics/deposit.frag"},
       {"caustics/grid.vert", "caustics/splat.geom", "caustics/deposit.frag"},
       {"specular/map.vert", "caustics/secondary.frag"},
+      {"gbuffer/gbuffer.vert", "transparency/transparency.frag"},
+      {"shadow_maps/shadow.vert", "shadow_maps/shadow.frag"},
   };
   std::map<int, std::string> sharedUnitOwner;  // unit >= 6 -> sampler name
   int samplers = 0;
@@ -809,6 +846,7 @@ TEST_F(ParityTest, SamplerUnitsAreUniqueAcrossTheFramesPrograms) {
                                     << it->second << " in another program";
       }
     }
+    EXPECT_LE(static_cast<GLint>(units.size()), maxStageSamplers) << files.back();
   }
   gl::checkError("sampler units");
   EXPECT_GE(samplers, 25);  // the programs' samplers were really enumerated

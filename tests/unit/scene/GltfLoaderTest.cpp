@@ -211,6 +211,63 @@ TEST(GltfLoader, PngTextureFromDataUriDecodesTexels) {
   EXPECT_EQ(s.features.textures, 2);
 }
 
+TEST(GltfLoader, LayeredExtensionTexturesAreReadWithTheirColourSpacesAndTransforms) {
+  // KHR_materials_clearcoat, _sheen and _specular name their textures in extension JSON, which tinygltf
+  // leaves unparsed: index, texCoord, the coat normal's scale and KHR_texture_transform come through,
+  // the colour textures (sheenColorTexture, specularColorTexture) are sRGB, the data ones linear, a
+  // coat normal map alone gets a tangent frame, and nothing is listed in stats.warnings.
+  const std::string png = test::encodePng(1, 1, {128, 128, 255, 255});
+  GltfBuilder b;
+  for (int i = 0; i < 3; ++i) b.push("images", {{"uri", "data:image/png;base64," + test::base64(png)}});
+  for (int i = 0; i < 3; ++i) b.push("textures", {{"source", i}});
+  const json transform = {{"KHR_texture_transform", {{"offset", {0.5, 0.0}}, {"scale", {2.0, 2.0}}}}};
+  const int mat = b.material(
+      {{"extensions",
+        {{"KHR_materials_clearcoat", {{"clearcoatFactor", 1.0}, {"clearcoatTexture", {{"index", 0}}},
+                                      {"clearcoatRoughnessTexture", {{"index", 0}, {"texCoord", 1}}},
+                                      {"clearcoatNormalTexture", {{"index", 0}, {"scale", 0.25}}}}},
+         {"KHR_materials_sheen", {{"sheenColorTexture", {{"index", 1}, {"extensions", transform}}},
+                                  {"sheenRoughnessTexture", {{"index", 0}}}}},
+         {"KHR_materials_specular", {{"specularTexture", {{"index", 2}}}, {"specularColorTexture", {{"index", 1}}}}}}}});
+  const int m = b.mesh(json::array({trianglePrimitive<std::uint8_t>(b, kTri, {0, 1, 2}, {}, {{0, 1}, {1, 1}, {0, 0}}, mat)}));
+  b.scene({b.node({{"mesh", m}})});
+  b.doc["extensionsUsed"] = json::array({"KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_specular",
+                                         "KHR_texture_transform"});
+  const Scene s = loadSceneFromMemory(b.gltf());
+  const Material& mm = s.materials[0];
+  EXPECT_EQ(mm.clearcoatTexture.texture, 0);
+  EXPECT_EQ(mm.clearcoatRoughnessTexture.texCoord, 1);
+  EXPECT_EQ(mm.clearcoatNormalTexture.texture, 0);
+  EXPECT_FLOAT_EQ(mm.clearcoatNormalTexture.scale, 0.25f);
+  EXPECT_EQ(mm.sheenColorTexture.texture, 1);
+  EXPECT_EQ(mm.sheenRoughnessTexture.texture, 0);
+  EXPECT_EQ(mm.specularTexture.texture, 2);
+  EXPECT_EQ(mm.specularColorTexture.texture, 1);
+  // uv' = T S uv: (2 u + 0.5, 2 v).
+  const glm::vec2 moved = mm.sheenColorTexture.transformUv({0.25f, 0.5f});
+  EXPECT_FLOAT_EQ(moved.x, 1.f);
+  EXPECT_FLOAT_EQ(moved.y, 1.f);
+  EXPECT_FLOAT_EQ(mm.specularColorTexture.transformUv({0.25f, 0.5f}).x, 0.25f);  // its own slot: no transform
+  EXPECT_EQ(s.textures[0].colorSpace, TextureColorSpace::Linear);
+  EXPECT_EQ(s.textures[1].colorSpace, TextureColorSpace::SRGB);
+  EXPECT_EQ(s.textures[2].colorSpace, TextureColorSpace::Linear);
+  EXPECT_EQ(s.meshes[0].tangents.size(), 3u);  // the coat's normal map needs the tangent frame
+  for (const std::string& w : s.warnings) ADD_FAILURE() << "unexpected warning: " << w;
+}
+
+TEST(GltfLoader, LayeredExtensionTextureThatDoesNotExistIsRefusedAtItsPointer) {
+  GltfBuilder b;
+  const int mat = b.material({{"extensions", {{"KHR_materials_sheen", {{"sheenColorTexture", {{"index", 3}}}}}}}});
+  const int m = b.mesh(json::array({trianglePrimitive<std::uint8_t>(b, kTri, {0, 1, 2}, {}, {}, mat)}));
+  b.scene({b.node({{"mesh", m}})});
+  try {
+    loadSceneFromMemory(b.gltf());
+    FAIL() << "a missing texture was accepted";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.pointer, "/materials/0/extensions/KHR_materials_sheen/sheenColorTexture/index");
+  }
+}
+
 // A normal-mapped triangle in the XY plane (normal +Z) with the given UVs at (0,0,0), (1,0,0), (0,1,0).
 Scene normalMapped(const std::vector<glm::vec2>& uv) {
   const std::string png = test::encodePng(1, 1, {128, 128, 255, 255});
