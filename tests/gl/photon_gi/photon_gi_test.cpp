@@ -472,6 +472,31 @@ TEST(PhotonGi, CameraChangeReusesPhotonsAndMorePhotonsExtendThem) {
   EXPECT_EQ(testing::cacheEvent(third, "photon_gi_splats"), 0);
 }
 
+// The splat buffers hold one photon set at a time: a scene rendered again after another scene (its splats
+// still cached) must gather its own photons, not the other's. Scene B is scene A with 4x the light, so
+// B's indirect light is 4x A's; A again must give A's image exactly (same photons, same seed). Before
+// the fix A again gathered B's splats (4x): the Fox sample rendered after BoxTextured came out unlit.
+TEST(PhotonGi, ASceneRenderedAgainAfterAnotherGathersItsOwnPhotons) {
+  const Scene a = loadBuiltinScene("cornell_box");
+  Scene b = a;
+  for (Light& l : b.lights) l.intensity *= 4.f;
+  b.digest = a.digest + "-4x-light";
+  const api::RenderRequest r = cornellRequest(24, {{"photons", 30000}});
+  const RenderOutput first = renderer().render(a, r);
+  const RenderOutput other = renderer().render(b, r);
+  const RenderOutput again = renderer().render(a, r);
+  EXPECT_EQ(testing::cacheEvent(again, "photon_gi_splats"), 1);
+  EXPECT_EQ(pass(again, "photon_gi")->counters.at("splats_rebuilt"), 1.0);
+  const double meanA = mean(aov(first, "indirect"));
+  ASSERT_GT(meanA, 0.0);
+  EXPECT_NEAR(mean(aov(other, "indirect")) / meanA, 4.0, 0.04);
+  const Image& x = aov(first, "indirect");
+  const Image& y = aov(again, "indirect");
+  double maxDiff = 0.0;
+  for (std::size_t i = 0; i < x.pixels.size(); ++i) maxDiff = std::max(maxDiff, double(std::abs(x.pixels[i] - y.pixels[i])));
+  EXPECT_LT(maxDiff, 1e-5 * std::max(1.0, meanA));
+}
+
 TEST(PhotonGi, ScaledScenesGiveTheSameImage) {
   // Scaling geometry by s and light intensity by s^2 leaves every radiance unchanged.
   const Scene base = loadBuiltinScene("cornell_box");
