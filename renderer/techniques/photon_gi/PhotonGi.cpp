@@ -92,9 +92,11 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
                                                                                   : photon_gi::Kernel::Biweight;
   splat_.renormalize = params.get<bool>("renormalize", true);
   splat_.minGlossyRoughness = params.get<float>("min_glossy_roughness", 0.2f);
-  splat_.gatherStep = params.get<int>("gather_step", 2);
-
   const FrameView& view = res.view();
+  // gather_step is in output pixels: on a k-times supersampled frame the block is k gather_step
+  // samples wide, so the gather costs what it costs at k = 1 and the block's light is still spread over
+  // the pixel's own surface samples (the estimator's surface test), which is what the anti-aliasing needs.
+  splat_.gatherStep = params.get<int>("gather_step", 2) * std::max(1, view.supersampling);
   // --- Photon records: derived data of the scene, its lights and environment, never of the camera.
   const rt::RayScene& rays = sharedRayScene(res, scene);
   const nlohmann::json photonKey = {{"scene", res.sceneKey()},
