@@ -365,10 +365,13 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     api::RenderRequest supersampled = request;
     supersampled.width *= k;
     supersampled.height *= k;
-    const FrameView view = makeFrameView(scene, supersampled, inputs.environment);
+    FrameView supersampledView = makeFrameView(scene, supersampled, inputs.environment);
+    supersampledView.supersampling = k;
+    const FrameView& view = supersampledView;
     FrameView outView = view;
     outView.width = request.width;
     outView.height = request.height;
+    outView.supersampling = 1;
     stats.camera = cameraStats(view);
     const GpuScene& gpu = im.gpuScene(scene, stats);
     stats.skipped = plan.skipped;

@@ -14,7 +14,11 @@
 namespace radiant {
 
 struct FrameView {
-  int width = 0, height = 0;
+  int width = 0, height = 0;  // the passes' size: k times the request's with supersampling k
+  // Raster samples per output pixel axis (RenderRequest::supersampling as capped, stats.supersampling).
+  // A pass whose sample spacing is a parameter in pixels (photon_gi's gather_step) counts it in output
+  // pixels by scaling it with k, so its work per output pixel does not grow k^2-fold.
+  int supersampling = 1;
   Camera camera;
   glm::mat4 view{1.f}, proj{1.f}, viewProj{1.f}, invViewProj{1.f};
   glm::vec3 eye{0.f};

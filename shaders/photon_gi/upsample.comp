@@ -5,12 +5,15 @@
 // kernel). The diffuse albedo is re-modulated per pixel, (albedo + 0.02) / (albedo_sample + 0.02), so
 // texture detail survives. Pixels without a matching sample are marked for a full-resolution gather
 // (i_fixup = 1), which the next dispatch of gather.comp does for them alone: no pixel is left dark.
+// u_refine = 1 (the fix-up cascade of a supersampled frame): only the marked pixels, from block samples
+// of a finer step taken at marked block centres (alpha -1: no sample there); a pixel that finds one is
+// unmarked, the others stay marked for the full gather.
 #include "photon_gi/photon.glsl"
 #include "photon_gi/surface.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(rgba32f, binding = 0) uniform writeonly image2D i_accum;
-layout(r32f, binding = 1) uniform writeonly image2D i_fixup;
+layout(rgba32f, binding = 0) uniform image2D i_accum;
+layout(r32f, binding = 1) uniform image2D i_fixup;
 layout(binding = 7) uniform sampler2D t_low;
 
 uniform ivec2 u_size;     // full resolution
@@ -19,12 +22,14 @@ uniform int u_step;
 uniform float u_hMin;
 uniform int u_renormalize;
 uniform float u_minKernelMass;
+uniform int u_refine;
 
 ivec2 samplePixel(ivec2 q) { return min(q * u_step + u_step / 2, u_size - 1); }
 
 void main() {
   ivec2 px = ivec2(gl_GlobalInvocationID.xy);
   if (px.x >= u_size.x || px.y >= u_size.y) return;
+  if (u_refine != 0 && imageLoad(i_fixup, px).r == 0.0) return;
   SplatSurface s;
   if (!loadSurface(px, s)) {
     imageStore(i_accum, px, vec4(0.0));
@@ -48,6 +53,7 @@ void main() {
       if (dot(s.ng, o.ng) < 0.9) continue;
       if (dot(d, d) > 0.25 * u_hMin * u_hMin) continue;
       vec4 a = texelFetch(t_low, q, 0);
+      if (a.a < 0.0) continue;  // u_refine: no block sample was taken there
       vec3 L = a.rgb;
       if (u_renormalize != 0 && a.a > 0.0) L /= max(a.a, u_minKernelMass);
       sum += wb * L * (s.p.baseColor.rgb + 0.02) / (o.p.baseColor.rgb + 0.02);
@@ -57,7 +63,7 @@ void main() {
     // a = 1: the resolve's renormalisation divides by max(1, minKernelMass) = 1.
     imageStore(i_accum, px, vec4(sum / wsum, 1.0));
     imageStore(i_fixup, px, vec4(0.0));
-  } else {
+  } else if (u_refine == 0) {
     imageStore(i_accum, px, vec4(0.0));
     imageStore(i_fixup, px, vec4(1.0));
   }

@@ -93,9 +93,11 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
                                                                                   : photon_gi::Kernel::Biweight;
   splat_.renormalize = params.get<bool>("renormalize", true);
   splat_.minGlossyRoughness = params.get<float>("min_glossy_roughness", 0.2f);
-  splat_.gatherStep = params.get<int>("gather_step", 2);
-
   const FrameView& view = res.view();
+  // gather_step is in output pixels: on a k-times supersampled frame the block is k gather_step
+  // samples wide, so the gather costs what it costs at k = 1 and the block's light is still spread over
+  // the pixel's own surface samples (the estimator's surface test), which is what the anti-aliasing needs.
+  splat_.gatherStep = params.get<int>("gather_step", 2) * std::max(1, view.supersampling);
   // --- Photon records: derived data of the scene, its lights and environment, never of the camera.
   const rt::RayScene& rays = sharedRayScene(res, scene);
   const nlohmann::json photonKey = {{"scene", res.sceneKey()},
@@ -140,8 +142,9 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
                                    {"ppm", s.ppm}, {"alpha", s.ppmAlpha}, {"base", s.ppmBase},
                                    {"renormalize", splat_.renormalize}};
   upload_ = false;
+  rebuilt_ = false;
   buildMs_ = 0.0;
-  SplatCache& splats = res.cached<SplatCache>("photon_gi_splats", splatKey.dump(), [&] {
+  auto buildSplats = [&] {
     upload_ = true;
     const auto t0 = Clock::now();
     auto c = std::make_unique<SplatCache>();
@@ -196,13 +199,23 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
     c->grid = photon_gi::buildSplatGrid(std::move(out));
     buildMs_ = msSince(t0);
     return c;
-  });
+  };
+  const std::string splatDigest = splatKey.dump();
+  SplatCache& splats = res.cached<SplatCache>("photon_gi_splats", splatDigest, buildSplats);
+  if (!res.hasBuffer("photon_gi_splats")) upload_ = true;  // resources were dropped after a failure
+  // A hit whose set is not the one in the buffers (another scene was rendered since): without this the
+  // frame gathered the other scene's photons (Fox after BoxTextured came out unlit, 2026-12-02).
+  if (residentSplats_ != splatDigest) upload_ = true;
+  if (upload_ && splats.grid.splats.size() != splats.grid.count) {
+    splats = std::move(*buildSplats());
+    rebuilt_ = true;
+  }
   grid_ = &splats.grid;
   photonSplats_ = splats.photonSplats;
   coveragePoints_ = splats.coveragePoints;
   hMin_ = splats.hMin;
   hMax_ = splats.hMax;
-  if (!res.hasBuffer("photon_gi_splats")) upload_ = true;  // resources were dropped after a failure
+  residentSplats_ = splatDigest;
   photon_gi::declareSplatResources(res, *grid_, splat_);
 }
 
@@ -226,6 +239,7 @@ void PhotonGiPass::execute(PassContext& ctx) {
       settings_.photons ? double(records_ * sizeof(rt::PhotonRecord)) / double(settings_.photons) : 0.0;
   c["splat_bytes"] = static_cast<double>(grid_->count * sizeof(photon_gi::GpuSplat));
   c["splats_uploaded"] = upload_ ? 1.0 : 0.0;
+  c["splats_rebuilt"] = rebuilt_ ? 1.0 : 0.0;
   c["h_min"] = hMin_;
   c["h_max"] = hMax_;
   c["C"] = settings_.C;

@@ -123,6 +123,11 @@ void declareSplatResources(FrameResources& res, const SplatGrid& grid, const Spl
     res.texture("photon_gi_accum_low", GL_TEXTURE_2D, GL_RGBA32F, (w + step - 1) / step, (h + step - 1) / step)
         .setFilter(GL_NEAREST, GL_NEAREST);
     res.texture("photon_gi_fixup", GL_TEXTURE_2D, GL_R32F, w, h).setFilter(GL_NEAREST, GL_NEAREST);
+    // The fix-up cascade's block samples (steps step / 2, step / 4, ... down to 2), one texture sized
+    // for the finest of them.
+    if (step >= 4)
+      res.texture("photon_gi_accum_refine", GL_TEXTURE_2D, GL_RGBA32F, (w + 1) / 2, (h + 1) / 2)
+          .setFilter(GL_NEAREST, GL_NEAREST);
   }
   gl::Framebuffer& splatFb = res.framebuffer("photon_gi_splat");
   splatFb.attach(GL_COLOR_ATTACHMENT0, accum);
@@ -194,12 +199,14 @@ void splatAndResolve(FrameResources& res, gl::ShaderLibrary& shaders, const Fram
     glUniform2iv(glGetUniformLocation(prog.id(), "u_size"), 1, size);
     const std::uint32_t slices = std::max<std::uint32_t>(1, (grid.maxPerCell + kGatherSlice - 1) / kGatherSlice);
     // One gather over an output grid (full resolution, the block samples, or the marked pixels).
-    auto gather = [&](gl::Texture& target, int step, int outW, int outH, bool fixup) {
+    // fixup: 0 every output pixel, 1 the marked pixels (full resolution), 2 the block samples whose
+    // centre pixel is marked (gather.comp).
+    auto gather = [&](gl::Texture& target, int step, int outW, int outH, int fixup) {
       prog.use();
       const int out[2] = {outW, outH};
       glUniform2iv(glGetUniformLocation(prog.id(), "u_outSize"), 1, out);
       prog.set("u_step", step);
-      prog.set("u_fixup", fixup ? 1 : 0);
+      prog.set("u_fixup", fixup);
       target.bindImage(0, GL_READ_WRITE);
       if (fixup) res.texture("photon_gi_fixup").bindImage(1, GL_READ_ONLY);
       for (std::uint32_t k = 0; k < slices; ++k) {
@@ -212,11 +219,11 @@ void splatAndResolve(FrameResources& res, gl::ShaderLibrary& shaders, const Fram
     };
     const int step = settings.gatherStep;
     if (step <= 1) {
-      gather(accum, 1, view.width, view.height, false);
+      gather(accum, 1, view.width, view.height, 0);
     } else {
       gl::Texture& low = res.texture("photon_gi_accum_low");
       const int lowW = (view.width + step - 1) / step, lowH = (view.height + step - 1) / step;
-      gather(low, step, lowW, lowH, false);
+      gather(low, step, lowW, lowH, 0);
       glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
       const gl::Program& up = shaders.program({"photon_gi/upsample.comp"});
       common(up);
@@ -227,13 +234,39 @@ void splatAndResolve(FrameResources& res, gl::ShaderLibrary& shaders, const Fram
       up.set("u_hMin", grid.hMin);
       up.set("u_renormalize", settings.renormalize ? 1 : 0);
       up.set("u_minKernelMass", kMinKernelMass);
+      up.set("u_refine", 0);
       low.bindUnit(7);
       accum.bindImage(0, GL_WRITE_ONLY);
       res.texture("photon_gi_fixup").bindImage(1, GL_WRITE_ONLY);
       glDispatchCompute((view.width + 7) / 8, (view.height + 7) / 8, 1);
       glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+      // The fix-up cascade: the marked pixels are edge pixels, k^2 times as many on a frame supersampled
+      // k times (whose step is k gather_step), so before the full gather they try block samples of half
+      // the step, taken only at marked block centres (about as many samples as at k = 1's step).
+      for (int fine = step / 2; fine >= 2; fine /= 2) {
+        gl::Texture& refine = res.texture("photon_gi_accum_refine");
+        const int fineW = (view.width + fine - 1) / fine, fineH = (view.height + fine - 1) / fine;
+        common(prog);
+        res.texture("photon_gi_fixup").bindImage(1, GL_READ_ONLY);
+        gather(refine, fine, fineW, fineH, 2);
+        glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+        common(up);
+        glUniform2iv(glGetUniformLocation(up.id(), "u_size"), 1, size);
+        const int fineSize[2] = {fineW, fineH};
+        glUniform2iv(glGetUniformLocation(up.id(), "u_lowSize"), 1, fineSize);
+        up.set("u_step", fine);
+        up.set("u_hMin", grid.hMin);
+        up.set("u_renormalize", settings.renormalize ? 1 : 0);
+        up.set("u_minKernelMass", kMinKernelMass);
+        up.set("u_refine", 1);
+        refine.bindUnit(7);
+        accum.bindImage(0, GL_READ_WRITE);
+        res.texture("photon_gi_fixup").bindImage(1, GL_READ_WRITE);
+        glDispatchCompute((view.width + 7) / 8, (view.height + 7) / 8, 1);
+        glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+      }
       common(prog);
-      gather(accum, 1, view.width, view.height, true);
+      gather(accum, 1, view.width, view.height, 1);
     }
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
   }

@@ -190,6 +190,46 @@ TEST_F(Content, EverySampleRendersAlikeInEveryShippedFormAndAsAnAsset) {
   }
 }
 
+// Issue 12's goal on the sample that misses it by the least, through the client and --asset-root:
+// Fox at 128x128 against the reference at 256 spp. With "supersampling": 2 (the raster's pixel
+// integral, as the reference takes it) it scores 30.75 and 30.80 dB in two measurements
+// (docs/PERFORMANCE.md); the bound 30.3 leaves 0.5 dB for llvmpipe builds and the reference's own
+// noise at 256 spp. At one sample per pixel it scored 28.95 dB: the gain (1.85 dB) is asserted to be
+// above 1 dB. Energy: supersampling box-filters radiance, so the frame's mean light stays that of
+// k = 1; measured within 0.4% (Fox) and 0.9% (BoxTextured, red) per channel, bound 1.5%. Rendered after
+// the other samples in the same daemon: a photon set left over from another scene (the photon_gi
+// splat buffers) would show here as an unlit Fox (21.7 dB before that fix).
+TEST_F(Content, SupersamplingTwoTakesFoxAbove30DbAgainstTheReferenceAndKeepsItsLight) {
+  const fs::path fox = fs::path(RADIANT_GLTF_SAMPLES_DIR) / "Fox" / "glTF" / "Fox.gltf";
+  if (!fs::exists(fox)) GTEST_SKIP() << "no Fox sample";
+  auto run = [&](int k) {
+    const std::string tag = "fox-k" + std::to_string(k);
+    const fs::path exr = *dir_ / (tag + ".exr"), stats = *dir_ / (tag + ".json"), req = *dir_ / (tag + "-request.json");
+    io::writeFile(req.string(), json{{"supersampling", k}}.dump());
+    const ProcessRun r = client(daemon_->url(), "render --asset Fox/glTF/Fox.gltf --size 128x128 --compare 256 --request '" +
+                                                    req.string() + "' -o '" + exr.string() + "' --float --aov beauty --aov depth --stats '" +
+                                                    stats.string() + "'",
+                                *dir_);
+    EXPECT_EQ(r.code, 0) << r.err;
+    return readFrame(exr, stats);
+  };
+  const Frame one = run(1), two = run(2);
+  EXPECT_EQ(one.stats["supersampling"], 1);
+  EXPECT_EQ(two.stats["supersampling"], 2);
+  const double psnr1 = one.stats["metrics"]["psnr"].get<double>(), psnr2 = two.stats["metrics"]["psnr"].get<double>();
+  std::cout << "Fox 128x128 against the reference at 256 spp: " << psnr1 << " dB at k = 1, " << psnr2 << " dB at k = 2\n";
+  EXPECT_GE(psnr2, 30.3);
+  EXPECT_GT(psnr2 - psnr1, 1.0);
+  for (int c = 0; c < 3; ++c) {
+    double m1 = 0.0, m2 = 0.0;
+    for (std::size_t p = 0; p < std::size_t(128) * 128; ++p) {
+      m1 += one.beauty.pixels[p * 3 + c];
+      m2 += two.beauty.pixels[p * 3 + c];
+    }
+    EXPECT_NEAR(m2 / m1, 1.0, 0.015) << "channel " << c;
+  }
+}
+
 TEST_F(Content, ClientRefusesUrisOutsideTheGltfFolderBeforeUploading) {
   const fs::path d = *dir_ / "escape" / "model";
   fs::create_directories(d);
