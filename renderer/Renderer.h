@@ -71,8 +71,9 @@ public:
   RenderOutput render(const Scene& scene, const api::RenderRequest& request,
                       const std::atomic<bool>* cancel = nullptr, const FrameInputs& inputs = {});
   static std::vector<TechniqueDescription> techniques();
-  // How many scenes stay uploaded to the GPU, and how many input digests each kind of derived data
-  // (BVH, shadow maps, photon maps, environment maps) keeps; least recently used evicted first.
+  // How many scenes stay uploaded to the GPU, and how many input digests each kind of cached derived
+  // data (BVH, photons, beams) keeps; least recently used evicted first. Maps held in shared frame
+  // resources (shadow and cube maps) hold the last scene rendered (FrameResources::holds).
   // Default 4; radiantd --gpu-scenes.
   void setGpuSceneCapacity(std::size_t scenes);
 

@@ -15,7 +15,6 @@ GLenum glFormat(api::AovFormat f) {
     default: return GL_RGBA32F;
   }
 }
-struct EnvironmentMapEntry {};  // marks the environment_map texture as holding the keyed map
 }  // namespace
 
 void allocateDeclaredOutputs(FrameResources& res, const std::vector<Technique*>& passes) {
@@ -41,13 +40,9 @@ void declareEnvironmentMap(FrameResources& res, const FrameView& view) {
   const Image& env = *view.environment;
   gl::Texture& t = res.texture(kEnvironmentMap, GL_TEXTURE_2D, GL_RGBA32F, env.width, env.height);
   t.setFilter(GL_NEAREST, GL_NEAREST);
-  bool built = false;
-  res.cached<EnvironmentMapEntry>(kEnvironmentMap, view.environmentKey + "|" + std::to_string(env.width) + "x" +
-                                                       std::to_string(env.height), [&] {
-    built = true;
-    return std::make_unique<EnvironmentMapEntry>();
-  });
-  if (!built) return;
+  const std::string digest = view.environmentKey + "|" + std::to_string(env.width) + "x" + std::to_string(env.height);
+  if (res.holds(kEnvironmentMap, digest)) return;
+  res.setHolds(kEnvironmentMap, digest);
   std::vector<float> rgba(static_cast<std::size_t>(env.width) * env.height * 4, 0.f);
   for (std::size_t p = 0; p < static_cast<std::size_t>(env.width) * env.height; ++p)
     for (int c = 0; c < 3; ++c) rgba[p * 4 + c] = env.pixels[p * env.channels + std::min(c, env.channels - 1)];

@@ -94,6 +94,7 @@ gl::Texture& FrameResources::texture(const std::string& name, GLenum target, GLe
                            "passes wrote into it)" + (inPass_ ? " by pass " + pass_ : std::string()));
   checkNoAllocation("texture", name);
   declaredThisFrame_.insert(name);
+  holds_.erase(name);  // a new texture holds nothing
   gl::Texture t(name, target, internalFormat, width, height, depth, levels);
   return textures_.insert_or_assign(name, std::make_pair(spec, std::move(t))).first->second.second;
 }
@@ -118,6 +119,7 @@ gl::Buffer& FrameResources::buffer(const std::string& name, std::size_t bytes, G
   auto it = buffers_.find(name);
   if (it != buffers_.end() && it->second.size() == bytes) return it->second;
   checkNoAllocation("buffer", name);
+  holds_.erase(name);  // a new buffer holds nothing
   return buffers_.insert_or_assign(name, gl::Buffer(name, bytes, nullptr, flags)).first->second;
 }
 
@@ -127,11 +129,19 @@ gl::Buffer& FrameResources::buffer(const std::string& name) {
   return it->second;
 }
 
+bool FrameResources::holds(const std::string& resource, const std::string& digest, const std::string& logKey) {
+  auto it = holds_.find(resource);
+  const bool hit = it != holds_.end() && it->second == digest;
+  if (cacheLog_) cacheLog_->push_back({logKey.empty() ? resource : logKey, hit});
+  return hit;
+}
+
 void FrameResources::clear() {
   textures_.clear();
   framebuffers_.clear();
   buffers_.clear();
   cache_.clear();
+  holds_.clear();
   written_.clear();
   declaredThisFrame_.clear();
 }

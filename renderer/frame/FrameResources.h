@@ -6,10 +6,12 @@
 // The Renderer declares the planned passes' AOV outputs, beauty and the environment map before any
 // pass (renderer/frame/FrameAllocation.h); passes look those up by name, as their TechniqueInfo
 // declares (beginPass below).
-// Derived data (shadow maps, BVHs, cube maps, photon maps) is cached under a key together with the
-// digest of exactly the inputs it depends on; every lookup is logged as a cache hit or miss. Each key
-// keeps the derived data of its `derivedCapacity` most recently used digests (renders alternating
-// between scenes or parameter sets reuse them; radiantd --gpu-scenes sets it with the scene cache).
+// Derived data a cache entry owns (BVHs, photons, beams, objects with their own GL storage) is cached
+// under a key together with the digest of exactly the inputs it depends on; every lookup is logged as
+// a cache hit or miss. Each key keeps the derived data of its `derivedCapacity` most recently used
+// digests (renders alternating between scenes or parameter sets reuse them; radiantd --gpu-scenes sets
+// it with the scene cache). Derived data that lives in a shared frame resource (shadow maps, cube maps,
+// uploaded buffers) is valid only while the resource holds it: holds() / setHolds() below.
 #include <functional>
 #include <list>
 #include <map>
@@ -61,6 +63,16 @@ public:
   gl::Buffer& buffer(const std::string& name, std::size_t bytes, GLbitfield flags = GL_DYNAMIC_STORAGE_BIT);
   gl::Buffer& buffer(const std::string& name);
   bool hasBuffer(const std::string& name) const { return buffers_.count(name) != 0; }
+
+  // Derived data that lives in a frame resource shared by every scene (the shadow maps, the specular
+  // and env_diffuse cube maps, the environment map and its prefiltered levels, uploaded beams): the
+  // resource holds only what was last written into it, however many digests cached() keeps. A cache
+  // hit for scene A after scene B wrote the resource would read B's data, so such data asks holds():
+  // true when `resource` still holds what `digest` describes (logged as a hit or miss of `logKey`,
+  // default the resource's name). After writing it, setHolds(). Reallocating a texture or buffer, and
+  // clear(), forget what it held.
+  bool holds(const std::string& resource, const std::string& digest, const std::string& logKey = "");
+  void setHolds(const std::string& resource, std::string digest) { holds_[resource] = std::move(digest); }
 
   // Which technique owns each light-path class this frame (FramePlan::lightPaths).
   void setLightPathOwners(std::map<std::string, std::string> owners) { lightPaths_ = std::move(owners); }
@@ -143,6 +155,7 @@ private:
   std::map<std::string, gl::Framebuffer> framebuffers_;
   std::map<std::string, gl::Buffer> buffers_;
   std::map<std::string, std::list<Entry>> cache_;
+  std::map<std::string, std::string> holds_;  // resource -> digest of what it holds (holds())
   std::size_t derivedCapacity_ = 4;
   std::set<std::string> written_;
   std::map<std::string, std::string> lightPaths_;

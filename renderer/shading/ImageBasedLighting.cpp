@@ -203,7 +203,6 @@ glm::vec3 irradianceFromSh(const std::array<glm::vec3, 9>& sh, const glm::vec3& 
 
 namespace radiant::ibl {
 namespace {
-struct Uploaded {};  // marks a texture as holding the keyed data
 struct ShCoefficients {
   std::array<glm::vec3, 9> c{};
 };
@@ -220,10 +219,10 @@ void prepare(FrameResources& res) {
   dfg.setFilter(GL_LINEAR, GL_LINEAR);
   glTextureParameteri(dfg.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
   glTextureParameteri(dfg.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-  res.cached<Uploaded>("ibl_dfg", "v1", [&] {
+  if (!res.holds("ibl_dfg", "v1")) {
     dfg.upload(0, 0, 0, 0, kDfgSize, kDfgSize, 1, GL_RGBA, GL_FLOAT, dfgTable().data());
-    return std::make_unique<Uploaded>();
-  });
+    res.setHolds("ibl_dfg", "v1");
+  }
   const FrameView& view = res.view();
   const int layers = view.environment ? kPrefilterLevels : 1;
   gl::Texture& pre = res.texture("ibl_prefiltered", GL_TEXTURE_2D_ARRAY, GL_RGBA32F,
@@ -234,11 +233,13 @@ void prepare(FrameResources& res) {
   if (view.environment) {
     const Image& env = *view.environment;
     const std::string key = view.environmentKey + "|" + std::to_string(env.width) + "x" + std::to_string(env.height);
-    res.cached<Uploaded>("ibl_prefiltered", key, [&] {
+    // The levels live in the shared texture: prefiltered again when it holds another map's (a frame
+    // with another environment since; FrameResources::holds).
+    if (!res.holds("ibl_prefiltered", key)) {
       const std::vector<float> texels = prefilterEnvironment(env);
       pre.upload(0, 0, 0, 0, kPrefilterWidth, kPrefilterHeight, kPrefilterLevels, GL_RGBA, GL_FLOAT, texels.data());
-      return std::make_unique<Uploaded>();
-    });
+      res.setHolds("ibl_prefiltered", key);
+    }
     res.cached<ShCoefficients>("ibl_sh", key, [&] {
       auto s = std::make_unique<ShCoefficients>();
       s->c = irradianceSh(env);

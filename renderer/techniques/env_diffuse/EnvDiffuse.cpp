@@ -26,7 +26,6 @@ struct EnvQuad {
 };
 static_assert(sizeof(EnvQuad) == 112, "std430 EnvQuad must be 7 vec4");
 
-struct CubeMapsCacheEntry {};  // the maps live in FrameResources; the entry marks them valid
 
 constexpr GLuint kQuadBinding = 4;
 
@@ -124,12 +123,9 @@ void EnvDiffusePass::prepare(const Scene& scene, const Params& params, FrameReso
     std::string digest = sceneKey + "|receiver:" + r.name + "|o:" + point + "|sky:" + skyText +
                          "|R:" + std::to_string(R) + "|M:" + std::to_string(M) + "|bounces:" + std::to_string(bounces_);
     if (bounces_ > 1) digest += std::string("|clip:") + (horizonClip_ ? "1" : "0");
-    bool built = false;
-    res.cached<CubeMapsCacheEntry>("env_diffuse_cube_maps:" + r.name, digest, [&] {
-      built = true;
-      return std::make_unique<CubeMapsCacheEntry>();
-    });
-    st.mapsValid = !built;
+    // The maps live in this receiver's shared textures (FrameResources::holds).
+    st.mapsValid = res.holds(st.prefix + "irradiance", digest, "env_diffuse_cube_maps:" + r.name);
+    st.digest = digest;  // set as held once execute() rendered them
     receivers_.push_back(std::move(st));
   }
 
@@ -236,6 +232,7 @@ void EnvDiffusePass::execute(PassContext& ctx) {
   for (const ReceiverState& r : receivers_)
     if (!r.mapsValid) {
       buildCubeMaps(ctx, r);
+      res.setHolds(r.prefix + "irradiance", r.digest);
       ++built;
     }
 

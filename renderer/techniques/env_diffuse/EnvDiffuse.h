@@ -35,6 +35,7 @@ private:
     env_diffuse::Receiver receiver;
     std::string prefix;  // resource name prefix
     bool mapsValid = false;
+    std::string digest;  // what its maps hold once rendered (FrameResources::holds)
   };
   void buildCubeMaps(PassContext& ctx, const ReceiverState& r);
 

@@ -115,11 +115,13 @@ void LightVolumesPass::prepare(const Scene& scene, const Params& params, FrameRe
     return c;
   });
   cache_ = &cache;
-  upload_ = built_ || !res.hasBuffer("light_volumes_beams");
   res.buffer("light_volumes_beams", bytesOf(cache.beams.beams));
   res.buffer("light_volumes_cones", bytesOf(cache.beams.cones));
   res.buffer("light_volumes_nodes", bytesOf(cache.bvh.nodes));
   res.buffer("light_volumes_prims", bytesOf(cache.bvh.primitives));
+  // The buffers hold the beams last uploaded, maybe another scene's (FrameResources::holds).
+  upload_ = !res.holds("light_volumes_beams", key.dump(), "light_volumes_upload");
+  digest_ = key.dump();
   // Declared outputs: allocated by the Renderer (renderer/frame/FrameAllocation.h).
   res.texture("light_volumes").setFilter(GL_NEAREST, GL_NEAREST);
   res.texture("beauty");
@@ -137,6 +139,7 @@ void LightVolumesPass::execute(PassContext& ctx) {
     if (!c.beams.cones.empty()) cones.upload(c.beams.cones.data(), c.beams.cones.size() * sizeof(light_volumes::BeamCone));
     if (!c.bvh.nodes.empty()) nodes.upload(c.bvh.nodes.data(), c.bvh.nodes.size() * sizeof(light_volumes::BeamBvhNode));
     if (!c.bvh.primitives.empty()) prims.upload(c.bvh.primitives.data(), c.bvh.primitives.size() * sizeof(glm::vec4));
+    res.setHolds("light_volumes_beams", digest_);  // after the upload
   }
   const char* inputs[] = {"gbuffer_position", "normal", "albedo", "material", "emission"};
   for (GLuint i = 0; i < std::size(inputs); ++i) res.texture(inputs[i]).bindUnit(i);

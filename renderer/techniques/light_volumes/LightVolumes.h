@@ -34,6 +34,7 @@ public:
 private:
   const Cache* cache_ = nullptr;  // in FrameResources' cache, valid for this frame
   bool upload_ = false, built_ = false, bvh_ = true, owns_ = true;
+  std::string digest_;  // what the beam buffers hold once uploaded (FrameResources::holds)
   light_volumes::Split split_ = light_volumes::Split::TwoD;
 };
 

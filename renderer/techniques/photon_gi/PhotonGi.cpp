@@ -202,10 +202,10 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   };
   const std::string splatDigest = splatKey.dump();
   SplatCache& splats = res.cached<SplatCache>("photon_gi_splats", splatDigest, buildSplats);
-  if (!res.hasBuffer("photon_gi_splats")) upload_ = true;  // resources were dropped after a failure
-  // A hit whose set is not the one in the buffers (another scene was rendered since): without this the
-  // frame gathered the other scene's photons (Fox after BoxTextured came out unlit, 2026-12-02).
-  if (residentSplats_ != splatDigest) upload_ = true;
+  // A hit whose set is not the one in the splat buffers (another scene was rendered since, or the
+  // resources were dropped after a failure; FrameResources::holds): without this the frame gathered
+  // the other scene's photons (Fox after BoxTextured came out unlit, 2026-12-02).
+  if (!res.holds("photon_gi_splats", splatDigest, "photon_gi_splats_resident")) upload_ = true;
   if (upload_ && splats.grid.splats.size() != splats.grid.count) {
     splats = std::move(*buildSplats());
     rebuilt_ = true;
@@ -215,8 +215,8 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   coveragePoints_ = splats.coveragePoints;
   hMin_ = splats.hMin;
   hMax_ = splats.hMax;
-  residentSplats_ = splatDigest;
   photon_gi::declareSplatResources(res, *grid_, splat_);
+  splatDigest_ = splatDigest;
 }
 
 void PhotonGiPass::execute(PassContext& ctx) {
@@ -226,6 +226,7 @@ void PhotonGiPass::execute(PassContext& ctx) {
   // The GPU holds the splats now: the CPU copy would double the memory of every cached photon set. A
   // lost GL context clears the cache entry too (FrameResources::clear), so it is rebuilt, not re-uploaded.
   if (upload_) std::vector<photon_gi::GpuSplat>().swap(grid_->splats);
+  if (upload_) ctx.resources.setHolds("photon_gi_splats", splatDigest_);  // after the upload
   auto& c = ctx.stats.counters;
   c["photons"] = static_cast<double>(settings_.photons);
   c["photons_traced"] = static_cast<double>(traced_);

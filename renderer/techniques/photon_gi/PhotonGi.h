@@ -44,10 +44,10 @@ private:
   photon_gi::SplatSettings splat_;
   photon_gi::SplatGrid* grid_ = nullptr;  // in the cache, valid for this frame
   bool upload_ = false;                          // the grid changed: upload it in execute()
-  // The splat set (its cache key) that the frame's splat buffers hold: they hold one set at a time, so
-  // a cached set of another scene or setting must be uploaded again (and rebuilt: the CPU copy is
-  // released after upload).
-  std::string residentSplats_;
+  // The splat set (its cache key) this frame uses. The splat buffers hold one set at a time
+  // (FrameResources::holds), so a cached set of another scene or setting is uploaded again (and rebuilt:
+  // the CPU copy is released after upload).
+  std::string splatDigest_;
   bool rebuilt_ = false;  // this frame rebuilt a cached set that was not resident
   std::size_t records_ = 0, photonSplats_ = 0, coveragePoints_ = 0;
   std::uint64_t traced_ = 0;  // photons traced by this frame (0 when the set was cached)

@@ -12,7 +12,6 @@
 namespace radiant {
 namespace {
 
-struct ShadowMapsCacheEntry {};  // the maps themselves live in FrameResources; the entry marks them valid
 
 glm::vec3 anyPerpendicular(const glm::vec3& d) {
   return std::abs(d.y) < 0.99f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
@@ -92,12 +91,10 @@ void ShadowMapsPass::prepare(const Scene& scene, const Params& params, FrameReso
   excluded_ = res.shadowMapExclusions();
   std::string digest = res.sceneKey() + "|" + std::to_string(size_);
   for (int m : excluded_) digest += "|-" + std::to_string(m);
-  bool built = false;
-  res.cached<ShadowMapsCacheEntry>("shadow_maps", digest, [&] {
-    built = true;
-    return std::make_unique<ShadowMapsCacheEntry>();
-  });
-  mapsValid_ = !built;
+  // The maps live in the shared shadow textures: valid only when they hold this digest's maps (another
+  // scene may have rendered into them since; FrameResources::holds).
+  mapsValid_ = res.holds("shadow_cube", digest, "shadow_maps");
+  digest_ = std::move(digest);
 }
 
 void ShadowMapsPass::execute(PassContext& ctx) {
@@ -141,6 +138,7 @@ void ShadowMapsPass::execute(PassContext& ctx) {
     // With textures: MASK and BLEND materials' coverage comes from the base colour's alpha (shadow.frag).
     ctx.gpu.drawMeshes(prog, true, [&](std::size_t m) { return !excluded_.count(static_cast<int>(m)); });
   }
+  res.setHolds("shadow_cube", digest_);  // after writing: a frame that fails before leaves them invalid
   ctx.stats.counters["map_size"] = size_;
 }
 

@@ -1,5 +1,6 @@
 #pragma once
 #include <set>
+#include <string>
 #include <vector>
 
 #include "renderer/frame/GpuTypes.h"
@@ -29,6 +30,7 @@ public:
 
 private:
   bool mapsValid_ = false;
+  std::string digest_;  // what the maps hold once execute() rendered them (FrameResources::holds)
   int size_ = 1024;
   std::vector<gpu::ShadowInfo> infos_;
   struct Draw {

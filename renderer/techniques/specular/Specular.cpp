@@ -16,7 +16,6 @@
 namespace radiant {
 namespace {
 
-struct SpecularMapsCacheEntry {};  // the maps live in FrameResources; the entry marks them valid
 
 // Branches of the reflection/refraction tree whose path weight drops below this are not traced: each
 // dropped branch changes the pixel by less than 1e-3 times the radiance it would have fetched, and
@@ -116,12 +115,9 @@ void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResour
   // shape. Not on the tracing knobs (steps, depth, minmax): a sweep over those reuses them.
   const std::string digest = res.sceneKey() + "|res=" + std::to_string(resolution_) +
                              "|layers=" + std::to_string(layers_) + "|objects=" + std::to_string(objects_.size());
-  bool built = false;
-  res.cached<SpecularMapsCacheEntry>("specular_maps", digest, [&] {
-    built = true;
-    return std::make_unique<SpecularMapsCacheEntry>();
-  });
-  mapsValid_ = !built;
+  // The maps live in the shared specular_ldm_* textures (FrameResources::holds).
+  mapsValid_ = res.holds("specular_ldm_distance", digest, "specular_maps");
+  digest_ = digest;
 }
 
 void SpecularPass::execute(PassContext& ctx) {
@@ -223,6 +219,7 @@ void SpecularPass::execute(PassContext& ctx) {
     }
     glMemoryBarrier(GL_ALL_BARRIER_BITS);
     ctx.stats.counters["maps_rendered"] = draws;
+    res.setHolds("specular_ldm_distance", digest_);  // after writing them
   }
   res.markWritten("specular_maps");
   ctx.stats.counters["cube_resolution"] = resolution_;

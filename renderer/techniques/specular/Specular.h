@@ -8,6 +8,7 @@
 // execute(): on a cache miss renders every layer of every face of every object and reduces each layer
 // to its min-max distances; then rasterises the specular objects, traces their reflected/refracted
 // rays in the maps (shaders/specular/specular.frag) into the `specular` AOV, and adds it to beauty.
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -47,6 +48,7 @@ private:
   int maxDepth_ = 4, linearSteps_ = 32, secantSteps_ = 4, resolution_ = 256, layers_ = 3;
   bool minmax_ = true;
   bool mapsValid_ = false;
+  std::string digest_;  // what the maps hold once execute() rendered them (FrameResources::holds)
 };
 
 }  // namespace radiant

@@ -1,6 +1,7 @@
 // Render-core tests on the real GL device (llvmpipe in CI). Every expected value is fixed by the
 // physics of the scene: glTF light units, the Lambertian BRDF, the KHR_lights_punctual falloffs.
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <memory>
 #include <mutex>
@@ -273,23 +274,59 @@ TEST(RenderCore, GpuSceneCacheKeepsTheMostRecentlyUsedScenes) {
     ADD_FAILURE() << "no " << what << " cache entry in the stats";
     return false;
   };
-  auto gpuHit = [&](const RenderOutput& o) {
-    EXPECT_EQ(hitOf(o, "shadow_maps"), hitOf(o, "gpu_scene")) << "derived data follows the scene";
+  // The uploaded scene is kept per scene (LRU); the shadow maps live in one shared texture, so they are
+  // reused only when the frame before rendered the same scene (FrameResources::holds).
+  const Scene* last = nullptr;
+  auto gpuHit = [&](const Scene& s) {
+    const RenderOutput o = renderer().render(s, request(8));
+    EXPECT_EQ(hitOf(o, "shadow_maps"), last == &s) << "the shadow textures hold the last scene's maps";
+    last = &s;
     return hitOf(o, "gpu_scene");
   };
   Renderer& r = renderer();
   r.setGpuSceneCapacity(2);
   Scene a = umbraScene(1.f, "lru-a"), b = umbraScene(1.f, "lru-b"), c = umbraScene(1.f, "lru-c");
-  EXPECT_FALSE(gpuHit(r.render(a, request(8))));
-  EXPECT_FALSE(gpuHit(r.render(b, request(8))));
-  EXPECT_TRUE(gpuHit(r.render(a, request(8))));
-  EXPECT_FALSE(gpuHit(r.render(c, request(8))));  // evicts b, the least recently used
-  EXPECT_TRUE(gpuHit(r.render(a, request(8))));
-  EXPECT_FALSE(gpuHit(r.render(b, request(8))));
-  r.setGpuSceneCapacity(1);                        // shrinking evicts at once
-  EXPECT_TRUE(gpuHit(r.render(b, request(8))));
-  EXPECT_FALSE(gpuHit(r.render(a, request(8))));
+  EXPECT_FALSE(gpuHit(a));
+  EXPECT_FALSE(gpuHit(b));
+  EXPECT_TRUE(gpuHit(a));
+  EXPECT_FALSE(gpuHit(c));  // evicts b, the least recently used
+  EXPECT_TRUE(gpuHit(a));
+  EXPECT_FALSE(gpuHit(b));
+  r.setGpuSceneCapacity(1);  // shrinking evicts at once
+  EXPECT_TRUE(gpuHit(b));
+  EXPECT_FALSE(gpuHit(a));
   r.setGpuSceneCapacity(4);
+}
+
+TEST(RenderCore, SharedDerivedResourcesHoldTheSceneRenderedLast) {
+  // Two scenes whose shadows differ (the occluder left or right of the light), rendered A, B, A with
+  // both kept uploaded: the third frame must equal the first. The shadow maps live in one texture that
+  // every scene renders into; a derived-data cache that kept both digests used to call the third
+  // frame's maps valid and shade A with B's shadow (FrameResources::holds). Rasterisation is
+  // deterministic on one device, so equal means equal to float rounding.
+  auto scene = [](float x, const char* digest) {
+    SceneBuilder b = planeScene();
+    int grey = b.material(lambertian(glm::vec3(0.5f)));
+    b.quad({x, 0.5f, 0}, {0.4f, 0, 0}, {0, 0, 0.4f}, grey, "occluder");
+    b.pointLight({0, 1, 0}, glm::pi<float>());
+    b.topDownOrtho(5.f, 1.5f);
+    return b.build(digest);
+  };
+  Scene a = scene(-0.6f, "shared-a"), b = scene(0.6f, "shared-b");
+  Renderer& r = renderer();
+  r.setGpuSceneCapacity(4);
+  const Image first = aov(r.render(a, request(32, {"direct"})), "direct");
+  const Image other = aov(r.render(b, request(32, {"direct"})), "direct");
+  const Image again = aov(r.render(a, request(32, {"direct"})), "direct");
+  EXPECT_GT(testing::maxAbsDifference(first, other), 0.5f) << "the two scenes' shadows differ";
+  EXPECT_LT(testing::maxAbsDifference(first, again), 1e-5f) << "A after B is shaded with A's shadow maps";
+  // A frame that fails after every pass prepared (cancelled before the first execute) leaves the maps
+  // as they were: B's frame prepared but never rendered B's maps, so they still hold A's, and the next
+  // frame of B must render them (setHolds comes after the write, not in prepare).
+  const std::atomic<bool> cancelled{true};
+  EXPECT_THROW(r.render(b, request(32, {"direct"}), &cancelled), api::ApiError);
+  const Image afterCancel = aov(r.render(b, request(32, {"direct"})), "direct");
+  EXPECT_LT(testing::maxAbsDifference(other, afterCancel), 1e-5f) << "B after a cancelled B frame has B's shadows";
 }
 
 TEST(RenderCore, GrazingViewsStayFinite) {
