@@ -48,8 +48,9 @@ const std::vector<AovInfo>& aovTable() {
          B::Overwrite, "gbuffer", true, "", Nearest},
         {0, "emission", F::Rgba16F, "emission", 0, 3, {"emission.R", "emission.G", "emission.B"}, B::Overwrite,
          "gbuffer", true, ""},
+        // Scored against the reference in the pass's own mode (ReferencePass::groundTruth): beauty by default.
         {0, "reference", F::Rgba32F, "reference", 0, 3, {"reference.R", "reference.G", "reference.B"}, B::Overwrite,
-         "reference", true, ""},
+         "reference", true, "beauty"},
         // Participating media: RGB = the media's radiance in front of the first surface
         // (premultiplied), A = the camera ray's transmittance to it; beauty = opaque * A + RGB. Scored
         // against the volumetric reference (VolumeTracer.h), in the mode of the technique that wrote it.

@@ -165,12 +165,7 @@ void compare(FrameResources& resources, const Scene& scene, const FrameView& vie
     reference = std::move(r);
   }
   const metrics::ImageMetrics e = metrics::compareImages(*test, reference, request.exposure);
-  m["rmse"] = e.rmse;
-  m["rel_mse"] = e.relMse;
-  m["psnr"] = e.psnr ? nlohmann::json(*e.psnr) : nlohmann::json(nullptr);
-  m["ssim"] = e.ssim;
-  m["mean_abs"] = e.meanAbs;
-  m["max_abs"] = e.maxAbs;
+  metrics::writeMetricsJson(e, m);
   out.stats.metrics = m;
   out.compareReference = reference;
   Image err = metrics::errorMap(*test, reference);

@@ -61,12 +61,7 @@ nlohmann::json scoreMean(const nlohmann::json& batchMetrics, const Image& mean, 
                          float exposureEV, int batches) {
   const metrics::ImageMetrics e = metrics::compareImages(mean, reference, exposureEV);
   nlohmann::json m = batchMetrics;
-  m["rmse"] = e.rmse;
-  m["rel_mse"] = e.relMse;
-  m["psnr"] = e.psnr ? nlohmann::json(*e.psnr) : nlohmann::json(nullptr);
-  m["ssim"] = e.ssim;
-  m["mean_abs"] = e.meanAbs;
-  m["max_abs"] = e.maxAbs;
+  metrics::writeMetricsJson(e, m);
   m["batches"] = batches;
   return m;
 }

@@ -8,6 +8,7 @@
 
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
+#include <nlohmann/json.hpp>
 
 namespace radiant::metrics {
 namespace {
@@ -97,6 +98,15 @@ double toneMap(double linear, float exposureEV) {
   if (!(v > 0.0)) return 0.0;  // also maps NaN to 0
   v = std::min(v, 1.0);
   return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
+}
+
+void writeMetricsJson(const ImageMetrics& e, nlohmann::json& out) {
+  out["rmse"] = e.rmse;
+  out["rel_mse"] = e.relMse;
+  out["psnr"] = e.psnr ? nlohmann::json(*e.psnr) : nlohmann::json(nullptr);
+  out["ssim"] = e.ssim;
+  out["mean_abs"] = e.meanAbs;
+  out["max_abs"] = e.maxAbs;
 }
 
 ImageMetrics compareImages(const Image& test, const Image& reference, float exposureEV) {

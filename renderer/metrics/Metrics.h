@@ -19,6 +19,8 @@
 //   Images smaller than 11 pixels in a dimension use the window clipped at the border and renormalised.
 #include <optional>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "renderer/Image.h"
 
 namespace radiant::metrics {
@@ -36,6 +38,10 @@ struct ImageMetrics {
   double meanAbs = 0.0;
   double maxAbs = 0.0;
 };
+
+// Sets out's rmse, rel_mse, psnr (null when identical), ssim, mean_abs and max_abs: the names of
+// stats.metrics (docs/API.md, compare), for a frame's compare block and a refined job's mean alike.
+void writeMetricsJson(const ImageMetrics& e, nlohmann::json& out);
 
 // Throws std::invalid_argument when the sizes or channel counts differ or an image is empty.
 ImageMetrics compareImages(const Image& test, const Image& reference, float exposureEV = 0.f);

@@ -225,45 +225,36 @@ void splatAndResolve(FrameResources& res, gl::ShaderLibrary& shaders, const Fram
       const int lowW = (view.width + step - 1) / step, lowH = (view.height + step - 1) / step;
       gather(low, step, lowW, lowH, 0);
       glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+      // Spreads the block samples of `samples` (one per `blockStep` x `blockStep` block) onto the pixels
+      // of their surface; refine = 0 writes every pixel and marks the unmatched ones in photon_gi_fixup,
+      // refine = 1 fills only marked pixels that this finer step matches and unmarks them.
       const gl::Program& up = shaders.program({"photon_gi/upsample.comp"});
-      common(up);
-      glUniform2iv(glGetUniformLocation(up.id(), "u_size"), 1, size);
-      const int lowSize[2] = {lowW, lowH};
-      glUniform2iv(glGetUniformLocation(up.id(), "u_lowSize"), 1, lowSize);
-      up.set("u_step", step);
-      up.set("u_hMin", grid.hMin);
-      up.set("u_renormalize", settings.renormalize ? 1 : 0);
-      up.set("u_minKernelMass", kMinKernelMass);
-      up.set("u_refine", 0);
-      low.bindUnit(7);
-      accum.bindImage(0, GL_WRITE_ONLY);
-      res.texture("photon_gi_fixup").bindImage(1, GL_WRITE_ONLY);
-      glDispatchCompute((view.width + 7) / 8, (view.height + 7) / 8, 1);
-      glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+      auto upsample = [&](gl::Texture& samples, int blockStep, int refine) {
+        common(up);
+        glUniform2iv(glGetUniformLocation(up.id(), "u_size"), 1, size);
+        const int lowSize[2] = {(view.width + blockStep - 1) / blockStep, (view.height + blockStep - 1) / blockStep};
+        glUniform2iv(glGetUniformLocation(up.id(), "u_lowSize"), 1, lowSize);
+        up.set("u_step", blockStep);
+        up.set("u_hMin", grid.hMin);
+        up.set("u_renormalize", settings.renormalize ? 1 : 0);
+        up.set("u_minKernelMass", kMinKernelMass);
+        up.set("u_refine", refine);
+        samples.bindUnit(7);
+        accum.bindImage(0, refine ? GL_READ_WRITE : GL_WRITE_ONLY);
+        res.texture("photon_gi_fixup").bindImage(1, refine ? GL_READ_WRITE : GL_WRITE_ONLY);
+        glDispatchCompute((view.width + 7) / 8, (view.height + 7) / 8, 1);
+        glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+      };
+      upsample(low, step, 0);
       // The fix-up cascade: the marked pixels are edge pixels, k^2 times as many on a frame supersampled
       // k times (whose step is k gather_step), so before the full gather they try block samples of half
       // the step, taken only at marked block centres (about as many samples as at k = 1's step).
       for (int fine = step / 2; fine >= 2; fine /= 2) {
         gl::Texture& refine = res.texture("photon_gi_accum_refine");
-        const int fineW = (view.width + fine - 1) / fine, fineH = (view.height + fine - 1) / fine;
         common(prog);
-        res.texture("photon_gi_fixup").bindImage(1, GL_READ_ONLY);
-        gather(refine, fine, fineW, fineH, 2);
+        gather(refine, fine, (view.width + fine - 1) / fine, (view.height + fine - 1) / fine, 2);
         glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
-        common(up);
-        glUniform2iv(glGetUniformLocation(up.id(), "u_size"), 1, size);
-        const int fineSize[2] = {fineW, fineH};
-        glUniform2iv(glGetUniformLocation(up.id(), "u_lowSize"), 1, fineSize);
-        up.set("u_step", fine);
-        up.set("u_hMin", grid.hMin);
-        up.set("u_renormalize", settings.renormalize ? 1 : 0);
-        up.set("u_minKernelMass", kMinKernelMass);
-        up.set("u_refine", 1);
-        refine.bindUnit(7);
-        accum.bindImage(0, GL_READ_WRITE);
-        res.texture("photon_gi_fixup").bindImage(1, GL_READ_WRITE);
-        glDispatchCompute((view.width + 7) / 8, (view.height + 7) / 8, 1);
-        glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+        upsample(refine, fine, 1);
       }
       common(prog);
       gather(accum, 1, view.width, view.height, 1);

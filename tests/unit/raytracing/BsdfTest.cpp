@@ -249,6 +249,48 @@ TEST(Brdf, SmoothMirrorAndDielectricDeltas) {
   EXPECT_NEAR(energy / n, 1.0, 1e-4);
 }
 
+TEST(Brdf, ReflectionIsReciprocalAndRefractionDiffersByEtaSquaredBetweenTransportModes) {
+  // Issue #20's adjointness oracle (Veach 1997, eq. 5.14): reflection is symmetric, f(wo, wi) =
+  // f(wi, wo), in either transport mode; refraction carries radiance compressed by 1 / eta^2 and
+  // importance uncompressed, so f_radiance / f_importance = 1 / eta^2 exactly, from either side.
+  std::mt19937 rng(20);
+  std::uniform_real_distribution<float> U(-1.f, 1.f);
+  auto upper = [&] {
+    glm::vec3 w;
+    do w = glm::vec3(U(rng), U(rng), std::abs(U(rng)));
+    while (glm::dot(w, w) > 1.f || w.z < 0.02f);
+    return glm::normalize(w);
+  };
+  int reflections = 0, refractions = 0;
+  for (int i = 0; i < 4000; ++i) {
+    GltfBsdf b;
+    b.baseColor = glm::vec3(0.9f, 0.6f, 0.3f);
+    b.metallic = i % 4 == 0 ? 1.f : 0.f;
+    b.roughness = 0.05f + 0.9f * (0.5f + 0.5f * U(rng));
+    b.transmission = i % 2 ? 1.f : 0.f;
+    b.eta = i % 3 ? 1.5f : 1.f / 1.5f;
+    const glm::vec3 wo = upper(), wi = upper();
+    for (TransportMode mode : {TransportMode::Radiance, TransportMode::Importance}) {
+      b.mode = mode;
+      const glm::vec3 f = b.eval(wo, wi), g = b.eval(wi, wo);
+      for (int c = 0; c < 3; ++c) ASSERT_NEAR(f[c], g[c], 1e-4f * std::max(1.f, f[c])) << i;
+    }
+    ++reflections;
+    if (b.transmission == 0.f || b.metallic == 1.f) continue;
+    const glm::vec3 wt = glm::vec3(wi.x, wi.y, -wi.z);  // below the surface: a refracted direction
+    b.mode = TransportMode::Radiance;
+    const glm::vec3 radiance = b.eval(wo, wt);
+    b.mode = TransportMode::Importance;
+    const glm::vec3 importance = b.eval(wo, wt);
+    if (!(importance.x > 1e-6f)) continue;
+    for (int c = 0; c < 3; ++c)
+      ASSERT_NEAR(radiance[c] / importance[c], 1.f / (b.eta * b.eta), 1e-5f) << i << " eta " << b.eta;
+    ++refractions;
+  }
+  EXPECT_EQ(reflections, 4000);
+  EXPECT_GT(refractions, 300);  // 437 of the 1500 transmissive dielectric pairs have f > 0 (rough refraction does not reach every pair)
+}
+
 TEST(Brdf, NeverNaN) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> U(0.f, 1.f);
