@@ -94,7 +94,7 @@ struct RenderRequest {
   std::optional<CompareSpec> compare;
   bool async = false;
   // A quality preset ("" none, draft, preview, final, reference) or a frame time budget (0 none), both
-  // resolved against the preset table (api/presets.json) by renderer/frame/Budget.h.
+  // resolved against the preset table (api/presets.json) by api/Presets.h, chooseConfiguration.
   std::string quality;
   double timeBudgetMs = 0;
   // Technique -> the parameter names the request gave itself (they win over quality and budget).
@@ -135,7 +135,7 @@ struct FrameStats {
   nlohmann::json scene;   // name, digest, bounds {min, max}, node names
   std::vector<std::string> warnings;  // things the scene has that this frame could not honour
   // With quality or time_budget_ms: what the preset table chose per technique, predicted and measured
-  // ms, predicted error (renderer/frame/Budget.h); null otherwise. With refine: also "refinement".
+  // ms, predicted error (api/Presets.h, chooseConfiguration); null otherwise. With refine: also "refinement".
   nlohmann::json budget;
   nlohmann::json refinement;
 };

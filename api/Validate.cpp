@@ -429,7 +429,7 @@ RenderRequest parseRenderRequest(const json& body, const RequestLimits& limits) 
     r.compare = CompareSpec{c["against"], c["aov"], c["spp"], c["max_bounces"]};
   }
   r.async = v["async"];
-  // The parameters the request gave itself win over quality and time_budget_ms (renderer/frame/Budget.h).
+  // The parameters the request gave itself win over quality and time_budget_ms (api/Presets.h, chooseConfiguration).
   if (body.contains("passes"))
     for (const auto& [name, params] : body["passes"].items())
       if (params.is_object())
