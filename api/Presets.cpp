@@ -81,10 +81,32 @@ json capsExceeded(const std::string& technique, const json& point, const std::se
 }
 
 // A point whose every capped parameter is lowered to its cap: what runs when no point of the front
-// fits the caps (its error was not measured).
-json clampedToCaps(const json& point, const json& exceeded) {
+// fits the caps (its error was not measured). The lowered value is one the schema allows: an
+// enumerated knob (cube_resolution 16..512) takes its largest value within the cap. When the schema
+// has no value within the cap (below the smallest enumerated value or the minimum), the technique
+// cannot run on this server: a 422 naming the flag, not a value the schema forbids.
+json clampedToCaps(const std::string& technique, const json& point, const json& exceeded) {
   json p = point;
-  for (const auto& [k, c] : exceeded.items()) p[k] = c["limit"];
+  const TechniqueSchema* schema = findTechnique(technique);
+  for (const auto& [k, c] : exceeded.items()) {
+    const double limit = c["limit"].get<double>();
+    json value = c["limit"];
+    const json* param = schema && schema->params.contains(k) ? &schema->params.at(k) : nullptr;
+    bool fits = !(param && param->contains("minimum") && limit < param->at("minimum").get<double>());
+    if (param && param->contains("enum")) {
+      value = nullptr;
+      for (const json& v : param->at("enum"))
+        if (v.is_number() && v.get<double>() <= limit && (value.is_null() || v.get<double>() > value.get<double>()))
+          value = v;
+      fits = fits && !value.is_null();
+    }
+    if (!fits)
+      throw ApiError(422, "limit-exceeded", "Limit exceeded",
+                     technique + "." + k + " has no allowed value within this server's limit " + c["limit"].dump() + " (" +
+                         c["flag"].get<std::string>() + "), so " + technique + " cannot run here",
+                     "/passes/" + technique + "/" + k);
+    p[k] = value;
+  }
   return p;
 }
 
@@ -196,7 +218,7 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
         if (i != preset) {
           const json exceeded = capsExceeded(t, front[preset]["params"], given, limits);
           entry["capped"] = {{"limits", exceeded}, {"preset_point", preset}, {"clamped", i < 0}};
-          if (i < 0) point = clampedToCaps(point, capsExceeded(t, point, given, limits));
+          if (i < 0) point = clampedToCaps(t, point, capsExceeded(t, point, given, limits));
           c.warnings.push_back("quality " + request.quality + ": " + t + " runs " +
                                (i < 0 ? "its cheapest front point lowered to the server's caps"
                                       : "front point " + std::to_string(i)) +
@@ -230,7 +252,8 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
                              std::to_string(front.size()) + " front points: " + describeCaps(exceededAll));
       }
       if (all.empty()) {
-        json p = techniqueParams(t, merged(c.params[t], clampedToCaps(front[0]["params"], capsExceeded(t, front[0]["params"], given, limits)), given));
+        const json lowered = clampedToCaps(t, front[0]["params"], capsExceeded(t, front[0]["params"], given, limits));
+        json p = techniqueParams(t, merged(c.params[t], lowered, given));
         const double ms = table.predictMs(t, p, pixels);
         all.push_back({std::move(p), ms, std::numeric_limits<double>::quiet_NaN(), -1});
       }

@@ -160,6 +160,38 @@ TEST(Presets, PresetsStayWithinTheServersCaps) {
   EXPECT_FALSE(own.stats["techniques"]["photon_gi"].contains("capped"));
 }
 
+TEST(Presets, ACapBelowTheWholeFrontLowersAnEnumeratedKnobToAnAllowedValue) {
+  // env_diffuse's cube_resolution is enumerated (16, 32, ..., 512) and capped by --max-map-resolution.
+  // With every front point above the cap, the cheapest point is lowered to the largest allowed value
+  // within it (64 under a cap of 100), not to the cap itself (100 is no allowed value: the schema would
+  // refuse it as a 422 for a parameter the request never sent).
+  json table = syntheticTable();
+  table["techniques"]["env_diffuse"] = json::parse(R"({
+      "model": {"terms": [{"coef": 1e-6, "vars": ["pixels", "cube_resolution"]}]},
+      "error": {"metric": "rmse", "aov": "indirect_diffuse", "scene": "cornell_box", "width": 64, "height": 64},
+      "front": [{"params": {"cube_resolution": 128}, "error": 0.1}, {"params": {"cube_resolution": 256}, "error": 0.05}],
+      "presets": {"draft": 0, "preview": 0, "final": 1, "reference": 1}})");
+  const PresetTable t(table);
+  const std::vector<std::string> planned{"gbuffer", "direct", "env_diffuse"};
+  RequestLimits caps;
+  caps.maxMapResolution = 100;
+  for (const json& extra : {json{{"quality", "final"}}, json{{"time_budget_ms", 1000}}}) {
+    const BudgetChoice c = chooseConfiguration(t, planned, request(extra), &caps);
+    EXPECT_EQ(c.params.at("env_diffuse")["cube_resolution"], 64) << extra;
+    EXPECT_TRUE(c.stats["techniques"]["env_diffuse"]["capped"]["clamped"].get<bool>()) << extra;
+  }
+  // Below the smallest allowed value the technique cannot run on this server: a 422 naming the flag.
+  caps.maxMapResolution = 8;
+  try {
+    chooseConfiguration(t, planned, request({{"quality", "draft"}}), &caps);
+    ADD_FAILURE() << "no 422";
+  } catch (const ApiError& e) {
+    EXPECT_EQ(e.status, 422);
+    EXPECT_EQ(e.pointer, "/passes/env_diffuse/cube_resolution");
+    EXPECT_NE(e.detail().find("--max-map-resolution"), std::string::npos) << e.detail();
+  }
+}
+
 TEST(Presets, BudgetsChooseOnlyAmongPointsWithinTheCaps) {
   const PresetTable t(syntheticTable());
   RequestLimits caps;
