@@ -397,21 +397,18 @@ TEST(PhotonGi, LayeredMaterialsReceiveIndirectLightAsTheReference) {
   EXPECT_NEAR(ours / truth, 1.0, 0.05);
 }
 
-TEST(PhotonGi, GatherStepSpreadsBlockSamplesWithoutLosingLight) {
-  // gather_step 2 gathers one pixel per 2x2 block and spreads it over the block's pixels on the same
-  // surface; pixels with no such sample get their own gather. Against the full gather with the same
-  // (cached) photons: the frame's light within 1%, no pixel left dark where the full gather has
-  // light, and the error against the reference's indirect no more than 5% above the full gather's
-  // (what the knob trades; measured 0.2097 and 0.2092 at 64 px, where a block is 2/3 of the kernel radius).
+// Block gathering against the full gather with the same (cached) photons: the frame's light within 1%,
+// no pixel left dark where the full gather has light, and the error against the reference's indirect
+// no more than 5% above the full gather's (what the knob trades).
+void expectBlockGatherKeepsTheLight(int gatherStep) {
   const Scene scene = loadBuiltinScene("cornell_box");
   api::RenderRequest full = cornellRequest(64, {{"photons", 200000}, {"gather_step", 1}});
   full.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"indirect"}, false}};
   full.compare = api::CompareSpec{"reference", "indirect", 256, 8};
   api::RenderRequest blocks = full;
-  blocks.passes["photon_gi"]["gather_step"] = 2;
+  blocks.passes["photon_gi"]["gather_step"] = gatherStep;
   const RenderOutput a = renderer().render(scene, full);
   const RenderOutput b = renderer().render(scene, blocks);
-  EXPECT_EQ(pass(b, "photon_gi")->counters.at("gather_step"), 2.0);
   const Image& ia = aov(a, "indirect");
   const Image& ib = aov(b, "indirect");
   EXPECT_NEAR(mean(ib) / mean(ia), 1.0, 0.01);
@@ -423,38 +420,22 @@ TEST(PhotonGi, GatherStepSpreadsBlockSamplesWithoutLosingLight) {
   }
   EXPECT_EQ(dark, 0);
   const double ra = a.stats.metrics["rmse"].get<double>(), rb = b.stats.metrics["rmse"].get<double>();
-  std::printf("indirect rmse vs reference: gather_step 1 %.4f, 2 %.4f\n", ra, rb);
+  std::printf("indirect rmse vs reference: gather_step 1 %.4f, %d %.4f; mean ratio %.4f\n", ra, gatherStep, rb,
+              mean(ib) / mean(ia));
   EXPECT_LT(rb, 1.05 * ra);
 }
 
-// gather_step 4 runs the fix-up cascade (Splatting.cpp): pixels without a matching step-4 block sample
-// try step-2 samples taken at marked block centres before the full gather. Against the full gather
-// with the same photons, as above: the frame's light within 1%, no pixel dark where the full gather has
-// light, and the error against the reference's indirect no more than 5% above the full gather's
-// (measured 0.2095 against 0.2097, mean ratio 1.0002).
-TEST(PhotonGi, GatherStepFourCascadesItsFixUpsWithoutLosingLight) {
-  const Scene scene = loadBuiltinScene("cornell_box");
-  api::RenderRequest full = cornellRequest(64, {{"photons", 200000}, {"gather_step", 1}});
-  full.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"indirect"}, false}};
-  full.compare = api::CompareSpec{"reference", "indirect", 256, 8};
-  api::RenderRequest blocks = full;
-  blocks.passes["photon_gi"]["gather_step"] = 4;
-  const RenderOutput a = renderer().render(scene, full);
-  const RenderOutput b = renderer().render(scene, blocks);
-  const Image& ia = aov(a, "indirect");
-  const Image& ib = aov(b, "indirect");
-  EXPECT_NEAR(mean(ib) / mean(ia), 1.0, 0.01);
-  const double m = mean(ia);
-  int dark = 0;
-  for (std::size_t i = 0; i < ia.pixels.size(); ++i) {
-    ASSERT_TRUE(std::isfinite(ib.pixels[i]));
-    if (ia.pixels[i] > 0.05 * m && ib.pixels[i] == 0.f) ++dark;
-  }
-  EXPECT_EQ(dark, 0);
-  const double ra = a.stats.metrics["rmse"].get<double>(), rb = b.stats.metrics["rmse"].get<double>();
-  std::printf("indirect rmse vs reference: gather_step 1 %.4f, 4 %.4f; mean ratio %.4f\n", ra, rb, mean(ib) / mean(ia));
-  EXPECT_LT(rb, 1.05 * ra);
+TEST(PhotonGi, GatherStepSpreadsBlockSamplesWithoutLosingLight) {
+  // gather_step 2 gathers one pixel per 2x2 block and spreads it over the block's pixels on the same
+  // surface; pixels with no such sample get their own gather. Measured rmse 0.2056 (step 1) and 0.2051
+  // at 64 px, where a block is 2/3 of the kernel radius (against the compare truth's own seed).
+  expectBlockGatherKeepsTheLight(2);
 }
+
+// gather_step 4 runs the fix-up cascade (Splatting.cpp): pixels without a matching step-4 block sample
+// try step-2 samples taken at marked block centres before the full gather. Measured 0.2056 against
+// 0.2056, mean ratio 1.0002.
+TEST(PhotonGi, GatherStepFourCascadesItsFixUpsWithoutLosingLight) { expectBlockGatherKeepsTheLight(4); }
 
 // gather_step counts output pixels: on a frame supersampled k = 2 the gather takes one sample per
 // 2k x 2k block of the supersampled image (the counter reports the step in those pixels, 4), so it
