@@ -24,6 +24,7 @@
 #include <httplib.h>
 #include <nlohmann/json.hpp>
 
+#include "api/Base64.h"
 #include "renderer/io/ImageIO.h"
 #include "renderer/metrics/Metrics.h"
 #include "tests/support/ImageDifference.h"
@@ -742,22 +743,17 @@ TEST(SweepInterrupt, CtrlCStopsCleanlyAndTheNextRunResumes) {
 
 namespace {
 
-std::string base64Decode(const std::string& in) {
-  std::string out;
-  unsigned v = 0;
-  int bits = 0;
-  for (char c : in) {
-    const char* digits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    const char* at = std::strchr(digits, c);
-    if (c == '=' || !at || !c) break;
-    v = v << 6 | static_cast<unsigned>(at - digits);
-    bits += 6;
-    if (bits >= 8) {
-      bits -= 8;
-      out += static_cast<char>((v >> bits) & 0xff);
-    }
-  }
-  return out;
+// Renders a results record's request again as a float EXR of the ao AOV (plus compare's error and
+// reference layers): the frame a report pictured for that point. Returns the EXR's bytes.
+std::string renderRecordAsFloatExr(httplib::Client& http, const json& rec) {
+  json request = rec["request"];
+  request["outputs"] = {{{"format", "exr"}, {"aovs", {"ao"}}, {"half", false}}};
+  auto res = http.Post("/v1/renders", request.dump(), "application/json");
+  EXPECT_TRUE(res && res->status == 200) << (res ? res->body : "no answer");
+  if (!res || res->status != 200) return {};
+  auto frame = http.Get(json::parse(res->body)["frames"][0]["url"].get<std::string>().c_str());
+  EXPECT_TRUE(frame && frame->status == 200);
+  return frame && frame->status == 200 ? frame->body : std::string();
 }
 
 // The mean of each 2x2 block: a 128 px frame's 64 px thumbnail, computed here independently.
@@ -805,7 +801,7 @@ TEST_F(SweepAgainstDaemon, ReportShowsTheParetoPointsFramesErrorMapsAndReference
   std::regex imgRe(R"re(<img class="thumb" data-point="([0-9a-f]+)" data-kind="(\w+)" alt="[^"]*" width="128" src="data:image/png;base64,([A-Za-z0-9+/=]+)">)re");
   int images = 0;
   for (auto it = std::sregex_iterator(page.begin(), page.end(), imgRe); it != std::sregex_iterator(); ++it, ++images)
-    shown[(*it)[2]][(*it)[1]] = radiant::io::decodeImage(base64Decode((*it)[3]));
+    shown[(*it)[2]][(*it)[1]] = radiant::io::decodeImage(radiant::api::base64Decode((*it)[3].str()).value_or(""));
   int imgTags = 0;
   for (std::size_t at = 0; (at = page.find("<img", at)) != std::string::npos; ++at) ++imgTags;
   EXPECT_EQ(images, imgTags)
@@ -832,15 +828,11 @@ TEST_F(SweepAgainstDaemon, ReportShowsTheParetoPointsFramesErrorMapsAndReference
   for (const auto& rec : recs) {
     const std::string id = rec["point_id"];
     if (!frontIds.count(id)) continue;
-    json request = rec["request"];
-    request["outputs"] = {{{"format", "exr"}, {"aovs", {"ao"}}, {"half", false}}};
-    auto res = http.Post("/v1/renders", request.dump(), "application/json");
-    ASSERT_TRUE(res && res->status == 200) << (res ? res->body : "no answer");
-    auto frame = http.Get(json::parse(res->body)["frames"][0]["url"].get<std::string>().c_str());
-    ASSERT_TRUE(frame && frame->status == 200);
-    const radiant::Image ao = halve(radiant::io::decodeImage(frame->body, "ao"));
-    errors[id] = halve(radiant::io::decodeImage(frame->body, "error"));
-    references[id] = halve(radiant::io::decodeImage(frame->body, "reference"));
+    const std::string exr = renderRecordAsFloatExr(http, rec);
+    ASSERT_FALSE(exr.empty());
+    const radiant::Image ao = halve(radiant::io::decodeImage(exr, "ao"));
+    errors[id] = halve(radiant::io::decodeImage(exr, "error"));
+    references[id] = halve(radiant::io::decodeImage(exr, "reference"));
     for (float v : errors[id].pixels) scale = std::max(scale, double(v));
     ASSERT_EQ(ao.width, 64);
     // 8-bit sRGB of a half-float thumbnail: half a step of rounding, and half's 2^-11 through the sRGB slope.
@@ -914,7 +906,7 @@ TEST_F(SweepAgainstDaemon, BenchReportShowsEachSectionsParetoPointsFramesAndThei
       heads.push_back({(*it)[1], (*it)[2]});
     std::vector<std::string> frames;
     for (auto it = std::sregex_iterator(fig.begin(), fig.end(), imgRe); it != std::sregex_iterator(); ++it) {
-      shown[(*it)[2]][(*it)[1]] = radiant::io::decodeImage(base64Decode((*it)[3]));
+      shown[(*it)[2]][(*it)[1]] = radiant::io::decodeImage(radiant::api::base64Decode((*it)[3].str()).value_or(""));
       if ((*it)[2] == "frame") frames.push_back((*it)[1]);
     }
     ASSERT_EQ(heads.size(), frames.size());
@@ -936,17 +928,13 @@ TEST_F(SweepAgainstDaemon, BenchReportShowsEachSectionsParetoPointsFramesAndThei
   for (const auto& rec : recs) {
     const std::string id = rec["point_id"];
     if (!pictured.count(id)) continue;
-    json request = rec["request"];
-    request["outputs"] = {{{"format", "exr"}, {"aovs", {"ao"}}, {"half", false}}};
-    auto res = http.Post("/v1/renders", request.dump(), "application/json");
-    ASSERT_TRUE(res && res->status == 200) << (res ? res->body : "no answer");
-    auto frame = http.Get(json::parse(res->body)["frames"][0]["url"].get<std::string>().c_str());
-    ASSERT_TRUE(frame && frame->status == 200);
-    const radiant::Image ao = radiant::io::decodeImage(frame->body, "ao");
+    const std::string exr = renderRecordAsFloatExr(http, rec);
+    ASSERT_FALSE(exr.empty());
+    const radiant::Image ao = radiant::io::decodeImage(exr, "ao");
     ASSERT_EQ(ao.width, rec["request"]["width"].get<int>());
     EXPECT_LE(radiant::testing::maxAbsDifference(shown["frame"][id], displayed(ao)), 1.0 / 255) << id;
     if (shown["reference"].count(id)) {
-      const radiant::Image reference = radiant::io::decodeImage(frame->body, "reference");
+      const radiant::Image reference = radiant::io::decodeImage(exr, "reference");
       EXPECT_LE(radiant::testing::maxAbsDifference(shown["reference"][id], displayed(reference)), 1.0 / 255) << id;
     }
   }
