@@ -294,6 +294,10 @@ Shading RayScene::shade(const SurfaceHit& hit, const glm::vec3& wo, TransportMod
   if (m.normals.size() == m.positions.size()) {
     const glm::vec3 n = hit.b0 * m.normals[i[0]] + hit.b1 * m.normals[i[1]] + hit.b2 * m.normals[i[2]];
     if (glm::dot(n, n) > 0.f) ns = glm::normalize(n);
+    // Vertex normals inconsistent with the winding are turned to its side before normal mapping (as
+    // material.glsl's windingSideNormal), so that a mapped normal tilted past the geometric horizon stays
+    // where the map put it instead of being mirrored.
+    if (glm::dot(ns, hit.ng) < 0.f) ns = -ns;
     coat = ns;
     if (mat.hasNormalMap() && m.tangents.size() == m.positions.size()) {
       const glm::vec4 t4 = hit.b0 * m.tangents[i[0]] + hit.b1 * m.tangents[i[1]] + hit.b2 * m.tangents[i[2]];
@@ -305,12 +309,16 @@ Shading RayScene::shade(const SurfaceHit& hit, const glm::vec3& wo, TransportMod
         coat = mapTangentNormal(textureAt(mat.clearcoatNormalTexture, hit, false), mat.clearcoatNormalTexture.scale,
                                 interpolated, frame);
     }
-    if (glm::dot(ns, hit.ng) < 0.f) ns = -ns;  // normals inconsistent with the winding
     if (!front) ns = -ns;
-    if (glm::dot(ns, wo) <= 1e-4f) ns = s.ngFacing;  // wo under the shading hemisphere
-    if (glm::dot(coat, hit.ng) < 0.f) coat = -coat;
     if (!front) coat = -coat;
-    if (glm::dot(coat, wo) <= 1e-4f) coat = s.ngFacing;
+    // wo under (or at) the shading hemisphere: bend the normal towards wo until n.wo = 1e-3, as every
+    // GLSL consumer does (direct.frag, transparency.frag, photon_gi's surface.glsl), not replace it.
+    auto towardsViewer = [&](glm::vec3 n) {
+      const float nv = glm::dot(n, wo);
+      return nv < 1e-3f ? glm::normalize(n + wo * (1e-3f - nv)) : n;
+    };
+    ns = towardsViewer(ns);
+    coat = towardsViewer(coat);
   } else {
     ns = s.ngFacing;
   }

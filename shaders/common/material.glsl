@@ -140,6 +140,15 @@ vec3 mapTangentNormal(vec3 tn, vec3 n, vec4 tangent) {
   return materialSafeNormalize(t * tn.x + b * tn.y + n * tn.z, n);
 }
 
+// The interpolated vertex normal n turned to the side of the winding's normal before normal mapping, as
+// RayScene::shade does: vertex normals inconsistent with the winding would otherwise shade the front
+// as a back. viewerFace is the geometric normal on the viewer's side; frontFacing says whether the
+// viewer sees the winding's front (gl_FrontFacing).
+vec3 windingSideNormal(vec3 n, vec3 viewerFace, bool frontFacing) {
+  vec3 winding = frontFacing ? viewerFace : -viewerFace;
+  return dot(n, winding) < 0.0 ? -n : n;
+}
+
 // The normal-mapped shading normal (glTF 3.9.3): n is the interpolated vertex normal (on the front
 // side of the winding), tangent the interpolated vertex tangent (xyz, w handedness). The back face of a
 // double-sided surface sees the whole tangent frame reversed (t, b and n, as the glTF sample viewer

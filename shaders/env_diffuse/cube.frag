@@ -34,7 +34,7 @@ void main() {
   vec3 wo = materialSafeNormalize(toO, vec3(0.0, 1.0, 0.0));
   vec3 faceNormal = materialSafeNormalize(cross(dFdx(v_position), dFdy(v_position)), wo);
   if (dot(faceNormal, wo) < 0.0) faceNormal = -faceNormal;
-  vec3 n = materialSafeNormalize(v_normal, faceNormal);
+  vec3 n = windingSideNormal(materialSafeNormalize(v_normal, faceNormal), faceNormal, gl_FrontFacing);
   n = decodeShadingNormal(m, n, v_tangent, v_uv0, v_uv1, gl_FrontFacing);
   float nv = dot(n, wo);
   if (nv < 1e-3) n = normalize(n + wo * (1e-3 - nv));

@@ -31,13 +31,12 @@ void main() {
   MaterialParams p = decodeMaterial(m, v_uv0, v_uv1);
 
   vec3 faceNormal = materialSafeNormalize(cross(dFdx(v_position), dFdy(v_position)), vec3(0, 1, 0));
-  vec3 n = materialSafeNormalize(v_normal, faceNormal);
+  // Geometric normal on the side the viewer sees: used for shadow normal-offset bias.
+  vec3 geo = dot(faceNormal, u_eye - v_position) < 0.0 ? -faceNormal : faceNormal;
+  vec3 n = windingSideNormal(materialSafeNormalize(v_normal, faceNormal), geo, gl_FrontFacing);
   // KHR_materials_clearcoat: its own normal map (clearcoatNormalTexture) or none, never the base's.
   vec3 coatNormal = decodeCoatNormal(m, n, v_tangent, v_uv0, v_uv1, gl_FrontFacing);
   n = decodeShadingNormal(m, n, v_tangent, v_uv0, v_uv1, gl_FrontFacing);
-
-  // Geometric normal on the side the viewer sees: used for shadow normal-offset bias.
-  vec3 geo = dot(faceNormal, u_eye - v_position) < 0.0 ? -faceNormal : faceNormal;
 
   float viewDepth = max(dot(v_position - u_eye, u_viewForward), 1e-30);
   o_position = vec4(v_position, viewDepth);

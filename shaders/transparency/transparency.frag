@@ -33,11 +33,11 @@ void main() {
     return;
   }
   vec3 faceNormal = materialSafeNormalize(cross(dFdx(v_position), dFdy(v_position)), vec3(0, 1, 0));
-  vec3 n0 = materialSafeNormalize(v_normal, faceNormal);
-  vec3 nc = decodeCoatNormal(m, n0, v_tangent, v_uv0, v_uv1, gl_FrontFacing);  // KHR_materials_clearcoat
-  vec3 n = decodeShadingNormal(m, n0, v_tangent, v_uv0, v_uv1, gl_FrontFacing);
   vec3 wo = u_orthographic != 0 ? -u_viewForward : normalize(u_eye - v_position);
   vec3 ng = dot(faceNormal, wo) < 0.0 ? -faceNormal : faceNormal;
+  vec3 n0 = windingSideNormal(materialSafeNormalize(v_normal, faceNormal), ng, gl_FrontFacing);
+  vec3 nc = decodeCoatNormal(m, n0, v_tangent, v_uv0, v_uv1, gl_FrontFacing);  // KHR_materials_clearcoat
+  vec3 n = decodeShadingNormal(m, n0, v_tangent, v_uv0, v_uv1, gl_FrontFacing);
   float nv = dot(n, wo);
   if (nv < 1e-3) n = normalize(n + wo * (1e-3 - nv));
   float ncv = dot(nc, wo);

@@ -775,6 +775,49 @@ TEST(LayerTextures, CoatNormalMapMovesTheCoatsHighlightAsInTheReference) {
   EXPECT_GT(tiltReference, 10.0 * mappedError);
 }
 
+// ---- shading normals: vertex normals against the winding --------------------------------------------
+
+// Exported files sometimes carry vertex normals opposite to their triangles' winding. Both languages
+// turn the interpolated normal to the winding's side before normal mapping (RayScene::shade,
+// material.glsl's windingSideNormal): such a card shades as the same card with consistent normals, in
+// the raster as in the reference. Before, only the reference flipped them and the raster lit the front
+// as a back (black under a light in front).
+TEST(ShadingNormals, VertexNormalsAgainstTheWindingShadeAsConsistentOnesRasterAndReference) {
+  const json lambert = {{"pbrMetallicRoughness", {{"baseColorFactor", {0.8, 0.8, 0.8, 1.0}},
+                                                  {"metallicFactor", 0.0}, {"roughnessFactor", 1.0}}}};
+  test::GltfBuilder cb, rb;
+  const Scene consistent = layeredQuads(cb, {lambert});
+  const Scene reversed = layeredQuads(rb, {lambert}, {0, 0, -1});  // the winding's normal is +z
+  api::RenderRequest req = exrRequest(kSize);
+  req.camera = kFillCamera;
+  req.defaultLighting = false;
+  req.disabledPasses.insert("photon_gi");  // one card: no interreflection, direct light only
+  req.compare = api::CompareSpec{"reference", "beauty", 64, 1};
+  const RenderOutput c = renderer().render(consistent, req);
+  const RenderOutput r = renderer().render(reversed, req);
+  auto relativeL1 = [](const Image& x, const Image& y) {
+    double num = 0.0, den = 0.0;
+    for (int j = 0; j < kSize; ++j)
+      for (int i = 0; i < kSize; ++i) {
+        num += std::abs(x.at(i, j)[1] - y.at(i, j)[1]);
+        den += y.at(i, j)[1];
+      }
+    return num / den;
+  };
+  const double rasterFlip = relativeL1(aov(r, "beauty"), aov(c, "beauty"));
+  const double referenceFlip = relativeL1(aov(r, "reference"), aov(c, "reference"));
+  const double rasterVsReference = relativeL1(aov(r, "beauty"), aov(r, "reference"));
+  std::cout << "reversed vertex normals: raster changes by " << rasterFlip << ", reference by " << referenceFlip
+            << "; raster/reference " << rasterVsReference << " (relative L1)\n";
+  // The same normals after the turn: the raster image is the consistent card's to float rounding, the
+  // reference's within its noise (the same seed traces the same paths).
+  EXPECT_LT(rasterFlip, 1e-4);
+  EXPECT_LT(referenceFlip, 1e-4);
+  // A Lambertian card under a point light: the raster's one sample per pixel against 64 spp over the
+  // pixel (the point light's falloff is smooth: 2% covers the noise).
+  EXPECT_LT(rasterVsReference, 0.02);
+}
+
 // ---- shadows of MASK and BLEND surfaces -------------------------------------------------------------
 
 TEST(Transparency, BlendedSurfaceCastsAShadowOfItsAlphaAsTheReference) {
