@@ -82,7 +82,9 @@ int main(int argc, char** argv) {
   cam.fromFile = true;
   scene.camera = cam;
   scene.features = computeFeatures(scene);
-  const json base = {{"scene", {{"builtin", "unused"}}}, {"width", size}, {"height", size},
+  // One raster sample per pixel, as this bench's figures in docs/PERFORMANCE.md were measured (the
+  // HTTP default is "supersampling": 2 since 2026-12-02; the C++ RenderRequest's stays 1).
+  const json base = {{"scene", {{"builtin", "unused"}}}, {"width", size}, {"height", size}, {"supersampling", 1},
                      {"passes", {{"direct", false}, {"photon_gi", false}}},
                      {"outputs", json::array({{{"format", "exr"}, {"aovs", {"media"}}}})}};
 

@@ -98,7 +98,9 @@ int main(int argc, char** argv) {
   scene.camera.fromFile = true;
   const json cloud = {{"kind", "cloud"}, {"tau", 10.0}, {"albedo", {0.9, 0.9, 0.9}},
                       {"particles", json::array({{{"p", {0, 0, 0}}, {"r", 1.0}}})}};
-  const json base = {{"scene", {{"builtin", "unused"}}}, {"width", size}, {"height", size},
+  // One raster sample per pixel, as this bench's figures in docs/PERFORMANCE.md were measured (the
+  // HTTP default is "supersampling": 2 since 2026-12-02; the C++ RenderRequest's stays 1).
+  const json base = {{"scene", {{"builtin", "unused"}}}, {"width", size}, {"height", size}, {"supersampling", 1},
                      {"ambient", {0.3, 0.35, 0.45}}, {"media", json::array({cloud})},
                      {"outputs", json::array({{{"format", "exr"}, {"aovs", {"media"}}}})}};
 

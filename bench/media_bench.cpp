@@ -54,7 +54,9 @@ int main(int argc, char** argv) {
   const Scene scene = loadBuiltinScene("explosion");
   // Only the G-buffer (the scene depth the particles read) besides the media pass: the opaque
   // shading passes cost seconds on llvmpipe and do not change the media pass's work.
-  json base = {{"scene", {{"builtin", "explosion"}}}, {"width", size}, {"height", size},
+  // One raster sample per pixel, as this bench's figures in docs/PERFORMANCE.md were measured (the
+  // HTTP default is "supersampling": 2 since 2026-12-02; the C++ RenderRequest's stays 1).
+  json base = {{"scene", {{"builtin", "explosion"}}}, {"width", size}, {"height", size}, {"supersampling", 1},
                {"passes", {{"direct", false}, {"photon_gi", false}}},
                {"outputs", json::array({{{"format", "exr"}, {"aovs", {"media"}}}})}};
 

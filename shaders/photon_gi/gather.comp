@@ -14,7 +14,8 @@ uniform float u_cellSize;
 uniform ivec3 u_gridDims;
 uniform ivec2 u_size;     // the G-buffer's (full) resolution
 // u_step > 1: one invocation per step x step block, at the block's centre pixel, written at the block's
-// index (upsample.comp spreads it). u_fixup = 1: full resolution, only the pixels upsample.comp marked.
+// index (upsample.comp spreads it). u_fixup = 1: full resolution, only the pixels upsample.comp marked
+// (i_fixup 1; 2 is a pixel its neighbour fill gave a value).
 // u_fixup = 2: block samples as for u_step > 1, but only at the blocks whose centre pixel is marked (the
 // fix-up cascade of a supersampled frame, Splatting.cpp); the others get alpha -1, no sample.
 uniform int u_step;
@@ -31,9 +32,9 @@ uniform int u_accumulate;
 void main() {
   ivec2 out_ = ivec2(gl_GlobalInvocationID.xy);
   if (out_.x >= u_outSize.x || out_.y >= u_outSize.y) return;
-  if (u_fixup == 1 && imageLoad(i_fixup, out_).r == 0.0) return;
+  if (u_fixup == 1 && imageLoad(i_fixup, out_).r != 1.0) return;  // 0 filled, 2 filled by a neighbour
   ivec2 px = min(out_ * u_step + u_step / 2, u_size - 1);
-  if (u_fixup == 2 && imageLoad(i_fixup, px).r == 0.0) {
+  if (u_fixup == 2 && imageLoad(i_fixup, px).r != 1.0) {
     imageStore(i_accum, out_, vec4(0.0, 0.0, 0.0, -1.0));
     return;
   }

@@ -8,6 +8,12 @@
 // u_refine = 1 (the fix-up cascade of a supersampled frame): only the marked pixels, from block samples
 // of a finer step taken at marked block centres (alpha -1: no sample there); a pixel that finds one is
 // unmarked, the others stay marked for the full gather.
+// u_refine = 2 (the neighbour fill, before the cascade): a marked pixel takes the mean of the pixels
+// within u_fillRadius that the block samples filled (i_fixup 0) and that pass the same surface test
+// (so the estimate is borrowed over less than h_min / 2, as above); it is then marked 2, which no pass
+// reads from or gathers for. Edge pixels usually have such a neighbour on their own surface one or two
+// pixels inwards, so only thin features and isolated triangles are left for the full gather. Race-free:
+// it reads only pixels marked 0, which it never writes, and writes only pixels marked 1 (as 2).
 #include "photon_gi/photon.glsl"
 #include "photon_gi/surface.glsl"
 
@@ -23,14 +29,48 @@ uniform float u_hMin;
 uniform int u_renormalize;
 uniform float u_minKernelMass;
 uniform int u_refine;
+uniform int u_fillRadius;
+
+// The surface test of a borrowed estimate: o's value may stand for s's (module comment).
+bool sameSurface(SplatSurface s, SplatSurface o) {
+  vec3 d = s.x - o.x;
+  return abs(dot(d, o.ng)) <= u_planeTolerance * u_hMin && dot(s.ng, o.ng) >= 0.9 &&
+         dot(d, d) <= 0.25 * u_hMin * u_hMin;
+}
+
+// The diffuse albedo re-modulation of a borrowed estimate (module comment).
+vec3 remodulate(SplatSurface s, SplatSurface o) { return (s.p.baseColor.rgb + 0.02) / (o.p.baseColor.rgb + 0.02); }
+
+void neighbourFill(ivec2 px, SplatSurface s) {
+  vec3 sum = vec3(0.0);
+  float n = 0.0;
+  for (int dy = -u_fillRadius; dy <= u_fillRadius; ++dy)
+    for (int dx = -u_fillRadius; dx <= u_fillRadius; ++dx) {
+      ivec2 q = px + ivec2(dx, dy);
+      if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, u_size))) continue;
+      if (imageLoad(i_fixup, q).r != 0.0) continue;  // marked: not filled yet (or filled by this pass)
+      SplatSurface o;
+      if (!loadSurface(q, o) || !sameSurface(s, o)) continue;
+      sum += imageLoad(i_accum, q).rgb * remodulate(s, o);
+      n += 1.0;
+    }
+  if (n > 0.0) {
+    imageStore(i_accum, px, vec4(sum / n, 1.0));
+    imageStore(i_fixup, px, vec4(2.0));
+  }
+}
 
 ivec2 samplePixel(ivec2 q) { return min(q * u_step + u_step / 2, u_size - 1); }
 
 void main() {
   ivec2 px = ivec2(gl_GlobalInvocationID.xy);
   if (px.x >= u_size.x || px.y >= u_size.y) return;
-  if (u_refine != 0 && imageLoad(i_fixup, px).r == 0.0) return;
+  if (u_refine != 0 && imageLoad(i_fixup, px).r != 1.0) return;
   SplatSurface s;
+  if (u_refine == 2) {
+    if (loadSurface(px, s)) neighbourFill(px, s);
+    return;
+  }
   if (!loadSurface(px, s)) {
     imageStore(i_accum, px, vec4(0.0));
     imageStore(i_fixup, px, vec4(0.0));
@@ -47,16 +87,12 @@ void main() {
       float wb = (i == 0 ? 1.0 - t.x : t.x) * (j == 0 ? 1.0 - t.y : t.y);
       if (wb <= 0.0) continue;
       SplatSurface o;
-      if (!loadSurface(samplePixel(q), o)) continue;
-      vec3 d = s.x - o.x;
-      if (abs(dot(d, o.ng)) > u_planeTolerance * u_hMin) continue;
-      if (dot(s.ng, o.ng) < 0.9) continue;
-      if (dot(d, d) > 0.25 * u_hMin * u_hMin) continue;
+      if (!loadSurface(samplePixel(q), o) || !sameSurface(s, o)) continue;
       vec4 a = texelFetch(t_low, q, 0);
       if (a.a < 0.0) continue;  // u_refine: no block sample was taken there
       vec3 L = a.rgb;
       if (u_renormalize != 0 && a.a > 0.0) L /= max(a.a, u_minKernelMass);
-      sum += wb * L * (s.p.baseColor.rgb + 0.02) / (o.p.baseColor.rgb + 0.02);
+      sum += wb * L * remodulate(s, o);
       wsum += wb;
     }
   if (wsum > 0.0) {
