@@ -87,9 +87,10 @@ struct RenderRequest {
   // With no lights, emission, ambient or environment, light the scene with the default studio
   // environment (renderer/scene/StudioEnvironment.h); false renders such a scene black.
   bool defaultLighting = true;
-  // Samples per pixel axis of the raster passes (the schema's "supersampling", default 1 there too):
-  // they run at (k width) x (k height) and readback resolves each AOV to width x height
-  // (api::AovResolve).
+  // Samples per pixel axis of the raster passes (the schema's "supersampling"): they run at (k width) x
+  // (k height) and readback resolves each AOV to width x height (api::AovResolve). The schema's default
+  // is 2 (what an HTTP request without the field gets, from parseRenderRequest); a RenderRequest built
+  // in C++ (the renderer's tests and benches) keeps 1, the single sample its expected values assume.
   int supersampling = 1;
   std::optional<CompareSpec> compare;
   bool async = false;
