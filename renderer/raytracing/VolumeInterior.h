@@ -4,9 +4,9 @@
 // length (the spec's thickness is a rasterizer's stand-in for that length: the tracers do not need it).
 //
 // Which medium: a material with a volume (Material::hasVolume) bounds a closed mesh whose outward side is
-// its counter-clockwise front face (glTF 3.7.2.1), so after scattering at such a surface the next segment
-// is inside when it leaves against the geometric normal (a refraction in, or a reflection inside: total
-// internal reflection keeps it inside) and outside otherwise. The BSDF's sampled side decides, nothing
+// its front face (counter-clockwise winding, as RayScene's geometric normal), so after scattering at
+// such a surface the next segment is inside when it leaves against the geometric normal (a refraction
+// in, or a reflection inside: total internal reflection keeps it inside) and outside otherwise. The BSDF's sampled side decides, nothing
 // is counted by hand. A surface without a volume leaves the medium as it is (an object immersed in a
 // medium). Nested volumes are not tracked: leaving an inner one puts the ray outside every medium.
 #include <cmath>
