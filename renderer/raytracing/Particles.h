@@ -5,20 +5,24 @@
 // `roulette`, Russian roulette with survival min(0.95, max channel of the weight), the survivors
 // re-weighted (unbiased; an albedo-1 path still ends). False when the particle ends: the direction
 // leaks through the geometric surface, the geometry factor degenerates, or roulette ends it.
+// `interior` follows the KHR_materials_volume medium the particle enters or leaves (VolumeInterior.h):
+// the caller attenuates the flux by interior.transmittance(hit.distance) at the next hit.
 #include <algorithm>
 #include <cmath>
 
 #include <glm/glm.hpp>
 
 #include "renderer/raytracing/RayScene.h"
+#include "renderer/raytracing/VolumeInterior.h"
 
 namespace radiant::rt {
 
 inline constexpr float kParticleMaxSurvival = 0.95f;
 
 // wo: unit direction towards where the particle came from; woL: wo in the shading frame.
-inline bool continueParticle(const SurfaceHit& hit, const Shading& sh, const glm::vec3& wo, const glm::vec3& woL,
-                             const GltfBsdf::Sample& s, bool roulette, Sampler& sampler, glm::vec3& flux, Ray& ray) {
+inline bool continueParticle(const RayScene& rays, const SurfaceHit& hit, const Shading& sh, const glm::vec3& wo, const glm::vec3& woL,
+                             const GltfBsdf::Sample& s, bool roulette, Sampler& sampler, glm::vec3& flux, Ray& ray,
+                             VolumeInterior& interior) {
   const glm::vec3 wi = sh.frame.toWorld(s.wi);
   const float gi = glm::dot(wi, sh.ngFacing);
   if (s.wi.z > 0.f ? gi <= 0.f : gi >= 0.f) return false;  // leaked through the geometric surface
@@ -32,6 +36,7 @@ inline bool continueParticle(const SurfaceHit& hit, const Shading& sh, const glm
     weight /= q;
   }
   flux *= weight;
+  interior.scatter(rays, hit, wi);
   ray = Ray{RayScene::offsetOrigin(hit.p, hit.ng, hit.offsetScale, wi), wi, 0.f, kInf};
   return true;
 }

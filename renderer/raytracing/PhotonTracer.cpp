@@ -26,9 +26,11 @@ void tracePhoton(const RayScene& rays, const SceneLights& lights, const PhotonOp
   const int lastBounce = o.maxBounces - 1;
   bool narrowLobePath = true;  // every scattering so far off a metal or glass by a non-diffuse lobe
   bool specularChain = true;  // every scattering vertex so far on a Material::isSpecular() surface
+  VolumeInterior interior;  // KHR_materials_volume: the absorbing medium the photon travels in
   for (int bounce = 0; bounce <= lastBounce; ++bounce) {
     SurfaceHit hit;
     if (!rays.intersect(ray, hit, sampler, counter)) return;
+    flux *= interior.transmittance(hit.distance);  // Beer-Lambert over the segment (VolumeInterior.h)
     if (bounce == 0 && e.windowRange > 0.f) flux *= rangeWindow(hit.distance, e.windowRange);
     if (!(maxComponent(flux) > 0.f) || !finite(flux)) return;
     if (rays.materialOf(hit.mesh).unlit) return;  // KHR_materials_unlit absorbs (the reference ends paths there)
@@ -57,7 +59,7 @@ void tracePhoton(const RayScene& rays, const SceneLights& lights, const PhotonOp
     if (!sh.bsdf.sample(woL, uLobe, uFresnel, uDir, s) || s.delta) return;
     narrowLobePath = narrowLobePath && (s.flags & (kLobeGlossy | kLobeSpecular)) != 0 &&
                      rays.materialOf(hit.mesh).scattersNarrowLobe();
-    if (!continueParticle(hit, sh, wo, woL, s, o.russianRoulette, sampler, flux, ray)) return;
+    if (!continueParticle(rays, hit, sh, wo, woL, s, o.russianRoulette, sampler, flux, ray, interior)) return;
   }
 }
 

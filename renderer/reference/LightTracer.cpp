@@ -38,7 +38,7 @@ struct Tracer {
 
   // Adds beta f |wp.ns| |wc.ng| / |wp.ng| x importance to the pixel that sees the hit (header comment).
   void connect(const SurfaceHit& hit, const Shading& sh, const glm::vec3& wp, const glm::vec3& beta,
-               std::vector<float>& image, Sampler& sampler, RayCounter& counter) const {
+               const VolumeInterior& interior, std::vector<float>& image, Sampler& sampler, RayCounter& counter) const {
     CameraRays::Connection c;
     if (!camera.connect(hit.p, c)) return;
     const float gp = glm::dot(wp, sh.ngFacing), gc = glm::dot(c.toCamera, sh.ngFacing);
@@ -48,7 +48,8 @@ struct Tracer {
     if (!(std::abs(gp) > 0.f)) return;
     const glm::vec3 f = sh.bsdf.eval(wpL, wcL);
     if (!(maxComponent(f) > 0.f)) return;
-    const glm::vec3 value = beta * f * (std::abs(wpL.z) * std::abs(gc) / std::abs(gp) * c.importance);
+    const glm::vec3 value = beta * f * interior.towards(rays, hit, c.toCamera).transmittance(c.distance) *
+                            (std::abs(wpL.z) * std::abs(gc) / std::abs(gp) * c.importance);
     if (!finite(value)) return;
     Ray shadow{RayScene::offsetOrigin(hit.p, hit.ng, hit.offsetScale, c.toCamera), c.toCamera, 0.f, c.distance};
     if (shadow.tfar > 0.f && rays.occluded(shadow, sampler, counter)) return;
@@ -64,9 +65,11 @@ struct Tracer {
     Ray ray = e.ray;
     const bool caustics = o.paths == LightTracerOptions::Paths::Caustics;
     int deltas = 0;  // delta scattering events so far (all of them, in the caustics class)
+    VolumeInterior interior;  // KHR_materials_volume: the absorbing medium the particle travels in
     for (int k = 1; k <= o.maxBounces; ++k) {  // k = the bounce count if this hit is connected
       SurfaceHit hit;
       if (!rays.intersect(ray, hit, sampler, counter)) return;
+      beta *= interior.transmittance(hit.distance);  // Beer-Lambert over the segment (VolumeInterior.h)
       if (k == 1 && e.windowRange > 0.f) beta *= rangeWindow(hit.distance, e.windowRange);
       if (!(maxComponent(beta) > 0.f) || !finite(beta)) return;
       if (rays.materialOf(hit.mesh).unlit) return;  // unlit surfaces do not scatter (as in the path tracer)
@@ -74,7 +77,7 @@ struct Tracer {
       const Shading sh = rays.shade(hit, wp, TransportMode::Importance);
       const glm::vec3 wpL = sh.frame.toLocal(wp);
       const bool classOk = caustics ? (deltas == k - 1 && k >= 2) : true;
-      if (classOk && inRange(k) && sh.bsdf.hasNonDeltaLobe(wpL)) connect(hit, sh, wp, beta, image, sampler, counter);
+      if (classOk && inRange(k) && sh.bsdf.hasNonDeltaLobe(wpL)) connect(hit, sh, wp, beta, interior, image, sampler, counter);
       if (k == o.maxBounces) return;
       const float uLobe = sampler.next(), uFresnel = sampler.next();
       const glm::vec2 uDir = sampler.next2();
@@ -83,7 +86,8 @@ struct Tracer {
       if (caustics && !s.delta) return;  // no longer L S+ D: nothing later can be a caustic
       if (s.delta) ++deltas;
       // Adjoint BSDF with shading normals and roulette from the fourth event on, as the photon tracer.
-      if (!continueParticle(hit, sh, wp, wpL, s, o.russianRoulette && k >= kRussianRouletteStart, sampler, beta, ray))
+      if (!continueParticle(rays, hit, sh, wp, wpL, s, o.russianRoulette && k >= kRussianRouletteStart, sampler, beta,
+                            ray, interior))
         return;
     }
   }

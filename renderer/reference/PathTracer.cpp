@@ -16,6 +16,7 @@
 #include "renderer/raytracing/CameraRays.h"
 #include "renderer/raytracing/Lights.h"
 #include "renderer/raytracing/RayScene.h"
+#include "renderer/raytracing/VolumeInterior.h"
 
 namespace radiant::reference {
 namespace {
@@ -35,8 +36,10 @@ struct PathTracer::Impl {
   bool inRange(int k, const ReferenceOptions& o) const { return k >= o.minPathBounce && k <= o.maxPathBounce; }
 
   // Direct light at a scattering vertex by next-event estimation (k = the vertex's bounce count).
+  // `interior`: the KHR_materials_volume medium of the path; a light segment is attenuated by the medium
+  // its direction enters (VolumeInterior::towards), so a light inside an absorbing solid dims.
   glm::vec3 estimateDirect(const SurfaceHit& hit, const Shading& sh, const glm::vec3& woL, const SceneLights& lights,
-                           Sampler& sampler, RayCounter& counter) const {
+                           const VolumeInterior& interior, Sampler& sampler, RayCounter& counter) const {
     const RayScene& rs = *rays;
     glm::vec3 L(0.f);
     auto visible = [&](const glm::vec3& wi, const glm::vec3& wiL) {
@@ -62,7 +65,7 @@ struct PathTracer::Impl {
         shadow.dir = d / shadow.tfar;
       }
       if (rs.occluded(shadow, sampler, counter)) continue;
-      L += f * std::abs(wiL.z) * Li;
+      L += f * std::abs(wiL.z) * Li * interior.towards(rs, hit, wi).transmittance(dist);
     }
 
     // One emissive triangle, chosen in proportion to power, sampled uniformly by area; MIS with the BSDF.
@@ -94,7 +97,7 @@ struct PathTracer::Impl {
                 shadow.dir = sd / shadow.tfar;
                 if (!rs.occluded(shadow, sampler, counter)) {
                   const float w = powerHeuristic(lightPdf, sh.bsdf.pdf(woL, wiL));
-                  L += f * std::abs(wiL.z) * Le * (w / lightPdf);
+                  L += f * std::abs(wiL.z) * Le * interior.towards(rs, hit, wi).transmittance(dist) * (w / lightPdf);
                 }
               }
             }
@@ -116,7 +119,7 @@ struct PathTracer::Impl {
           Ray shadow{RayScene::offsetOrigin(hit.p, hit.ng, hit.offsetScale, wi), wi, 0.f, kInf};
           if (!rs.occluded(shadow, sampler, counter)) {
             const float w = powerHeuristic(envPdf, sh.bsdf.pdf(woL, wiL));
-            L += f * std::abs(wiL.z) * Le * (w / envPdf);
+            L += f * std::abs(wiL.z) * Le * interior.towards(rs, hit, wi).transmittance(kInf) * (w / envPdf);
           }
         }
       }
@@ -136,10 +139,14 @@ struct PathTracer::Impl {
     // L S+ D E bookkeeping (ReferenceOptions::excludeCaustics): true while the first vertex scattered
     // through a non-delta lobe and every later vertex through a delta lobe.
     bool causticChain = false;
+    VolumeInterior interior;  // KHR_materials_volume: the absorbing medium the path travels in
     const int lastVertex = std::min(o.maxBounces, o.maxPathBounce);
     for (;;) {
       SurfaceHit hit;
-      if (!rays->intersect(ray, hit, sampler, counter)) {
+      const bool found = rays->intersect(ray, hit, sampler, counter);
+      // Beer-Lambert over the segment just travelled (an escape from inside an open mesh: infinite).
+      if (interior.absorbs()) beta *= interior.transmittance(found ? hit.distance : kInf);
+      if (!found) {
         if (env.active() && inRange(k, o) && !(o.excludeCaustics && causticChain && k >= 2)) {
           const float w = prevDelta ? 1.f : powerHeuristic(prevPdf, env.pdf(ray.dir));
           L += beta * env.radiance(ray.dir) * w;
@@ -165,7 +172,7 @@ struct PathTracer::Impl {
       const Shading sh = rays->shade(hit, wo);
       const glm::vec3 woL = sh.frame.toLocal(wo);
       if (inRange(k, o) && sh.bsdf.hasNonDeltaLobe(woL))
-        L += beta * estimateDirect(hit, sh, woL, lights, sampler, counter);
+        L += beta * estimateDirect(hit, sh, woL, lights, interior, sampler, counter);
 
       const float uLobe = sampler.next(), uFresnel = sampler.next();
       const glm::vec2 uDir = sampler.next2();
@@ -177,6 +184,7 @@ struct PathTracer::Impl {
       beta *= bs.weight;
       causticChain = k == 1 ? !bs.delta : causticChain && bs.delta;
       if (bs.wi.z < 0.f) etaScale *= sh.bsdf.eta * sh.bsdf.eta;
+      interior.scatter(*rays, hit, wi);
       prevDelta = bs.delta;
       prevPdf = bs.pdf;
       if (!(maxComponent(beta) > 0.f)) break;

@@ -18,6 +18,7 @@ const std::vector<std::string>& supportedExtensions() {
       "KHR_materials_clearcoat",  // factors and textures (coat normal map included)
       "KHR_materials_sheen",      // factors and textures
       "KHR_materials_specular",   // factors and textures
+      "KHR_materials_volume",     // Beer-Lambert absorption over the traced path (thickness: see Scene.h)
       "KHR_mesh_quantization",  // any component type is read and normalised
       "KHR_texture_transform",
       "KHR_materials_unlit",

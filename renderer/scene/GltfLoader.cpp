@@ -715,8 +715,53 @@ private:
         mat.specularTexture = layerTexture(*e, x, "specularTexture", false);
         mat.specularColorTexture = layerTexture(*e, x, "specularColorTexture", true);
       }
+      if (const auto* e = extension(g.extensions, "KHR_materials_volume")) convertVolume(*e, ep + "KHR_materials_volume", mat);
       scene_.materials.push_back(std::move(mat));
     }
+  }
+
+  // KHR_materials_volume. Values outside the spec's ranges (thicknessFactor >= 0, attenuationDistance
+  // in (0, inf), attenuationColor in [0, 1]) are repaired with a warning naming the field, as a renderer
+  // draws a valid-looking file rather than refuse it: a negative thickness is a thin wall (0), a
+  // non-positive or non-numeric distance means no absorption, a colour is clamped to [0, 1].
+  void convertVolume(const tinygltf::Value& e, const std::string& at, Material& mat) {
+    auto warn = [&](const char* key, const std::string& what) {
+      scene_.warnings.push_back(at + "/" + key + ": " + what);
+    };
+    auto value = [&](const char* key, double fallback, bool& ok) {
+      ok = true;
+      if (!e.Has(key)) return fallback;
+      const tinygltf::Value& v = e.Get(key);
+      ok = v.IsNumber() && std::isfinite(v.GetNumberAsDouble());
+      return ok ? v.GetNumberAsDouble() : fallback;
+    };
+    bool ok = true;
+    const double thickness = value("thicknessFactor", 0.0, ok);
+    if (!ok || thickness < 0.0) warn("thicknessFactor", "must be a number >= 0: the surface is a thin wall (0)");
+    else mat.thicknessFactor = float(std::min(thickness, double(std::numeric_limits<float>::max())));
+    const double distance = value("attenuationDistance", std::numeric_limits<double>::infinity(), ok);
+    if (!ok || !(distance > 0.0)) warn("attenuationDistance", "must be a number > 0: the medium does not absorb");
+    // Above FLT_MAX: infinite, no absorption. Below FLT_MIN a float is subnormal, which the ray tracer's
+    // threads read as 0 (Embree's recommended flush-to-zero / denormals-are-zero mode): FLT_MIN instead,
+    // as opaque as the value asked for.
+    else mat.attenuationDistance = float(std::max(distance, double(std::numeric_limits<float>::min())));
+    if (e.Has("attenuationColor")) {
+      const tinygltf::Value& a = e.Get("attenuationColor");
+      bool valid = a.IsArray() && a.ArrayLen() == 3;
+      glm::vec3 c(1.f);
+      for (int k = 0; valid && k < 3; ++k) {
+        valid = a.Get(k).IsNumber() && std::isfinite(a.Get(k).GetNumberAsDouble());
+        if (valid) c[k] = float(a.Get(k).GetNumberAsDouble());
+      }
+      if (!valid) {
+        warn("attenuationColor", "must be three numbers in [0, 1]: white (no absorption) used");
+      } else {
+        if (glm::any(glm::lessThan(c, glm::vec3(0.f))) || glm::any(glm::greaterThan(c, glm::vec3(1.f))))
+          warn("attenuationColor", "components outside [0, 1] clamped");
+        mat.attenuationColor = glm::clamp(c, 0.f, 1.f);
+      }
+    }
+    if (e.Has("thicknessTexture")) mat.thicknessTexture = textureRef(e.Get("thicknessTexture"), at + "/thicknessTexture");
   }
 
   void walkScene() {

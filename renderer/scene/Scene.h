@@ -10,6 +10,8 @@
 //   candela (W/sr in our radiometric reading), directional in lux (W/m^2). A point light of
 //   intensity I lights a white Lambertian plane head-on at distance d with radiance I/(pi d^2).
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -78,12 +80,22 @@ struct Material {
   float sheenRoughnessFactor = 0.f;
   float specularFactor = 1.f;            // KHR_materials_specular
   glm::vec3 specularColorFactor{1.f};
+  // KHR_materials_volume: thicknessFactor > 0 makes the closed mesh the boundary of a homogeneous
+  // absorbing medium (0, the default, is the spec's thin wall: no medium). attenuationDistance is in
+  // world units (infinite = no absorption); attenuationColor is what white light turns into after
+  // travelling that distance inside. thicknessFactor (mesh units) and thicknessTexture (green) are the
+  // spec's hint for renderers that cannot trace the inside: every path here traces the real distance
+  // (docs/TECHNIQUES.md, "Volume absorption"), so they only decide that the medium exists.
+  float thicknessFactor = 0.f;
+  float attenuationDistance = std::numeric_limits<float>::infinity();
+  glm::vec3 attenuationColor{1.f};
   TextureRef baseColorTexture, metallicRoughnessTexture, normalTexture, occlusionTexture,
       emissiveTexture, transmissionTexture;
   // The layered extensions' textures (their channels: MaterialDecode.h): KHR_materials_clearcoat
   // (clearcoatNormalTexture.scale is its normal scale), KHR_materials_sheen, KHR_materials_specular.
   TextureRef clearcoatTexture, clearcoatRoughnessTexture, clearcoatNormalTexture, sheenColorTexture,
       sheenRoughnessTexture, specularTexture, specularColorTexture;
+  TextureRef thicknessTexture;  // KHR_materials_volume (green channel; see thicknessFactor)
   bool doubleSided = false;
   bool unlit = false;  // KHR_materials_unlit: the surface shows its base colour, lit by nothing
   AlphaMode alphaMode = AlphaMode::Opaque;
@@ -94,6 +106,24 @@ struct Material {
   glm::vec3 emission() const { return emissiveFactor * emissiveStrength; }
   bool isEmissive() const { return emission() != glm::vec3(0.f) || emissiveTexture.valid(); }
   bool isTransmissive() const { return transmissionFactor > 0.f; }
+  // KHR_materials_volume: the inside of this closed mesh absorbs (Beer-Lambert).
+  bool hasVolume() const { return thicknessFactor > 0.f; }
+  // The medium's extinction coefficient sigma_t = -ln(attenuationColor) / attenuationDistance per
+  // channel (KHR_materials_volume, "Attenuation"), so that transmittance T(x) = exp(-sigma_t x) equals
+  // attenuationColor at x = attenuationDistance. Zero without a medium or with an infinite distance;
+  // finite always (a black colour or a vanishing distance gives FLT_MAX: opaque, never NaN: 0 x FLT_MAX = 0).
+  glm::vec3 attenuationCoefficient() const {
+    glm::vec3 sigma(0.f);
+    if (!hasVolume() || !(attenuationDistance > 0.f) || !(attenuationDistance < std::numeric_limits<float>::infinity()))
+      return sigma;
+    for (int k = 0; k < 3; ++k) {
+      const float c = attenuationColor[k];
+      if (!(c < 1.f)) continue;  // 1 (or NaN, refused by the loader): no absorption in this channel
+      const double s = -std::log(std::max(double(c), 1e-300)) / double(attenuationDistance);
+      sigma[k] = float(std::min(s, double(std::numeric_limits<float>::max())));
+    }
+    return sigma;
+  }
   // A tangent frame is needed for the base's or the clear coat's normal map.
   bool hasNormalMap() const { return normalTexture.valid() || clearcoatNormalTexture.valid(); }
   bool isSpecular() const {

@@ -43,9 +43,19 @@ layout(binding = kUnitLdmDistance) uniform samplerCubeArray t_ldmDistance;  // l
 
 struct SpecularObject {
   vec4 referenceRadius;  // xyz reference point (world), w bounding radius of the object
-  vec4 extent;           // x distance from the reference point to the farthest scene-bounds corner
+  vec4 extent;           // x distance from the reference point to the farthest scene-bounds corner,
+                         // yzw sigma_t of the object's KHR_materials_volume medium (0: none)
 };
+
 layout(std430, binding = 3) readonly buffer SpecularObjects { SpecularObject objects[]; };
+
+// Beer-Lambert transmittance exp(-sigma_t d) of a segment of length d inside `object`'s medium
+// (KHR_materials_volume; Material::attenuationCoefficient). The exponent is capped so that an opaque
+// medium (sigma_t up to FLT_MAX) or an escaping ray (d huge) gives 0, never a NaN from inf x 0.
+vec3 volumeTransmittance(int object, float d) {
+  vec3 sigma = objects[object].extent.yzw;
+  return exp(-min(sigma * max(d, 0.0), vec3(88.0)));
+}
 // Per cube (object * layers + layer): floatBitsToUint of the minimum and maximum stored distance
 // (min = FLT_MAX, max = 0 for an empty layer). Written by minmax.comp when the maps are built.
 layout(std430, binding = 4) readonly buffer LayerMinMax { uint layerMinMax[]; };

@@ -33,14 +33,16 @@ struct Ray {
   vec3 weight;
   int depth;   // specular interactions on the path so far (the one that spawned this ray included)
   int object;  // whose layered distance map the ray is traced in: the object it leaves
+  bool inside; // travels inside `object` (refracted in, or reflected inside): its medium absorbs
+  vec3 surface; // the surface point it leaves (origin is pushed off it by the self-intersection offset)
 };
 
 Ray stack[MAX_STACK];
 int sp = 0;
 
-void push(vec3 origin, vec3 dir, vec3 weight, int depth, int object) {
+void push(vec3 origin, vec3 dir, vec3 weight, int depth, int object, bool inside, vec3 surface) {
   if (max(weight.r, max(weight.g, weight.b)) < u_minWeight || sp >= MAX_STACK) return;
-  stack[sp] = Ray(origin, dir, weight, depth, object);
+  stack[sp] = Ray(origin, dir, weight, depth, object, inside, surface);
   ++sp;
 }
 
@@ -58,18 +60,19 @@ void scatter(vec3 p, vec3 R, vec3 n, vec4 texel, vec3 weight, int depth, int obj
   vec3 rl = normalize(reflect(R, nn));
   if (texel.a < 0.0) {
     // Mirror: Schlick with F0 = the stored colour (glTF conductor Fresnel, as the reference).
-    push(p + nn * eps, rl, weight * schlick(texel.rgb, cosI), depth, object);
+    push(p + nn * eps, rl, weight * schlick(texel.rgb, cosI), depth, object, !entering, p);
     return;
   }
   float ior = texel.a;
   float eta = entering ? ior : 1.0 / ior;  // n_t / n_i
   float F = fresnelDielectric(cosI, eta);
-  push(p + nn * eps, rl, weight * F, depth, object);
+  // The reflection stays on the side it came from: inside when it was leaving (internal reflection).
+  push(p + nn * eps, rl, weight * F, depth, object, !entering, p);
   if (F < 1.0) {
     vec3 rf = refract(R, nn, 1.0 / eta);  // GLSL's eta is n_i / n_t
     if (dot(rf, rf) > 0.0)
       // Radiance crossing an interface scales by 1 / eta^2 (Veach 1997, 5.2), as in the reference.
-      push(p - nn * eps, normalize(rf), weight * (1.0 - F) * texel.rgb / (eta * eta), depth, object);
+      push(p - nn * eps, normalize(rf), weight * (1.0 - F) * texel.rgb / (eta * eta), depth, object, entering, p);
   }
 }
 
@@ -90,11 +93,16 @@ vec3 traceSpecularTree(vec3 p, vec3 R, vec3 n, vec4 texel, int object, bool ente
     float d;
     int layer;
     if (!traceLayers(r.object, r.origin, r.dir, d, layer)) {
-      // No surface in any layer: the ray leaves the scene.
-      L += r.weight * missRadiance(r.dir);
+      // No surface in any layer: the ray leaves the scene (from inside an open mesh: through all of
+      // its medium, which absorbs everything it can).
+      L += r.weight * (r.inside ? volumeTransmittance(r.object, 3.0e38) : vec3(1.0)) * missRadiance(r.dir);
       continue;
     }
+    // KHR_materials_volume: Beer-Lambert over the segment's traced length, the real path inside the
+    // object as the reference tracer takes it (not the spec's thickness stand-in), measured from the
+    // surface point: the origin's offset (~0.3% of the object's radius) would otherwise go unabsorbed.
     vec3 hit = r.origin + r.dir * d;
+    if (r.inside) r.weight *= volumeTransmittance(r.object, length(hit - r.surface));
     vec3 dir = hit - objects[r.object].referenceRadius.xyz;
     if (dot(dir, dir) < 1e-30) dir = r.dir;
     float cube = float(r.object * u_layers + layer);

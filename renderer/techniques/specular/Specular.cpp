@@ -70,7 +70,9 @@ void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResour
       extent = std::max(extent, glm::length(corner - ref));
     }
     o.gpu.referenceRadius = glm::vec4(ref, std::max(m.bounds.radius(), 1e-6f));
-    o.gpu.extent = glm::vec4(extent * 1.01f + 1e-6f, 0.f, 0.f, 0.f);
+    // KHR_materials_volume: the object's medium, which the traced rays inside it cross (trace.glsl).
+    const glm::vec3 sigmaT = scene.material(m.material).attenuationCoefficient();
+    o.gpu.extent = glm::vec4(extent * 1.01f + 1e-6f, sigmaT);
     objectOfMesh_[i] = static_cast<int>(objects_.size());
     objects_.push_back(o);
   }

@@ -28,7 +28,8 @@ public:
   // One specular object's map data (std430 in shaders/specular/ldm.glsl, binding 3).
   struct GpuObject {
     glm::vec4 referenceRadius;  // xyz reference point, w bounding radius
-    glm::vec4 extent;           // x distance from the reference point to the farthest scene-bounds corner
+    glm::vec4 extent;           // x distance from the reference point to the farthest scene-bounds corner,
+                                // yzw the extinction sigma_t of its KHR_materials_volume medium (0: none)
   };
   static_assert(sizeof(GpuObject) == 32, "std430 SpecularObject must be 32 bytes");
 

@@ -186,6 +186,39 @@ void expectSlabTransmitsFresnelSquaredAtNormalIncidence(int primitives) {
 }
 TEST(Caustics, GlassSlabTransmitsFresnelSquaredAtNormalIncidence) { expectSlabTransmitsFresnelSquaredAtNormalIncidence(1); }
 
+// KHR_materials_volume: the same slab absorbing, white light turning into c = (0.5, 0.8, 1) over d0 =
+// 0.1. Each photon crosses the thickness t = 0.2 once at normal incidence, so the caustic under it is
+// E (1 - F)^2 a / pi with a = c^(t / d0) = (0.25, 0.64, 1) per channel (Beer-Lambert over the traced
+// length in the distance maps, shaders/caustics/photon.frag), within the clear slab's 1%.
+TEST(Caustics, AbsorbingSlabTransmitsBeerLambertTimesFresnelSquared) {
+  const float E = 2.f, t = 0.2f, d0 = 0.1f;
+  const glm::vec3 c(0.5f, 0.8f, 1.f);
+  Scene scene = slabScene(1.5f, t, 1.2f, 1.f, {0, -1, 0}, E, "caustics-slab-volume");
+  for (Material& m : scene.materials)
+    if (m.isTransmissive()) {
+      m.thicknessFactor = 1.f;
+      m.attenuationColor = c;
+      m.attenuationDistance = d0;
+    }
+  const int n = 64;
+  const float half = 1.5f;
+  RenderOutput out = renderer().render(scene, request(n));
+  const Image& caustics = findAov(out, "caustics");
+  expectFinite(caustics);
+  int in = 0;
+  for (int py = 0; py < n; ++py)
+    for (int px = 0; px < n; ++px) {
+      const glm::vec2 p = floorPoint(px, py, n, half);
+      if (std::max(std::abs(p.x), std::abs(p.y)) >= 0.5f - 0.1f) continue;
+      ++in;
+      for (int k = 0; k < 3; ++k) {
+        const double under = 0.9216 * E * std::pow(double(c[k]), t / d0) / kPi;
+        EXPECT_NEAR(caustics.at(px, py)[k], under, 0.01 * under) << px << "," << py << " channel " << k;
+      }
+    }
+  EXPECT_GT(in, 200);
+}
+
 // A generator made of several primitives (each its own specular object with its own reference point
 // and maps): the photons entering the top face are traced on through the other primitive's maps, and
 // the receivers under the slab lie behind that other primitive as seen from the top face's reference

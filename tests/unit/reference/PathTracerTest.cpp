@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <vector>
 
 #include "renderer/reference/PathTracer.h"
@@ -301,6 +302,64 @@ TEST(PathTracer, DielectricSlabTransmittanceMatchesFresnelSeries) {
     const double T = (1 - R) / (1 + R);  // 0.923 at normal incidence
     const float L = renderPoint(s, {0, 0.2f, 0}, {float(std::sin(theta)), float(std::cos(theta)), 0}, o);
     EXPECT_NEAR(L, T, 0.01 * T) << theta;
+  }
+}
+
+// KHR_materials_volume: the same slab bounding an absorbing medium. One crossing at angle theta_t
+// inside travels d / cos(theta_t), so it transmits a = c^(d / (d0 cos theta_t)) (Beer-Lambert with
+// sigma_t = -ln(c) / d0); the series becomes T = (1 - R)^2 a / (1 - R^2 a^2). Against the clear slab
+// the ratio is a (1 - R^2) / (1 - R^2 a^2): c^(d/d0) within R^2 = 0.16% at normal incidence.
+TEST(PathTracer, AbsorbingSlabTransmitsBeerLambertInsideTheFresnelSeries) {
+  const float d = 0.2f, d0 = 0.1f;
+  const glm::vec3 c(0.5f, 0.8f, 1.f);
+  Scene s;
+  s.meshes.push_back(testing::box({-50, 0, -50}, {50, d, 50}, addMaterial(s, testing::absorbingGlass(1.5f, c, d0))));
+  s.meshes.push_back(testing::square({0, -1, 0}, {0, 1, 0}, 1000.f, addMaterial(s, testing::emitter(glm::vec3(1.f)))));
+  Scene clear = s;
+  clear.materials[0].thicknessFactor = 0.f;  // the spec's thin-wall default: no medium
+  ReferenceOptions o;
+  o.spp = 20000;
+  o.maxBounces = 64;
+  for (double theta : {0.0, M_PI / 4}) {
+    const double R = fresnelUnpolarised(std::cos(theta), 1.0, 1.5);
+    const double cosT = std::sqrt(1 - std::pow(std::sin(theta) / 1.5, 2));
+    const Camera cam = pinpointCamera({0, d, 0}, {float(std::sin(theta)), float(std::cos(theta)), 0}, 0.5f);
+    const Image vol = render(s, cam, 1, 1, o), ref = render(clear, cam, 1, 1, o);
+    for (int k = 0; k < 3; ++k) {
+      const double a = std::pow(double(c[k]), d / (d0 * cosT));
+      const double T = (1 - R) * (1 - R) * a / (1 - R * R * a * a);
+      // 1%: the Fresnel branching's noise at 20000 samples, as the clear slab's test.
+      EXPECT_NEAR(vol.pixels[k], T, 0.01 * T) << "theta " << theta << " channel " << k;
+      const double ratio = double(vol.pixels[k]) / ref.pixels[k];
+      EXPECT_NEAR(ratio, a * (1 - R * R) / (1 - R * R * a * a), 0.015 * a) << "theta " << theta << " channel " << k;
+      if (theta == 0.0) EXPECT_NEAR(ratio, std::pow(double(c[k]), d / d0), 0.02 * std::pow(double(c[k]), d / d0));
+    }
+  }
+}
+
+// Extremes stay finite: an infinite or huge distance or a white colour is the clear slab, a black colour
+// or a vanishing distance is opaque (exactly 0, never NaN).
+TEST(PathTracer, VolumeExtremesAreClearOrOpaqueAndFinite) {
+  Scene s;
+  s.meshes.push_back(testing::box({-50, 0, -50}, {50, 0.2f, 50}, addMaterial(s, testing::smoothGlass(1.5f))));
+  s.meshes.push_back(testing::square({0, -1, 0}, {0, 1, 0}, 1000.f, addMaterial(s, testing::emitter(glm::vec3(1.f)))));
+  ReferenceOptions o;
+  o.spp = 4000;
+  o.maxBounces = 64;
+  const Camera cam = pinpointCamera({0, 0.2f, 0}, {0, 1, 0}, 0.5f);
+  const Image clear = render(s, cam, 1, 1, o);
+  struct Case { glm::vec3 color; float distance; bool opaque; };
+  for (const Case& k : {Case{glm::vec3(0.5f), 1e30f, false}, Case{glm::vec3(0.5f), std::numeric_limits<float>::infinity(), false},
+                        Case{glm::vec3(1.f), 1e-30f, false}, Case{glm::vec3(0.f), 1.f, true},
+                        Case{glm::vec3(0.5f), 1e-30f, true}, Case{glm::vec3(0.f), std::numeric_limits<float>::min(), true}}) {
+    Scene v = s;
+    v.materials[0] = testing::absorbingGlass(1.5f, k.color, k.distance);
+    const Image img = render(v, cam, 1, 1, o);
+    for (int c = 0; c < 3; ++c) {
+      ASSERT_TRUE(std::isfinite(img.pixels[c]));
+      if (k.opaque) EXPECT_EQ(img.pixels[c], 0.f) << k.distance;
+      else EXPECT_NEAR(img.pixels[c], clear.pixels[c], 1e-5f) << k.distance;  // same seeds, same paths
+    }
   }
 }
 

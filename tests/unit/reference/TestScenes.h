@@ -58,6 +58,16 @@ inline Material smoothGlass(float ior) {
   return m;
 }
 
+// smoothGlass bounding an absorbing medium (KHR_materials_volume): white light turns into `color`
+// after `distance` inside.
+inline Material absorbingGlass(float ior, glm::vec3 color, float distance) {
+  Material m = smoothGlass(ior);
+  m.thicknessFactor = 1.f;
+  m.attenuationColor = color;
+  m.attenuationDistance = distance;
+  return m;
+}
+
 // The BSDF of a material's factors (no textures), outside any scene.
 inline rt::GltfBsdf bsdfOf(const Material& m) {
   rt::GltfBsdf b;

@@ -2,6 +2,8 @@
 // loads with exactly the positions, normals and triangles it was encoded from.
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -170,10 +172,10 @@ TEST(GltfCompression, UnsupportedOptionalExtensionIsAWarningNotSilence) {
   GltfBuilder b;
   const int m = b.mesh(json::array({test::trianglePrimitive<std::uint8_t>(b, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {0, 1, 2})}));
   b.scene({b.node({{"mesh", m}})});
-  b.doc["extensionsUsed"] = {"KHR_materials_volume", "KHR_texture_transform"};
+  b.doc["extensionsUsed"] = {"KHR_materials_iridescence", "KHR_texture_transform"};
   const Scene s = loadSceneFromMemory(b.gltf());
   ASSERT_EQ(s.warnings.size(), 1u);
-  EXPECT_NE(s.warnings[0].find("KHR_materials_volume"), std::string::npos) << s.warnings[0];
+  EXPECT_NE(s.warnings[0].find("KHR_materials_iridescence"), std::string::npos) << s.warnings[0];
 }
 
 TEST(GltfExtensions, ClearcoatSheenAndSpecularFactorsAreReadAndClamped) {
@@ -196,6 +198,65 @@ TEST(GltfExtensions, ClearcoatSheenAndSpecularFactorsAreReadAndClamped) {
   EXPECT_EQ(x.specularColorFactor, glm::vec3(2.f, 1.f, 0.5f));  // may exceed 1 (F0 = min(F0 color, 1))
   // Supported, factors and textures (GltfLoader.LayeredExtensionTexturesAreRead...): nothing to warn of.
   EXPECT_TRUE(s.warnings.empty());
+}
+
+// KHR_materials_volume: the factors as written; sigma_t = -ln(c) / d (the spec's "Attenuation"), so
+// that exp(-sigma_t d) gives back the colour; the thin-wall default (thicknessFactor 0) has no medium.
+TEST(GltfExtensions, VolumeFactorsAreReadAndGiveTheSpecsAttenuationCoefficient) {
+  GltfBuilder b;
+  const int vol = b.material({{"extensions",
+                               {{"KHR_materials_transmission", {{"transmissionFactor", 1.0}}},
+                                {"KHR_materials_volume",
+                                 {{"thicknessFactor", 0.5}, {"attenuationDistance", 2.0}, {"attenuationColor", {0.25, 0.5, 1.0}}}}}}});
+  const int thin = b.material({{"extensions", {{"KHR_materials_volume", {{"attenuationDistance", 2.0}, {"attenuationColor", {0.25, 0.5, 1.0}}}}}}});
+  const int m = b.mesh(json::array({test::trianglePrimitive<std::uint8_t>(b, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {0, 1, 2}, {}, {}, vol),
+                                    test::trianglePrimitive<std::uint8_t>(b, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {0, 1, 2}, {}, {}, thin)}));
+  b.scene({b.node({{"mesh", m}})});
+  b.doc["extensionsUsed"] = {"KHR_materials_transmission", "KHR_materials_volume"};
+  const Scene s = loadSceneFromMemory(b.gltf());
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
+  ASSERT_EQ(s.materials.size(), 2u);
+  const Material& x = s.materials[0];
+  EXPECT_FLOAT_EQ(x.thicknessFactor, 0.5f);
+  EXPECT_FLOAT_EQ(x.attenuationDistance, 2.f);
+  EXPECT_EQ(x.attenuationColor, glm::vec3(0.25f, 0.5f, 1.f));
+  const glm::vec3 sigma = x.attenuationCoefficient();
+  EXPECT_NEAR(sigma.r, std::log(4.0) / 2.0, 1e-6);
+  EXPECT_NEAR(sigma.g, std::log(2.0) / 2.0, 1e-6);
+  EXPECT_EQ(sigma.b, 0.f);
+  EXPECT_NEAR(std::exp(-sigma.r * 2.f), 0.25f, 1e-6);
+  EXPECT_FALSE(s.materials[1].hasVolume());
+  EXPECT_EQ(s.materials[1].attenuationCoefficient(), glm::vec3(0.f));
+}
+
+// Values outside the spec's ranges render with a warning naming the field (the file is drawn, the
+// value repaired): never a NaN or infinite coefficient.
+TEST(GltfWarnings, VolumeValuesOutOfRangeAreRepairedWithAWarning) {
+  GltfBuilder b;
+  const int mat = b.material({{"extensions",
+                               {{"KHR_materials_volume",
+                                 {{"thicknessFactor", -1.0}, {"attenuationDistance", 0.0}, {"attenuationColor", {-0.5, 0.5, 3.0}}}}}}});
+  const int black = b.material({{"extensions",
+                                 {{"KHR_materials_volume",
+                                   {{"thicknessFactor", 1.0}, {"attenuationDistance", 1e-38}, {"attenuationColor", {0.0, 1.0, 0.5}}}}}}});
+  const int m = b.mesh(json::array({test::trianglePrimitive<std::uint8_t>(b, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {0, 1, 2}, {}, {}, mat),
+                                    test::trianglePrimitive<std::uint8_t>(b, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {0, 1, 2}, {}, {}, black)}));
+  b.scene({b.node({{"mesh", m}})});
+  b.doc["extensionsUsed"] = {"KHR_materials_volume"};
+  const Scene s = loadSceneFromMemory(b.gltf());
+  ASSERT_EQ(s.warnings.size(), 3u);
+  EXPECT_NE(s.warnings[0].find("/materials/0/extensions/KHR_materials_volume/thicknessFactor"), std::string::npos) << s.warnings[0];
+  EXPECT_NE(s.warnings[1].find("/materials/0/extensions/KHR_materials_volume/attenuationDistance"), std::string::npos) << s.warnings[1];
+  EXPECT_NE(s.warnings[2].find("/materials/0/extensions/KHR_materials_volume/attenuationColor"), std::string::npos) << s.warnings[2];
+  EXPECT_EQ(s.materials[0].thicknessFactor, 0.f);
+  EXPECT_EQ(s.materials[0].attenuationDistance, std::numeric_limits<float>::infinity());
+  EXPECT_EQ(s.materials[0].attenuationColor, glm::vec3(0.f, 0.5f, 1.f));
+  // Black at a vanishing distance: the largest finite coefficient, and 0 x sigma stays 0 (no NaN).
+  const glm::vec3 sigma = s.materials[1].attenuationCoefficient();
+  EXPECT_EQ(sigma.r, std::numeric_limits<float>::max());
+  EXPECT_EQ(sigma.g, 0.f);
+  EXPECT_TRUE(std::isfinite(sigma.b) && sigma.b > 0.f);
+  EXPECT_EQ(0.f * sigma.r, 0.f);
 }
 
 // glTF-Validator accepts a texture without a source (an extension may hold its only image): the file

@@ -255,6 +255,41 @@ TEST(GltfLoader, LayeredExtensionTexturesAreReadWithTheirColourSpacesAndTransfor
   for (const std::string& w : s.warnings) ADD_FAILURE() << "unexpected warning: " << w;
 }
 
+// KHR_materials_volume's thicknessTexture (green, data) comes through with its texCoord and
+// KHR_texture_transform, linear, without a warning; an index that does not exist is refused at its pointer.
+TEST(GltfLoader, VolumeThicknessTextureIsReadWithItsTransform) {
+  const std::string png = test::encodePng(1, 1, {128, 128, 255, 255});
+  GltfBuilder b;
+  b.push("images", {{"uri", "data:image/png;base64," + test::base64(png)}});
+  b.push("textures", {{"source", 0}});
+  const json transform = {{"KHR_texture_transform", {{"offset", {0.5, 0.0}}, {"scale", {2.0, 2.0}}}}};
+  const int mat = b.material({{"extensions",
+                               {{"KHR_materials_volume",
+                                 {{"thicknessFactor", 0.3}, {"thicknessTexture", {{"index", 0}, {"texCoord", 1}, {"extensions", transform}}}}}}}});
+  const int bad = b.material({{"extensions", {{"KHR_materials_volume", {{"thicknessTexture", {{"index", 4}}}}}}}});
+  const int m = b.mesh(json::array({trianglePrimitive<std::uint8_t>(b, kTri, {0, 1, 2}, {}, {{0, 1}, {1, 1}, {0, 0}}, mat)}));
+  b.scene({b.node({{"mesh", m}})});
+  b.doc["extensionsUsed"] = json::array({"KHR_materials_volume", "KHR_texture_transform"});
+  GltfBuilder good = b;
+  good.doc["materials"].erase(std::size_t(bad));
+  const Scene s = loadSceneFromMemory(good.gltf());
+  const Material& mm = s.materials[0];
+  EXPECT_FLOAT_EQ(mm.thicknessFactor, 0.3f);
+  EXPECT_EQ(mm.thicknessTexture.texture, 0);
+  EXPECT_EQ(mm.thicknessTexture.texCoord, 1);
+  const glm::vec2 moved = mm.thicknessTexture.transformUv({0.25f, 0.5f});  // (2 u + 0.5, 2 v)
+  EXPECT_FLOAT_EQ(moved.x, 1.f);
+  EXPECT_FLOAT_EQ(moved.y, 1.f);
+  EXPECT_EQ(s.textures[0].colorSpace, TextureColorSpace::Linear);
+  for (const std::string& w : s.warnings) ADD_FAILURE() << "unexpected warning: " << w;
+  try {
+    loadSceneFromMemory(b.gltf());
+    ADD_FAILURE() << "a thicknessTexture that does not exist loaded";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.pointer, "/materials/1/extensions/KHR_materials_volume/thicknessTexture/index");
+  }
+}
+
 TEST(GltfLoader, LayeredExtensionTextureThatDoesNotExistIsRefusedAtItsPointer) {
   GltfBuilder b;
   const int mat = b.material({{"extensions", {{"KHR_materials_sheen", {{"sheenColorTexture", {{"index", 3}}}}}}}});
