@@ -14,7 +14,7 @@ took 285 s on the 2-core llvmpipe machine (load average 11-13), so `all` is the 
 
 RUNS IN PARTS: `all --only caustics,specular --dir DIR2 [OLD/results.jsonl ...]` measures only those
 techniques (same seeds as a full run) and fits the table from the given earlier results files plus the new
-run's, the new run's points replacing earlier points of the same sweep point; generated.runs lists every
+run's: a technique the new run measured takes only the new run's records; generated.runs lists every
 run (its techniques, start time, duration and load average, from the run.json `all` writes next to its
 results), so a merged table says that its parts were measured at different times. The shared models
 (gbuffer, direct, shadow_maps, overhead) are fitted over all the parts' records. A fresh daemon per run:
@@ -150,6 +150,12 @@ TECHNIQUES = {
     "illumination_network": {
         "scene": "explosion",
         "passes": {"photon_gi": False},
+        # A cold frame: the network (nodes, directions, visibility) is cached by the technique's own seed, not
+        # the frame's, so each cost point gets its own (technique_seed), and warm_start is off so that a point
+        # iterates from zero radiance rather than from a previous point's converged network (which made
+        # "4 iterations" as accurate as 8 in the 07:01 run). A single frame never has a warm start anyway.
+        "fixed": {"warm_start": False},
+        "technique_seed": True,
         # A first sweep (nodes 256/1024 x directions 32/128 x iterations 8/32) gave the same RMSE at 8 and 32
         # iterations (warm start converges) and at 32 and 128 directions: the nodes buy the accuracy.
         "configs": [{"nodes": n, "directions": d, "iterations": 8} for n in (128, 256, 512, 1024, 2048) for d in (16, 32, 64)]
@@ -175,19 +181,22 @@ def selected(only):
 
 def base_request(name, t, size, seed):
     passes = dict(t["passes"])
-    passes[name] = {}
+    passes[name] = dict(t.get("fixed", {}))
     r = {"scene": {"builtin": t["scene"]}, "width": size, "height": size, "seed": seed, "passes": passes,
          "outputs": [{"format": "exr", "aovs": ["beauty"] + ([t["output_aov"]] if t["output_aov"] != "beauty" else [])}]}
     r.update(t.get("extra", {}))
     return r
 
 
-def zip_group(name, points):
-    """points: list of (config, size, seed) -> one zip group over the dotted paths."""
+def zip_group(name, points, technique_seed=False):
+    """points: list of (config, size, seed) -> one zip group over the dotted paths. technique_seed: the
+    technique's own "seed" parameter follows the frame's (its seed-keyed cache is then cold per point)."""
     group = {}
     for config, size, seed in points:
         for k, v in config.items():
             group.setdefault(f"passes.{name}.{k}", []).append(v)
+        if technique_seed:
+            group.setdefault(f"passes.{name}.seed", []).append(seed)
         group.setdefault("width", []).append(size)
         group.setdefault("height", []).append(size)
         group.setdefault("seed", []).append(seed)
@@ -213,7 +222,8 @@ def make_spec(server, out_dir, names):
                 points.append((config, size, seed))
                 seed += 1
         sweeps.append({"name": f"presets-cost-{name}", "technique": name, "base": base_request(name, t, 32, 0),
-                       "zip": [zip_group(name, points)], "repeats": 1, "warmup": t.get("warmup", 0)})
+                       "zip": [zip_group(name, points, t.get("technique_seed", False))], "repeats": 1,
+                       "warmup": t.get("warmup", 0)})
     for name, t in techniques.items():
         if t["compare"] is None:
             continue  # no ground truth: a cost model without a front (t["no_front"] says why)
@@ -401,20 +411,27 @@ def fit(records, command, runs=()):
 
 
 def read_jsonl(paths):
-    out = []
+    """The records of the results files, later files first in authority: a technique measured in a later
+    file keeps only that file's records (a re-measured technique's sweep may have other points, so its
+    earlier points must not mix in), and within one file the last record of a point wins."""
+    per_file = []
     for p in paths:
+        recs = {}
         with open(p) as f:
             for line in f:
                 line = line.strip()
                 if line:
                     try:
-                        out.append(json.loads(line))
+                        r = json.loads(line)
                     except json.JSONDecodeError:
-                        pass
-    latest = {}
-    for r in out:
-        latest[r.get("point_id", id(r))] = r
-    return list(latest.values())
+                        continue
+                    recs[r.get("point_id", id(r))] = r
+        per_file.append(list(recs.values()))
+    owner = {}  # technique -> index of the last file that measured it
+    for i, recs in enumerate(per_file):
+        for r in recs:
+            owner[r.get("technique")] = i
+    return [r for i, recs in enumerate(per_file) for r in recs if owner[r.get("technique")] == i]
 
 
 def write_table(table, path):
@@ -476,7 +493,7 @@ def main():
     ap.add_argument("--only", default=None,
                     help="all/spec: measure only these techniques (comma-separated); fit the table from this run's "
                          "results together with earlier runs' results files (see RUNS IN PARTS in the docstring)")
-    a = ap.parse_args()
+    a = ap.parse_intermixed_args()  # results files may follow the options
     command = a.command_text or "bench/presets.py " + " ".join(sys.argv[1:])
     if a.command == "markdown":  # the docs' tables of a table: bench/presets.py markdown [api/presets.json]
         with open(a.results[0] if a.results else a.output) as f:
