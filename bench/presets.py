@@ -128,6 +128,18 @@ TECHNIQUES = {
                     "caustics class is L S+ D E) and the technique has no cost knob",
         "output_aov": "light_volumes",
     },
+    # No built-in scene plans env_diffuse by default (a request names it); on ao_creases its receivers are
+    # found by the default rule. downsample stays at its default: the lights are 6 (C / downsample)^2 texels,
+    # a quotient the model's products of parameters cannot express.
+    "env_diffuse": {
+        "scene": "ao_creases",
+        "passes": {"photon_gi": False},
+        "configs": [{"cube_resolution": c} for c in (16, 32, 64, 128, 256)],
+        # the cube's faces (6 C^2), then per receiver pixel a sum over the downsampled texels.
+        "terms": [[], ["pixels"], ["cube_resolution", "cube_resolution"], ["pixels", "cube_resolution", "cube_resolution"]],
+        "compare": {"aov": "indirect_diffuse", "spp": 256},  # the reference's indirect, 1 + bounces
+        "output_aov": "indirect_diffuse",
+    },
     "spherical_billboards": {
         "scene": "explosion",
         "passes": {"photon_gi": False},

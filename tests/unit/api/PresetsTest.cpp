@@ -278,7 +278,7 @@ TEST(Presets, TheEmbeddedTableIsAGeneratedParetoFront) {
 }
 
 // Issue 19 item 6: the passes of the built-in scenes (what the planner runs on cornell_glass and
-// explosion by default, and the passes a request can name there) all have a cost model in the embedded
+// explosion by default, and the passes a request can name there or on ao_creases) all have a cost model in the embedded
 // table, so a budget charges every one of them; the techniques with a ground truth have a front; and over
 // budgets from the cheapest frame to beyond the dearest one, a larger budget never gives any technique a
 // larger predicted error, the predicted frame cost never exceeds the budget once the cheapest frame fits,
@@ -295,8 +295,9 @@ TEST(Presets, EveryPassOfTheBuiltinScenesIsChargedAndLargerBudgetsNeverRaiseAnEr
       {"explosion (default passes)", {"gbuffer", "shadow_maps", "direct", "photon_gi", "spherical_billboards"}},
       {"explosion, depth_impostors", {"gbuffer", "shadow_maps", "direct", "depth_impostors"}},
       {"explosion, illumination_network", {"gbuffer", "shadow_maps", "direct", "illumination_network"}},
+      {"ao_creases, env_diffuse", {"gbuffer", "shadow_maps", "direct", "env_diffuse"}},
   };
-  for (const char* fronted : {"caustics", "spherical_billboards", "depth_impostors", "illumination_network"})
+  for (const char* fronted : {"caustics", "spherical_billboards", "depth_impostors", "illumination_network", "env_diffuse"})
     EXPECT_TRUE(t.hasFront(fronted)) << fronted;
   for (const char* modelOnly : {"specular", "light_volumes"}) {
     EXPECT_TRUE(t.hasModel(modelOnly)) << modelOnly;
