@@ -4,20 +4,34 @@
 
     bench/presets.py all  [--server URL] [--radiant build/client/radiant] [-o api/presets.json] [--dir bench-presets]
     bench/presets.py spec [--server URL] [--dir bench-presets]      # ground truths + bench-presets/presets.spec.json
-    bench/presets.py fit  RESULTS.jsonl [...] [-o api/presets.json] [--command TEXT]
+    bench/presets.py fit  RESULTS.jsonl [...] [-o api/presets.json] [--command-text TEXT]
+    bench/presets.py markdown [api/presets.json]                    # docs/PERFORMANCE.md's tables of a table
 
 `all` = spec, then `radiant sweep DIR/presets.spec.json -o DIR/results.jsonl`, then fit. Run it against a
 radiantd on the machine the table is for (a GPU server regenerates its own table with the same command)
-with a long --request-timeout; rebuild afterwards (the table is embedded in the binary).
+with a long --request-timeout; rebuild afterwards (the table is embedded in the binary). The whole run
+took 285 s on the 2-core llvmpipe machine (load average 11-13), so `all` is the normal command.
+
+RUNS IN PARTS: `all --only caustics,specular --dir DIR2 [OLD/results.jsonl ...]` measures only those
+techniques (same seeds as a full run) and fits the table from the given earlier results files plus the new
+run's: a technique the new run measured takes only the new run's records; generated.runs lists every
+run (its techniques, start time, duration and load average, from the run.json `all` writes next to its
+results), so a merged table says that its parts were measured at different times. The shared models
+(gbuffer, direct, shadow_maps, overhead) are fitted over all the parts' records. A fresh daemon per run:
+the seed-keyed caches of an earlier run would make the same seeds' costs warm.
 
 What is measured (TECHNIQUES below; each technique on its canonical built-in scene):
   cost sweeps  every configuration at each of SIZES, one point each with its own seed, warmup 0 and
                repeats 1, so that the seed-keyed caches (photon records, reference images) are cold: the
                cost is that of a first render. Shaders are warmed first by one untimed sweep.
-  error sweeps every configuration at ERROR_SIZE, seed 0, with a compare block: photon_gi's indirect and
-               ambient_occlusion's ao against the reference renderer at 256 / 64 spp; the reference
-               itself against an uploaded ground truth (the reference at TRUTH_SPP spp, seed 99) because a
-               compare reference with the frame's own seed would share its first samples.
+  error sweeps every configuration at ERROR_SIZE (or the technique's error_size), seed 0, with a compare
+               block: each technique's AOV against the reference in the matching mode (photon_gi's
+               indirect, ambient_occlusion's ao, caustics' caustics = the light tracer's L S+ D E class, the
+               media techniques' media in the model each solves) at the compare spp in TECHNIQUES; the
+               reference itself against an uploaded ground truth (the reference at TRUTH_SPP spp, seed 99)
+               because a compare reference with the frame's own seed would share its first samples. A
+               technique whose AOV has no ground truth (specular, light_volumes: "no_front" says why) gets
+               a cost model and no front: a budget charges its cost and leaves its parameters alone.
 
 The fit (Python standard library only):
   cost model   per technique, ms = sum of coef * product(vars) (vars: "pixels" and the technique's numeric
@@ -28,8 +42,8 @@ The fit (Python standard library only):
                runs GL work asynchronously, so a pass's GPU timer also spans later passes' CPU work). Every
                other pass seen in the records gets coef + coef * pixels, and the frame's overhead
                (render_ms - the passes' cost) likewise.
-  front        per technique, the error records sorted by the model's cost at ERROR_SIZE, keeping the
-               points that lower the RMSE (the Pareto front); errors are those of ERROR_SIZE.
+  front        per technique, the error records sorted by the model's cost at the error size (ties: the
+               most accurate first), keeping the points that lower the RMSE (the Pareto front).
   presets      draft = the cheapest front point, reference = the most accurate, preview and final = the
                points nearest 1/3 and 2/3 of the way in log cost.
 """
@@ -76,12 +90,110 @@ TECHNIQUES = {
         "output_aov": "ao",
         "warmup": 1,  # compiles the shader of each sample count; AO has no seed-keyed cache
     },
+    # Issue 19 item 6: the other passes a built-in scene plans (caustics and specular on cornell_glass and
+    # cornell_mirror, spherical_billboards on explosion) or that a request names (light_volumes,
+    # depth_impostors, illumination_network). photon_gi is off in these sweeps: it is not what is timed.
+    "caustics": {
+        "scene": "cornell_glass",
+        "passes": {"photon_gi": False},
+        "configs": [{"photon_resolution": p, "cube_resolution": c} for p in (32, 64, 128, 256) for c in (64, 128, 256, 512)],
+        # caustic photons traced on the GPU (P^2 texels per light face), the distance cube (6 C^2), splats.
+        "terms": [[], ["pixels"], ["photon_resolution", "photon_resolution"], ["cube_resolution", "cube_resolution"]],
+        "compare": {"aov": "caustics", "spp": 1024},  # the light tracer's L S+ D E class
+        # At 64x64 every configuration scored 0.105-0.108 (the caustic is a few pixels wide: the error is
+        # the ground truth's noise and the kernel's bias); at 128x128 photon_resolution buys accuracy.
+        "error_size": 128,
+        "output_aov": "caustics",
+    },
+    "specular": {
+        "scene": "cornell_glass",
+        "passes": {"photon_gi": False, "caustics": False},
+        # Not linear_steps: the layered maps are cached by scene, cube_resolution and layers (not the seed), so
+        # a point that changes only the search steps reuses the previous point's maps and is not a cold cost.
+        "configs": [{"cube_resolution": c, "layers": n} for c in (64, 128, 256, 512) for n in (3, 6)],
+        # layered distance maps (6 C^2 texels per layer), then the per-pixel search.
+        "terms": [[], ["pixels"], ["cube_resolution", "cube_resolution", "layers"]],
+        "compare": None,
+        "no_front": "the reference has no ground truth for the specular AOV (docs/API.md, compare: no path-class "
+                    "filter keeps exactly E S+ D L and E S+ L, no per-pixel mask of the specular pixels)",
+        "output_aov": "specular",
+    },
+    "light_volumes": {
+        "scene": "cornell_glass",
+        "passes": {"photon_gi": False},
+        "configs": [{}, {}, {}],  # no cost knob: the beams are the scene's; three seeds per size
+        "terms": [[], ["pixels"]],
+        "compare": None,
+        "no_front": "the light_volumes AOV has no ground truth (first-order L S D E + L G D E only; the reference's "
+                    "caustics class is L S+ D E) and the technique has no cost knob",
+        "output_aov": "light_volumes",
+    },
+    # No built-in scene plans env_diffuse by default (a request names it); on ao_creases its receivers are
+    # found by the default rule. downsample stays at its default: the lights are 6 (C / downsample)^2 texels,
+    # a quotient the model's products of parameters cannot express.
+    "env_diffuse": {
+        "scene": "ao_creases",
+        "passes": {"photon_gi": False},
+        "configs": [{"cube_resolution": c} for c in (16, 32, 64, 128, 256)],
+        # the cube's faces (6 C^2), then per receiver pixel a sum over the downsampled texels.
+        "terms": [[], ["pixels"], ["cube_resolution", "cube_resolution"], ["pixels", "cube_resolution", "cube_resolution"]],
+        "compare": {"aov": "indirect_diffuse", "spp": 256},  # the reference's indirect, 1 + bounces
+        "output_aov": "indirect_diffuse",
+    },
+    "spherical_billboards": {
+        "scene": "explosion",
+        "passes": {"photon_gi": False},
+        "configs": [{"resolution_ratio": r} for r in (0.125, 0.25, 0.5, 1)],
+        "terms": [[], ["pixels"], ["pixels", "resolution_ratio", "resolution_ratio"]],
+        "compare": {"aov": "media", "spp": 64},  # single_scatter_unshadowed
+        "output_aov": "media",
+    },
+    "depth_impostors": {
+        "scene": "explosion",
+        "passes": {"photon_gi": False},
+        "configs": [{"slices": k, "slice_resolution": r, "impostor_resolution": 32} for k in (2, 4, 8, 16) for r in (64, 256)]
+                   + [{"slices": 8, "slice_resolution": 128, "impostor_resolution": i} for i in (16, 32, 64)],
+        # impostor atlas (blocks x I^2), K slices of R^2 each, then K lookups per pixel.
+        "terms": [[], ["impostor_resolution", "impostor_resolution"], ["slices", "slice_resolution", "slice_resolution"],
+                  ["pixels", "slices"]],
+        "compare": {"aov": "media", "spp": 16},  # single_scatter (shadowed): 64 spp took 174 s at 64x64 here
+        "output_aov": "media",
+    },
+    "illumination_network": {
+        "scene": "explosion",
+        "passes": {"photon_gi": False},
+        # A cold frame: the network (nodes, directions, visibility) is cached by the technique's own seed, not
+        # the frame's, so each cost point gets its own (technique_seed), and warm_start is off so that a point
+        # iterates from zero radiance rather than from a previous point's converged network (which made
+        # "4 iterations" as accurate as 8 in the 07:01 run). A single frame never has a warm start anyway.
+        "fixed": {"warm_start": False},
+        "technique_seed": True,
+        # A first sweep (nodes 256/1024 x directions 32/128 x iterations 8/32) gave the same RMSE at 8 and 32
+        # iterations (warm start converges) and at 32 and 128 directions: the nodes buy the accuracy.
+        "configs": [{"nodes": n, "directions": d, "iterations": 8} for n in (128, 256, 512, 1024, 2048) for d in (16, 32, 64)]
+                   + [{"nodes": 1024, "directions": 32, "iterations": i} for i in (2, 4)],
+        # links N x D, iterated; the splat of N nodes per pixel.
+        "terms": [[], ["pixels"], ["nodes", "directions"], ["nodes", "directions", "iterations"]],
+        "compare": {"aov": "media", "spp": 16},  # media_mode full
+        "output_aov": "media",
+    },
 }
+
+
+def selected(only):
+    """The techniques a run measures: all of TECHNIQUES, or the --only subset (in TECHNIQUES' order)."""
+    if not only:
+        return list(TECHNIQUES)
+    names = [n.strip() for n in only.split(",") if n.strip()]
+    unknown = [n for n in names if n not in TECHNIQUES]
+    if unknown:
+        raise SystemExit(f"--only: unknown technique(s) {', '.join(unknown)}; known: {', '.join(TECHNIQUES)}")
+    return [n for n in TECHNIQUES if n in names]
 
 
 def base_request(name, t, size, seed):
     passes = dict(t["passes"])
-    passes[name] = {}
+    passes[name] = dict(t.get("fixed", {}))
     # One raster sample per pixel: a request with quality or time_budget_ms and no supersampling of its
     # own runs at 1 (api/Validate.cpp), so the table is measured there (the plain default is 2).
     r = {"scene": {"builtin": t["scene"]}, "width": size, "height": size, "seed": seed, "supersampling": 1,
@@ -90,35 +202,45 @@ def base_request(name, t, size, seed):
     return r
 
 
-def zip_group(name, points):
-    """points: list of (config, size, seed) -> one zip group over the dotted paths."""
+def zip_group(name, points, technique_seed=False):
+    """points: list of (config, size, seed) -> one zip group over the dotted paths. technique_seed: the
+    technique's own "seed" parameter follows the frame's (its seed-keyed cache is then cold per point)."""
     group = {}
     for config, size, seed in points:
         for k, v in config.items():
             group.setdefault(f"passes.{name}.{k}", []).append(v)
+        if technique_seed:
+            group.setdefault(f"passes.{name}.seed", []).append(seed)
         group.setdefault("width", []).append(size)
         group.setdefault("height", []).append(size)
         group.setdefault("seed", []).append(seed)
     return group
 
 
-def make_spec(server, out_dir):
+def make_spec(server, out_dir, names):
     os.makedirs(out_dir, exist_ok=True)
     sweeps = []
+    techniques = {n: TECHNIQUES[n] for n in names}
     # Shader compilation and scene upload happen once per daemon: one untimed render per technique.
-    for name, t in TECHNIQUES.items():
+    for name, t in techniques.items():
         sweeps.append({"name": f"presets-warm-{name}", "technique": name, "base": base_request(name, t, 32, 7),
                        "repeats": 1, "warmup": 0})
     seed = 1000
-    for name, t in TECHNIQUES.items():
+    for name, t in TECHNIQUES.items():  # every technique's seeds, so that a subset run uses the same ones
+        if name not in techniques:
+            seed += len(SIZES) * len(t["configs"])
+            continue
         points = []
         for size in SIZES:
             for config in t["configs"]:
                 points.append((config, size, seed))
                 seed += 1
         sweeps.append({"name": f"presets-cost-{name}", "technique": name, "base": base_request(name, t, 32, 0),
-                       "zip": [zip_group(name, points)], "repeats": 1, "warmup": t.get("warmup", 0)})
-    for name, t in TECHNIQUES.items():
+                       "zip": [zip_group(name, points, t.get("technique_seed", False))], "repeats": 1,
+                       "warmup": t.get("warmup", 0)})
+    for name, t in techniques.items():
+        if t["compare"] is None:
+            continue  # no ground truth: a cost model without a front (t["no_front"] says why)
         compare = dict(t["compare"])
         if name == "reference":
             base = {"scene": {"builtin": t["scene"]}, "width": ERROR_SIZE, "height": ERROR_SIZE, "seed": 99,
@@ -132,9 +254,10 @@ def make_spec(server, out_dir):
                 else compare["against"]["digest"]
             print(f"ground truth: reference {TRUTH_SPP} spp at {ERROR_SIZE}x{ERROR_SIZE}, "
                   f"{time.time() - t0:.1f} s", file=sys.stderr)
-        points = [(config, ERROR_SIZE, 0) for config in t["configs"]]
+        size = t.get("error_size", ERROR_SIZE)
+        points = [(config, size, 0) for config in t["configs"]]
         sweeps.append({"name": f"presets-error-{name}", "technique": name,
-                       "base": base_request(name, t, ERROR_SIZE, 0), "zip": [zip_group(name, points)],
+                       "base": base_request(name, t, size, 0), "zip": [zip_group(name, points)],
                        "repeats": 1, "warmup": 0, "compare": compare})
     spec = os.path.join(out_dir, "presets.spec.json")
     with open(spec, "w") as f:
@@ -222,7 +345,7 @@ def predict(terms, params, pixels):
     return sum(t["coef"] * term_value(t["vars"], params, pixels) for t in terms)
 
 
-def fit(records, command):
+def fit(records, command, runs=()):
     ok = [r for r in records if "error" not in r and r.get("passes")]
     device = next((r.get("device") for r in ok if r.get("device")), {})
     table = {"generated": {
@@ -230,7 +353,9 @@ def fit(records, command):
         "command": command, "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "device": device,
         "sizes": SIZES, "error_size": ERROR_SIZE,
         "note": "cost = api::passCostMs of a cold first render (own seed); error = RMSE against the reference at "
-                "error_size on the technique's canonical built-in scene"}, "techniques": {}}
+                "error_size on the technique's canonical built-in scene; each model is fitted on that scene (its "
+                "beams, particles and triangles are constants of the model)",
+        "runs": list(runs)}, "techniques": {}}
     cost = [r for r in ok if r["sweep"].startswith("presets-cost-")]
     other_rows, overhead_rows = {}, []
     for r in cost:
@@ -255,21 +380,23 @@ def fit(records, command):
         if not rows:
             continue
         terms, resid, dropped = fit_terms(t["terms"], rows)
-        entry = {"model": {"terms": terms, "rms_residual_ms": resid, "records": len(rows), "outliers_dropped": dropped}}
+        entry = {"model": {"terms": terms, "rms_residual_ms": resid, "records": len(rows), "outliers_dropped": dropped,
+                           "scene": t["scene"]}}
         errs = [r for r in ok if r["sweep"] == f"presets-error-{name}" and r.get("metrics")]
         pts = []
         for r in errs:
             params = {k: r["request"]["passes"][name][k] for k in t["configs"][0]}
             px = r["request"]["width"] * r["request"]["height"]
             pts.append({"params": params, "error": r["metrics"]["rmse"], "predicted_ms": predict(terms, params, px)})
-        pts.sort(key=lambda q: q["predicted_ms"])
+        pts.sort(key=lambda q: (q["predicted_ms"], q["error"]))  # of equal cost, only the most accurate stays
         front = []
         for q in pts:
             if not front or q["error"] < front[-1]["error"]:
                 front.append(q)
         if front:
             entry["error"] = {"metric": "rmse", "aov": t["compare"]["aov"], "scene": t["scene"],
-                              "width": ERROR_SIZE, "height": ERROR_SIZE, "seed": 0,
+                              "width": t.get("error_size", ERROR_SIZE), "height": t.get("error_size", ERROR_SIZE),
+                              "seed": 0,
                               "against": "reference" if "spp" in t["compare"] else
                               f"the reference at {TRUTH_SPP} spp, seed 99 (uploaded)"}
             if "spp" in t["compare"]:
@@ -282,6 +409,8 @@ def fit(records, command):
                 return min(range(len(front)), key=lambda i: abs(lc[i] - target))
             entry["presets"] = {"draft": 0, "preview": nearest(1 / 3), "final": nearest(2 / 3),
                                 "reference": len(front) - 1}
+        elif t.get("no_front"):
+            entry["no_front"] = t["no_front"]
         table["techniques"][name] = entry
     for name, rows in sorted(other_rows.items()):
         if name in table["techniques"]:
@@ -296,20 +425,27 @@ def fit(records, command):
 
 
 def read_jsonl(paths):
-    out = []
+    """The records of the results files, later files first in authority: a technique measured in a later
+    file keeps only that file's records (a re-measured technique's sweep may have other points, so its
+    earlier points must not mix in), and within one file the last record of a point wins."""
+    per_file = []
     for p in paths:
+        recs = {}
         with open(p) as f:
             for line in f:
                 line = line.strip()
                 if line:
                     try:
-                        out.append(json.loads(line))
+                        r = json.loads(line)
                     except json.JSONDecodeError:
-                        pass
-    latest = {}
-    for r in out:
-        latest[r.get("point_id", id(r))] = r
-    return list(latest.values())
+                        continue
+                    recs[r.get("point_id", id(r))] = r
+        per_file.append(list(recs.values()))
+    owner = {}  # technique -> index of the last file that measured it
+    for i, recs in enumerate(per_file):
+        for r in recs:
+            owner[r.get("technique")] = i
+    return [r for i, recs in enumerate(per_file) for r in recs if owner[r.get("technique")] == i]
 
 
 def write_table(table, path):
@@ -319,28 +455,91 @@ def write_table(table, path):
     print(f"wrote {path}", file=sys.stderr)
 
 
+def fmt_model(terms):
+    out = []
+    for t in terms:
+        c = f"{t['coef']:.4g}"
+        out.append(" * ".join([c] + t["vars"]) if t["vars"] else c)
+    return " + ".join(out) or "0"
+
+
+def markdown(table):
+    """docs/PERFORMANCE.md's tables of a preset table: the cost models, then the fronts with preset names."""
+    g = table["generated"]
+    lines = [f"Table generated {g['date']} on `{g.get('device', {}).get('renderer', '?')}` "
+             f"({g.get('device', {}).get('version', '?')}); command `{g['command']}`."]
+    for run in g.get("runs", []):
+        lines.append(f"Sweep run {run['started']}: {', '.join(run['techniques'])}; {run['seconds']} s; load average "
+                     f"(1, 5, 15 min) {run['load_average_before']} before, {run['load_average_after']} after.")
+    lines += ["", "| technique | scene | model (ms) | RMS residual ms | records (outliers dropped) |", "|---|---|---|---|---|"]
+    for name, e in sorted(table["techniques"].items()):
+        m = e["model"]
+        lines.append(f"| {name} | {m.get('scene', 'any (other passes of the sweeps)')} | {fmt_model(m['terms'])} | "
+                     f"{m['rms_residual_ms']:.3g} | {m['records']} ({m['outliers_dropped']}) |")
+    o = table["overhead"]
+    lines.append(f"| frame overhead (render_ms - passes) | all | {fmt_model(o['terms'])} | {o['rms_residual_ms']:.3g} | "
+                 f"{o['records']} ({o['outliers_dropped']}) |")
+    lines += ["", "| technique (scene, AOV, against) | configuration | predicted ms | RMSE | preset |", "|---|---|---|---|---|"]
+    for name, e in sorted(table["techniques"].items()):
+        if "front" not in e:
+            continue
+        err = e["error"]
+        against = f"reference {err['spp']} spp" if "spp" in err else "uploaded truth"
+        for i, q in enumerate(e["front"]):
+            names = ", ".join(k for k in ("draft", "preview", "final", "reference") if e["presets"][k] == i)
+            lines.append(f"| {name} ({err['scene']}, {err['aov']}, {against}) | {json.dumps(q['params'], sort_keys=True)} | "
+                         f"{q['predicted_ms']:.0f} | {q['error']:.4f} | {names} |")
+    no_front = [(n, e["no_front"]) for n, e in sorted(table["techniques"].items()) if "no_front" in e]
+    if no_front:
+        lines += ["", "Cost model without a front:"] + [f"- {n}: {why}" for n, why in no_front]
+    return "\n".join(lines)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("command", choices=["all", "spec", "fit"])
+    ap.add_argument("command", choices=["all", "spec", "fit", "markdown"])
     ap.add_argument("results", nargs="*")
     ap.add_argument("--server", default=os.environ.get("RADIANT_SERVER", "http://127.0.0.1:8080"))
     ap.add_argument("--radiant", default="build/client/radiant")
     ap.add_argument("--dir", default="bench-presets")
     ap.add_argument("-o", "--output", default="api/presets.json")
     ap.add_argument("--command-text", default=None, help="recorded as generated.command")
-    a = ap.parse_args()
+    ap.add_argument("--only", default=None,
+                    help="all/spec: measure only these techniques (comma-separated); fit the table from this run's "
+                         "results together with earlier runs' results files (see RUNS IN PARTS in the docstring)")
+    a = ap.parse_intermixed_args()  # results files may follow the options
     command = a.command_text or "bench/presets.py " + " ".join(sys.argv[1:])
+    if a.command == "markdown":  # the docs' tables of a table: bench/presets.py markdown [api/presets.json]
+        with open(a.results[0] if a.results else a.output) as f:
+            print(markdown(json.load(f)))
+        return
     if a.command in ("all", "spec"):
-        spec = make_spec(a.server, a.dir)
+        names = selected(a.only)
+        t0 = time.time()
+        load0 = os.getloadavg()
+        spec = make_spec(a.server, a.dir, names)
         print(f"wrote {spec}", file=sys.stderr)
         if a.command == "spec":
             return
         results = os.path.join(a.dir, "results.jsonl")
         subprocess.run([a.radiant, "sweep", spec, "-o", results, "--server", a.server, "--quiet"], check=False)
-        a.results = [results]
+        run = {"techniques": names, "started": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime(t0)),
+               "seconds": round(time.time() - t0, 1), "load_average_before": [round(x, 2) for x in load0],
+               "load_average_after": [round(x, 2) for x in os.getloadavg()], "results": "results.jsonl"}
+        with open(os.path.join(a.dir, "run.json"), "w") as f:
+            json.dump(run, f, indent=1)
+        print(f"sweep run: {run['seconds']} s, load average {run['load_average_before']} -> "
+              f"{run['load_average_after']}", file=sys.stderr)
+        a.results = a.results + [results]  # the newest run last: its points replace earlier ones (read_jsonl)
     if not a.results:
         ap.error("fit needs the results files")
-    write_table(fit(read_jsonl(a.results), command), a.output)
+    runs = []
+    for path in a.results:  # the run.json `all` wrote next to each results file, when there is one
+        info = os.path.join(os.path.dirname(os.path.abspath(path)), "run.json")
+        if os.path.exists(info):
+            with open(info) as f:
+                runs.append(json.load(f))
+    write_table(fit(read_jsonl(a.results), command, runs), a.output)
 
 
 if __name__ == "__main__":

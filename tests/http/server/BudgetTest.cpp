@@ -220,6 +220,103 @@ TEST(Budgets, PresetsAndBudgetsStayWithinTheDaemonsCaps) {
   EXPECT_EQ(photonGiPass(d.render(body))["counters"]["photons"], cap);
 }
 
+// Issue 19 item 6: budgets on the scenes whose other passes the table now models. `base` is a frame of
+// a built-in scene; `technique` the pass whose front the budgets climb, scored by `compare` (its AOV
+// against the reference in the table's mode and spp). Budgets of 1, 1.5, 2.5, 4 and 8 times the cheapest
+// frame's predicted ms: every planned pass is charged (predicted_ms a number), a larger budget never gives
+// a larger predicted or measured error, the prediction fits the budget, and the measured frame time
+// (a fresh seed each) fits it in most runs, which the caller asserts loosely.
+struct Ladder {
+  int fits = 0, runs = 0;
+  double firstError = 0, lastError = 0;
+};
+// `errorTolerance`: how near the measured RMSE of a seed-0 frame must be to the table's error of the
+// chosen point (relative): the error sweep rendered the same frame.
+Ladder climbBudgets(RealDaemon& d, const json& base, const std::string& technique, double errorTolerance) {
+  Ladder out;
+  const json& entry = tableEntry(technique);
+  const json compare{{"aov", entry["error"]["aov"]}, {"spp", entry["error"]["spp"]}};
+  json warm = base;
+  warm["seed"] = 7;
+  d.render(warm);  // shaders compiled, scene uploaded
+  json probe = base;
+  probe["time_budget_ms"] = 1;
+  const json p = d.render(probe);
+  EXPECT_FALSE(p.contains("http_status")) << p.dump();
+  const double cheapest = p["stats"]["budget"]["predicted_ms"];
+  EXPECT_GT(cheapest, 0.0);
+  for (const auto& [name, t] : p["stats"]["budget"]["techniques"].items())
+    EXPECT_TRUE(t["predicted_ms"].is_number()) << name << " is not charged: " << t.dump();
+  double lastPredicted = 1e9, lastMeasured = 1e9, lastMs = 0;
+  for (double factor : {1.0, 1.5, 2.5, 4.0, 8.0}) {
+    const double budget = cheapest * factor * 1.0001;
+    json body = base;  // seed 0, the table's error sweep
+    body["time_budget_ms"] = budget;
+    body["compare"] = compare;
+    const json r = d.render(body);
+    EXPECT_FALSE(r.contains("http_status")) << r.dump();
+    if (r.contains("http_status")) return out;
+    const json& b = r["stats"]["budget"];
+    const double predictedMs = b["predicted_ms"], predicted = b["techniques"][technique]["predicted_error"]["value"];
+    const double measured = r["stats"]["metrics"]["rmse"];
+    EXPECT_LE(predictedMs, budget) << technique << " " << budget;
+    EXPECT_GE(predictedMs, lastMs) << technique << " " << budget;
+    EXPECT_LE(predicted, lastPredicted) << technique << " " << budget;
+    EXPECT_LE(measured, lastMeasured * 1.02) << technique << " " << budget;
+    EXPECT_NEAR(measured, predicted, errorTolerance * predicted) << technique << " " << budget;
+    if (out.runs == 0) out.firstError = measured;
+    out.lastError = measured;
+    lastPredicted = predicted, lastMeasured = measured, lastMs = predictedMs;
+    json timed = base;
+    timed["seed"] = 600 + out.runs;
+    // A technique with its own seed-keyed cache (the illumination network): its seed follows the frame's,
+    // so that the timed frame is cold like the table's cost sweep, not the error frame's network reused.
+    if (base.contains("passes") && base["passes"].contains(technique) && base["passes"][technique].contains("seed"))
+      timed["passes"][technique]["seed"] = 600 + out.runs;
+    timed["time_budget_ms"] = budget;
+    const json t = d.render(timed);
+    const double ms = t["stats"]["budget"]["measured_ms"];
+    ++out.runs;
+    out.fits += ms <= budget;
+    std::printf("%s budget %.1f ms: predicted %.1f ms, measured %.1f ms, %s %s, predicted rmse %.4f, measured %.4f\n",
+                technique.c_str(), budget, predictedMs, ms, technique.c_str(),
+                t["stats"]["budget"]["techniques"][technique]["params"].dump().c_str(), predicted, measured);
+  }
+  std::printf("%s: measured frame time within the budget in %d of %d runs\n", technique.c_str(), out.fits, out.runs);
+  ::testing::Test::RecordProperty("within_budget_" + technique, std::to_string(out.fits) + "/" + std::to_string(out.runs));
+  return out;
+}
+
+TEST(Budgets, BudgetsOnTheCausticsSceneChargeEveryPassAndMostRunsFit) {
+  ASSERT_TRUE(tableEntry("caustics").contains("front")) << "api/presets.json has no caustics front";
+  RealDaemon& d = sharedDaemon();
+  ASSERT_TRUE(d.ready()) << testing::slurp(d.dir / "stderr.log");
+  const int size = tableEntry("caustics")["error"]["width"];  // the caustics sweep's error size (128)
+  // cornell_glass with its default passes: specular, caustics and photon_gi all charged.
+  const json base{{"scene", {{"builtin", "cornell_glass"}}}, {"width", size}, {"height", size}, {"seed", 0},
+                  {"outputs", {{{"format", "exr"}, {"aovs", {"beauty", "caustics"}}}}}};
+  // The caustic triangles are deterministic: the table's error up to llvmpipe's rounding (2%).
+  const Ladder l = climbBudgets(d, base, "caustics", 0.02);
+  EXPECT_LT(l.lastError, l.firstError);  // the budgets bought caustics accuracy
+  EXPECT_GE(l.fits, 2);  // loose on purpose (a shared, loaded machine): at least 2 of the 5
+}
+
+TEST(Budgets, BudgetsOnTheMediaSceneChargeEveryPassAndMostRunsFit) {
+  ASSERT_TRUE(tableEntry("illumination_network").contains("front")) << "api/presets.json has no illumination_network front";
+  RealDaemon& d = sharedDaemon();
+  ASSERT_TRUE(d.ready()) << testing::slurp(d.dir / "stderr.log");
+  const int size = tableEntry("illumination_network")["error"]["width"];
+  // explosion with the illumination network owning the media (its multiple scattering is the dearest
+  // media pass); photon_gi off and no warm start, as in the table's sweep (a frame's first render).
+  const json base{{"scene", {{"builtin", "explosion"}}}, {"width", size}, {"height", size}, {"seed", 0},
+                  {"passes", {{"photon_gi", false}, {"illumination_network", {{"warm_start", false}, {"seed", 0}}}}},
+                  {"outputs", {{{"format", "exr"}, {"aovs", {"beauty", "media"}}}}}};
+  // Without a warm start the frame is the table's error frame: its error up to llvmpipe's rounding.
+  const Ladder l = climbBudgets(d, base, "illumination_network", 0.02);
+  EXPECT_LT(l.lastError, l.firstError);
+  EXPECT_GE(l.fits, 2);
+}
+
 double rmse(const Image& a, const Image& b) {
   double s = 0;
   for (std::size_t i = 0; i < a.pixels.size(); ++i) s += (double(a.pixels[i]) - b.pixels[i]) * (double(a.pixels[i]) - b.pixels[i]);

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 
 #include "api/Presets.h"
 #include "api/Validate.h"
@@ -274,4 +275,64 @@ TEST(Presets, TheEmbeddedTableIsAGeneratedParetoFront) {
     EXPECT_TRUE(t.hasModel(name)) << name;
   }
   EXPECT_GE(fronts, 3);  // reference, photon_gi, ambient_occlusion
+}
+
+// Issue 19 item 6: the passes of the built-in scenes (what the planner runs on cornell_glass and
+// explosion by default, and the passes a request can name there or on ao_creases) all have a cost model in the embedded
+// table, so a budget charges every one of them; the techniques with a ground truth have a front; and over
+// budgets from the cheapest frame to beyond the dearest one, a larger budget never gives any technique a
+// larger predicted error, the predicted frame cost never exceeds the budget once the cheapest frame fits,
+// and the largest budget reaches every front's most accurate point.
+TEST(Presets, EveryPassOfTheBuiltinScenesIsChargedAndLargerBudgetsNeverRaiseAnError) {
+  const PresetTable& t = PresetTable::builtin();
+  struct Frame {
+    const char* what;
+    std::vector<std::string> planned;
+  };
+  const std::vector<Frame> frames{
+      {"cornell_glass (default passes)", {"gbuffer", "shadow_maps", "direct", "specular", "caustics", "photon_gi"}},
+      {"cornell_glass + light_volumes", {"gbuffer", "shadow_maps", "direct", "specular", "caustics", "light_volumes"}},
+      {"explosion (default passes)", {"gbuffer", "shadow_maps", "direct", "photon_gi", "spherical_billboards"}},
+      {"explosion, depth_impostors", {"gbuffer", "shadow_maps", "direct", "depth_impostors"}},
+      {"explosion, illumination_network", {"gbuffer", "shadow_maps", "direct", "illumination_network"}},
+      {"ao_creases, env_diffuse", {"gbuffer", "shadow_maps", "direct", "env_diffuse"}},
+  };
+  for (const char* fronted : {"caustics", "spherical_billboards", "depth_impostors", "illumination_network", "env_diffuse"})
+    EXPECT_TRUE(t.hasFront(fronted)) << fronted;
+  for (const char* modelOnly : {"specular", "light_volumes"}) {
+    EXPECT_TRUE(t.hasModel(modelOnly)) << modelOnly;
+    EXPECT_TRUE(t.data()["techniques"][modelOnly].contains("no_front")) << modelOnly << ": say why it has no front";
+  }
+  for (const Frame& f : frames) {
+    const auto choose = [&](double budget) {
+      return chooseConfiguration(t, f.planned, request({{"width", 64}, {"height", 64}, {"time_budget_ms", budget}}));
+    };
+    const BudgetChoice cheapest = choose(1e-3), dearest = choose(8.64e7);  // the front's ends
+    for (const auto& name : f.planned)
+      EXPECT_TRUE(cheapest.stats["techniques"][name]["predicted_ms"].is_number()) << f.what << ": " << name << " not charged";
+    const double lo = cheapest.stats["predicted_ms"], hi = dearest.stats["predicted_ms"];
+    ASSERT_GT(hi, lo) << f.what << ": no front to climb";
+    std::map<std::string, double> last;
+    double lastMs = 0;
+    for (int i = 0; i <= 200; ++i) {
+      const double budget = lo * std::pow(1.1 * hi / lo, i / 200.0);
+      const BudgetChoice c = choose(budget);
+      const double ms = c.stats["predicted_ms"];
+      EXPECT_LE(ms, budget * (1 + 1e-12)) << f.what << " budget " << budget;
+      EXPECT_GE(ms, lastMs - 1e-9) << f.what << " budget " << budget;
+      lastMs = ms;
+      for (const auto& name : f.planned) {
+        const json& e = c.stats["techniques"][name]["predicted_error"];
+        if (!t.hasFront(name)) continue;
+        ASSERT_TRUE(e.is_object()) << f.what << ": " << name;
+        const double v = e["value"];
+        if (last.count(name)) {
+          EXPECT_LE(v, last[name]) << f.what << ": " << name << " at budget " << budget;
+        }
+        last[name] = v;
+      }
+    }
+    for (const auto& [name, v] : last)
+      EXPECT_DOUBLE_EQ(v, t.front(name).back()["error"].get<double>()) << f.what << ": " << name;
+  }
 }
