@@ -5,7 +5,8 @@
 //
 // The table holds, per technique:
 //   - a cost model: ms = sum of terms coef * product(vars), vars being "pixels" (width x height) and the
-//     technique's numeric parameters ("spp", "photons", "C", "samples"), fitted by least squares to
+//     technique's numeric parameters (e.g. "spp", "photons", "C", "samples", "photon_resolution",
+//     "cube_resolution", "layers", "nodes", "directions", "iterations"), fitted by least squares to
 //     the measured cost of the pass (passCostMs below);
 //   - its measured Pareto front: configurations (the swept parameters only) with their measured error
 //     against the reference, cheapest first, and the preset names' indices into it;
