@@ -41,7 +41,12 @@ public:
   struct Network;  // the cached derived data (nodes, directions, GPU network)
 
 private:
+  void reportStats(PassContext& ctx, bool build, const std::vector<double>& residuals) const;
   Network* net_ = nullptr;
+  bool march_ = true, skyExact_ = true, linearSource_ = true;
+  int marchSteps_ = 64;
+  float kernel_ = 0.f;  // the march's Gaussian width (world units)
+  std::vector<gpu::MediaParticle> particles_;  // the medium's own particles, for the march
   bool fresh_ = false, warm_ = false;
   int iterations_ = 0;
   std::vector<network::DirectionalLight> lights_;
