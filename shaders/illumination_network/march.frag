@@ -11,8 +11,12 @@
 //            + J_ms(x)   what the network adds: every node's e_p(emission) + a_p sum_d W_d(w_c) I[p,d]
 //            (camera.comp without the lights: the sun scattered twice and more, the sky scattered once
 //            and more), interpolated at x by normalised Gaussian weights of width u_kernel (Shepard).
-// a(x) is the extinction-weighted albedo of the particles over the piece. Output for the media layer's
-// premultiplied blending: (L, 1 - T), so the cleared target ends as (L, T).
+// a(x) is the extinction-weighted albedo of the particles over the piece. One draw marches the pieces
+// [u_stepBegin, u_stepEnd) and outputs (L, 1 - T) of that stretch for the media layer's premultiplied
+// blending; the pass draws the stretches back to front, so the blending composes them exactly
+// (C = L_k + T_k C). The stretches exist because llvmpipe ends every loop of a shader invocation after
+// 65535 iterations in all (gallivm's LP_MAX_TGSI_LOOP_ITERATIONS, shared between the loops): the pass
+// sizes them to stay below it (IlluminationNetwork.cpp marchStretch).
 #include "illumination_network/network.glsl"
 #include "common/particle_density.glsl"
 
@@ -28,6 +32,7 @@ uniform vec2 u_targetSize;
 uniform ivec2 u_fullSize;
 uniform int u_particleCount;
 uniform int u_steps;
+uniform int u_stepBegin, u_stepEnd;  // this draw's stretch of pieces
 uniform float u_kernel;  // Gaussian width of the node interpolation (world units)
 uniform int u_lightCount;
 uniform int u_phaseModel;
@@ -111,7 +116,7 @@ void main() {
   const float dt = (t1 - t0) / float(u_steps);
   vec3 L = vec3(0.0);
   float T = 1.0;
-  for (int s = 0; s < u_steps && T > 1e-6; ++s) {
+  for (int s = u_stepBegin; s < u_stepEnd; ++s) {
     const float a = t0 + float(s) * dt, b = a + dt;
     float dtau = 0.0;
     vec3 albedo = vec3(0.0);

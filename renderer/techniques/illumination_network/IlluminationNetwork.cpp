@@ -15,6 +15,8 @@ namespace {
 constexpr int kMaxLights = 8;
 constexpr std::size_t kMaxLinks = std::size_t(1) << 20;  // N x D: 16 MiB per radiance buffer
 constexpr std::size_t kMaxBins = std::size_t(1) << 22;   // D x M^2: 16 MiB per bin table (three of them)
+constexpr long long kLoopBudget = 60000;  // of llvmpipe's 65535 loop iterations per shader invocation
+constexpr std::size_t kSkyExactBudget = 8192;            // particles x D per march step for sky_single_scatter auto
 }  // namespace
 
 struct IlluminationNetworkPass::Network {
@@ -73,9 +75,9 @@ void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, 
   const bool fibonacci = params.get<std::string>("sampling", "fibonacci") == "fibonacci";
   const float splatScale = params.get<float>("splat_radius", 1.f);
   march_ = params.get<std::string>("final_render", "march") == "march";
+  marchFallback_ = false;
   marchSteps_ = params.get<int>("march_steps", 64);
   const float kernelScale = params.get<float>("march_kernel", 0.35f);
-  skyExact_ = march_ && params.get<std::string>("sky_single_scatter", "exact") == "exact";
   const std::string digest = view.mediaKey + "|" + std::to_string(N) + "|" + std::to_string(D) + "|" +
                              std::to_string(M) + "|" + params.subsetKey({"seed", "sampling"});
   fresh_ = false;
@@ -136,6 +138,20 @@ void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, 
   // The march reads the medium's own particles (exact extinction along the view ray and to the lights).
   particles_.clear();
   if (march_) particles_ = mediaParticles(view.media, glm::vec3(0.f), view.eye, forward, ortho, /*sort=*/false);
+  // The sky scattered once exactly costs D x particles chords per step of the march: "auto" affords it
+  // up to kSkyExactBudget of them (a few big particles, the thesis' homogeneous cloud) and leaves it to
+  // the network beyond.
+  const std::string sky = params.get<std::string>("sky_single_scatter", "auto");
+  skyExact_ = march_ && (sky == "exact" || (sky == "auto" && particles_.size() * std::size_t(D) <= kSkyExactBudget));
+  if (march_) {
+    // Loop iterations of one march.frag invocation (llvmpipe stops a shader's loops after 65535 in all):
+    // the particles met by the ray, then per piece the particles again (all of them when more than 128
+    // meet the ray), the nodes, and per light (and per sky direction) the particles towards it.
+    const long long P = static_cast<long long>(particles_.size()), L = static_cast<long long>(lights_.size());
+    const long long perPiece = 1 + P + N + L * (1 + P) + (skyExact_ ? static_cast<long long>(D) * (1 + P) : 0);
+    marchStretch_ = static_cast<int>(std::min<long long>(marchSteps_, (kLoopBudget - P - 64) / perPiece));
+    if (marchStretch_ < 1) march_ = false, skyExact_ = false, marchFallback_ = true;  // too big for one piece
+  }
 
   if (vao_.id() == 0) vao_ = gl::VertexArray("illumination_network");
   declareMediaLayer(res, view.width, view.height);
@@ -168,8 +184,12 @@ void IlluminationNetworkPass::execute(PassContext& ctx) {
   }
   gpu.setLights(lights_, transmittance_);
   if (!warm_) gpu.clearRadiance();
-  const std::vector<double> residuals = gpu.iterate(ctx.shaders, iterations_, view.ambient, linearSource_);
-  net_->stateValid = true;
+  const std::vector<double> residuals = gpu.iterate(ctx.shaders, iterations_, view.ambient, linearSource_, ctx.cancelled);
+  net_->stateValid = true;  // a partial iteration is still a valid start for the next request
+  if (static_cast<int>(residuals.size()) < iterations_)
+    throw api::ApiError(409, "cancelled", "Render cancelled",
+                        "the render was cancelled during illumination_network's iteration " +
+                            std::to_string(residuals.size() + 1) + " of " + std::to_string(iterations_));
 
   gl::Buffer& splats = res.buffer("network_splats");
   gl::Buffer& order = res.buffer("network_order");
@@ -200,7 +220,12 @@ void IlluminationNetworkPass::execute(PassContext& ctx) {
     prog.set("u_sky", &view.ambient.x, 3);
     particles.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingMediaParticles);
     splats.bindBase(GL_SHADER_STORAGE_BUFFER, 15);
-    if (!particles_.empty() && !splats_.empty()) glDrawArrays(GL_TRIANGLES, 0, 3);
+    // Stretches of marchStretch_ pieces, back to front (march.frag).
+    for (int end = marchSteps_; end > 0 && !particles_.empty() && !splats_.empty(); end -= marchStretch_) {
+      prog.set("u_stepBegin", std::max(0, end - marchStretch_));
+      prog.set("u_stepEnd", end);
+      glDrawArrays(GL_TRIANGLES, 0, 3);
+    }
     glDisable(GL_BLEND);
     res.markWritten("media");
     res.markWritten("media_transmittance");
@@ -245,6 +270,9 @@ void IlluminationNetworkPass::reportStats(PassContext& ctx, bool build, const st
   c["ignored_lights"] = ignoredLights_;
   c["splat_radius"] = net_->splatRadius;
   c["march_steps"] = march_ ? marchSteps_ : 0;  // 0: the splatted final render
+  c["sky_single_scatter_exact"] = skyExact_ ? 1 : 0;
+  c["march_stretch"] = march_ ? marchStretch_ : 0;  // pieces per draw (llvmpipe's loop limit)
+  c["march_fallback"] = marchFallback_ ? 1 : 0;     // march asked for but too big for one piece: splatted
   for (std::size_t n = 0; n < residuals.size(); ++n) {
     char name[32];
     std::snprintf(name, sizeof name, "residual_%03zu", n + 1);

@@ -44,7 +44,8 @@ private:
   void reportStats(PassContext& ctx, bool build, const std::vector<double>& residuals) const;
   Network* net_ = nullptr;
   bool march_ = true, skyExact_ = true, linearSource_ = true;
-  int marchSteps_ = 64;
+  int marchSteps_ = 64, marchStretch_ = 64;
+  bool marchFallback_ = false;
   float kernel_ = 0.f;  // the march's Gaussian width (world units)
   std::vector<gpu::MediaParticle> particles_;  // the medium's own particles, for the march
   bool fresh_ = false, warm_ = false;

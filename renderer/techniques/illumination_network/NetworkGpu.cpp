@@ -10,6 +10,7 @@ namespace radiant::network {
 namespace {
 
 constexpr int kMaxIterationsPerBatch = 256;  // the residual buffer's length
+constexpr int kCancelPollIterations = 4;     // how often iterate() asks whether the request was cancelled
 
 int phaseCode(api::PhaseModel m) {
   return m == api::PhaseModel::HenyeyGreenstein ? gpu::kPhaseHenyeyGreenstein
@@ -159,15 +160,19 @@ std::vector<double> NetworkGpu::iterate(gl::ShaderLibrary& shaders, int count, g
   transmittance_.bindBase(GL_SHADER_STORAGE_BUFFER, 13);
   residual_.bindBase(GL_SHADER_STORAGE_BUFFER, 14);
   source_.bindBase(GL_SHADER_STORAGE_BUFFER, 18);
-  for (int done = 0; done < count;) {
-    // A cancelled or timed-out request stops between batches (each batch ends in a read-back, so the
-    // GPU work queued so far is done when the check runs).
-    if (cancelled && cancelled()) break;
-    const int batch = std::min(kMaxIterationsPerBatch, count - done);
+  bool stop = false;
+  for (int done = 0; done < count && !stop;) {
+    int batch = std::min(kMaxIterationsPerBatch, count - done);
     const std::uint32_t zero = 0;
     glClearNamedBufferData(residual_.id(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     for (int n = 0; n < batch; ++n) {
+      // A cancelled or timed-out request stops within kCancelPollIterations iterations: the GPU is
+      // drained first, so the check sees the time the queued iterations really took.
+      if (cancelled && n % kCancelPollIterations == 0 && (glFinish(), cancelled())) {
+        batch = n, stop = true;
+        break;
+      }
       radiance_[current_].bindBase(GL_SHADER_STORAGE_BUFFER, 10);
       radiance_[1 - current_].bindBase(GL_SHADER_STORAGE_BUFFER, 11);
       source.use();
@@ -181,7 +186,7 @@ std::vector<double> NetworkGpu::iterate(gl::ShaderLibrary& shaders, int count, g
     }
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     std::vector<std::uint32_t> bits(static_cast<std::size_t>(batch));
-    residual_.download(bits.data(), bits.size() * sizeof(std::uint32_t));
+    if (batch > 0) residual_.download(bits.data(), bits.size() * sizeof(std::uint32_t));
     for (std::uint32_t b : bits) {
       float f;
       std::memcpy(&f, &b, sizeof f);

@@ -138,5 +138,33 @@ TEST_F(NetworkGpuTest, GpuFurnaceRisesMonotonicallyToTheSky) {
   EXPECT_LE(drop, 1e-6);  // monotone up to rounding
 }
 
+// A cancelled request stops the iteration (the pass then answers 409): iterate() asks every 4
+// iterations, so a request cancelled at the third question has run exactly 8 iterations, and the state
+// is those 8 iterations' (a valid warm start).
+TEST_F(NetworkGpuTest, CancelledIterationStopsAtTheNextPoll) {
+  api::ParticleSystem s;
+  s.kind = api::MediumKind::Cloud;
+  api::Particle p;
+  p.radius = 1.f, p.tau = 4.f, p.albedo = glm::vec3(0.9f);
+  s.particles = {p};
+  const rt::ParticleMedium medium({s});
+  const NodeSet ns = sampleNodes(medium, 200, 1);
+  const auto dirs = makeDirections(16, true, 1);
+  NetworkGpu gpu(ns, dirs, phaseWeights(dirs, ns.phase, ns.g), 6, 1);
+  gpu.buildVisibility(library_);
+  gpu.setLights({}, {});
+  int asked = 0;
+  const std::vector<double> r = gpu.iterate(library_, 1000, glm::vec3(1.f), true, [&] { return ++asked == 3; });
+  EXPECT_EQ(asked, 3);
+  ASSERT_EQ(r.size(), 8u);
+  const std::vector<glm::dvec3> cancelled = gpu.downloadRadiance();
+  gpu.clearRadiance();
+  gpu.iterate(library_, 8, glm::vec3(1.f), true);
+  const std::vector<glm::dvec3> eight = gpu.downloadRadiance();
+  double diff = 0;
+  for (std::size_t k = 0; k < eight.size(); ++k) diff = std::max(diff, glm::length(eight[k] - cancelled[k]));
+  EXPECT_EQ(diff, 0.0);
+}
+
 }  // namespace
 }  // namespace radiant::network
