@@ -39,7 +39,9 @@ void main() {
     if (u_excludeSky == 1) S -= P * u_sky * skyTransmittance[p * u_directions + d];
     sum += P;
   }
-  vec3 J = nodes[p].emission.rgb + nodes[p].albedo.rgb * (sum > 0.0 ? S / sum : vec3(0.0));
+  // Without the sky scattered once, S is non-negative only once every chain has been iterated (I >= sky
+  // T0 from then on); a cold request with fewer iterations than the longest chain may dip below.
+  vec3 J = nodes[p].emission.rgb + nodes[p].albedo.rgb * (sum > 0.0 ? max(S / sum, vec3(0.0)) : vec3(0.0));
   for (int l = 0; l < (u_includeLights == 1 ? u_lightCount : 0); ++l)
     J += nodes[p].albedo.rgb * phaseValue(u_phaseModel, u_phaseG, dot(lights[l].direction.xyz, w)) *
          lights[l].irradiance.rgb * transmittance[p * u_lightCount + l];
