@@ -79,7 +79,7 @@ void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, 
   marchSteps_ = params.get<int>("march_steps", 64);
   const float kernelScale = params.get<float>("march_kernel", 0.35f);
   const std::string digest = view.mediaKey + "|" + std::to_string(N) + "|" + std::to_string(D) + "|" +
-                             std::to_string(M) + "|" + params.subsetKey({"seed", "sampling"});
+                             std::to_string(M) + "|" + params.subsetKey({"seed", "sampling", "link_opacity"});
   fresh_ = false;
   net_ = &res.cached<Network>("illumination_network", digest, [&] {
     auto n = std::make_unique<Network>();
@@ -93,6 +93,7 @@ void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, 
   });
   iterations_ = params.get<int>("iterations", 32);
   linearSource_ = params.get<std::string>("link_source", "linear") == "linear";
+  exactLinks_ = params.get<std::string>("link_opacity", "medium") == "medium";
   warm_ = params.get<bool>("warm_start", true) && net_->stateValid;
 
   // Directional lights (the network's lights) and their transmittance to every node, recomputed per
@@ -168,7 +169,11 @@ void IlluminationNetworkPass::execute(PassContext& ctx) {
   if (build) {
     gpu.buildVisibility(ctx.shaders);
     // Link statistics, once per network.
-    const network::Visibility V = gpu.downloadVisibility();
+    network::Visibility V = gpu.downloadVisibility();
+    if (exactLinks_) {
+      V.alpha = network::exactLinkOpacity(net_->nodes, net_->dirs, V, *net_->medium);
+      gpu.uploadAlpha(V.alpha);
+    }
     net_->occupancy = V.occupancy();
     net_->longestChain = V.longestChain();
     double q = 0.0;

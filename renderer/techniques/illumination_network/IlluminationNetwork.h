@@ -45,7 +45,7 @@ public:
 private:
   void reportStats(PassContext& ctx, bool build, const std::vector<double>& residuals) const;
   Network* net_ = nullptr;
-  bool march_ = true, skyExact_ = true, linearSource_ = true;
+  bool march_ = true, skyExact_ = true, linearSource_ = true, exactLinks_ = false;
   int marchSteps_ = 64, marchStretch_ = 64;
   bool marchFallback_ = false;
   float kernel_ = 0.f;  // the march's Gaussian width (world units)

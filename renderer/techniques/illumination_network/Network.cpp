@@ -210,6 +210,22 @@ Visibility buildVisibility(const NodeSet& ns, const std::vector<Direction>& dirs
   return v;
 }
 
+std::vector<float> exactLinkOpacity(const NodeSet& ns, const std::vector<Direction>& dirs, const Visibility& V,
+                                    const rt::ParticleMedium& medium) {
+  const std::size_t D = dirs.size();
+  std::vector<float> alpha(V.alpha.size());
+  for (std::size_t at = 0; at < alpha.size(); ++at) {
+    const Direction& d = dirs[at % D];
+    const glm::vec3 x = ns.nodes[at / D].position;
+    const int q = V.upstream[at];
+    const float length = q >= 0 ? depthAlong(d, ns.center, x) - depthAlong(d, ns.center, ns.nodes[std::size_t(q)].position)
+                                : boundaryDistance(d, ns.center, ns.radius, x);
+    alpha[at] = length > 0.f ? static_cast<float>(1.0 - std::exp(-medium.opticalDepth(x - length * d.w, d.w, 0.f, length)))
+                             : 0.f;
+  }
+  return alpha;
+}
+
 std::vector<float> skyTransmittance(const Visibility& V) {
   const std::size_t D = static_cast<std::size_t>(V.directions);
   std::vector<float> T(V.upstream.size(), -1.f);

@@ -90,6 +90,13 @@ struct Visibility {
 // (depth, index) below p's).
 Visibility buildVisibility(const NodeSet& nodes, const std::vector<Direction>& dirs, int window);
 
+// The link opacities from the medium itself: alpha = 1 - exp(-optical depth of the medium along w_i over
+// the link's length before p) (the boundary link: from the bounding sphere), instead of the nodes' mean
+// extinction times the length. The same for a homogeneous medium; in a lumpy one the nodes, sampled in
+// proportion to the extinction, sit in denser spots than the mean and make the links too opaque.
+std::vector<float> exactLinkOpacity(const NodeSet& nodes, const std::vector<Direction>& dirs, const Visibility& V,
+                                    const rt::ParticleMedium& medium);
+
 // T0[p * D + i]: the transmittance of the unscattered sky along p's chain in direction i, the product
 // of (1 - alpha) over the links up to and including the boundary link: the fixed point of the iteration
 // with every source and albedo 0 and sky 1. I - sky T0 is the radiance scattered at least once.

@@ -68,6 +68,10 @@ void NetworkGpu::bindCommon(const gl::Program& p) const {
   p.set("u_radius", radius_);
 }
 
+void NetworkGpu::uploadAlpha(const std::vector<float>& alpha) {
+  alpha_.upload(alpha.data(), alpha.size() * sizeof(float));
+}
+
 void NetworkGpu::setSkyTransmittance(const std::vector<float>& T0) {
   skyTransmittance_ = gl::Buffer("network sky transmittance", T0.size() * sizeof(float), T0.data(), 0);
 }

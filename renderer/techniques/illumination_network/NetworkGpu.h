@@ -30,6 +30,8 @@ public:
   void buildVisibility(gl::ShaderLibrary& shaders);
   bool visibilityBuilt() const { return built_; }
   Visibility downloadVisibility() const;
+  // Replaces the link opacities (exactLinkOpacity).
+  void uploadAlpha(const std::vector<float>& alpha);
 
   // This frame's directional lights and their transmittance T[p * L + l] (lightTransmittance).
   void setLights(const std::vector<DirectionalLight>& lights, const std::vector<double>& transmittance);
