@@ -426,6 +426,7 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
       gl::DebugGroup group(t->info().name);
       PassContext ctx{scene, gpu, view, params[i], im.resources, im.shaders, stats.passes[i]};
       ctx.progress = [&, i](double f) { report(0.95 * (static_cast<double>(i) + std::clamp(f, 0.0, 1.0)) / passCount); };
+      ctx.cancelled = [cancel] { return cancel && cancel->load(); };
       im.resources.beginPass(t->info().name, declaredAccess(t->info()), FrameResources::Phase::Execute);
       {
         GpuProfiler::Scope scope(im.profiler, stats.passes[i]);

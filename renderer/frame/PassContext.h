@@ -21,6 +21,9 @@ struct PassContext {
   api::PassStats& stats;
   // The pass's own progress in [0, 1] (optional to call; thread-safe; the Renderer maps it onto the frame).
   std::function<void(double)> progress = [](double) {};
+  // Whether the request has been cancelled or has timed out (the Renderer polls it between passes; a
+  // long pass may poll it inside and stop early, e.g. illumination_network between iteration batches).
+  std::function<bool()> cancelled = [] { return false; };
 };
 
 }  // namespace radiant

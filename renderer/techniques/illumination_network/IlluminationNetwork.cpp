@@ -15,6 +15,8 @@ namespace {
 constexpr int kMaxLights = 8;
 constexpr std::size_t kMaxLinks = std::size_t(1) << 20;  // N x D: 16 MiB per radiance buffer
 constexpr std::size_t kMaxBins = std::size_t(1) << 22;   // D x M^2: 16 MiB per bin table (three of them)
+constexpr long long kLoopBudget = 60000;  // of llvmpipe's 65535 loop iterations per shader invocation
+constexpr std::size_t kSkyExactBudget = 8192;            // particles x D per march step for sky_single_scatter auto
 }  // namespace
 
 struct IlluminationNetworkPass::Network {
@@ -72,8 +74,12 @@ void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, 
   const auto seed = params.get<std::uint64_t>("seed", 0);
   const bool fibonacci = params.get<std::string>("sampling", "fibonacci") == "fibonacci";
   const float splatScale = params.get<float>("splat_radius", 1.f);
+  march_ = params.get<std::string>("final_render", "march") == "march";
+  marchFallback_ = false;
+  marchSteps_ = params.get<int>("march_steps", 64);
+  const float kernelScale = params.get<float>("march_kernel", 0.35f);
   const std::string digest = view.mediaKey + "|" + std::to_string(N) + "|" + std::to_string(D) + "|" +
-                             std::to_string(M) + "|" + params.subsetKey({"seed", "sampling"});
+                             std::to_string(M) + "|" + params.subsetKey({"seed", "sampling", "link_opacity"});
   fresh_ = false;
   net_ = &res.cached<Network>("illumination_network", digest, [&] {
     auto n = std::make_unique<Network>();
@@ -86,6 +92,8 @@ void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, 
     return n;
   });
   iterations_ = params.get<int>("iterations", 32);
+  linearSource_ = params.get<std::string>("link_source", "linear") == "linear";
+  exactLinks_ = params.get<std::string>("link_opacity", "medium") == "medium";
   warm_ = params.get<bool>("warm_start", true) && net_->stateValid;
 
   // Directional lights (the network's lights) and their transmittance to every node, recomputed per
@@ -114,6 +122,7 @@ void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, 
   const double m = net_->nodes.mass / double(std::max<std::size_t>(1, nodes.size()));
   const float tauSplat = r > 0.0 ? static_cast<float>(3.0 * m / (3.14159265358979 * r * r * r)) : 0.f;
   net_->splatRadius = r;
+  kernel_ = kernelScale * static_cast<float>(r / splatScale);
   const glm::vec3 forward = -glm::normalize(glm::vec3(view.camera.world[2]));
   const bool ortho = view.camera.projection == ProjectionType::Orthographic;
   std::vector<float> key(nodes.size());
@@ -127,8 +136,27 @@ void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, 
     splats_[s] = {glm::vec4(nodes[std::size_t(order_[s])].position, static_cast<float>(r)), glm::vec4(0.f, 0.f, 0.f, tauSplat),
                   glm::vec4(0.f), glm::ivec4(gpu::kProfileLinearExact, gpu::kPhaseIsotropic, 0, 0)};
 
+  // The march reads the medium's own particles (exact extinction along the view ray and to the lights).
+  particles_.clear();
+  if (march_) particles_ = mediaParticles(view.media, glm::vec3(0.f), view.eye, forward, ortho, /*sort=*/false);
+  // The sky scattered once exactly costs D x particles chords per step of the march: "auto" affords it
+  // up to kSkyExactBudget of them (a few big particles, the thesis' homogeneous cloud) and leaves it to
+  // the network beyond.
+  const std::string sky = params.get<std::string>("sky_single_scatter", "auto");
+  skyExact_ = march_ && (sky == "exact" || (sky == "auto" && particles_.size() * std::size_t(D) <= kSkyExactBudget));
+  if (march_) {
+    // Loop iterations of one march.frag invocation (llvmpipe stops a shader's loops after 65535 in all):
+    // the particles met by the ray, then per piece the particles again (all of them when more than 128
+    // meet the ray), the nodes, and per light (and per sky direction) the particles towards it.
+    const long long P = static_cast<long long>(particles_.size()), L = static_cast<long long>(lights_.size());
+    const long long perPiece = 1 + P + N + L * (1 + P) + (skyExact_ ? static_cast<long long>(D) * (1 + P) : 0);
+    marchStretch_ = static_cast<int>(std::min<long long>(marchSteps_, (kLoopBudget - P - 64) / perPiece));
+    if (marchStretch_ < 1) march_ = false, skyExact_ = false, marchFallback_ = true;  // too big for one piece
+  }
+
   if (vao_.id() == 0) vao_ = gl::VertexArray("illumination_network");
   declareMediaLayer(res, view.width, view.height);
+  res.buffer("network_particles", std::max<std::size_t>(1, particles_.size()) * sizeof(gpu::MediaParticle));
   res.buffer("network_splats", std::max<std::size_t>(1, splats_.size()) * sizeof(gpu::MediaParticle));
   res.buffer("network_order", std::max<std::size_t>(1, order_.size()) * sizeof(int));
 }
@@ -141,7 +169,11 @@ void IlluminationNetworkPass::execute(PassContext& ctx) {
   if (build) {
     gpu.buildVisibility(ctx.shaders);
     // Link statistics, once per network.
-    const network::Visibility V = gpu.downloadVisibility();
+    network::Visibility V = gpu.downloadVisibility();
+    if (exactLinks_) {
+      V.alpha = network::exactLinkOpacity(net_->nodes, net_->dirs, V, *net_->medium);
+      gpu.uploadAlpha(V.alpha);
+    }
     net_->occupancy = V.occupancy();
     net_->longestChain = V.longestChain();
     double q = 0.0;
@@ -153,11 +185,16 @@ void IlluminationNetworkPass::execute(PassContext& ctx) {
         q = std::max(q, 1.0 - double(V.alpha[at]) * (1.0 - double(std::max(a.x, std::max(a.y, a.z)))));
       }
     net_->contraction = q;
+    gpu.setSkyTransmittance(network::skyTransmittance(V));
   }
   gpu.setLights(lights_, transmittance_);
   if (!warm_) gpu.clearRadiance();
-  const std::vector<double> residuals = gpu.iterate(ctx.shaders, iterations_, view.ambient);
-  net_->stateValid = true;
+  const std::vector<double> residuals = gpu.iterate(ctx.shaders, iterations_, view.ambient, linearSource_, ctx.cancelled);
+  net_->stateValid = true;  // a partial iteration is still a valid start for the next request
+  if (static_cast<int>(residuals.size()) < iterations_)
+    throw api::ApiError(409, "cancelled", "Render cancelled",
+                        "the render was cancelled during illumination_network's iteration " +
+                            std::to_string(residuals.size() + 1) + " of " + std::to_string(iterations_));
 
   gl::Buffer& splats = res.buffer("network_splats");
   gl::Buffer& order = res.buffer("network_order");
@@ -167,13 +204,42 @@ void IlluminationNetworkPass::execute(PassContext& ctx) {
   }
   const glm::vec3 toCamera = glm::normalize(glm::vec3(view.camera.world[2]));
   gpu.cameraSources(ctx.shaders, order, splats, view.camera.projection == ProjectionType::Orthographic, view.eye,
-                    toCamera);
+                    toCamera, /*includeLights=*/!march_, /*excludeSky=*/skyExact_, view.ambient);
 
-  // The splats as spherical billboards (exact chords, no lights: the source is the network's).
   const bool hasDepth = res.hasTexture("gbuffer_position") && res.written("gbuffer_position");
   vao_.bind();
   beginMediaLayer(res.framebuffer("media"), view.width, view.height);
   if (hasDepth) res.texture("gbuffer_position").bindUnit(0);
+  if (march_) {
+    // The view ray marched through the medium's exact extinction, the lights scattered once exactly,
+    // the network's J_ms interpolated from the nodes (march.frag).
+    gl::Buffer& particles = res.buffer("network_particles");
+    if (!particles_.empty()) particles.upload(particles_.data(), particles_.size() * sizeof(gpu::MediaParticle));
+    const gl::Program& prog = ctx.shaders.program({"common/fullscreen.vert", "illumination_network/march.frag"});
+    gpu.bindForRender(prog);
+    setMediaCameraUniforms(prog, view, hasDepth, view.width, view.height);
+    prog.set("u_particleCount", static_cast<int>(particles_.size()));
+    prog.set("u_steps", marchSteps_);
+    prog.set("u_kernel", kernel_);
+    prog.set("u_skyExact", skyExact_ ? 1 : 0);
+    prog.set("u_sky", &view.ambient.x, 3);
+    particles.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingMediaParticles);
+    splats.bindBase(GL_SHADER_STORAGE_BUFFER, 15);
+    // Stretches of marchStretch_ pieces, back to front (march.frag).
+    for (int end = marchSteps_; end > 0 && !particles_.empty() && !splats_.empty(); end -= marchStretch_) {
+      prog.set("u_stepBegin", std::max(0, end - marchStretch_));
+      prog.set("u_stepEnd", end);
+      glDrawArrays(GL_TRIANGLES, 0, 3);
+    }
+    glDisable(GL_BLEND);
+    res.markWritten("media");
+    res.markWritten("media_transmittance");
+    composeMediaIntoBeauty(ctx);
+    reportStats(ctx, build, residuals);
+    return;
+  }
+
+  // The splats as spherical billboards (exact chords, no lights: the source is the network's).
   splats.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingMediaParticles);
   ctx.gpu.lights.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingLights);
   const gl::Program& prog = ctx.shaders.program({"spherical_billboards/particle.vert", "spherical_billboards/particle.frag"});
@@ -190,7 +256,11 @@ void IlluminationNetworkPass::execute(PassContext& ctx) {
 
   // The planner runs this exclusive pass only when it owns the media light path.
   composeMediaIntoBeauty(ctx);
+  reportStats(ctx, build, residuals);
+}
 
+void IlluminationNetworkPass::reportStats(PassContext& ctx, bool build, const std::vector<double>& residuals) const {
+  const network::NetworkGpu& gpu = *net_->gpu;
   auto& c = ctx.stats.counters;
   c["nodes"] = gpu.nodes();
   c["directions"] = gpu.directions();
@@ -204,6 +274,10 @@ void IlluminationNetworkPass::execute(PassContext& ctx) {
   c["directional_lights"] = static_cast<double>(lights_.size());
   c["ignored_lights"] = ignoredLights_;
   c["splat_radius"] = net_->splatRadius;
+  c["march_steps"] = march_ ? marchSteps_ : 0;  // 0: the splatted final render
+  c["sky_single_scatter_exact"] = skyExact_ ? 1 : 0;
+  c["march_stretch"] = march_ ? marchStretch_ : 0;  // pieces per draw (llvmpipe's loop limit)
+  c["march_fallback"] = marchFallback_ ? 1 : 0;     // march asked for but too big for one piece: splatted
   for (std::size_t n = 0; n < residuals.size(); ++n) {
     char name[32];
     std::snprintf(name, sizeof name, "residual_%03zu", n + 1);

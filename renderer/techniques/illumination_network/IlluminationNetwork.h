@@ -5,9 +5,11 @@
 // network V (N x D: upstream node and link opacity) is built on the GPU by per-direction binning in
 // an M x M window and cached with the nodes by medium digest and the parameters that shape it; each
 // request iterates eq. 9.1 `iterations` times, warm-started from the cached radiance (so when only
-// the lights move the previous solution is the start, §9.2). The final image splats every node as a
-// spherical billboard (the spherical_billboards shaders, exact chords) carrying its share of the
-// medium's optical mass and the radiance it sends towards the camera.
+// the lights move the previous solution is the start, §9.2). The final image (final_render) marches
+// each pixel's ray through the medium's own particles with the lights (and, when affordable, the sky)
+// scattered once exactly and the rest interpolated from the nodes (march.frag), or splats every node
+// as a spherical billboard carrying its share of the optical mass (the thesis; the spherical_billboards
+// shaders).
 //
 // Writes the `media` AOV (premultiplied radiance, transmittance in media_transmittance) and, when it
 // owns the "media" light path, composes beauty = beauty * T + media. Ground truth: the volumetric
@@ -41,7 +43,13 @@ public:
   struct Network;  // the cached derived data (nodes, directions, GPU network)
 
 private:
+  void reportStats(PassContext& ctx, bool build, const std::vector<double>& residuals) const;
   Network* net_ = nullptr;
+  bool march_ = true, skyExact_ = true, linearSource_ = true, exactLinks_ = false;
+  int marchSteps_ = 64, marchStretch_ = 64;
+  bool marchFallback_ = false;
+  float kernel_ = 0.f;  // the march's Gaussian width (world units)
+  std::vector<gpu::MediaParticle> particles_;  // the medium's own particles, for the march
   bool fresh_ = false, warm_ = false;
   int iterations_ = 0;
   std::vector<network::DirectionalLight> lights_;

@@ -210,6 +210,43 @@ Visibility buildVisibility(const NodeSet& ns, const std::vector<Direction>& dirs
   return v;
 }
 
+std::vector<float> exactLinkOpacity(const NodeSet& ns, const std::vector<Direction>& dirs, const Visibility& V,
+                                    const rt::ParticleMedium& medium) {
+  const std::size_t D = dirs.size();
+  std::vector<float> alpha(V.alpha.size());
+  for (std::size_t at = 0; at < alpha.size(); ++at) {
+    const Direction& d = dirs[at % D];
+    const glm::vec3 x = ns.nodes[at / D].position;
+    const int q = V.upstream[at];
+    const float length = q >= 0 ? depthAlong(d, ns.center, x) - depthAlong(d, ns.center, ns.nodes[std::size_t(q)].position)
+                                : boundaryDistance(d, ns.center, ns.radius, x);
+    alpha[at] = length > 0.f ? static_cast<float>(1.0 - std::exp(-medium.opticalDepth(x - length * d.w, d.w, 0.f, length)))
+                             : 0.f;
+  }
+  return alpha;
+}
+
+std::vector<float> skyTransmittance(const Visibility& V) {
+  const std::size_t D = static_cast<std::size_t>(V.directions);
+  std::vector<float> T(V.upstream.size(), -1.f);
+  std::vector<std::size_t> chain;
+  for (std::size_t at = 0; at < T.size(); ++at) {
+    // Walk up to the first link already known (or the boundary), then multiply back down.
+    chain.clear();
+    for (std::size_t k = at; T[k] < 0.f;) {
+      chain.push_back(k);
+      const int q = V.upstream[k];
+      if (q < 0) break;
+      k = std::size_t(q) * D + at % D;
+    }
+    for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+      const int q = V.upstream[*it];
+      T[*it] = (1.f - V.alpha[*it]) * (q < 0 ? 1.f : T[std::size_t(q) * D + at % D]);
+    }
+  }
+  return T;
+}
+
 std::vector<double> lightTransmittance(const NodeSet& ns, const std::vector<DirectionalLight>& lights, int window) {
   const std::size_t N = ns.nodes.size(), L = lights.size();
   std::vector<double> T(N * L, 1.0);
@@ -245,23 +282,36 @@ glm::dvec3 nodeSource(const Problem& pb, int p, glm::vec3 w) {
   return e;
 }
 
+double linearSourceWeight(double alpha) {
+  if (!(alpha < 1.0)) return 1.0;
+  const double u = -std::log1p(-alpha);
+  return u > 1e-6 ? 1.0 - alpha / u : 0.5 * u;
+}
+
 double iterate(const Problem& pb, const std::vector<glm::dvec3>& in, std::vector<glm::dvec3>& out) {
   const Visibility& V = *pb.visibility;
   const int N = V.nodes, D = V.directions;
   const std::vector<float>& W = *pb.weights;
   out.resize(in.size());
+  // Every node's source towards every direction: e_p(w_i) + a_p sum_d W[d,i] I[p,d].
+  std::vector<glm::dvec3> src(in.size());
+  for (int p = 0; p < N; ++p)
+    for (int i = 0; i < D; ++i) {
+      glm::dvec3 S(0.0);
+      for (int d = 0; d < D; ++d) S += double(W[std::size_t(d) * D + i]) * in[std::size_t(p) * D + d];
+      src[std::size_t(p) * D + i] =
+          nodeSource(pb, p, (*pb.dirs)[std::size_t(i)].w) + glm::dvec3(pb.nodes->nodes[std::size_t(p)].albedo) * S;
+    }
   double residual = 0.0;
   for (int p = 0; p < N; ++p)
     for (int i = 0; i < D; ++i) {
       const std::size_t at = std::size_t(p) * D + i;
       const int up = V.upstream[at];
-      const int q = up >= 0 ? up : p;
       const double alpha = V.alpha[at];
-      glm::dvec3 S(0.0);
-      for (int d = 0; d < D; ++d) S += double(W[std::size_t(d) * D + i]) * in[std::size_t(q) * D + d];
-      const glm::dvec3 upstreamI = up >= 0 ? in[std::size_t(q) * D + i] : pb.sky;
-      const glm::dvec3 src = nodeSource(pb, q, (*pb.dirs)[std::size_t(i)].w) + glm::dvec3(pb.nodes->nodes[q].albedo) * S;
-      out[at] = (1.0 - alpha) * upstreamI + alpha * src;
+      const glm::dvec3 upstreamI = up >= 0 ? in[std::size_t(up) * D + i] : pb.sky;
+      const glm::dvec3 Sq = src[up >= 0 ? std::size_t(up) * D + i : at];
+      out[at] = (1.0 - alpha) * upstreamI + alpha * Sq;
+      if (pb.linearSource) out[at] += linearSourceWeight(alpha) * (src[at] - Sq);
       const glm::dvec3 diff = glm::abs(out[at] - in[at]);
       residual = std::max(residual, std::max(diff.x, std::max(diff.y, diff.z)));
     }

@@ -15,6 +15,7 @@
 //
 // The iteration (eq. 9.1 in the array form of §9.1.2, with the per-link opacity):
 //   I'[p,i] = (1 - alpha) I[q,i] + alpha (e_q(w_i) + a_q S[q,i]),   S[q,i] = sum_d W[d,i] I[q,d],
+// or, with Problem::linearSource, the link's source taken linear between q's and p's (see there),
 // where W[d,i] = P(w_d . w_i) / sum_d' P(w_d' . w_i) (each column normalised, so a uniform field
 // scatters into itself exactly: the furnace), e_q = emission (1 - a) L_e + the single-scattered
 // directional lights a P(w_l . w_i) E_l T_l(q) at their exact directions (T_l from the network's
@@ -89,6 +90,18 @@ struct Visibility {
 // (depth, index) below p's).
 Visibility buildVisibility(const NodeSet& nodes, const std::vector<Direction>& dirs, int window);
 
+// The link opacities from the medium itself: alpha = 1 - exp(-optical depth of the medium along w_i over
+// the link's length before p) (the boundary link: from the bounding sphere), instead of the nodes' mean
+// extinction times the length. The same for a homogeneous medium; in a lumpy one the nodes, sampled in
+// proportion to the extinction, sit in denser spots than the mean and make the links too opaque.
+std::vector<float> exactLinkOpacity(const NodeSet& nodes, const std::vector<Direction>& dirs, const Visibility& V,
+                                    const rt::ParticleMedium& medium);
+
+// T0[p * D + i]: the transmittance of the unscattered sky along p's chain in direction i, the product
+// of (1 - alpha) over the links up to and including the boundary link: the fixed point of the iteration
+// with every source and albedo 0 and sky 1. I - sky T0 is the radiance scattered at least once.
+std::vector<float> skyTransmittance(const Visibility& V);
+
 struct DirectionalLight {
   glm::vec3 w;         // propagation direction (unit)
   glm::vec3 irradiance;
@@ -110,7 +123,18 @@ struct Problem {
   std::vector<DirectionalLight> lights;
   std::vector<double> transmittance;  // lightTransmittance
   glm::dvec3 sky{0.0};
+  // The source along a link: false = the upstream node's, constant over the link (Algorithm 7, eq. 9.1);
+  // true = linear from q's to p's, integrated exactly: I' = (1 - alpha) I_q + alpha S_q + (S_p - S_q)
+  // linearSourceWeight(alpha). Every coefficient stays in [0, 1] and a row still sums
+  // to 1 - alpha (1 - a) for a uniform albedo, so the furnace, the pure absorber and the contraction
+  // factor are unchanged; the scheme is second order along the link instead of first.
+  bool linearSource = false;
 };
+
+// 1 - alpha / u with u = -ln(1 - alpha) the link's optical thickness: the weight of S_p - S_q in the
+// exact transport of a source linear along the link, int_0^1 u t e^(-u (1 - t)) dt (u/2 for thin links,
+// 1 for opaque ones).
+double linearSourceWeight(double alpha);
 
 // e_p(w): the node's source per unit opacity towards w (emission and single-scattered lights).
 glm::dvec3 nodeSource(const Problem& pb, int p, glm::vec3 w);

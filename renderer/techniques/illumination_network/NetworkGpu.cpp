@@ -10,6 +10,7 @@ namespace radiant::network {
 namespace {
 
 constexpr int kMaxIterationsPerBatch = 256;  // the residual buffer's length
+constexpr int kCancelPollIterations = 4;     // how often iterate() asks whether the request was cancelled
 
 int phaseCode(api::PhaseModel m) {
   return m == api::PhaseModel::HenyeyGreenstein ? gpu::kPhaseHenyeyGreenstein
@@ -53,6 +54,7 @@ NetworkGpu::NetworkGpu(const NodeSet& ns, const std::vector<Direction>& dirs, co
   lightBuf_ = gl::Buffer("network lights", std::size_t(maxLights_) * sizeof(gpu::NetworkLight));
   transmittance_ = gl::Buffer("network light transmittance", std::size_t(N_) * maxLights_ * sizeof(float));
   residual_ = gl::Buffer("network residuals", kMaxIterationsPerBatch * sizeof(std::uint32_t));
+  source_ = gl::Buffer("network sources", links * sizeof(glm::vec4));
   for (int k = 0; k < 2; ++k) radiance_[k] = gl::Buffer(k ? "network radiance B" : "network radiance A", links * sizeof(glm::vec4));
   clearRadiance();
 }
@@ -64,6 +66,23 @@ void NetworkGpu::bindCommon(const gl::Program& p) const {
   p.set("u_window", M_);
   p.set("u_center", &center_.x, 3);
   p.set("u_radius", radius_);
+}
+
+void NetworkGpu::uploadAlpha(const std::vector<float>& alpha) {
+  alpha_.upload(alpha.data(), alpha.size() * sizeof(float));
+}
+
+void NetworkGpu::setSkyTransmittance(const std::vector<float>& T0) {
+  skyTransmittance_ = gl::Buffer("network sky transmittance", T0.size() * sizeof(float), T0.data(), 0);
+}
+
+void NetworkGpu::bindForRender(const gl::Program& p) const {
+  bindCommon(p);
+  p.set("u_lightCount", lights_);
+  p.set("u_phaseModel", phaseModel_);
+  p.set("u_phaseG", g_);
+  lightBuf_.bindBase(GL_SHADER_STORAGE_BUFFER, 12);
+  dirs_.bindBase(GL_SHADER_STORAGE_BUFFER, 1);
 }
 
 void NetworkGpu::buildVisibility(gl::ShaderLibrary& shaders) {
@@ -124,14 +143,18 @@ void NetworkGpu::clearRadiance() {
   current_ = 0;
 }
 
-std::vector<double> NetworkGpu::iterate(gl::ShaderLibrary& shaders, int count, glm::vec3 sky) {
+std::vector<double> NetworkGpu::iterate(gl::ShaderLibrary& shaders, int count, glm::vec3 sky, bool linearSource,
+                                        const std::function<bool()>& cancelled) {
   std::vector<double> out;
-  const gl::Program& prog = shaders.program({"illumination_network/iterate.comp"});
-  bindCommon(prog);
-  prog.set("u_lightCount", lights_);
-  prog.set("u_phaseModel", phaseModel_);
-  prog.set("u_phaseG", g_);
-  prog.set("u_sky", &sky.x, 3);
+  const gl::Program& source = shaders.program({"illumination_network/source.comp"});
+  bindCommon(source);
+  source.set("u_lightCount", lights_);
+  source.set("u_phaseModel", phaseModel_);
+  source.set("u_phaseG", g_);
+  const gl::Program& link = shaders.program({"illumination_network/iterate.comp"});
+  bindCommon(link);
+  link.set("u_sky", &sky.x, 3);
+  link.set("u_linearSource", linearSource ? 1 : 0);
   nodes_.bindBase(GL_SHADER_STORAGE_BUFFER, 0);
   dirs_.bindBase(GL_SHADER_STORAGE_BUFFER, 1);
   upstream_.bindBase(GL_SHADER_STORAGE_BUFFER, 7);
@@ -140,22 +163,34 @@ std::vector<double> NetworkGpu::iterate(gl::ShaderLibrary& shaders, int count, g
   lightBuf_.bindBase(GL_SHADER_STORAGE_BUFFER, 12);
   transmittance_.bindBase(GL_SHADER_STORAGE_BUFFER, 13);
   residual_.bindBase(GL_SHADER_STORAGE_BUFFER, 14);
-  for (int done = 0; done < count;) {
-    const int batch = std::min(kMaxIterationsPerBatch, count - done);
+  source_.bindBase(GL_SHADER_STORAGE_BUFFER, 18);
+  bool stop = false;
+  for (int done = 0; done < count && !stop;) {
+    int batch = std::min(kMaxIterationsPerBatch, count - done);
     const std::uint32_t zero = 0;
     glClearNamedBufferData(residual_.id(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     for (int n = 0; n < batch; ++n) {
+      // A cancelled or timed-out request stops within kCancelPollIterations iterations: the GPU is
+      // drained first, so the check sees the time the queued iterations really took.
+      if (cancelled && n % kCancelPollIterations == 0 && (glFinish(), cancelled())) {
+        batch = n, stop = true;
+        break;
+      }
       radiance_[current_].bindBase(GL_SHADER_STORAGE_BUFFER, 10);
       radiance_[1 - current_].bindBase(GL_SHADER_STORAGE_BUFFER, 11);
-      prog.set("u_iteration", n);
+      source.use();
+      glDispatchCompute(groups(N_ * D_), 1, 1);
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+      link.use();
+      link.set("u_iteration", n);
       glDispatchCompute(groups(N_ * D_), 1, 1);
       glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
       current_ = 1 - current_;
     }
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     std::vector<std::uint32_t> bits(static_cast<std::size_t>(batch));
-    residual_.download(bits.data(), bits.size() * sizeof(std::uint32_t));
+    if (batch > 0) residual_.download(bits.data(), bits.size() * sizeof(std::uint32_t));
     for (std::uint32_t b : bits) {
       float f;
       std::memcpy(&f, &b, sizeof f);
@@ -183,10 +218,15 @@ void NetworkGpu::uploadRadiance(const std::vector<glm::dvec3>& I) {
 }
 
 void NetworkGpu::cameraSources(gl::ShaderLibrary& shaders, const gl::Buffer& order, gl::Buffer& splats,
-                               bool orthographic, glm::vec3 eye, glm::vec3 toCamera) {
+                               bool orthographic, glm::vec3 eye, glm::vec3 toCamera, bool includeLights,
+                               bool excludeSky, glm::vec3 sky) {
   const gl::Program& prog = shaders.program({"illumination_network/camera.comp"});
   bindCommon(prog);
   prog.set("u_lightCount", lights_);
+  prog.set("u_includeLights", includeLights ? 1 : 0);
+  prog.set("u_excludeSky", excludeSky && skyTransmittance_.id() != 0 ? 1 : 0);
+  prog.set("u_sky", &sky.x, 3);
+  if (skyTransmittance_.id() != 0) skyTransmittance_.bindBase(GL_SHADER_STORAGE_BUFFER, 17);
   prog.set("u_phaseModel", phaseModel_);
   prog.set("u_phaseG", g_);
   prog.set("u_orthographic", orthographic ? 1 : 0);

@@ -5,6 +5,7 @@
 // (created once per network: the technique caches an instance as derived data keyed by the medium
 // and the parameters that shape it), so a warm start is the radiance it already holds.
 // The CPU twin and oracle is Network.h.
+#include <functional>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -29,21 +30,38 @@ public:
   void buildVisibility(gl::ShaderLibrary& shaders);
   bool visibilityBuilt() const { return built_; }
   Visibility downloadVisibility() const;
+  // Replaces the link opacities (exactLinkOpacity).
+  void uploadAlpha(const std::vector<float>& alpha);
 
   // This frame's directional lights and their transmittance T[p * L + l] (lightTransmittance).
   void setLights(const std::vector<DirectionalLight>& lights, const std::vector<double>& transmittance);
   // I := 0 (a cold start).
   void clearRadiance();
-  // `count` iterations with sky radiance `sky`; returns ||I^{n+1} - I^n||_inf of each.
-  std::vector<double> iterate(gl::ShaderLibrary& shaders, int count, glm::vec3 sky);
+  // `count` iterations with sky radiance `sky` (each a source pass, source.comp, and a link pass,
+  // iterate.comp; linearSource as Problem::linearSource); returns ||I^{n+1} - I^n||_inf of each.
+  // `cancelled` is polled between batches of up to 256 iterations: when it turns true the iteration
+  // stops early (fewer residuals are returned).
+  std::vector<double> iterate(gl::ShaderLibrary& shaders, int count, glm::vec3 sky, bool linearSource = false,
+                              const std::function<bool()>& cancelled = {});
   // I as iterated so far, [p * D + i].
   std::vector<glm::dvec3> downloadRadiance() const;
   void uploadRadiance(const std::vector<glm::dvec3>& I);
 
   // Fills the splats' source (MediaParticle::sourceTau.rgb; slot s is node order[s]) with each
-  // node's radiance towards the camera (camera.comp).
+  // node's radiance towards the camera (camera.comp); without includeLights the directional lights'
+  // single scattering is left out (the march adds it exactly).
   void cameraSources(gl::ShaderLibrary& shaders, const gl::Buffer& order, gl::Buffer& splats, bool orthographic,
-                     glm::vec3 eye, glm::vec3 toCamera);
+                     glm::vec3 eye, glm::vec3 toCamera, bool includeLights = true, bool excludeSky = false,
+                     glm::vec3 sky = glm::vec3(0.f));
+  // Binds the common uniforms (N, D, M, the bounding sphere) and the lights (binding 12) for a
+  // program of the final render.
+  void bindForRender(const gl::Program& p) const;
+  // T0[p * D + i]: the unscattered sky's transmittance along each link chain (skyTransmittance); with
+  // it, cameraSources can leave the sky scattered once out too (excludeSky), for the march to add exactly.
+  void setSkyTransmittance(const std::vector<float>& T0);
+  int lightCount() const { return lights_; }
+  int phaseModel() const { return phaseModel_; }
+  float phaseG() const { return g_; }
 
 private:
   void bindCommon(const gl::Program& p) const;
@@ -55,7 +73,7 @@ private:
   bool built_ = false;
   int current_ = 0;  // which radiance buffer holds the latest I
   gl::Buffer nodes_, dirs_, binCount_, binStart_, binFill_, binItems_, nodeBin_, upstream_, alpha_, weights_,
-      lightBuf_, transmittance_, residual_;
+      lightBuf_, transmittance_, residual_, skyTransmittance_, source_;
   gl::Buffer radiance_[2];
 };
 

@@ -78,25 +78,33 @@ TEST_F(NetworkGpuTest, VisibilityAndIterationMatchTheCpuDoubleVersion) {
   pb.sky = glm::dvec3(0.3, 0.4, 0.6);
   gpu.setLights(lights, pb.transmittance);
   const int n = 24;
-  const std::vector<double> rg = gpu.iterate(library_, n, glm::vec3(pb.sky));
-  std::vector<glm::dvec3> I(std::size_t(ns.nodes.size()) * dirs.size(), glm::dvec3(0.0)), next;
-  std::vector<double> rc;
-  for (int k = 0; k < n; ++k) rc.push_back(iterate(pb, I, next)), I.swap(next);
-  const std::vector<glm::dvec3> Ig = gpu.downloadRadiance();
-  double peak = 0, err = 0;
-  for (std::size_t k = 0; k < I.size(); ++k)
-    for (int c = 0; c < 3; ++c) peak = std::max(peak, I[k][c]), err = std::max(err, std::abs(Ig[k][c] - I[k][c]));
-  double residualErr = 0;
-  for (int k = 0; k < n; ++k) residualErr = std::max(residualErr, std::abs(rg[k] - rc[k]));
-  std::printf("I after %d iterations: peak %.4f, max |gpu - cpu| %.2e (%.2e of peak); residuals %.4g -> %.4g, max "
-              "diff %.2e\n", n, peak, err, err / peak, rc.front(), rc.back(), residualErr);
-  ASSERT_GT(peak, 0.1);
-  EXPECT_LT(err / peak, std::ldexp(1.0, -10));
-  EXPECT_LT(residualErr, std::ldexp(1.0, -10) * peak);
+  // Both link schemes: the upstream source (Algorithm 7) and the linear one (Problem::linearSource).
+  std::vector<glm::dvec3> I, Ig;
+  for (const bool linear : {false, true}) {
+    pb.linearSource = linear;
+    gpu.clearRadiance();
+    const std::vector<double> rg = gpu.iterate(library_, n, glm::vec3(pb.sky), linear);
+    I.assign(std::size_t(ns.nodes.size()) * dirs.size(), glm::dvec3(0.0));
+    std::vector<glm::dvec3> next;
+    std::vector<double> rc;
+    for (int k = 0; k < n; ++k) rc.push_back(iterate(pb, I, next)), I.swap(next);
+    Ig = gpu.downloadRadiance();
+    double peak = 0, err = 0;
+    for (std::size_t k = 0; k < I.size(); ++k)
+      for (int c = 0; c < 3; ++c) peak = std::max(peak, I[k][c]), err = std::max(err, std::abs(Ig[k][c] - I[k][c]));
+    double residualErr = 0;
+    for (int k = 0; k < n; ++k) residualErr = std::max(residualErr, std::abs(rg[k] - rc[k]));
+    std::printf("%s source: I after %d iterations: peak %.4f, max |gpu - cpu| %.2e (%.2e of peak); residuals %.4g -> "
+                "%.4g, max diff %.2e\n", linear ? "linear" : "upstream", n, peak, err, err / peak, rc.front(), rc.back(),
+                residualErr);
+    ASSERT_GT(peak, 0.1);
+    EXPECT_LT(err / peak, std::ldexp(1.0, -10));
+    EXPECT_LT(residualErr, std::ldexp(1.0, -10) * peak);
+  }
 
   // Deterministic: the same iterations again from 0 give the same bits.
   gpu.clearRadiance();
-  gpu.iterate(library_, n, glm::vec3(pb.sky));
+  gpu.iterate(library_, n, glm::vec3(pb.sky), true);
   const std::vector<glm::dvec3> again = gpu.downloadRadiance();
   double rerun = 0;
   for (std::size_t k = 0; k < I.size(); ++k) rerun = std::max(rerun, glm::length(again[k] - Ig[k]));
@@ -128,6 +136,34 @@ TEST_F(NetworkGpuTest, GpuFurnaceRisesMonotonicallyToTheSky) {
   std::printf("GPU furnace after 1000 iterations: max |I - 1| %.2e, largest decrease %.2e\n", err, drop);
   EXPECT_LT(err, 1e-5);   // fp32 rounding of a fixed point
   EXPECT_LE(drop, 1e-6);  // monotone up to rounding
+}
+
+// A cancelled request stops the iteration (the pass then answers 409): iterate() asks every 4
+// iterations, so a request cancelled at the third question has run exactly 8 iterations, and the state
+// is those 8 iterations' (a valid warm start).
+TEST_F(NetworkGpuTest, CancelledIterationStopsAtTheNextPoll) {
+  api::ParticleSystem s;
+  s.kind = api::MediumKind::Cloud;
+  api::Particle p;
+  p.radius = 1.f, p.tau = 4.f, p.albedo = glm::vec3(0.9f);
+  s.particles = {p};
+  const rt::ParticleMedium medium({s});
+  const NodeSet ns = sampleNodes(medium, 200, 1);
+  const auto dirs = makeDirections(16, true, 1);
+  NetworkGpu gpu(ns, dirs, phaseWeights(dirs, ns.phase, ns.g), 6, 1);
+  gpu.buildVisibility(library_);
+  gpu.setLights({}, {});
+  int asked = 0;
+  const std::vector<double> r = gpu.iterate(library_, 1000, glm::vec3(1.f), true, [&] { return ++asked == 3; });
+  EXPECT_EQ(asked, 3);
+  ASSERT_EQ(r.size(), 8u);
+  const std::vector<glm::dvec3> cancelled = gpu.downloadRadiance();
+  gpu.clearRadiance();
+  gpu.iterate(library_, 8, glm::vec3(1.f), true);
+  const std::vector<glm::dvec3> eight = gpu.downloadRadiance();
+  double diff = 0;
+  for (std::size_t k = 0; k < eight.size(); ++k) diff = std::max(diff, glm::length(eight[k] - cancelled[k]));
+  EXPECT_EQ(diff, 0.0);
 }
 
 }  // namespace
