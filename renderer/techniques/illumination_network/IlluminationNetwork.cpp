@@ -26,8 +26,39 @@ struct IlluminationNetworkPass::Network {
   std::unique_ptr<network::NetworkGpu> gpu;
   double occupancy = 0.0, contraction = 0.0, splatRadius = 0.0;
   int longestChain = 0;
-  bool stateValid = false;  // the GPU radiance holds an earlier request's solution
+  // The GPU radiance: `stateIterations` iterations of eq. 9.1 from 0 under the sources `stateKey` (the
+  // lights, their transmittance, the sky, the link source), or nothing usable (stateIterations < 0).
+  // A request resumes only from a state it would itself pass through (the same sources, no more
+  // iterations than it asks for), so its frame is bitwise the cold frame whatever came before.
+  std::string stateKey;
+  int stateIterations = -1;
+  std::vector<double> residuals;  // ||I^{n+1} - I^n|| of iterations 1..stateIterations
 };
+
+namespace {
+
+// Everything the iteration's result depends on beyond the cached network: the directional lights
+// (direction and irradiance, exactly), how they reach the nodes, the sky and the link source.
+std::string sourcesKey(const std::vector<network::DirectionalLight>& lights, bool networkTransmittance,
+                       glm::vec3 sky, bool linearSource) {
+  std::string key;
+  char buf[64];
+  auto put = [&](float v) {
+    std::snprintf(buf, sizeof buf, "%a,", double(v));
+    key += buf;
+  };
+  for (const auto& l : lights) {
+    put(l.w.x), put(l.w.y), put(l.w.z);
+    put(l.irradiance.x), put(l.irradiance.y), put(l.irradiance.z);
+    key += ';';
+  }
+  put(sky.x), put(sky.y), put(sky.z);
+  key += networkTransmittance ? "network" : "exact";
+  key += linearSource ? "|linear" : "|upstream";
+  return key;
+}
+
+}  // namespace
 
 const TechniqueInfo& IlluminationNetworkPass::info() const {
   static const TechniqueInfo i{"illumination_network",
@@ -94,7 +125,6 @@ void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, 
   iterations_ = params.get<int>("iterations", 32);
   linearSource_ = params.get<std::string>("link_source", "linear") == "linear";
   exactLinks_ = params.get<std::string>("link_opacity", "medium") == "medium";
-  warm_ = params.get<bool>("warm_start", true) && net_->stateValid;
 
   // Directional lights (the network's lights) and their transmittance to every node, recomputed per
   // frame since lights move: exact through the medium, or from the network's chains along each light.
@@ -108,9 +138,17 @@ void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, 
     }
     lights_.push_back({glm::normalize(l.direction), l.color * l.intensity});
   }
-  transmittance_ = params.get<std::string>("light_transmittance", "exact") == "network"
-                       ? network::lightTransmittance(net_->nodes, lights_, M)
-                       : network::lightTransmittance(net_->nodes, lights_, *net_->medium);
+  const bool networkTransmittance = params.get<std::string>("light_transmittance", "exact") == "network";
+  transmittance_ = networkTransmittance ? network::lightTransmittance(net_->nodes, lights_, M)
+                                       : network::lightTransmittance(net_->nodes, lights_, *net_->medium);
+  // Warm start (a render service returns the same frame for the same request): resume only from a
+  // state this request would itself pass through, i.e. iterated from 0 under the same sources for at
+  // most `iterations` iterations, and run the rest. The result is then bitwise the cold start's (the
+  // iteration is deterministic); moved lights or a changed sky start from 0.
+  stateKey_ = sourcesKey(lights_, networkTransmittance, view.ambient, linearSource_);
+  warm_ = params.get<bool>("warm_start", true) && net_->stateIterations >= 0 && net_->stateKey == stateKey_ &&
+          net_->stateIterations <= iterations_;
+  resumedFrom_ = warm_ ? net_->stateIterations : 0;
 
   // Splats: each node a linear-falloff sphere carrying mass / N of the optical mass, of radius
   // splat_radius times the mean node spacing (V / N)^(1/3), V = mass / (mean node extinction).
@@ -188,9 +226,19 @@ void IlluminationNetworkPass::execute(PassContext& ctx) {
     gpu.setSkyTransmittance(network::skyTransmittance(V));
   }
   gpu.setLights(lights_, transmittance_);
-  if (!warm_) gpu.clearRadiance();
-  const std::vector<double> residuals = gpu.iterate(ctx.shaders, iterations_, view.ambient, linearSource_, ctx.cancelled);
-  net_->stateValid = true;  // a partial iteration is still a valid start for the next request
+  if (!warm_) {
+    gpu.clearRadiance();
+    net_->residuals.clear();
+  }
+  net_->residuals.resize(std::size_t(resumedFrom_));
+  net_->stateKey = stateKey_;
+  const std::vector<double> run =
+      gpu.iterate(ctx.shaders, iterations_ - resumedFrom_, view.ambient, linearSource_, ctx.cancelled);
+  iterationsRun_ = static_cast<int>(run.size());
+  // A cancelled request still leaves a valid state: its first resumedFrom_ + run.size() iterations.
+  net_->residuals.insert(net_->residuals.end(), run.begin(), run.end());
+  net_->stateIterations = static_cast<int>(net_->residuals.size());
+  const std::vector<double>& residuals = net_->residuals;  // iterations 1..iterations_, whatever the start
   if (static_cast<int>(residuals.size()) < iterations_)
     throw api::ApiError(409, "cancelled", "Render cancelled",
                         "the render was cancelled during illumination_network's iteration " +
@@ -270,6 +318,8 @@ void IlluminationNetworkPass::reportStats(PassContext& ctx, bool build, const st
   c["contraction_factor"] = net_->contraction;
   c["visibility_built"] = build ? 1 : 0;
   c["warm_start"] = warm_ ? 1 : 0;
+  c["resumed_from_iteration"] = resumedFrom_;  // iterations taken from the cached state
+  c["iterations_run"] = iterationsRun_;        // iterations run by this request
   c["iterations"] = iterations_;
   c["directional_lights"] = static_cast<double>(lights_.size());
   c["ignored_lights"] = ignoredLights_;

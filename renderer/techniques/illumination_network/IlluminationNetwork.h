@@ -4,8 +4,10 @@
 // proportion to their extinction carry the incoming radiance of D shared directions; the visibility
 // network V (N x D: upstream node and link opacity) is built on the GPU by per-direction binning in
 // an M x M window and cached with the nodes by medium digest and the parameters that shape it; each
-// request iterates eq. 9.1 `iterations` times, warm-started from the cached radiance (so when only
-// the lights move the previous solution is the start, §9.2). The final image (final_render) marches
+// request iterates eq. 9.1 `iterations` times from 0, resuming from the cached radiance when that is
+// an earlier request's state under the same sources and at most as many iterations (warm_start), so a
+// frame never depends on earlier requests (the thesis' §9.2 start from the previous lights' solution
+// would make it so; not done). The final image (final_render) marches
 // each pixel's ray through the medium's own particles with the lights (and, when affordable, the sky)
 // scattered once exactly and the rest interpolated from the nodes (march.frag), or splats every node
 // as a spherical billboard carrying its share of the optical mass (the thesis; the spherical_billboards
@@ -15,6 +17,7 @@
 // owns the "media" light path, composes beauty = beauty * T + media. Ground truth: the volumetric
 // reference's `full` mode. CPU side and oracles: Network.h; GPU: NetworkGpu.h.
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "renderer/frame/GpuTypes.h"
@@ -51,7 +54,8 @@ private:
   float kernel_ = 0.f;  // the march's Gaussian width (world units)
   std::vector<gpu::MediaParticle> particles_;  // the medium's own particles, for the march
   bool fresh_ = false, warm_ = false;
-  int iterations_ = 0;
+  int iterations_ = 0, resumedFrom_ = 0, iterationsRun_ = 0;
+  std::string stateKey_;  // the sources of this request's iteration (sourcesKey)
   std::vector<network::DirectionalLight> lights_;
   std::vector<double> transmittance_;
   int ignoredLights_ = 0;
