@@ -8,15 +8,22 @@
 // The goal runs on two clouds of the same optical size: the homogeneous sphere (one particle: what the
 // network samples its nodes from) and 8000 constant particles in the unit ball (the depth_impostors
 // bench's cloud), so the single-scatter methods see particles they can shadow between.
-// Timing: the pass's GPU time (GL_TIME_ELAPSED) and CPU time, medians of `repeats` frames after a
-// warm-up frame, cold starts (warm_start false) so every frame iterates from 0. Per iteration (iter_ms): the
-// difference between frames of `iterations` and of 0 iterations, over `iterations`. Error: RMSE of
-// the media AOV's RGB over 4x4-pixel blocks, relative to the reference's mean.
+// Timing: the pass's GPU time (GL_TIME_ELAPSED) and CPU time, medians of `repeats` frames, cold starts
+// (warm_start false) so every frame iterates from 0. Per (N, D) of the table: one warm-up frame of 0
+// iterations (builds the visibility network, compiles the shaders), then the timed frames of 0 and of
+// `iterations` iterations (the network cached). Per iteration (iter_ms): the difference between the
+// two, over `iterations`; the rest of the frame (the light transmittance, the camera sources and the
+// final render, march by default) is frame0_ms. Error (the table's and the goal's): RMSE of the media
+// AOV's RGB over 4x4-pixel blocks, relative to the mean of the reference (`full`, 64 scattering events).
+// The table prints the UTC date and the load average before and after (docs/PERFORMANCE.md).
 #include <algorithm>
 #include <cmath>
 #include <tuple>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
+#include <fstream>
+#include <string>
 #include <vector>
 
 #include "api/Validate.h"
@@ -56,10 +63,21 @@ struct Timing {
   double gpuMs, cpuMs;
 };
 
+// "2026-12-02 07:46 UTC, load average 2.33 3.37 5.36" (the machine is shared: docs/PERFORMANCE.md).
+std::string whenAndLoad() {
+  char when[64];
+  const std::time_t now = std::time(nullptr);
+  std::strftime(when, sizeof when, "%Y-%m-%d %H:%M:%S UTC", std::gmtime(&now));
+  std::ifstream f("/proc/loadavg");
+  std::string l1, l5, l15;
+  f >> l1 >> l5 >> l15;
+  return std::string(when) + ", load average (1, 5, 15 min) " + l1 + " " + l5 + " " + l15;
+}
+
 Timing median(Renderer& r, const Scene& scene, const json& body, const std::string& pass, int repeats, Image* media,
-              api::PassStats* stats = nullptr) {
+              api::PassStats* stats = nullptr, bool warmUp = true) {
   std::vector<double> gpu, cpu;
-  for (int i = 0; i <= repeats; ++i) {
+  for (int i = warmUp ? 0 : 1; i <= repeats; ++i) {
     const RenderOutput out = r.render(scene, api::parseRenderRequest(body));
     if (i == 0) continue;
     const api::PassStats& p = passOf(out, pass);
@@ -121,23 +139,26 @@ int main(int argc, char** argv) {
   if (mode != "goal") {
   std::printf("\nillumination_network, %d iterations per frame (cold start), %dx%d, median of %d frames\n", iterations,
               size, size, repeats);
-  std::printf("%6s %4s %4s %9s %12s %12s %12s %12s %10s %9s\n", "N", "D", "M", "sky_links", "frame_gpu_ms",
-              "frame_cpu_ms", "iter_ms", "us/node/it", "residual", "error");
+  std::printf("start: %s\n", whenAndLoad().c_str());
+  std::printf("%6s %4s %4s %9s %12s %12s %10s %10s %11s %11s %10s %9s\n", "N", "D", "M", "sky_links", "frame_gpu_ms",
+              "frame_cpu_ms", "frame0_ms", "iter_ms", "us/node/it", "ms/node/fr", "residual", "error");
   for (int N : {512, 1024, 2048, 4096})
     for (int D : {32, 64, 128}) {
       Image media;
       api::PassStats p;
-      const Timing frame =
-          median(renderer, scene, networkBody(N, D, iterations), "illumination_network", repeats, &media, &p);
       const Timing zero = median(renderer, scene, networkBody(N, D, 0), "illumination_network", repeats, nullptr);
-      const double perIter = std::max(frame.gpuMs, frame.cpuMs) - std::max(zero.gpuMs, zero.cpuMs);
+      const Timing frame = median(renderer, scene, networkBody(N, D, iterations), "illumination_network", repeats,
+                                  &media, &p, /*warmUp=*/false);
+      const double zeroMs = std::max(zero.gpuMs, zero.cpuMs), frameMs = std::max(frame.gpuMs, frame.cpuMs);
+      const double perIter = (frameMs - zeroMs) / std::max(1, iterations);
       const double err = blockError(media, reference);
-      std::printf("%6d %4d %4.0f %9.3f %12.2f %12.2f %12.3f %12.4f %10.2e %9.4f\n", N, D, p.counters.at("window"),
-                  p.counters.at("link_occupancy"), frame.gpuMs, frame.cpuMs, perIter / iterations,
-                  1e3 * perIter / iterations / N, p.counters.at("residual_last"), err);
+      std::printf("%6d %4d %4.0f %9.3f %12.2f %12.2f %10.2f %10.3f %11.4f %11.4f %10.2e %9.4f\n", N, D,
+                  p.counters.at("window"), p.counters.at("link_occupancy"), frame.gpuMs, frame.cpuMs, zeroMs, perIter,
+                  1e3 * perIter / N, frameMs / N, iterations > 0 ? p.counters.at("residual_last") : 0.0, err);
       std::fflush(stdout);
     }
 
+  std::printf("end: %s\n", whenAndLoad().c_str());
   }
   if (mode == "table") return 0;
 
