@@ -4,7 +4,8 @@
 // built-in scenes and never edited by hand (docs/PERFORMANCE.md, "Presets and budgets").
 //
 // The table holds, per technique:
-//   - a cost model: ms = sum of terms coef * product(vars), vars being "pixels" (width x height) and the
+//   - a cost model: ms = sum of terms coef * product(vars), vars being "pixels" (the raster's: width x
+//     height x k^2 under supersampling k; the Renderer passes the supersampled request) and the
 //     technique's numeric parameters (e.g. "spp", "photons", "C", "samples", "photon_resolution",
 //     "cube_resolution", "layers", "nodes", "directions", "iterations"), fitted by least squares to
 //     the measured cost of the pass (passCostMs below);

@@ -388,7 +388,10 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     // without them, the request's own.
     std::vector<std::string> planned;
     for (Technique* t : plan.passes) planned.push_back(t->info().name);
-    api::BudgetChoice choice = api::chooseConfiguration(api::PresetTable::builtin(), planned, request, inputs.limits);
+    // The supersampled request: the cost models' `pixels` are the raster's (the table was measured at
+    // k = 1, so a request that keeps its own supersampling under a budget is charged k^2 the pixels:
+    // conservative for passes whose work follows the output size, as photon_gi's gather_step does).
+    api::BudgetChoice choice = api::chooseConfiguration(api::PresetTable::builtin(), planned, supersampled, inputs.limits);
     for (auto& w : choice.warnings) stats.warnings.push_back(std::move(w));
     std::set<int> shadowMapExclusions;  // meshes whose shadows a pass supplies itself (light_volumes)
     for (std::size_t i = 0; i < plan.passes.size(); ++i) {
@@ -420,7 +423,7 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     for (std::size_t i = 0; i < plan.passes.size(); ++i) {
       report(0.95 * static_cast<double>(i) / passCount);
       if (cancel && cancel->load())
-        throw api::ApiError(409, "cancelled", "Render cancelled", "the render was cancelled before pass " +
+        throw api::ApiError(409, "canceled", "Render canceled", "the render was cancelled before pass " +
                                                                   plan.passes[i]->info().name);
       Technique* t = plan.passes[i];
       gl::DebugGroup group(t->info().name);

@@ -424,9 +424,11 @@ void RenderService::renderLoop() {
     job->rendered = rendered;
     job->renderMs = renderS * 1000;
     if (job->terminal()) continue;  // timed out meanwhile
-    if (problem) {
+    if (problem && !(job->cancel && problem->status == 409)) {
       finishLocked(*job, JobState::Failed, problem);
     } else if (job->cancel) {
+      // Canceled while running, whether the renderer noticed (its 409 between passes or inside a long
+      // pass) or finished first: the job ends "canceled" as docs/API.md says, never "failed".
       finishLocked(*job, JobState::Canceled, Problem{409, "canceled", "Render canceled", "canceled while running", ""});
     } else {
       job->state = JobState::Encoding;

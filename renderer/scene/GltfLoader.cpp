@@ -744,6 +744,8 @@ private:
     // Above FLT_MAX: infinite, no absorption. Below FLT_MIN a float is subnormal, which the ray tracer's
     // threads read as 0 (Embree's recommended flush-to-zero / denormals-are-zero mode): FLT_MIN instead,
     // as opaque as the value asked for.
+    else if (distance > double(std::numeric_limits<float>::max()))
+      mat.attenuationDistance = std::numeric_limits<float>::infinity();  // a cast would be undefined
     else mat.attenuationDistance = float(std::max(distance, double(std::numeric_limits<float>::min())));
     if (e.Has("attenuationColor")) {
       const tinygltf::Value& a = e.Get("attenuationColor");

@@ -10,7 +10,8 @@
 // unmarked, the others stay marked for the full gather.
 // u_refine = 2 (the neighbour fill, before the cascade): a marked pixel takes the mean of the pixels
 // within u_fillRadius that the block samples filled (i_fixup 0) and that pass the same surface test
-// (so the estimate is borrowed over less than h_min / 2, as above); it is then marked 2, which no pass
+// (a block sample's estimate may thus reach a pixel up to h_min from where it was gathered: h_min / 2
+// to the neighbour, h_min / 2 more to this pixel); it is then marked 2, which no pass
 // reads from or gathers for. Edge pixels usually have such a neighbour on their own surface one or two
 // pixels inwards, so only thin features and isolated triangles are left for the full gather. Race-free:
 // it reads only pixels marked 0, which it never writes, and writes only pixels marked 1 (as 2).

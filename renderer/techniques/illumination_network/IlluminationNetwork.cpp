@@ -240,7 +240,7 @@ void IlluminationNetworkPass::execute(PassContext& ctx) {
   net_->stateIterations = static_cast<int>(net_->residuals.size());
   const std::vector<double>& residuals = net_->residuals;  // iterations 1..iterations_, whatever the start
   if (static_cast<int>(residuals.size()) < iterations_)
-    throw api::ApiError(409, "cancelled", "Render cancelled",
+    throw api::ApiError(409, "canceled", "Render canceled",
                         "the render was cancelled during illumination_network's iteration " +
                             std::to_string(residuals.size() + 1) + " of " + std::to_string(iterations_));
 

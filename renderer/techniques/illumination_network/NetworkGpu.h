@@ -39,7 +39,7 @@ public:
   void clearRadiance();
   // `count` iterations with sky radiance `sky` (each a source pass, source.comp, and a link pass,
   // iterate.comp; linearSource as Problem::linearSource); returns ||I^{n+1} - I^n||_inf of each.
-  // `cancelled` is polled between batches of up to 256 iterations: when it turns true the iteration
+  // `cancelled` is polled every kCancelPollIterations (4) iterations: when it turns true the iteration
   // stops early (fewer residuals are returned).
   std::vector<double> iterate(gl::ShaderLibrary& shaders, int count, glm::vec3 sky, bool linearSource = false,
                               const std::function<bool()>& cancelled = {});

@@ -123,8 +123,22 @@ TEST(Budgets, LargerBudgetsNeverGiveLargerErrorsAndMostRunsFit) {
   // Budgets spanning the front: the cheapest frame's predicted ms times 1, 1.5, 2.5, 4, 8.
   json probe = cornell(size, 0);
   probe["time_budget_ms"] = 1;
-  const double cheapest = d.render(probe)["stats"]["budget"]["predicted_ms"];
+  const json probed = d.render(probe);
+  const double cheapest = probed["stats"]["budget"]["predicted_ms"];
   ASSERT_GT(cheapest, 0.0);
+  // A request that keeps its own supersampling k under a budget is charged the raster's pixels,
+  // k^2 width height (the table was measured at k = 1): direct's model at 4x the pixels for k = 2.
+  json probe2 = probe;
+  probe2["supersampling"] = 2;
+  const json probed2 = d.render(probe2);
+  ASSERT_EQ(probed2["stats"]["supersampling"], 2) << probed2.dump();
+  const api::PresetTable& table = api::PresetTable::builtin();
+  const json& direct1 = probed["stats"]["budget"]["techniques"]["direct"];
+  const json& direct2 = probed2["stats"]["budget"]["techniques"]["direct"];
+  const double px = double(size) * size;
+  EXPECT_NEAR(direct1["predicted_ms"].get<double>(), table.predictMs("direct", json::object(), px), 1e-6) << direct1.dump();
+  EXPECT_NEAR(direct2["predicted_ms"].get<double>(), table.predictMs("direct", json::object(), 4 * px), 1e-6) << direct2.dump();
+  EXPECT_GT(probed2["stats"]["budget"]["predicted_ms"].get<double>(), cheapest);
   double lastPredicted = 1e9, lastMeasured = 1e9, lastMs = 0;
   int fits = 0, runs = 0;
   for (double factor : {1.0, 1.5, 2.5, 4.0, 8.0}) {
