@@ -354,14 +354,16 @@ TEST(Presets, EveryPassOfTheBuiltinScenesIsChargedAndLargerBudgetsNeverRaiseAnEr
   struct Frame {
     const char* what;
     std::vector<std::string> planned;
+    SceneCounts counts;  // the scene's (renderer/scene/CostCounts.cpp; stats.scene.counts of its frames)
   };
+  const SceneCounts glass{0, 1920}, explosion{159, 0}, none{};
   const std::vector<Frame> frames{
-      {"cornell_glass (default passes)", {"gbuffer", "shadow_maps", "direct", "specular", "caustics", "photon_gi"}},
-      {"cornell_glass + light_volumes", {"gbuffer", "shadow_maps", "direct", "specular", "caustics", "light_volumes"}},
-      {"explosion (default passes)", {"gbuffer", "shadow_maps", "direct", "photon_gi", "spherical_billboards"}},
-      {"explosion, depth_impostors", {"gbuffer", "shadow_maps", "direct", "depth_impostors"}},
-      {"explosion, illumination_network", {"gbuffer", "shadow_maps", "direct", "illumination_network"}},
-      {"ao_creases, env_diffuse", {"gbuffer", "shadow_maps", "direct", "env_diffuse"}},
+      {"cornell_glass (default passes)", {"gbuffer", "shadow_maps", "direct", "specular", "caustics", "photon_gi"}, glass},
+      {"cornell_glass + light_volumes", {"gbuffer", "shadow_maps", "direct", "specular", "caustics", "light_volumes"}, glass},
+      {"explosion (default passes)", {"gbuffer", "shadow_maps", "direct", "photon_gi", "spherical_billboards"}, explosion},
+      {"explosion, depth_impostors", {"gbuffer", "shadow_maps", "direct", "depth_impostors"}, explosion},
+      {"explosion, illumination_network", {"gbuffer", "shadow_maps", "direct", "illumination_network"}, explosion},
+      {"ao_creases, env_diffuse", {"gbuffer", "shadow_maps", "direct", "env_diffuse"}, none},
   };
   for (const char* fronted : {"caustics", "spherical_billboards", "depth_impostors", "illumination_network", "env_diffuse"})
     EXPECT_TRUE(t.hasFront(fronted)) << fronted;
@@ -371,7 +373,8 @@ TEST(Presets, EveryPassOfTheBuiltinScenesIsChargedAndLargerBudgetsNeverRaiseAnEr
   }
   for (const Frame& f : frames) {
     const auto choose = [&](double budget) {
-      return chooseConfiguration(t, f.planned, request({{"width", 64}, {"height", 64}, {"time_budget_ms", budget}}));
+      return chooseConfiguration(t, f.planned, request({{"width", 64}, {"height", 64}, {"time_budget_ms", budget}}),
+                                 nullptr, f.counts);
     };
     const BudgetChoice cheapest = choose(1e-3), dearest = choose(8.64e7);  // the front's ends
     for (const auto& name : f.planned)
