@@ -10,7 +10,8 @@
 `all` = spec, then `radiant sweep DIR/presets.spec.json -o DIR/results.jsonl`, then fit. Run it against a
 radiantd on the machine the table is for (a GPU server regenerates its own table with the same command)
 with a long --request-timeout; rebuild afterwards (the table is embedded in the binary). The whole run
-took 285 s on the 2-core llvmpipe machine (load average 11-13), so `all` is the normal command.
+took 285 s on the 2-core llvmpipe machine (load average 11-13), 532 s with the scene-count variants (load
+4-5), so `all` is the normal command.
 
 RUNS IN PARTS: `all --only caustics,specular --dir DIR2 [OLD/results.jsonl ...]` measures only those
 techniques (same seeds as a full run) and fits the table from the given earlier results files plus the new
