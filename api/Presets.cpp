@@ -19,14 +19,17 @@ const json& emptyArray() {
   return a;
 }
 
-// sum of coef * product of vars; a var is "pixels" or a numeric parameter (a boolean counts as 0/1).
-double evalTerms(const json& terms, const json& params, double pixels) {
+// sum of coef * product of vars; a var is "pixels", a scene count ("particles", "beams") or a numeric
+// parameter (a boolean counts as 0/1).
+double evalTerms(const json& terms, const json& params, double pixels, const SceneCounts& counts = {}) {
   double ms = 0.0;
   for (const auto& t : terms) {
     double v = t.value("coef", 0.0);
     for (const auto& name : t.value("vars", json::array())) {
       const std::string n = name.get<std::string>();
       if (n == "pixels") v *= pixels;
+      else if (n == "particles") v *= counts.particles;
+      else if (n == "beams") v *= counts.beams;
       else if (params.contains(n) && params[n].is_number()) v *= params[n].get<double>();
       else if (params.contains(n) && params[n].is_boolean()) v *= params[n].get<bool>() ? 1.0 : 0.0;
       else throw std::logic_error("preset table: cost term names '" + n + "', which is no numeric parameter");
@@ -146,9 +149,10 @@ bool PresetTable::hasModel(const std::string& technique) const {
   return t.contains(technique) && t[technique].contains("model");
 }
 
-double PresetTable::predictMs(const std::string& technique, const json& params, double pixels) const {
+double PresetTable::predictMs(const std::string& technique, const json& params, double pixels,
+                              const SceneCounts& counts) const {
   if (!hasModel(technique)) return -1.0;
-  return std::max(0.0, evalTerms(table_["techniques"][technique]["model"]["terms"], params, pixels));
+  return std::max(0.0, evalTerms(table_["techniques"][technique]["model"]["terms"], params, pixels, counts));
 }
 
 double PresetTable::predictOverheadMs(double pixels) const {
@@ -170,7 +174,8 @@ int PresetTable::presetIndex(const std::string& technique, const std::string& qu
 }
 
 BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std::string>& planned,
-                                 const RenderRequest& request, const RequestLimits* limits) {
+                                 const RenderRequest& request, const RequestLimits* limits,
+                                 const SceneCounts& counts) {
   BudgetChoice c;
   for (const auto& t : planned) c.params[t] = paramsOf(request, t);
   c.active = !request.quality.empty() || request.timeBudgetMs > 0;
@@ -243,7 +248,7 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
           continue;
         }
         json p = techniqueParams(t, merged(c.params[t], front[i]["params"], given));
-        const double ms = table.predictMs(t, p, pixels);
+        const double ms = table.predictMs(t, p, pixels, counts);
         all.push_back({std::move(p), ms, front[i]["error"].get<double>(), int(i)});
       }
       if (!excluded.empty()) {
@@ -254,7 +259,7 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
       if (all.empty()) {
         const json lowered = clampedToCaps(t, front[0]["params"], capsExceeded(t, front[0]["params"], given, limits));
         json p = techniqueParams(t, merged(c.params[t], lowered, given));
-        const double ms = table.predictMs(t, p, pixels);
+        const double ms = table.predictMs(t, p, pixels, counts);
         all.push_back({std::move(p), ms, std::numeric_limits<double>::quiet_NaN(), -1});
       }
       // The front at this frame's pixel count: by predicted cost, then only points that lower the error.
@@ -266,7 +271,7 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
       techniques[t] = entry;
       continue;
     }
-    const double ms = table.predictMs(t, c.params[t], pixels);
+    const double ms = table.predictMs(t, c.params[t], pixels, counts);
     entry["predicted_ms"] = ms >= 0 ? json(ms) : json(nullptr);
     if (ms >= 0) fixedMs += ms;
     techniques[t] = entry;
@@ -316,12 +321,13 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
   double total = table.predictOverheadMs(pixels);
   for (const auto& t : planned) {
     if (!techniques[t].contains("predicted_ms")) {
-      const double ms = table.predictMs(t, c.params[t], pixels);
+      const double ms = table.predictMs(t, c.params[t], pixels, counts);
       techniques[t]["predicted_ms"] = ms >= 0 ? json(ms) : json(nullptr);
     }
     if (techniques[t]["predicted_ms"].is_number()) total += techniques[t]["predicted_ms"].get<double>();
   }
   c.stats["techniques"] = techniques;
+  c.stats["scene_counts"] = counts.toJson();
   c.stats["predicted_overhead_ms"] = table.predictOverheadMs(pixels);
   c.stats["predicted_ms"] = total;
   return c;

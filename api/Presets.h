@@ -5,10 +5,11 @@
 //
 // The table holds, per technique:
 //   - a cost model: ms = sum of terms coef * product(vars), vars being "pixels" (the raster's: width x
-//     height x k^2 under supersampling k; the Renderer passes the supersampled request) and the
-//     technique's numeric parameters (e.g. "spp", "photons", "C", "samples", "photon_resolution",
-//     "cube_resolution", "layers", "nodes", "directions", "iterations"), fitted by least squares to
-//     the measured cost of the pass (passCostMs below);
+//     height x k^2 under supersampling k; the Renderer passes the supersampled request), the frame's
+//     scene counts (SceneCounts below: "particles", "beams") and the technique's numeric parameters
+//     (e.g. "spp", "photons", "C", "samples", "photon_resolution", "cube_resolution", "layers",
+//     "nodes", "directions", "iterations"), fitted by least squares to the measured cost of the pass
+//     (passCostMs below) over sweeps that vary the counts too;
 //   - its measured Pareto front: configurations (the swept parameters only) with their measured error
 //     against the reference, cheapest first, and the preset names' indices into it;
 // and a frame overhead model (render_ms minus the passes' cost: readback, planning, prepare work).
@@ -34,6 +35,20 @@ namespace radiant::api {
 // CPU work; GPU work left unsynchronised shows in the frame overhead (readback waits for it).
 double passCostMs(const PassStats& pass);
 
+// What the frame's scene holds that the cost models scale with (the models' scene variables). The
+// renderer computes them once per frame (renderer/scene/CostCounts.h, sceneCostCounts) and reports them
+// in stats.scene.counts, which is where bench/presets.py reads them from for the fit.
+struct SceneCounts {
+  // Particles of every particle system of the frame: the scene's plus the request's `media`.
+  double particles = 0;
+  // light_volumes' scattered beams before culling: per light, one per triangle of each narrow-lobe
+  // scatterer (Material::scattersNarrowLobe), two on a transmissive one (reflected and refracted). An
+  // upper bound known before the pass runs: its `beams` counter leaves out the triangles facing away
+  // from the light and TIR, and adds the negative shadow beams (1570 of 1920 on cornell_glass).
+  double beams = 0;
+  nlohmann::json toJson() const { return {{"particles", particles}, {"beams", beams}}; }
+};
+
 class PresetTable {
 public:
   explicit PresetTable(nlohmann::json table);
@@ -43,8 +58,10 @@ public:
 
   bool hasFront(const std::string& technique) const;  // configurations to choose from
   bool hasModel(const std::string& technique) const;  // a cost model
-  // Predicted ms of `technique` with `params` (complete, defaults filled) at `pixels`; < 0 without a model.
-  double predictMs(const std::string& technique, const nlohmann::json& params, double pixels) const;
+  // Predicted ms of `technique` with `params` (complete, defaults filled) at `pixels` on a scene with
+  // `counts`; < 0 without a model.
+  double predictMs(const std::string& technique, const nlohmann::json& params, double pixels,
+                   const SceneCounts& counts = {}) const;
   double predictOverheadMs(double pixels) const;
   // The front's configurations (params, error, ...), cheapest first at the bench size.
   const nlohmann::json& front(const std::string& technique) const;
@@ -78,8 +95,11 @@ struct BudgetChoice {
 // capped parameters lowered to the caps (predicted_error null). stats.techniques[t].capped says which
 // limits excluded what ({"limits": {param: {wanted, limit, flag}}, "preset_point" | "excluded_points",
 // "clamped"}), and a warning says it in words.
+//
+// `counts`: the frame's scene counts (the models' "particles" and "beams"); stats.scene_counts echoes them.
 BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std::string>& planned,
-                                 const RenderRequest& request, const RequestLimits* limits = nullptr);
+                                 const RenderRequest& request, const RequestLimits* limits = nullptr,
+                                 const SceneCounts& counts = {});
 
 // Adds measured_ms per technique (passCostMs) and for the frame (`frameMs`: the render up to readback,
 // without a compare block's reference) to choice.stats.

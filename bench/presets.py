@@ -10,7 +10,8 @@
 `all` = spec, then `radiant sweep DIR/presets.spec.json -o DIR/results.jsonl`, then fit. Run it against a
 radiantd on the machine the table is for (a GPU server regenerates its own table with the same command)
 with a long --request-timeout; rebuild afterwards (the table is embedded in the binary). The whole run
-took 285 s on the 2-core llvmpipe machine (load average 11-13), so `all` is the normal command.
+took 285 s on the 2-core llvmpipe machine (load average 11-13), 532 s with the scene-count variants (load
+4-5), so `all` is the normal command.
 
 RUNS IN PARTS: `all --only caustics,specular --dir DIR2 [OLD/results.jsonl ...]` measures only those
 techniques (same seeds as a full run) and fits the table from the given earlier results files plus the new
@@ -33,9 +34,15 @@ What is measured (TECHNIQUES below; each technique on its canonical built-in sce
                technique whose AOV has no ground truth (specular, light_volumes: "no_front" says why) gets
                a cost model and no front: a budget charges its cost and leaves its parameters alone.
 
+  scene counts the cost models' scene variables (api::SceneCounts: "particles" of the scene and the
+               request's media, light_volumes' "beams") are varied by extra cost sweeps ("variants": the
+               request's media with generated particles on explosion, other built-in scenes with other
+               scatterers for light_volumes), and read per record from stats.scene.counts (the sweep
+               record's scene_counts), the same numbers the daemon's budget chooser evaluates.
+
 The fit (Python standard library only):
-  cost model   per technique, ms = sum of coef * product(vars) (vars: "pixels" and the technique's numeric
-               parameters), least squares over the cost records with non-negative coefficients (a term
+  cost model   per technique, ms = sum of coef * product(vars) (vars: "pixels", the scene counts and the
+               technique's numeric parameters), least squares over the cost records with non-negative coefficients (a term
                whose coefficient comes out negative is dropped and the rest refitted), refitted once
                without outliers (residual > 4x the median and > 5 ms). The measured cost of a pass is
                api::passCostMs: cpu_ms + the counters trace_ms and splat_build_ms (not gpu_ms: llvmpipe
@@ -59,8 +66,19 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from photon_gi_goal import call, render  # noqa: E402  (the same HTTP helpers)
 
 SIZES = [32, 64]
+SCENE_COUNTS = ("particles", "beams")  # api::SceneCounts
 ERROR_SIZE = 64
 TRUTH_SPP = 1024
+
+# The particle-count variants of the media techniques' cost sweeps: explosion's own 159 particles plus a
+# request `media` smoke of 480 or 1440 generated particles over the explosion (4x and 10x the particles).
+def media_variant(count):
+    return {"media": [{"name": "bench_smoke", "kind": "smoke", "tau": 1.0, "seed": 5, "profile": "linear_exact",
+                       "generator": {"shape": "sphere", "center": [0, 1.1, 0], "extent": [1.0, 0.7, 1.0],
+                                     "count": count, "radius": 0.25, "radius_jitter": 0.3}}]}
+
+
+MEDIA_VARIANTS = [media_variant(480), media_variant(1440)]
 
 # technique -> canonical scene, extra request keys, swept configurations, cost model terms, compare block.
 TECHNIQUES = {
@@ -122,7 +140,11 @@ TECHNIQUES = {
         "scene": "cornell_glass",
         "passes": {"photon_gi": False},
         "configs": [{}, {}, {}],  # no cost knob: the beams are the scene's; three seeds per size
-        "terms": [[], ["pixels"]],
+        # The beams (api::SceneCounts): 1920 on cornell_glass (960 glass triangles, reflected and refracted),
+        # 960 on cornell_mirror (960 mirror triangles), 12 on cornell_glossy (the glossy tall box).
+        "variants": [{"scene": {"builtin": "cornell_mirror"}}, {"scene": {"builtin": "cornell_glossy"}}],
+        # beam construction, the beam BVH, then per pixel the beams found through it.
+        "terms": [[], ["pixels"], ["beams"], ["pixels", "beams"]],
         "compare": None,
         "no_front": "the light_volumes AOV has no ground truth (first-order L S D E + L G D E only; the reference's "
                     "caustics class is L S+ D E) and the technique has no cost knob",
@@ -144,7 +166,10 @@ TECHNIQUES = {
         "scene": "explosion",
         "passes": {"photon_gi": False},
         "configs": [{"resolution_ratio": r} for r in (0.125, 0.25, 0.5, 1)],
-        "terms": [[], ["pixels"], ["pixels", "resolution_ratio", "resolution_ratio"]],
+        "variants": MEDIA_VARIANTS,
+        # per-particle sort and upload, then the billboards' fill: particles x their share of the layer's pixels.
+        "terms": [[], ["pixels"], ["particles"], ["pixels", "resolution_ratio", "resolution_ratio"],
+                  ["pixels", "resolution_ratio", "resolution_ratio", "particles"]],
         "compare": {"aov": "media", "spp": 64},  # single_scatter_unshadowed
         "output_aov": "media",
     },
@@ -153,9 +178,13 @@ TECHNIQUES = {
         "passes": {"photon_gi": False},
         "configs": [{"slices": k, "slice_resolution": r, "impostor_resolution": 32} for k in (2, 4, 8, 16) for r in (64, 256)]
                    + [{"slices": 8, "slice_resolution": 128, "impostor_resolution": i} for i in (16, 32, 64)],
-        # impostor atlas (blocks x I^2), K slices of R^2 each, then K lookups per pixel.
-        "terms": [[], ["impostor_resolution", "impostor_resolution"], ["slices", "slice_resolution", "slice_resolution"],
-                  ["pixels", "slices"]],
+        "variants": MEDIA_VARIANTS,
+        "variant_configs": [{"slices": k, "slice_resolution": r, "impostor_resolution": 32} for k in (2, 16) for r in (64, 256)]
+                           + [{"slices": 8, "slice_resolution": 128, "impostor_resolution": i} for i in (16, 64)],
+        # impostor atlas (blocks x I^2, the blocks a fixed number of particles each), K slices of R^2 each
+        # (the blocks drawn into each), then K lookups per pixel.
+        "terms": [[], ["particles", "impostor_resolution", "impostor_resolution"],
+                  ["slices", "slice_resolution", "slice_resolution"], ["particles", "slices"], ["pixels", "slices"]],
         "compare": {"aov": "media", "spp": 16},  # single_scatter (shadowed): 64 spp took 174 s at 64x64 here
         "output_aov": "media",
     },
@@ -170,10 +199,21 @@ TECHNIQUES = {
         "technique_seed": True,
         # A first sweep (nodes 256/1024 x directions 32/128 x iterations 8/32) gave the same RMSE at 8 and 32
         # iterations (warm start converges) and at 32 and 128 directions: the nodes buy the accuracy.
-        "configs": [{"nodes": n, "directions": d, "iterations": 8} for n in (128, 256, 512, 1024, 2048) for d in (16, 32, 64)]
-                   + [{"nodes": 1024, "directions": 32, "iterations": i} for i in (2, 4)],
-        # links N x D, iterated; the splat of N nodes per pixel.
-        "terms": [[], ["pixels"], ["nodes", "directions"], ["nodes", "directions", "iterations"]],
+        # sky_single_scatter "network" on every point: "auto" (the default) switches to the exact sky when
+        # particles x directions <= 8192 (IlluminationNetwork.cpp, kSkyExactBudget), which costs D x particles
+        # chords per march step: 2-7 s instead of 0.2-0.4 s at 64x64 on explosion's 159 particles with 16 or 32
+        # directions (the 07:54 run), a switch in the scene's particles that no product of the variables
+        # expresses. The front's points name it, so a preset or budget runs what was measured.
+        "configs": [{"nodes": n, "directions": d, "iterations": 8, "sky_single_scatter": "network"}
+                    for n in (128, 256, 512, 1024, 2048) for d in (16, 32, 64)]
+                   + [{"nodes": 1024, "directions": 32, "iterations": i, "sky_single_scatter": "network"} for i in (2, 4)],
+        "variants": MEDIA_VARIANTS,
+        "variant_configs": [{"nodes": n, "directions": d, "iterations": 8, "sky_single_scatter": "network"}
+                            for n in (256, 2048) for d in (16, 64)],
+        # links N x D (their opacity: one ray each through the particles), iterated; the marched final render:
+        # per pixel and step the nodes' kernel and, per light, the particles.
+        "terms": [[], ["pixels"], ["particles"], ["nodes", "directions"], ["nodes", "directions", "particles"],
+                  ["nodes", "directions", "iterations"], ["pixels", "particles"], ["pixels", "nodes"]],
         "compare": {"aov": "media", "spp": 16},  # media_mode full
         "output_aov": "media",
     },
@@ -202,6 +242,12 @@ def base_request(name, t, size, seed):
     return r
 
 
+def variant_request(base, variant):
+    r = json.loads(json.dumps(base))
+    r.update(json.loads(json.dumps(variant)))
+    return r
+
+
 def zip_group(name, points, technique_seed=False):
     """points: list of (config, size, seed) -> one zip group over the dotted paths. technique_seed: the
     technique's own "seed" parameter follows the frame's (its seed-keyed cache is then cold per point)."""
@@ -225,6 +271,9 @@ def make_spec(server, out_dir, names):
     for name, t in techniques.items():
         sweeps.append({"name": f"presets-warm-{name}", "technique": name, "base": base_request(name, t, 32, 7),
                        "repeats": 1, "warmup": 0})
+        for k, v in enumerate(t.get("variants", [])):  # each variant's scene, medium (depth_impostors' blocks)
+            sweeps.append({"name": f"presets-warm-{name}~{k + 1}", "technique": name,
+                           "base": variant_request(base_request(name, t, 32, 7), v), "repeats": 1, "warmup": 0})
     seed = 1000
     for name, t in TECHNIQUES.items():  # every technique's seeds, so that a subset run uses the same ones
         if name not in techniques:
@@ -238,6 +287,22 @@ def make_spec(server, out_dir, names):
         sweeps.append({"name": f"presets-cost-{name}", "technique": name, "base": base_request(name, t, 32, 0),
                        "zip": [zip_group(name, points, t.get("technique_seed", False))], "repeats": 1,
                        "warmup": t.get("warmup", 0)})
+    # The scene-count variants: seeds from 5000 on, so that the canonical points keep the seeds of earlier runs.
+    vseed = 5000
+    for name, t in TECHNIQUES.items():
+        for k, v in enumerate(t.get("variants", [])):
+            configs = t.get("variant_configs", t["configs"])
+            points = []
+            for size in SIZES:
+                for config in configs:
+                    points.append((config, size, vseed))
+                    vseed += 1
+            if name not in techniques:
+                continue
+            sweeps.append({"name": f"presets-cost-{name}~{k + 1}", "technique": name,
+                           "base": variant_request(base_request(name, t, 32, 0), v),
+                           "zip": [zip_group(name, points, t.get("technique_seed", False))], "repeats": 1,
+                           "warmup": t.get("warmup", 0)})
     for name, t in techniques.items():
         if t["compare"] is None:
             continue  # no ground truth: a cost model without a front (t["no_front"] says why)
@@ -278,8 +343,19 @@ def pass_cost(p):
 def term_value(vars_, params, pixels):
     v = 1.0
     for n in vars_:
+        if n != "pixels" and n not in params:
+            raise SystemExit(f"fit: a cost term names {n!r}, which the record has neither as a parameter nor in "
+                             "scene_counts (a results file from a radiant or radiantd older than the scene counts?)")
         v *= pixels if n == "pixels" else float(params[n])
     return v
+
+
+def with_counts(params, record):
+    """A record's parameters plus its scene counts (api::SceneCounts, stats.scene.counts), the models' scene
+    variables."""
+    p = dict(params)
+    p.update(record.get("scene_counts") or {})
+    return p
 
 
 def solve(a, b):
@@ -341,6 +417,27 @@ def fit_terms_once(terms, rows):
     return [], float("nan")
 
 
+def count_checks(t, terms, rows, counted):
+    """What the model says against what was measured across the scene counts: per value of the counts, the
+    measured cost summed over the records at the largest size of the configurations every variant ran
+    (variant_configs: one record each, so a sum rather than one noisy record), and the model's prediction
+    of the same sum. tests/unit/api/PresetsTest.cpp compares the two."""
+    configs = t.get("variant_configs", t["configs"])
+    px = max(SIZES) ** 2
+    groups = {}
+    for params, pixels, ms in rows:
+        if pixels == px and any(all(params.get(k) == v for k, v in c.items()) for c in configs):
+            groups.setdefault(tuple(params[n] for n in counted), []).append((params, ms))
+    out = []
+    for key in sorted(groups):
+        recs = groups[key]
+        out.append({"pixels": px, "counts": dict(zip(counted, key)), "records": len(recs),
+                    "params": [{k: p[k] for k in configs[0]} for p, _ in recs],
+                    "measured_ms": sum(ms for _, ms in recs),
+                    "predicted_ms": sum(predict(terms, p, px) for p, _ in recs)})
+    return out
+
+
 def predict(terms, params, pixels):
     return sum(t["coef"] * term_value(t["vars"], params, pixels) for t in terms)
 
@@ -353,8 +450,9 @@ def fit(records, command, runs=()):
         "command": command, "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "device": device,
         "sizes": SIZES, "error_size": ERROR_SIZE,
         "note": "cost = api::passCostMs of a cold first render (own seed); error = RMSE against the reference at "
-                "error_size on the technique's canonical built-in scene; each model is fitted on that scene (its "
-                "beams, particles and triangles are constants of the model)",
+                "error_size on the technique's canonical built-in scene; a model's scene variables (particles, beams: "
+                "api::SceneCounts) were varied by its sweep's variants (model.scene_counts: the values measured); "
+                "other scene properties (triangles, a caustics generator's size) are constants of the model",
         "runs": list(runs)}, "techniques": {}}
     cost = [r for r in ok if r["sweep"].startswith("presets-cost-")]
     other_rows, overhead_rows = {}, []
@@ -375,19 +473,24 @@ def fit(records, command, runs=()):
             p = next((q for q in r["passes"] if q["name"] == name), None)
             if p is None:
                 continue
-            params = dict(r["request"]["passes"][name])
+            params = with_counts(r["request"]["passes"][name], r)
             rows.append((params, r["request"]["width"] * r["request"]["height"], pass_cost(p)))
         if not rows:
             continue
         terms, resid, dropped = fit_terms(t["terms"], rows)
         entry = {"model": {"terms": terms, "rms_residual_ms": resid, "records": len(rows), "outliers_dropped": dropped,
                            "scene": t["scene"]}}
+        counted = sorted({n for term in t["terms"] for n in term if n in SCENE_COUNTS})
+        if counted:  # the scene counts the records spanned
+            entry["model"]["scene_counts"] = {n: sorted({q[0][n] for q in rows}) for n in counted}
+            entry["model"]["count_checks"] = count_checks(t, terms, rows, counted)
         errs = [r for r in ok if r["sweep"] == f"presets-error-{name}" and r.get("metrics")]
         pts = []
         for r in errs:
             params = {k: r["request"]["passes"][name][k] for k in t["configs"][0]}
             px = r["request"]["width"] * r["request"]["height"]
-            pts.append({"params": params, "error": r["metrics"]["rmse"], "predicted_ms": predict(terms, params, px)})
+            pts.append({"params": params, "error": r["metrics"]["rmse"],
+                        "predicted_ms": predict(terms, with_counts(params, r), px)})
         pts.sort(key=lambda q: (q["predicted_ms"], q["error"]))  # of equal cost, only the most accurate stays
         front = []
         for q in pts:
@@ -474,7 +577,10 @@ def markdown(table):
     lines += ["", "| technique | scene | model (ms) | RMS residual ms | records (outliers dropped) |", "|---|---|---|---|---|"]
     for name, e in sorted(table["techniques"].items()):
         m = e["model"]
-        lines.append(f"| {name} | {m.get('scene', 'any (other passes of the sweeps)')} | {fmt_model(m['terms'])} | "
+        scene = m.get('scene', 'any (other passes of the sweeps)')
+        for n, vals in m.get("scene_counts", {}).items():
+            scene += f" ({n} {', '.join(f'{v:g}' for v in vals)})"
+        lines.append(f"| {name} | {scene} | {fmt_model(m['terms'])} | "
                      f"{m['rms_residual_ms']:.3g} | {m['records']} ({m['outliers_dropped']}) |")
     o = table["overhead"]
     lines.append(f"| frame overhead (render_ms - passes) | all | {fmt_model(o['terms'])} | {o['rms_residual_ms']:.3g} | "

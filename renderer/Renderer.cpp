@@ -20,6 +20,7 @@
 #include "renderer/frame/PassContext.h"
 #include "renderer/gl/ShaderLibrary.h"
 #include "renderer/metrics/Metrics.h"
+#include "renderer/scene/CostCounts.h"
 #include "renderer/scene/StudioEnvironment.h"
 #include "renderer/techniques/reference/ReferencePass.h"
 #include "renderer/techniques/Registry.h"
@@ -388,10 +389,14 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     // without them, the request's own.
     std::vector<std::string> planned;
     for (Technique* t : plan.passes) planned.push_back(t->info().name);
+    // The cost models' scene variables (particles of the scene and the request's media, light_volumes' beams).
+    const api::SceneCounts counts = sceneCostCounts(scene, request.media);
+    stats.scene["counts"] = counts.toJson();
     // The supersampled request: the cost models' `pixels` are the raster's (the table was measured at
     // k = 1, so a request that keeps its own supersampling under a budget is charged k^2 the pixels:
     // conservative for passes whose work follows the output size, as photon_gi's gather_step does).
-    api::BudgetChoice choice = api::chooseConfiguration(api::PresetTable::builtin(), planned, supersampled, inputs.limits);
+    api::BudgetChoice choice =
+        api::chooseConfiguration(api::PresetTable::builtin(), planned, supersampled, inputs.limits, counts);
     for (auto& w : choice.warnings) stats.warnings.push_back(std::move(w));
     std::set<int> shadowMapExclusions;  // meshes whose shadows a pass supplies itself (light_volumes)
     for (std::size_t i = 0; i < plan.passes.size(); ++i) {

@@ -467,6 +467,9 @@ private:
       record["encode_ms"] = summarize(encode);
       if (!record.contains("metrics")) record["metrics"] = nullptr;
       record["skipped"] = last.value("skipped", json::object());
+      // The cost models' scene variables (api::SceneCounts), which bench/presets.py fits against.
+      if (last.contains("scene") && last["scene"].is_object() && last["scene"].contains("counts"))
+        record["scene_counts"] = last["scene"]["counts"];
       record["cache"] = last.value("cache", json::array());
       record["device"] = last.value("device", s.info.value("device", json()));
       if (!daemons.empty()) record["daemons"] = daemons;

@@ -331,6 +331,71 @@ TEST(Budgets, BudgetsOnTheMediaSceneChargeEveryPassAndMostRunsFit) {
   EXPECT_GE(l.fits, 2);
 }
 
+// Issue 19, the scene variables: the media scene with ten times its particles (the request's `media`: a
+// smoke of 1440 generated particles over explosion's own 159). The budget chooser sees the frame's
+// particles (stats.budget.scene_counts, exactly the scene's plus the request's), charges the media pass
+// more for them than on the bare scene, and over budgets of 1 to 8 times the cheapest frame's prediction
+// a larger budget never gives a larger predicted error and the measured frame time (a fresh seed and
+// a cold network each) fits the budget in most runs: the rate is printed and asserted loosely (a shared,
+// loaded machine), as for the other ladders. Without the particles in the model the prediction was that
+// of 159 particles, and the frames of 1599 ran over.
+TEST(Budgets, BudgetsOnTheMediaSceneWithTenTimesTheParticlesChargeThemAndMostRunsFit) {
+  ASSERT_TRUE(tableEntry("illumination_network").contains("front")) << "api/presets.json has no illumination_network front";
+  RealDaemon& d = sharedDaemon();
+  ASSERT_TRUE(d.ready()) << testing::slurp(d.dir / "stderr.log");
+  constexpr int kSceneParticles = 115 + 28 + 16, kAdded = 1440;  // scenes/explosion.gltf: fire, smoke, dust
+  const json smoke{{"name", "many"}, {"kind", "smoke"}, {"tau", 1.0}, {"seed", 5}, {"profile", "linear_exact"},
+                   {"generator", {{"shape", "sphere"}, {"center", {0, 1.1, 0}}, {"extent", {1.0, 0.7, 1.0}},
+                                  {"count", kAdded}, {"radius", 0.25}, {"radius_jitter", 0.3}}}};
+  json bare{{"scene", {{"builtin", "explosion"}}}, {"width", 64}, {"height", 64}, {"seed", 0},
+            {"passes", {{"photon_gi", false}, {"illumination_network", {{"warm_start", false}, {"seed", 0}}}}},
+            {"outputs", {{{"format", "exr"}, {"aovs", {"beauty", "media"}}}}}};
+  json base = bare;
+  base["media"] = json::array({smoke});
+  json warm = base;
+  warm["seed"] = 7;
+  d.render(warm);
+  json probe = base, probeBare = bare;
+  probe["time_budget_ms"] = probeBare["time_budget_ms"] = 1;
+  const json p = d.render(probe), pb = d.render(probeBare);
+  ASSERT_FALSE(p.contains("http_status")) << p.dump();
+  ASSERT_FALSE(pb.contains("http_status")) << pb.dump();
+  EXPECT_EQ(p["stats"]["budget"]["scene_counts"]["particles"], kSceneParticles + kAdded);
+  EXPECT_EQ(pb["stats"]["budget"]["scene_counts"]["particles"], kSceneParticles);
+  EXPECT_EQ(p["stats"]["scene"]["counts"], p["stats"]["budget"]["scene_counts"]);
+  const double many = p["stats"]["budget"]["techniques"]["illumination_network"]["predicted_ms"];
+  const double few = pb["stats"]["budget"]["techniques"]["illumination_network"]["predicted_ms"];
+  EXPECT_GT(many, few) << "the particles are not charged";
+  const double cheapest = p["stats"]["budget"]["predicted_ms"];
+  int fits = 0, runs = 0;
+  double lastError = 1e9;
+  for (double factor : {1.0, 1.5, 2.5, 4.0, 8.0}) {
+    const double budget = cheapest * factor * 1.0001;
+    json timed = base;
+    timed["seed"] = 700 + runs;
+    timed["passes"]["illumination_network"]["seed"] = 700 + runs;  // a cold network, as in the cost sweep
+    timed["time_budget_ms"] = budget;
+    const json r = d.render(timed);
+    ASSERT_FALSE(r.contains("http_status")) << r.dump();
+    const json& b = r["stats"]["budget"];
+    const double predictedMs = b["predicted_ms"], ms = b["measured_ms"];
+    const double error = b["techniques"]["illumination_network"]["predicted_error"]["value"];
+    EXPECT_LE(predictedMs, budget);
+    EXPECT_LE(error, lastError) << budget;
+    lastError = error;
+    ++runs;
+    fits += ms <= budget;
+    std::printf("1599 particles, budget %.1f ms: predicted %.1f ms, measured %.1f ms, illumination_network %s "
+                "(predicted %.1f ms, measured %.1f ms)\n",
+                budget, predictedMs, ms, b["techniques"]["illumination_network"]["params"].dump().c_str(),
+                b["techniques"]["illumination_network"]["predicted_ms"].get<double>(),
+                b["techniques"]["illumination_network"].value("measured_ms", -1.0));
+  }
+  std::printf("1599 particles: measured frame time within the budget in %d of %d runs\n", fits, runs);
+  ::testing::Test::RecordProperty("within_budget_1599_particles", std::to_string(fits) + "/" + std::to_string(runs));
+  EXPECT_GE(fits, 2);  // loose on purpose (a shared, loaded machine): at least 2 of the 5
+}
+
 double rmse(const Image& a, const Image& b) {
   double s = 0;
   for (std::size_t i = 0; i < a.pixels.size(); ++i) s += (double(a.pixels[i]) - b.pixels[i]) * (double(a.pixels[i]) - b.pixels[i]);

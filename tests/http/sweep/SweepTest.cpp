@@ -287,6 +287,9 @@ TEST_F(SweepAgainstDaemon, TwoByTwoGivesFourRecordsWithTheirParametersAndTimings
     EXPECT_GT(rec["metrics"]["rmse"].get<double>(), 0.0);
     EXPECT_LT(rec["metrics"]["rmse"].get<double>(), 1.0);
     EXPECT_NE(rec["device"]["renderer"].get<std::string>().find("llvmpipe"), std::string::npos) << rec["device"].dump();
+    // The preset table's scene variables (stats.scene.counts), which bench/presets.py fits against:
+    // ao_creases has no particles and no metal or glass (no beams).
+    EXPECT_EQ(rec["scene_counts"], (json{{"particles", 0.0}, {"beams", 0.0}})) << rec.dump();
     (void)sum;
   }
   EXPECT_EQ(seen, (std::set<std::pair<std::string, int>>{{"volumetric", 4}, {"volumetric", 8}, {"gtao", 4}, {"gtao", 8}}));
