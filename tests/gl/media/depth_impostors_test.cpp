@@ -169,9 +169,11 @@ TEST(DepthImpostors, CloudSphereAgainstTheSingleScatterReferenceErrorFallsWithN)
                 count, rel, relB, mean, meanOurs / truth.pixels.size());
     ASSERT_GT(mean, 1e-3);
     // Self-shadowing: the unshadowed billboards are 3x too bright on average; the impostors' means
-    // are within 10-40% of the reference's, their error the blocks' coarseness (one light value per
-    // block texel, at the middle of a block interval of optical depth ~2, and slices ~1.25 mean free
-    // paths apart): measured 1.53, 1.31, 0.86 against the billboards' 2.72, 3.21, 3.20.
+    // are within 10-65% of the reference's, their error the blocks' coarseness (the light's
+    // transmittance from the slices at the two ends of a block interval of optical depth ~2, slices
+    // ~1.25 mean free paths apart, each block's opacity lumped at its centre's depth): measured 1.41,
+    // 1.01, 0.67 against the billboards' 2.72, 3.21, 3.20 (1.53, 1.31, 0.86 with the light's
+    // transmittance taken once at the interval's middle).
     EXPECT_LT(rel, 0.7 * relB);
     if (count == 2048) {
       EXPECT_LT(rel, 0.35 * relB);
@@ -251,12 +253,12 @@ TEST(DepthImpostors, ForwardScatterHeuristicOnABackLitForwardScatteringCloud) {
   // Multiple scattering more than doubles this cloud's light (albedo 0.9, forward peaked: the light
   // scattered forward keeps travelling towards the camera).
   EXPECT_GT(mean(full), 2.0 * mean(single));
-  // The heuristic's weights are normalised: the light's energy stays within 1% ...
-  EXPECT_LT(std::abs(mean(on) - mean(off)), 0.01 * mean(off));
-  // ... so it recovers under 2% of the multiple-scattering deficit. What it does is smooth the
-  // blocks' coarse shadows: the block error falls by about 5% against full (1.009 -> 0.962) and by
-  // about 2% against single_scatter too (3.24 -> 3.19), so not because it scatters.
-  EXPECT_LT(std::abs(mean(on) - mean(off)), 0.02 * (mean(full) - mean(single)));
+  // The heuristic's weights are normalised: it blurs the knots' transmittance without adding light;
+  // the mean still moves (+4%) because the shadow over an interval is a convex function of the two
+  // ends' values (shadowOverInterval in gather.frag), so a blur of a deep shadow raises it. It recovers
+  // about 5% of the multiple-scattering deficit (full is 2.2x single_scatter here); what it does is
+  // smooth the blocks' coarse shadows: the block error falls by about 6% against full (0.714 -> 0.671).
+  EXPECT_LT(std::abs(mean(on) - mean(off)), 0.1 * (mean(full) - mean(single)));
   EXPECT_LT(onFull, offFull);
   EXPECT_GT(onFull, 0.9 * offFull);
 }
@@ -294,6 +296,63 @@ TEST(DepthImpostors, NamedItOwnsTheMediaAovAndItsImpostorsAreCached) {
   } catch (const api::ApiError& e) {
     EXPECT_EQ(e.status, 422);
     EXPECT_EQ(e.pointer, "/passes/depth_impostors");
+  }
+}
+
+// Single scattering with self-shadowing against its ground truth (single_scatter) with the light on
+// the camera's side, beside the cloud and behind it: the thesis' cloud (N = 2048, b = 8, K = 16, 32^2,
+// isotropic). Every light gets its own scene digest: the reference image (and the GPU scene) are cached
+// by the digest, so three scenes built under one digest would all be scored against the first one's
+// reference (that made the front-lit cloud look 9x too bright: its reference was the back-lit one).
+// Tolerance: the mean within 25% and the block RMSE below 0.5 of the mean. What remains is the slices'
+// lumping of every block's opacity at its centre's depth (the slice transmittance's RMS error at particle
+// centres is 0.09 at K = 16, impostor_slices_test) and the uniform density assumed inside a block;
+// measured 0.92, 1.08, 1.16 for the mean and 0.18, 0.39, 0.41 RMSE (taking the light's transmittance
+// once at the middle of the interval, before: 0.96, 0.90, 1.26 and 0.33, 0.55, 0.72; at N = 256 the
+// back-lit mean was 2.23x, now 1.48x).
+TEST(DepthImpostors, SingleScatterMeanWithinItsReferenceLitFromFrontSideAndBack) {
+  const int n = 32, count = 2048;
+  const json media = json::array({thesisCloud(count)});
+  struct Case { const char* name; glm::vec3 dir; };
+  for (const Case& cs : {Case{"front", {-0.25f, -0.15f, -1.f}}, Case{"side", {-1.f, -0.5f, -0.6f}},
+                         Case{"back", {0.25f, 0.15f, 1.f}}}) {
+    testing::SceneBuilder b;
+    b.directionalLight(cs.dir, 3.f);  // travelling along dir; the camera looks down -z
+    Scene scene = b.build(std::string("impostors-lit-") + cs.name);
+    scene.camera = testing::orthoCameraAlongZ(1.4f);
+    const RenderOutput ref = render(scene, n, {{"media", media}, {"ambient", {0, 0, 0}},
+                                               {"passes", {{"spherical_billboards", false},
+                                                           {"reference", {{"aov", "media"}, {"media_mode", "single_scatter"},
+                                                                          {"spp", 1}}}}}},
+                                    {"reference"});
+    const RenderOutput out = render(scene, n, {{"media", media}, {"ambient", {0, 0, 0}},
+                                               {"passes", {{"depth_impostors", {{"particles_per_block", 8}, {"slices", 16}}}}}},
+                                    {"media"});
+    ASSERT_TRUE(testing::allFinite(out));
+    const Image& R = aov(ref, "reference");
+    const Image& I = aov(out, "media");
+    auto mean = [](const Image& a) {
+      double s = 0;
+      for (float v : a.pixels) s += v;
+      return s / a.pixels.size();
+    };
+    // RMSE of the RGB over 4x4-pixel blocks, relative to the reference's mean.
+    const int B = 4, m = n / B;
+    double e2 = 0;
+    for (int by = 0; by < m; ++by)
+      for (int bx = 0; bx < m; ++bx)
+        for (int c = 0; c < 3; ++c) {
+          double sa = 0, sr = 0;
+          for (int y = 0; y < B; ++y)
+            for (int x = 0; x < B; ++x) sa += I.at(bx * B + x, by * B + y)[c], sr += R.at(bx * B + x, by * B + y)[c];
+          e2 += std::pow((sa - sr) / (B * B), 2);
+        }
+    const double ratio = mean(I) / mean(R), rmse = std::sqrt(e2 / (m * m * 3)) / mean(R);
+    std::printf("%s-lit: mean radiance reference %.5f, depth_impostors %.5f (ratio %.3f), block rmse %.3f\n", cs.name,
+                mean(R), mean(I), ratio, rmse);
+    ASSERT_GT(mean(R), 1e-3);
+    EXPECT_NEAR(ratio, 1.0, 0.25) << cs.name;
+    EXPECT_LT(rmse, 0.5) << cs.name;
   }
 }
 
