@@ -792,6 +792,17 @@ TEST(LayerTextures, FactorTimesTexelAsTheSpecsWriteRasterAndReference) {
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(tMean[h][c], rMean[h][c], 0.01 * rMean[h][c]) << "half " << h << " channel " << c;
 }
 
+// sum |x - y| / sum y over a kSize x kSize frame (green).
+double relativeL1(const Image& x, const Image& y) {
+  double num = 0.0, den = 0.0;
+  for (int j = 0; j < kSize; ++j)
+    for (int i = 0; i < kSize; ++i) {
+      num += std::abs(x.at(i, j)[1] - y.at(i, j)[1]);
+      den += y.at(i, j)[1];
+    }
+  return num / den;
+}
+
 TEST(LayerTextures, CoatNormalMapMovesTheCoatsHighlightAsInTheReference) {
   // A black base with no specular (KHR_materials_specular 0) reflects nothing: the card shows its clear
   // coat alone. A constant clearcoatNormalTexture texel tilts the coat normal towards +x (the card's
@@ -819,16 +830,6 @@ TEST(LayerTextures, CoatNormalMapMovesTheCoatsHighlightAsInTheReference) {
   req.compare = api::CompareSpec{"reference", "beauty", 128, 1};
   const RenderOutput a = renderer().render(mappedScene, req);
   const RenderOutput f = renderer().render(flatScene, req);
-  // sum |x - y| / sum y over the frame (green).
-  auto relativeL1 = [](const Image& x, const Image& y) {
-    double num = 0.0, den = 0.0;
-    for (int j = 0; j < kSize; ++j)
-      for (int i = 0; i < kSize; ++i) {
-        num += std::abs(x.at(i, j)[1] - y.at(i, j)[1]);
-        den += y.at(i, j)[1];
-      }
-    return num / den;
-  };
   const double mappedError = relativeL1(aov(a, "beauty"), aov(a, "reference"));
   const double flatError = relativeL1(aov(f, "beauty"), aov(f, "reference"));
   const double tiltRaster = relativeL1(aov(f, "beauty"), aov(a, "beauty"));
@@ -862,15 +863,6 @@ TEST(ShadingNormals, VertexNormalsAgainstTheWindingShadeAsConsistentOnesRasterAn
   req.compare = api::CompareSpec{"reference", "beauty", 64, 1};
   const RenderOutput c = renderer().render(consistent, req);
   const RenderOutput r = renderer().render(reversed, req);
-  auto relativeL1 = [](const Image& x, const Image& y) {
-    double num = 0.0, den = 0.0;
-    for (int j = 0; j < kSize; ++j)
-      for (int i = 0; i < kSize; ++i) {
-        num += std::abs(x.at(i, j)[1] - y.at(i, j)[1]);
-        den += y.at(i, j)[1];
-      }
-    return num / den;
-  };
   const double rasterFlip = relativeL1(aov(r, "beauty"), aov(c, "beauty"));
   const double referenceFlip = relativeL1(aov(r, "reference"), aov(c, "reference"));
   const double rasterVsReference = relativeL1(aov(r, "beauty"), aov(r, "reference"));
