@@ -178,8 +178,24 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
                                  const SceneCounts& counts) {
   BudgetChoice c;
   for (const auto& t : planned) c.params[t] = paramsOf(request, t);
+  // A default the request does not set (or a pass the planner added) still above this server's caps
+  // once the preset or budget has chosen runs at the cap: validation refuses only values the request
+  // gives (api/Validate.cpp capCosts). Applied on every return path below.
+  auto lowerDefaultsToCaps = [&] {
+    for (const auto& t : planned) {
+      auto it = request.explicitParams.find(t);
+      const std::set<std::string> given = it == request.explicitParams.end() ? std::set<std::string>{} : it->second;
+      const json exceeded = capsExceeded(t, c.params[t], given, limits);
+      if (exceeded.empty()) continue;
+      c.params[t] = techniqueParams(t, clampedToCaps(t, c.params[t], exceeded));
+      c.warnings.push_back(t + ": default lowered to this server's caps: " + describeCaps(exceeded));
+    }
+  };
   c.active = !request.quality.empty() || request.timeBudgetMs > 0;
-  if (!c.active) return c;
+  if (!c.active) {
+    lowerDefaultsToCaps();
+    return c;
+  }
   const double pixels = double(request.width) * request.height;
   const json& gen = table.data().value("generated", json::object());
   c.stats = {{"table", {{"generated", gen.value("date", "")}, {"command", gen.value("command", "")},
@@ -318,6 +334,7 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
           k.point < 0 ? json(nullptr) : errorBlock(t, point, overridden(point["params"], explicitOf(t)));
     }
   }
+  lowerDefaultsToCaps();
   double total = table.predictOverheadMs(pixels);
   for (const auto& t : planned) {
     if (!techniques[t].contains("predicted_ms")) {

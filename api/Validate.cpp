@@ -4,6 +4,7 @@
 #include <cmath>
 #include <regex>
 #include <sstream>
+#include <type_traits>
 
 #include "api/JsonLimits.h"
 #include "embedded/radiant_api_schema.h"
@@ -67,23 +68,39 @@ json checkType(const std::string& type, const json& v, const std::string& pointe
 }
 
 // Caps every value whose schema declares "x-cost" (Validate.h), walking the validated request beside
-// its schema. Values the request does not carry (a pass it does not name) are not there to cap.
-void capCosts(const json& schema, const json& value, const std::string& pointer, const RequestLimits& limits) {
+// its schema and the request as sent (`given`, null where the request carries nothing). A pass
+// parameter the request does not give (its schema default) is not refused here: the renderer lowers it
+// to the cap with a warning (api::chooseConfiguration), as it does for passes the planner adds. Every
+// other default is capped like a given value.
+void capCosts(const json& schema, const json& value, const json* given, const std::string& pointer,
+              const RequestLimits& limits) {
   if (auto c = schema.find("x-cost"); c != schema.end() && value.is_number_integer()) {
+    const bool passDefault = !given && pointer.rfind("/passes/", 0) == 0;
     const std::string kind = c->get<std::string>();
-    if (const auto l = costLimit(kind, limits); l && value.get<long long>() > l->max)
+    if (const auto l = costLimit(kind, limits); l && !passDefault && value.get<long long>() > l->max)
       throw ApiError(422, "limit-exceeded", "Server limit exceeded",
                      pointer + ": " + std::to_string(value.get<long long>()) + " is above this server's " + kind +
                          " limit " + std::to_string(l->max) + " (radiantd " + l->flag + ")",
                      pointer);
   }
+  auto child = [&](const auto& key) -> const json* {
+    if (!given) return nullptr;
+    if constexpr (std::is_integral_v<std::decay_t<decltype(key)>>) {
+      return given->is_array() && key < given->size() ? &(*given)[key] : nullptr;
+    } else {
+      if (!given->is_object()) return nullptr;
+      auto it = given->find(key);
+      return it == given->end() ? nullptr : &*it;
+    }
+  };
   if (value.is_object()) {
     if (auto p = schema.find("properties"); p != schema.end())
       for (const auto& [key, sub] : p->items())
-        if (auto it = value.find(key); it != value.end()) capCosts(sub, *it, pointerAppend(pointer, key), limits);
+        if (auto it = value.find(key); it != value.end())
+          capCosts(sub, *it, child(key), pointerAppend(pointer, key), limits);
   } else if (value.is_array()) {
     if (auto items = schema.find("items"); items != schema.end())
-      for (std::size_t i = 0; i < value.size(); ++i) capCosts(*items, value[i], pointerAppend(pointer, i), limits);
+      for (std::size_t i = 0; i < value.size(); ++i) capCosts(*items, value[i], child(i), pointerAppend(pointer, i), limits);
   }
 }
 
@@ -312,7 +329,7 @@ json normaliseRenderRequest(const json& body, const RequestLimits& limits) {
   };
   limit("/width", v["width"].get<long long>(), limits.maxWidth, "width");
   limit("/height", v["height"].get<long long>(), limits.maxHeight, "height");
-  capCosts(renderRequestSchema(), v, "", limits);
+  capCosts(renderRequestSchema(), v, &input, "", limits);
 
   const json& outputs = v["outputs"];
   for (std::size_t i = 0; i < outputs.size(); ++i)

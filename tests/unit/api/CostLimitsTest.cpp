@@ -121,8 +121,9 @@ long long smallestValue(const json& knob) {
 
 // Every x-cost knob, one above its cap (and within the schema's range; for an enumerated knob, the next
 // allowed value): 422 limit-exceeded naming exactly that field and the flag that raises the cap; at the
-// cap it is accepted. The knobs of the same kind beside it (a named pass gets every default, and those
-// are capped too) are set to their smallest values, and the cap is at least those.
+// cap it is accepted. The knobs of the same kind beside it are set to their smallest values and the cap
+// is at least those (a pass default above a cap is lowered by the renderer, not refused: Presets.
+// DefaultsAboveTheServersCapsRunAtTheCaps; media defaults are still refused).
 TEST(CostLimits, AnOverCapValueOfEveryCostKnobIsA422NamingIt) {
   const json& schema = renderRequestSchema();
   int checked = 0;

@@ -259,6 +259,51 @@ TEST(Presets, ACapBelowTheWholeFrontLowersAnEnumeratedKnobToAnAllowedValue) {
   }
 }
 
+// A schema default the request does not set is not the user's value: a named pass's default above a
+// daemon cap is not a 422, and neither it nor a pass the planner adds runs above the cap (it used to run
+// uncapped). It runs at the cap (an enumerated knob: its largest allowed value within it), with a
+// warning naming the flag; a value the request gives is still refused by validation.
+TEST(Presets, DefaultsAboveTheServersCapsRunAtTheCaps) {
+  const PresetTable t(syntheticTable());
+  RequestLimits caps;
+  caps.maxPhotons = 150000;        // photon_gi's default is 250000
+  caps.maxMapResolution = 100;     // specular's cube_resolution default 256, shadow maps' 1024 (minimum 256)
+  const std::vector<std::string> planned{"gbuffer", "direct", "photon_gi", "specular"};
+  const RenderRequest named = parseRenderRequest(
+      json{{"scene", {{"builtin", "cornell_box"}}}, {"passes", {{"photon_gi", json::object()}}}}, caps);
+  const BudgetChoice c = chooseConfiguration(t, planned, named, &caps);
+  EXPECT_EQ(c.params.at("photon_gi")["photons"], 150000);
+  EXPECT_EQ(c.params.at("specular")["cube_resolution"], 100);
+  ASSERT_EQ(c.warnings.size(), 2u);
+  EXPECT_NE(c.warnings[0].find("--max-photons"), std::string::npos) << c.warnings[0];
+  EXPECT_NE(c.warnings[1].find("--max-map-resolution"), std::string::npos) << c.warnings[1];
+  // Under a preset the front point decides first (within the caps), then the remaining defaults.
+  const BudgetChoice q = chooseConfiguration(t, planned, request({{"quality", "final"}}), &caps);
+  EXPECT_EQ(q.params.at("photon_gi")["photons"], 100000);
+  EXPECT_EQ(q.params.at("specular")["cube_resolution"], 100);
+  // Without caps nothing changes.
+  const BudgetChoice free = chooseConfiguration(t, planned, named, nullptr);
+  EXPECT_EQ(free.params.at("photon_gi")["photons"], 250000);
+  EXPECT_TRUE(free.warnings.empty());
+  // A given value above the cap is the request's own: refused, naming it.
+  try {
+    parseRenderRequest(json{{"scene", {{"builtin", "cornell_box"}}}, {"passes", {{"photon_gi", {{"photons", 200000}}}}}},
+                       caps);
+    ADD_FAILURE() << "no 422";
+  } catch (const ApiError& e) {
+    EXPECT_EQ(e.status, 422);
+    EXPECT_EQ(e.pointer, "/passes/photon_gi/photons");
+  }
+  // A default with no allowed value within the cap (shadow maps' minimum 256): the technique cannot run.
+  try {
+    chooseConfiguration(t, {"gbuffer", "shadow_maps"}, named, &caps);
+    ADD_FAILURE() << "no 422";
+  } catch (const ApiError& e) {
+    EXPECT_EQ(e.status, 422);
+    EXPECT_EQ(e.pointer, "/passes/shadow_maps/shadow_map_size");
+  }
+}
+
 TEST(Presets, BudgetsChooseOnlyAmongPointsWithinTheCaps) {
   const PresetTable t(syntheticTable());
   RequestLimits caps;

@@ -332,7 +332,9 @@ TEST(PathTracer, AbsorbingSlabTransmitsBeerLambertInsideTheFresnelSeries) {
       EXPECT_NEAR(vol.pixels[k], T, 0.01 * T) << "theta " << theta << " channel " << k;
       const double ratio = double(vol.pixels[k]) / ref.pixels[k];
       EXPECT_NEAR(ratio, a * (1 - R * R) / (1 - R * R * a * a), 0.015 * a) << "theta " << theta << " channel " << k;
-      if (theta == 0.0) EXPECT_NEAR(ratio, std::pow(double(c[k]), d / d0), 0.02 * std::pow(double(c[k]), d / d0));
+      if (theta == 0.0) {
+        EXPECT_NEAR(ratio, std::pow(double(c[k]), d / d0), 0.02 * std::pow(double(c[k]), d / d0));
+      }
     }
   }
 }
