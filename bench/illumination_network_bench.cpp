@@ -4,7 +4,7 @@
 // sphere, R = 1, tau = 10, so 2 R tau = 20; albedo 0.9; isotropic phase) lit by a directional light and
 // a uniform sky; then the goal: the network at N = 1024, D = 128 against the single-scatter methods
 // on the same cloud (spherical_billboards; depth_impostors when the registry has it).
-//   build/bench/illumination_network_bench [size=64] [iterations=32] [spp=256] [repeats=1] [table|goal|both]
+//   build/bench/illumination_network_bench [size=64] [iterations=32] [spp=256] [repeats=1] [table|goal|both|directions]
 // The goal runs on two clouds of the same optical size: the homogeneous sphere (one particle: what the
 // network samples its nodes from) and 8000 constant particles in the unit ball (the depth_impostors
 // bench's cloud), so the single-scatter methods see particles they can shadow between.
@@ -136,7 +136,7 @@ int main(int argc, char** argv) {
                    {"illumination_network", {{"nodes", N}, {"directions", D}, {"iterations", iters}, {"warm_start", false}}}};
     return b;
   };
-  if (mode != "goal") {
+  if (mode == "table" || mode == "both") {
   std::printf("\nillumination_network, %d iterations per frame (cold start), %dx%d, median of %d frames\n", iterations,
               size, size, repeats);
   std::printf("start: %s\n", whenAndLoad().c_str());
@@ -161,6 +161,52 @@ int main(int argc, char** argv) {
   std::printf("end: %s\n", whenAndLoad().c_str());
   }
   if (mode == "table") return 0;
+
+  // Error against D at N 1024 (issue 17's "falls with N and D", a numeric Fig. 9.6), for the isotropic
+  // phase (the thesis') and Henyey-Greenstein g 0.5 and 0.8, each against its own references. The image
+  // splits into the part scattered once (the frame of 0 iterations: the sun exactly, the sky over the
+  // D directions' normalised phase column) and the rest (the network's multiply scattered part:
+  // the frame of `iterations` minus that of 0), scored against full - single_scatter of the reference.
+  if (mode == "directions") {
+    std::printf("\nerror against D at N 1024, %d cold iterations, %dx%d, references %d spp\n", iterations, size, size, spp);
+    std::printf("start: %s\n", whenAndLoad().c_str());
+    std::printf("%-10s %4s %9s %9s %9s %9s %9s\n", "phase", "D", "error", "once_err", "ms_err", "ms_share", "frame_ms");
+    for (const double g : {0.0, 0.5, 0.8}) {
+      json medium = cloud;
+      if (g > 0) medium["phase"] = {{"model", "hg"}, {"g", g}};
+      json b0 = base;
+      b0["media"] = json::array({medium});
+      auto referenceOf = [&](const char* mediaMode) {
+        json rb = b0;
+        rb["passes"] = {{"spherical_billboards", false},
+                        {"reference", {{"aov", "media"}, {"media_mode", mediaMode}, {"spp", spp}, {"max_bounces", 64}}}};
+        rb["outputs"] = refBody["outputs"];
+        return aovOf(renderer.render(scene, api::parseRenderRequest(rb)), "reference");
+      };
+      const Image full = referenceOf("full"), once = referenceOf("single_scatter");
+      Image ms = full;
+      for (std::size_t k = 0; k < ms.pixels.size(); ++k) ms.pixels[k] = full.pixels[k] - once.pixels[k];
+      double meanFull = 0, meanMs = 0;
+      for (std::size_t k = 0; k < ms.pixels.size(); ++k) meanFull += full.pixels[k], meanMs += ms.pixels[k];
+      for (int D : {4, 8, 16, 32, 64, 128}) {
+        json b = b0;
+        b["passes"] = {{"spherical_billboards", false},
+                       {"illumination_network", {{"nodes", 1024}, {"directions", D}, {"iterations", iterations}, {"warm_start", false}}}};
+        Image img, img0;
+        const Timing t = median(renderer, scene, b, "illumination_network", repeats, &img, nullptr, /*warmUp=*/false);
+        b["passes"]["illumination_network"]["iterations"] = 0;
+        median(renderer, scene, b, "illumination_network", 1, &img0, nullptr, /*warmUp=*/false);
+        Image msNet = img;
+        for (std::size_t k = 0; k < msNet.pixels.size(); ++k) msNet.pixels[k] = img.pixels[k] - img0.pixels[k];
+        std::printf("%-10s %4d %9.4f %9.4f %9.4f %9.3f %9.0f\n", g > 0 ? ("hg " + std::to_string(g).substr(0, 3)).c_str() : "isotropic",
+                    D, blockError(img, full), blockError(img0, once), blockError(msNet, ms), meanMs / meanFull,
+                    std::max(t.gpuMs, t.cpuMs));
+        std::fflush(stdout);
+      }
+    }
+    std::printf("end: %s\n", whenAndLoad().c_str());
+    return 0;
+  }
 
   // The goal: N 1024, D 128 against single scattering, per cloud, against that cloud's own reference.
   bool impostors = false;

@@ -3,8 +3,11 @@
 // default cloud: a homogeneous sphere of albedo 0.9 and optical diameter 2 R tau = 20 (R = 1,
 // tau = 10), isotropic phase, lit by a directional light and a uniform sky.
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -32,18 +35,22 @@ Scene cloudScene() {
   return s;
 }
 
-RenderOutput render(const Scene& scene, json passes, json aovs = {"beauty", "media", "media_transmittance"}) {
+json requestBody(json passes, json aovs = {"beauty", "media", "media_transmittance"}, json medium = kCloud) {
   json body = {{"scene", {{"builtin", "unused"}}},
                {"width", kSize},
                {"height", kSize},
                {"ambient", {0.3, 0.35, 0.45}},
-               {"media", json::array({kCloud})},
+               {"media", json::array({medium})},
                {"outputs", json::array({{{"format", "exr"}, {"aovs", aovs}}})},
                {"passes", passes}};
   // One raster sample per pixel, as these tests' bounds were measured (the HTTP default is
   // "supersampling": 2 since 2026-12-02; this body goes through the same validator).
   body["supersampling"] = 1;
-  return renderer().render(scene, api::parseRenderRequest(body));
+  return body;
+}
+
+RenderOutput render(const Scene& scene, json passes, json aovs = {"beauty", "media", "media_transmittance"}) {
+  return renderer().render(scene, api::parseRenderRequest(requestBody(passes, aovs)));
 }
 
 // The reference image (cached by the renderer across the calls of this process).
@@ -134,9 +141,75 @@ TEST(IlluminationNetworkPass, OversizedNetworksAre422sNamingTheField) {
   };
   EXPECT_EQ(pointerOf({{"nodes", 65536}, {"directions", 32}}), "/passes/illumination_network/nodes");
   EXPECT_EQ(pointerOf({{"nodes", 64}, {"directions", 512}, {"window", 256}}), "/passes/illumination_network/window");
+  // The exact sky's particles x directions chords per step of the march (the one product in the march's
+  // work that no server cap bounds) above 65536: 1024 particles x 128 directions; 64 directions pass.
+  const json many = {{"kind", "cloud"}, {"tau", 10.0}, {"albedo", {0.9, 0.9, 0.9}}, {"seed", 1},
+                     {"generator", {{"count", 1024}, {"extent", {1, 1, 1}}, {"radius", 0.1}}}};
+  auto exactSky = [&](int D) -> std::string {
+    json p = network(64, D, {{"iterations", 0}, {"sky_single_scatter", "exact"}, {"march_steps", 1}});
+    try {
+      renderer().render(scene, api::parseRenderRequest(requestBody(p, {"media"}, many)));
+    } catch (const api::ApiError& e) {
+      EXPECT_EQ(e.status, 422);
+      return e.pointer;
+    }
+    return "no error";
+  };
+  EXPECT_EQ(exactSky(128), "/passes/illumination_network/sky_single_scatter");
+  EXPECT_EQ(exactSky(64), "no error");
   // The renderer keeps serving.
   const RenderOutput ok = render(scene, network(64, 8, {{"iterations", 1}}));
   EXPECT_TRUE(testing::allFinite(ok));
+}
+
+// A cancel during the marched final render ends the frame "canceled" (409, which the server's job
+// takes as its state) within one stretch: each stretch is finished before the pass asks again. The
+// pass reports its progress 0.5 when the march starts and 0.5 + 0.5 k / S after stretch k of S; the
+// flag is raised at the report after stretch 2 of 8, and no stretch is drawn after it.
+TEST(IlluminationNetworkPass, CancelDuringTheMarchEndsTheFrameCanceledWithinOneStretch) {
+  const Scene scene = cloudScene();
+  const json passes = network(256, 8, {{"iterations", 0}, {"march_steps", 64}, {"march_stretch", 8}, {"seed", 5}});
+  const RenderOutput whole = render(scene, passes);
+  const auto* p = testing::pass(whole, "illumination_network");
+  ASSERT_NE(p, nullptr);
+  EXPECT_EQ(p->counters.at("march_stretch"), 8);
+  EXPECT_EQ(p->counters.at("march_draws"), 8);
+  // The pass's share of the frame's progress: 0.95 (i + f) / n for pass i of n (Renderer::render).
+  std::size_t index = 0;
+  while (whole.stats.passes[index].name != "illumination_network") ++index;
+  const double n = static_cast<double>(whole.stats.passes.size());
+  auto fraction = [&](double v) { return v / 0.95 * n - static_cast<double>(index); };
+
+  std::atomic<bool> cancel{false};
+  std::vector<double> inPass, afterCancel;
+  FrameInputs inputs;
+  inputs.progress = [&](double v) {
+    const double f = fraction(v);
+    if (!(f > 1e-9 && f <= 1.0 + 1e-9)) return;
+    if (cancel.load()) afterCancel.push_back(f);
+    inPass.push_back(f);
+    if (inPass.size() == 3) cancel.store(true);  // reports 0.5 (start), 0.5625 (1 of 8), 0.625 (2 of 8)
+  };
+  std::string detail;
+  try {
+    renderer().render(scene, api::parseRenderRequest(requestBody(passes)), &cancel, inputs);
+    ADD_FAILURE() << "the cancelled frame finished";
+  } catch (const api::ApiError& e) {
+    EXPECT_EQ(e.status, 409);
+    EXPECT_EQ(e.type, "canceled");
+    detail = e.detail();
+  }
+  ASSERT_EQ(inPass.size(), 3u);
+  EXPECT_NEAR(inPass[2], 0.5 + 0.5 * 2 / 8, 1e-6);
+  EXPECT_TRUE(afterCancel.empty()) << afterCancel.size() << " more stretches reported after the cancel";
+  EXPECT_NE(detail.find("after stretch 2 of 8"), std::string::npos) << detail;
+  std::printf("cancelled: %s\n", detail.c_str());
+  // The renderer keeps serving, and the frame is the uncancelled one.
+  const RenderOutput again = render(scene, passes);
+  const Image &a = aov(whole, "media"), &b = aov(again, "media");
+  double d = 0;
+  for (std::size_t i = 0; i < a.pixels.size(); ++i) d = std::max(d, double(std::abs(a.pixels[i] - b.pixels[i])));
+  EXPECT_EQ(d, 0.0);
 }
 
 // warm_start (default on) never makes a frame depend on earlier requests: it resumes only from a
