@@ -98,6 +98,10 @@ int main(int argc, char** argv) {
   const int spp = argc > 3 ? std::atoi(argv[3]) : 256;
   const int repeats = argc > 4 ? std::atoi(argv[4]) : 1;
   const std::string mode = argc > 5 ? argv[5] : "both";
+  if (mode != "table" && mode != "goal" && mode != "both" && mode != "directions") {
+    std::fprintf(stderr, "mode must be table, goal, both or directions, not %s\n", mode.c_str());
+    return 2;
+  }
   Renderer renderer;
   std::printf("GL renderer: %s | %s\n", renderer.device().renderer.c_str(), renderer.device().version.c_str());
 
