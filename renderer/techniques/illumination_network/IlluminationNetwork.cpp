@@ -15,8 +15,11 @@ namespace {
 constexpr int kMaxLights = 8;
 constexpr std::size_t kMaxLinks = std::size_t(1) << 20;  // N x D: 16 MiB per radiance buffer
 constexpr std::size_t kMaxBins = std::size_t(1) << 22;   // D x M^2: 16 MiB per bin table (three of them)
-constexpr long long kLoopBudget = 60000;  // of llvmpipe's 65535 loop iterations per shader invocation
 constexpr std::size_t kSkyExactBudget = 8192;            // particles x D per march step for sky_single_scatter auto
+// particles x D per march step that sky_single_scatter exact may ask for (422 beyond): the one product of
+// request values in the march's work that no server cap bounds (every other term of a piece is linear
+// in nodes or particles, and the pieces are march_steps, all capped: network::marchPieceLoops).
+constexpr std::size_t kSkyExactMax = 65536;
 }  // namespace
 
 struct IlluminationNetworkPass::Network {
@@ -181,14 +184,28 @@ void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, 
   // up to kSkyExactBudget of them (a few big particles, the thesis' homogeneous cloud) and leaves it to
   // the network beyond.
   const std::string sky = params.get<std::string>("sky_single_scatter", "auto");
+  if (march_ && sky == "exact" && particles_.size() * std::size_t(D) > kSkyExactMax)
+    throw api::ApiError(422, "invalid-value", "Exact sky single scattering too costly",
+                        "sky_single_scatter exact sums particles x directions = " +
+                            std::to_string(particles_.size() * std::size_t(D)) + " chords per step of the march, above " +
+                            std::to_string(kSkyExactMax) + " (use auto or network, or fewer directions)",
+                        "/passes/illumination_network/sky_single_scatter");
   skyExact_ = march_ && (sky == "exact" || (sky == "auto" && particles_.size() * std::size_t(D) <= kSkyExactBudget));
+  // The driver's loop budget per invocation and draw (network::shaderLoopBudget), read once per context.
+  if (loopBudget_ == 0) {
+    const auto* name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+    loopBudget_ = network::shaderLoopBudget(name ? name : "");
+  }
+  piecesLoops_ = 0;
   if (march_) {
-    // Loop iterations of one march.frag invocation (llvmpipe stops a shader's loops after 65535 in all):
-    // the particles met by the ray, then per piece the particles again (all of them when more than 128
-    // meet the ray), the nodes, and per light (and per sky direction) the particles towards it.
+    // Loop iterations of one march.frag invocation: the particles met by the ray once, then per piece
+    // network::marchPieceLoops. A draw marches as many pieces as the budget allows (or march_stretch);
+    // when one piece alone exceeds it (llvmpipe: e.g. > 30000 particles), the splats stand in.
     const long long P = static_cast<long long>(particles_.size()), L = static_cast<long long>(lights_.size());
-    const long long perPiece = 1 + P + N + L * (1 + P) + (skyExact_ ? static_cast<long long>(D) * (1 + P) : 0);
-    marchStretch_ = static_cast<int>(std::min<long long>(marchSteps_, (kLoopBudget - P - 64) / perPiece));
+    piecesLoops_ = network::marchPieceLoops(P, N, L, D, skyExact_);
+    const int asked = params.get<int>("march_stretch", 0);
+    marchStretch_ = static_cast<int>(std::min<long long>(marchSteps_, (loopBudget_ - P - 64) / piecesLoops_));
+    if (asked > 0) marchStretch_ = std::min(marchStretch_, asked);
     if (marchStretch_ < 1) march_ = false, skyExact_ = false, marchFallback_ = true;  // too big for one piece
   }
 
@@ -273,12 +290,29 @@ void IlluminationNetworkPass::execute(PassContext& ctx) {
     prog.set("u_sky", &view.ambient.x, 3);
     particles.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingMediaParticles);
     splats.bindBase(GL_SHADER_STORAGE_BUFFER, 15);
-    // Stretches of marchStretch_ pieces, back to front (march.frag).
+    // Stretches of marchStretch_ pieces, back to front (march.frag). Each is finished before the next
+    // one starts when there is a next one, and a cancelled or timed-out request stops there: within one
+    // stretch of GPU work (the iteration's poll is every kCancelPollIterations iterations).
+    const int stretches = (marchSteps_ + marchStretch_ - 1) / marchStretch_;
+    int drawn = 0;
+    ctx.progress(0.5);
     for (int end = marchSteps_; end > 0 && !particles_.empty() && !splats_.empty(); end -= marchStretch_) {
+      if (drawn > 0) {
+        glFinish();
+        ctx.progress(0.5 + 0.5 * drawn / stretches);
+        if (ctx.cancelled()) {
+          glDisable(GL_BLEND);
+          throw api::ApiError(409, "canceled", "Render canceled",
+                              "the render was cancelled during illumination_network's march after stretch " +
+                                  std::to_string(drawn) + " of " + std::to_string(stretches));
+        }
+      }
       prog.set("u_stepBegin", std::max(0, end - marchStretch_));
       prog.set("u_stepEnd", end);
       glDrawArrays(GL_TRIANGLES, 0, 3);
+      ++drawn;
     }
+    marchDraws_ = drawn;
     glDisable(GL_BLEND);
     res.markWritten("media");
     res.markWritten("media_transmittance");
@@ -326,7 +360,10 @@ void IlluminationNetworkPass::reportStats(PassContext& ctx, bool build, const st
   c["splat_radius"] = net_->splatRadius;
   c["march_steps"] = march_ ? marchSteps_ : 0;  // 0: the splatted final render
   c["sky_single_scatter_exact"] = skyExact_ ? 1 : 0;
-  c["march_stretch"] = march_ ? marchStretch_ : 0;  // pieces per draw (llvmpipe's loop limit)
+  c["march_stretch"] = march_ ? marchStretch_ : 0;  // pieces per draw (the driver's loop budget, or march_stretch)
+  c["march_draws"] = march_ ? marchDraws_ : 0;      // stretches drawn (each a cancel point)
+  c["march_piece_loops"] = static_cast<double>(piecesLoops_);  // loop iterations per piece and pixel
+  c["loop_budget"] = static_cast<double>(loopBudget_);         // per invocation and draw (shaderLoopBudget)
   c["march_fallback"] = marchFallback_ ? 1 : 0;     // march asked for but too big for one piece: splatted
   for (std::size_t n = 0; n < residuals.size(); ++n) {
     char name[32];

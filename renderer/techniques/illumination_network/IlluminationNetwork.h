@@ -49,7 +49,9 @@ private:
   void reportStats(PassContext& ctx, bool build, const std::vector<double>& residuals) const;
   Network* net_ = nullptr;
   bool march_ = true, skyExact_ = true, linearSource_ = true, exactLinks_ = false;
-  int marchSteps_ = 64, marchStretch_ = 64;
+  int marchSteps_ = 64, marchStretch_ = 64, marchDraws_ = 0;
+  long long loopBudget_ = 0;   // network::shaderLoopBudget of this context's GL_RENDERER (0: not read yet)
+  long long piecesLoops_ = 0;  // loop iterations of one piece of the march (network::marchPieceLoops)
   bool marchFallback_ = false;
   float kernel_ = 0.f;  // the march's Gaussian width (world units)
   std::vector<gpu::MediaParticle> particles_;  // the medium's own particles, for the march

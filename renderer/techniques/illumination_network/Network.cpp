@@ -1,6 +1,7 @@
 #include "renderer/techniques/illumination_network/Network.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <numeric>
 
@@ -337,6 +338,24 @@ glm::dvec3 cameraSource(const Problem& pb, const std::vector<glm::dvec3>& I, int
   const std::size_t D = col.size();
   for (std::size_t d = 0; d < D; ++d) S += col[d] * I[std::size_t(p) * D + d];
   return nodeSource(pb, p, w) + glm::dvec3(pb.nodes->nodes[std::size_t(p)].albedo) * S;
+}
+
+long long shaderLoopBudget(std::string_view glRenderer) {
+  auto contains = [&](std::string_view word) {
+    if (glRenderer.size() < word.size()) return false;
+    for (std::size_t i = 0; i + word.size() <= glRenderer.size(); ++i) {
+      bool match = true;
+      for (std::size_t k = 0; k < word.size() && match; ++k)
+        match = std::tolower(static_cast<unsigned char>(glRenderer[i + k])) == word[k];
+      if (match) return true;
+    }
+    return false;
+  };
+  return contains("llvmpipe") || contains("softpipe") ? kSoftwareLoopBudget : kHardwareLoopBudget;
+}
+
+long long marchPieceLoops(long long particles, long long nodes, long long lights, long long directions, bool skyExact) {
+  return 1 + particles + nodes + lights * (1 + particles) + (skyExact ? directions * (1 + particles) : 0);
 }
 
 }  // namespace radiant::network

@@ -23,6 +23,7 @@
 // factor max(1 - alpha (1 - a)) in the max norm (the thesis' convergence claim, L1566).
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -145,5 +146,22 @@ double contractionFactor(const Problem& pb);
 // The radiance the node sends towards w per unit opacity (the splat's source): e_p(w) + a_p sum_d
 // W_d(w) I[p, d].
 glm::dvec3 cameraSource(const Problem& pb, const std::vector<glm::dvec3>& I, int p, glm::vec3 w);
+
+// Loop iterations one invocation of the marched final render (march.frag) may run in one draw, for the
+// driver GL_RENDERER names (read once per context). Mesa's software rasterisers end every loop of a
+// shader invocation after 65535 iterations in all, silently (gallivm's LP_MAX_TGSI_LOOP_ITERATIONS:
+// llvmpipe; softpipe is treated alike, conservatively): kSoftwareLoopBudget leaves a margin under it.
+// Other drivers have no such limit; there kHardwareLoopBudget only bounds one draw's work per pixel,
+// so that a long march is split into stretches (each a cancel point) instead of one draw. The march
+// falls back to splats only when one piece exceeds the budget, which on hardware the request limits
+// rule out (IlluminationNetwork.cpp: kSkyExactMax).
+inline constexpr long long kSoftwareLoopBudget = 60000;
+inline constexpr long long kHardwareLoopBudget = 1 << 20;
+long long shaderLoopBudget(std::string_view glRenderer);
+
+// Loop iterations of one piece of the march: the particles met by the ray (all of them when more than
+// 128 meet it), the nodes, per light the particles towards it, and per direction of the exact sky the
+// same (march.frag).
+long long marchPieceLoops(long long particles, long long nodes, long long lights, long long directions, bool skyExact);
 
 }  // namespace radiant::network

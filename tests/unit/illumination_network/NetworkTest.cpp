@@ -295,5 +295,30 @@ TEST(IlluminationNetwork, LinearLinkSourceKeepsTheFurnace) {
   EXPECT_LE(drop, 1e-15);  // monotone from 0: every coefficient of the map is non-negative
 }
 
+// The march's loop budget applies only where the driver needs it: Mesa's software rasterisers end a
+// shader invocation's loops after 65535 iterations in all, other drivers do not (the budget there
+// only splits long marches into stretches). GL_RENDERER strings as the drivers report them.
+TEST(IlluminationNetwork, LoopBudgetOnlyForSoftwareRasterisers) {
+  EXPECT_EQ(shaderLoopBudget("llvmpipe (LLVM 15.0.6, 256 bits)"), kSoftwareLoopBudget);
+  EXPECT_EQ(shaderLoopBudget("softpipe"), kSoftwareLoopBudget);
+  EXPECT_EQ(shaderLoopBudget("LLVMPIPE (LLVM 17.0.0, 128 bits)"), kSoftwareLoopBudget);
+  EXPECT_EQ(shaderLoopBudget("NVIDIA GeForce RTX 3080/PCIe/SSE2"), kHardwareLoopBudget);
+  EXPECT_EQ(shaderLoopBudget("AMD Radeon RX 6800 XT (navi21, LLVM 15.0.6, DRM 3.49, 6.1.0-13-amd64)"),
+            kHardwareLoopBudget);
+  EXPECT_EQ(shaderLoopBudget("Mesa Intel(R) UHD Graphics 630 (CFL GT2)"), kHardwareLoopBudget);
+  EXPECT_EQ(shaderLoopBudget(""), kHardwareLoopBudget);
+  EXPECT_LT(kSoftwareLoopBudget, 65535);
+  EXPECT_GT(kHardwareLoopBudget, kSoftwareLoopBudget);
+  // One piece of the march on the thesis' cloud (1 particle, N 1024, 1 light, D 128, exact sky) and on
+  // the 8000-particle cloud (sky in the network): 1 + P + N + L (1 + P) [+ D (1 + P)].
+  EXPECT_EQ(marchPieceLoops(1, 1024, 1, 128, true), 1 + 1 + 1024 + 2 + 128 * 2);
+  EXPECT_EQ(marchPieceLoops(8000, 1024, 1, 128, false), 1 + 8000 + 1024 + 8001);
+  // 40000 particles and one light: a piece exceeds the software budget (the splats stand in there) but
+  // not the hardware one, which no piece within the request limits reaches (65536 particles, 8 lights,
+  // 65536 nodes, exact sky at most 65536 chords).
+  EXPECT_GT(marchPieceLoops(40000, 1024, 1, 128, false), kSoftwareLoopBudget);
+  EXPECT_LT(marchPieceLoops(65536, 65536, 8, 1, true) + 65536, kHardwareLoopBudget);
+}
+
 }  // namespace
 }  // namespace radiant::network
