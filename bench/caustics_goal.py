@@ -4,13 +4,17 @@ default frame with caustics land within 1.5x the RMSE of the reference at 256 sp
 its time? Same procedure as bench/photon_gi_goal.py (whose helpers it uses), one run on one machine:
 
     bench/caustics_goal.py [--server URL] [--size 128] [--truth-spp 2048] [--truth FILE.exr]
+                           [--supersampling K] [--photon-variants]
 
   1. ground truth: the reference at --truth-spp (seed 99; path tracer + light-traced caustics);
   2. the reference at 256 spp (seed 5): its time (the reference pass) and RMSE;
   3. frames with photons cached (a first render from another camera traces them), scored on beauty:
      the default frame (caustics on), the same with caustics off, without the secondary lookup (the
      reference has no L S+ D S+ E paths), and caustics at P 256 / C 512.
-Prints a Markdown table for docs/PERFORMANCE.md. Python standard library only.
+  4. with --photon-variants, the default frame at photon_gi 100k photons and at gather_step 4.
+The reference pass caches its images: run each measurement against a fresh radiantd, or its time is a
+cache hit's. Prints a Markdown table (with the photon_gi and specular passes' ms) for
+docs/PERFORMANCE.md. Python standard library only.
 """
 import argparse
 import os
