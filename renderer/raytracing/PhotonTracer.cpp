@@ -26,6 +26,7 @@ void tracePhoton(const RayScene& rays, const SceneLights& lights, const PhotonOp
   const int lastBounce = o.maxBounces - 1;
   bool narrowLobePath = true;  // every scattering so far off a metal or glass by a non-diffuse lobe
   bool specularChain = true;  // every scattering vertex so far on a Material::isSpecular() surface
+  bool scatteredNonDelta = false;  // some earlier vertex scattered through a non-delta lobe
   VolumeInterior interior;  // KHR_materials_volume: the absorbing medium the photon travels in
   for (int bounce = 0; bounce <= lastBounce; ++bounce) {
     SurfaceHit hit;
@@ -56,7 +57,12 @@ void tracePhoton(const RayScene& rays, const SceneLights& lights, const PhotonOp
     const float uLobe = sampler.next(), uFresnel = sampler.next();
     const glm::vec2 uDir = sampler.next2();
     GltfBsdf::Sample s;
-    if (!sh.bsdf.sample(woL, uLobe, uFresnel, uDir, s) || s.delta) return;
+    if (!sh.bsdf.sample(woL, uLobe, uFresnel, uDir, s)) return;
+    // A delta scattering ends only a path that has had no other: L S+ D is the caustics' class. After a
+    // diffuse or glossy vertex the photon crosses glass and mirrors (L D S+ D: a lit ceiling seen through
+    // a glass sphere by the floor), as the reference path tracer's paths do.
+    if (s.delta && !scatteredNonDelta) return;
+    scatteredNonDelta = scatteredNonDelta || !s.delta;
     narrowLobePath = narrowLobePath && (s.flags & (kLobeGlossy | kLobeSpecular)) != 0 &&
                      rays.materialOf(hit.mesh).scattersNarrowLobe();
     if (!continueParticle(rays, hit, sh, wo, woL, s, o.russianRoulette, sampler, flux, ray, interior)) return;

@@ -10,8 +10,9 @@
 // "rescaled" by using 1 / (m + m') instead of 1 / m, and the result is exactly a fresh run of m + m'
 // photons with the same seed (photon i's random numbers depend only on (i, seed)).
 //
-// A delta (mirror, smooth glass) scattering ends a photon: what it would carry is LS+D light, caustics,
-// which this tracer does not own. Near-mirrors (Material::isSpecular() with roughness > 0) have a
+// A delta (mirror, smooth glass) scattering ends a photon whose path has had no other scattering: what
+// it would carry is LS+D light, caustics, which this tracer does not own. After a diffuse or glossy
+// vertex the photon follows delta scatterings (L D S+ D, as the reference's paths). Near-mirrors (Material::isSpecular() with roughness > 0) have a
 // glossy lobe and are scattered by it; a record whose earlier vertices all lie on such surfaces is
 // flagged kPhotonSpecularChain (class LS+D), so that a consumer can leave it to the caustics pass.
 #include <cstdint>
