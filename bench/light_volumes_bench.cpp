@@ -177,7 +177,7 @@ const api::PassStats& passOf(const RenderOutput& out, const std::string& name) {
 struct Timed {
   double gpuMs = 0.0, firstCpuMs = 0.0;
   Image image;
-  double beams = 0.0, segments = 0.0, setupMs = 0.0, bvhMs = 0.0, fallbacks = 0.0;
+  double beams = 0.0, segments = 0.0, setupMs = 0.0, bvhMs = 0.0, fallbacks = 0.0, added = 0.0, exhausted = 0.0;
 };
 
 // The pass `pass` of `r` on `scene`: a first frame (which builds and caches the pass's derived data),
@@ -202,6 +202,8 @@ Timed timedPass(const Scene& scene, const api::RenderRequest& r, const std::stri
         t.beams = passOf(out, pass).counters.at("beams");
         t.segments = passOf(out, pass).counters.at("bvh_segments");
         t.fallbacks = passOf(out, pass).counters.at("tessellation_specular_fallbacks");
+        t.added = passOf(out, pass).counters.at("subdivision_beams_added");
+        t.exhausted = passOf(out, pass).counters.at("subdivision_budget_exhausted");
       }
     }
   }
@@ -277,8 +279,10 @@ void compare(const char* name, const Scene& scene, int size, int ltPaths, bool s
   };
   {
     const Timed lv = timed(scene, size, size, "bvh", 3);
-    char d[96];
-    std::snprintf(d, sizeof d, " (%.0f beams%s)", lv.beams, lv.fallbacks > 0 ? ", specular fallback" : "");
+    char d[160];
+    std::snprintf(d, sizeof d, " (%.0f beams%s%s%s)", lv.beams,
+                  lv.added > 0 ? (", " + std::to_string(long(lv.added)) + " by subdivision").c_str() : "",
+                  lv.exhausted > 0 ? ", subdivision budget exhausted" : "", lv.fallbacks > 0 ? ", specular fallback" : "");
     row("light_volumes", lv, d);
   }
   if (specular) {
