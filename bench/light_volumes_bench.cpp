@@ -2,7 +2,7 @@
 // (the paper's loop over every beam) and the culled one (BVH over the beams' cones), the error against
 // the reference light tracer, and the comparison with caustic triangles and photon splatting.
 //   build/bench/light_volumes_bench timing <width> <height> [max_linear_beams=5120] [max_bvh_beams=81920] [frames=3]
-//   build/bench/light_volumes_bench compare [size=128] [lt_paths_per_pixel=256] [scene name prefix] [methods=all|light_volumes]
+//   build/bench/light_volumes_bench compare [size=128] [lt_paths_per_pixel=256] [scene name prefix] [methods=all|light_volumes] [max_subdivision_beams]
 // Scenes (a Lambertian floor, albedo 0.5, seen from straight above by an orthographic camera that sits
 // below every scatterer, so that the light tracer's camera connections see the floor directly):
 //   ring    the paper's cardioid (Fig. 2): a half ring of mirror (radius 0.5 m, 0.2 m tall, roughness
@@ -157,11 +157,14 @@ Scene windowScene(float roughness) {
   return b.build("bench:light_volumes:window:" + std::to_string(roughness));
 }
 
+long gSubdivisionBeams = -1;  // compare's light_volumes max_subdivision_beams; < 0: the schema's default
+
 api::RenderRequest request(int width, int height, const std::string& traversal) {
   api::RenderRequest r;
   r.width = width;
   r.height = height;
   r.passes["light_volumes"] = {{"traversal", traversal}};
+  if (gSubdivisionBeams >= 0) r.passes["light_volumes"]["max_subdivision_beams"] = gSubdivisionBeams;
   r.disabledPasses.insert("photon_gi");
   r.disabledPasses.insert("caustics");
   r.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty", "light_volumes"}, false}};
@@ -334,6 +337,7 @@ int main(int argc, char** argv) {
   const std::string only = argc > 4 ? argv[4] : "";  // run only the scenes whose name starts with this
   auto wanted = [&](const char* name) { return std::string(name).rfind(only, 0) == 0; };
   const bool others = !(argc > 5 && std::string(argv[5]) == "light_volumes");  // the other techniques' rows too
+  if (argc > 6) gSubdivisionBeams = std::atol(argv[6]);
   std::printf("%dx%d; ms = the pass's GPU ms, caches warm (median of 3); first-frame CPU ms includes building "
               "beams, photon images or photon maps\n\n",
               size, size);

@@ -296,6 +296,12 @@ float lightMeasure(const Light& light, const glm::vec3 p[3]) {
   return solidAngle(p[0] - light.position, p[1] - light.position, p[2] - light.position);
 }
 
+// The 1-to-4 levels a triangle needs to meet the condition at its own receiver distance (each level
+// halves the edges).
+int subdivisionLevel(float ratio, float maxTriangleSigma) {
+  return std::clamp(int(std::ceil(std::log2(ratio / maxTriangleSigma))), 1, kMaxSubdivisionLevel);
+}
+
 // One glossy beam of a scatterer and where it came from.
 struct GlossySource {
   std::size_t beam;
@@ -329,7 +335,7 @@ public:
     if (!(parentMeasure_ > 0.f)) return true;
     // The level the parent's own bound asks for: each level halves the edges at about the same
     // receiver distance; children that still fail (a nearer receiver under them) split again.
-    const int level = std::clamp(int(std::ceil(std::log2(ratio / o_.maxTriangleSigma))), 1, kMaxSubdivisionLevel);
+    const int level = subdivisionLevel(ratio, o_.maxTriangleSigma);
     const glm::vec3 bary[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
     if (!recurse(bary, level, 0, children)) return false;
     const std::size_t made = children.size() - base_;
@@ -433,7 +439,16 @@ void appendScattererBeams(const Light& light, const std::vector<TriangleInput>& 
   // Subdivision of the failing triangles, all of them or (budget exceeded) none.
   std::size_t failingAfter = failed;
   const std::size_t left = o.maxSubdivisionBeams > out.subdivisionBeamsAdded ? o.maxSubdivisionBeams - out.subdivisionBeamsAdded : 0;
-  if (failed > 0 && left > 0) {
+  // What the parents' own bounds ask for is a lower bound of the beams the subdivision adds (children
+  // with a nearer receiver split further): when it exceeds the budget, do not start.
+  double leastAdded = 0.0;
+  for (const GlossySource& g : glossy)
+    if (g.ratio > o.maxTriangleSigma)
+      leastAdded += std::pow(4.0, subdivisionLevel(g.ratio, o.maxTriangleSigma)) - 1.0;
+  if (failed > 0 && left > 0 && leastAdded > double(left)) {
+    record.budgetExhausted = true;
+    ++out.subdivisionBudgetExhausted;
+  } else if (failed > 0 && left > 0) {
     Subdivider subdivider(light, o, receiverDistance, left);
     std::vector<Beam> children;
     std::vector<std::pair<std::size_t, std::pair<std::size_t, std::size_t>>> replaced;  // beam, [begin, end)
