@@ -9,6 +9,7 @@
 
 #include "renderer/raytracing/Bsdf.h"
 #include "renderer/raytracing/Lights.h"
+#include "renderer/raytracing/VolumeInterior.h"
 
 namespace radiant::light_volumes {
 namespace {
@@ -403,6 +404,36 @@ private:
 
 }  // namespace
 
+namespace {
+
+// KHR_materials_volume: a beam leaving a scatterer with a medium against its geometric normal (the
+// outward side is the front face) travels inside the closed mesh, as rt::VolumeInterior decides for the
+// CPU tracers: refracted into it, or reflected inside it. Its flux is multiplied by the Beer-Lambert
+// transmittance exp(-sigma_t t) over its chord t inside, the distance from its centroid along its mean
+// direction to the first surface (the exit face; no hit: an open mesh, t = infinity, as the tracers
+// take it). The beam keeps going after that face (one interface: it is not refracted again).
+void attenuateInsideVolume(const std::vector<TriangleInput>& triangles, const ReceiverDistance& receiverDistance,
+                           std::size_t first, BeamSet& out) {
+  if (triangles.empty() || !triangles.front().material.hasVolume()) return;
+  const rt::VolumeInterior inside{triangles.front().material.attenuationCoefficient()};
+  if (!inside.absorbs()) return;
+  for (std::size_t i = first; i < out.beams.size(); ++i) {
+    Beam& b = out.beams[i];
+    if (b.vertexB.w == 1.f) continue;  // shadow beams: the unscattered light, outside
+    const glm::vec3 V[3] = {glm::vec3(b.vertexA), glm::vec3(b.vertexB), glm::vec3(b.vertexC)};
+    const glm::vec3 N = glm::normalize(glm::vec3(b.dirA) + glm::vec3(b.dirB) + glm::vec3(b.dirC));
+    const glm::vec3 ng = glm::cross(V[1] - V[0], V[2] - V[0]);
+    if (!(glm::dot(N, ng) < 0.f)) continue;
+    const float chord = receiverDistance((V[0] + V[1] + V[2]) / 3.f, N);
+    const glm::vec3 T = inside.transmittance(chord > 0.f ? chord : rt::kInf);
+    out.flux += glm::dvec3(glm::vec3(b.fluxSigma) * (T - glm::vec3(1.f))) * double(planeGain(b.fluxSigma.w));
+    b.fluxSigma = v4(glm::vec3(b.fluxSigma) * T, b.fluxSigma.w);
+    ++out.volumeAttenuated;
+  }
+}
+
+}  // namespace
+
 void appendScattererBeams(const Light& light, const std::vector<TriangleInput>& triangles, const BeamOptions& o,
                           const ReceiverDistance& receiverDistance, BeamSet& out, std::size_t mesh,
                           std::size_t lightIndex, const std::string& name) {
@@ -419,8 +450,9 @@ void appendScattererBeams(const Light& light, const std::vector<TriangleInput>& 
         if (out.beams[i].vertexB.w != 1.f && out.beams[i].fluxSigma.w > 0.f) glossy.push_back({i, ti, refract, -1.f});
     }
   }
-  // The tessellation condition for this scatterer and light.
   if (!receiverDistance) return;
+  attenuateInsideVolume(triangles, receiverDistance, first, out);
+  // The tessellation condition for this scatterer and light.
   std::size_t checked = 0, failed = 0;
   float worst = 0.f;
   for (GlossySource& g : glossy) {

@@ -74,6 +74,7 @@ struct BeamSet {
   std::size_t backfacing = 0;   // triangles facing away from a light (not scattering)
   std::size_t tirDropped = 0;   // refracted beams dropped for total internal reflection at a vertex
   std::size_t degenerate = 0;   // zero-area triangles or zero solid angle
+  std::size_t volumeAttenuated = 0;  // beams travelling inside a KHR_materials_volume medium (Beer-Lambert)
   // The tessellation condition (notes A5: a glossy beam conserves energy when its triangle subtends
   // at most about sigma / 2 from the receiver): glossy beams checked, those that fail it, the worst
   // (edge / distance) / sigma, and the scatterers (mesh x light) that fell back to specular beams.

@@ -198,6 +198,7 @@ void LightVolumesPass::execute(PassContext& ctx) {
   s["triangles_backfacing"] = static_cast<double>(b.backfacing);
   s["beams_tir_dropped"] = static_cast<double>(b.tirDropped);
   s["triangles_degenerate"] = static_cast<double>(b.degenerate);
+  s["beams_volume_attenuated"] = static_cast<double>(b.volumeAttenuated);
   s["tessellation_checked"] = static_cast<double>(b.tessellationChecked);
   s["tessellation_failed"] = static_cast<double>(b.tessellationFailed);
   s["tessellation_worst_triangle_sigma"] = b.worstTriangleSigma;

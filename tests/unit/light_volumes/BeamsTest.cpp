@@ -15,6 +15,7 @@
 // - a coarse glossy plate (triangles 1.2-1.4 sigma) subdivided until every child meets the condition
 //   matches the same quadrature; the children carry their triangle's flux (1e-3) and the negative beams
 //   stay one per triangle (umbra still 0); a budget too small for a scatterer makes it fall back;
+// - refracted beams inside a KHR_materials_volume slab carry attenuationColor^(chord / distance);
 // - a cylindrical mirror under collimated light focuses at R/2, and the irradiance clamp holds;
 // - degenerate input gives finite, non-negative irradiance.
 #include <algorithm>
@@ -555,6 +556,49 @@ TEST(LightVolumesMath, SubdivisionBudgetExhaustedFallsBackToSpecularAndSaysSo) {
   EXPECT_EQ(none.subdivisionBudgetExhausted, 0u) << "budget 0 means no subdivision asked, not an exhausted budget";
   EXPECT_EQ(none.specularFallbacks, 1u);
   EXPECT_EQ(none.glossy, 0u);
+}
+
+TEST(LightVolumesMath, RefractedBeamsInsideAVolumeAreAttenuatedByBeerLambert) {
+  // KHR_materials_volume: a glass slab 0.3 m thick (its top face 4 x 4 x 2 triangles at y = 0, its
+  // bottom at y = -0.3), attenuationColor (0.5, 0.8, 1) at attenuationDistance 0.5 m, under a point
+  // light. A refracted beam with mean direction N crosses the slab over the chord t = 0.3 / |N.y|, so
+  // its flux is the volume-less slab's times attenuationColor^(t / 0.5) per channel (the closed form of
+  // exp(-sigma_t t), sigma_t = -ln(color) / distance); reflected and shadow beams are not attenuated.
+  const glm::vec3 L(0.05f, 1.5f, 0.02f), color(0.5f, 0.8f, 1.f);
+  Material clear = mirror(0.f);
+  clear.metallicFactor = 0.f;
+  clear.transmissionFactor = 1.f;
+  clear.doubleSided = true;
+  Material tinted = clear;
+  tinted.thicknessFactor = 1.f;
+  tinted.attenuationDistance = 0.5f;
+  tinted.attenuationColor = color;
+  auto bottom = [](const glm::vec3& o, const glm::vec3& d) { return d.y < 0.f ? (-0.3f - o.y) / d.y : -1.f; };
+  BeamOptions o;
+  o.negativeBeams = true;
+  BeamSet a, b;
+  appendScattererBeams(pointLight(L, 1.f), plate(4, -0.2f, 0.2f, -0.2f, 0.2f, 0.f, clear), o, bottom, a);
+  appendScattererBeams(pointLight(L, 1.f), plate(4, -0.2f, 0.2f, -0.2f, 0.2f, 0.f, tinted), o, bottom, b);
+  ASSERT_EQ(a.beams.size(), b.beams.size());
+  EXPECT_EQ(a.volumeAttenuated, 0u);
+  EXPECT_EQ(b.volumeAttenuated, 32u) << "one refracted beam per triangle";
+  int refracted = 0;
+  double worst = 0.0;
+  for (std::size_t i = 0; i < a.beams.size(); ++i) {
+    const Beam& x = a.beams[i];
+    const Beam& y = b.beams[i];
+    const glm::vec3 N = glm::normalize(glm::vec3(x.dirA) + glm::vec3(x.dirB) + glm::vec3(x.dirC));
+    const bool inside = x.vertexB.w != 1.f && N.y < 0.f;
+    for (int c = 0; c < 3; ++c) {
+      const double expected = inside ? std::pow(double(color[c]), 0.3 / std::abs(N.y) / 0.5) : 1.0;
+      worst = std::max(worst, std::abs(double(y.fluxSigma[c]) / x.fluxSigma[c] / expected - 1.0));
+    }
+    refracted += inside ? 1 : 0;
+  }
+  EXPECT_EQ(refracted, 32);
+  EXPECT_LT(worst, 1e-5) << "largest relative error against color^(t / distance)";
+  EXPECT_LT(b.flux.x, a.flux.x);
+  EXPECT_EQ(b.flux.z, a.flux.z) << "attenuationColor 1 in blue: no absorption";
 }
 
 TEST(LightVolumesMath, CylindricalMirrorFocusesAtHalfItsRadius) {
