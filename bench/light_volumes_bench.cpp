@@ -2,7 +2,7 @@
 // (the paper's loop over every beam) and the culled one (BVH over the beams' cones), the error against
 // the reference light tracer, and the comparison with caustic triangles and photon splatting.
 //   build/bench/light_volumes_bench timing <width> <height> [max_linear_beams=5120] [max_bvh_beams=81920] [frames=3]
-//   build/bench/light_volumes_bench compare [size=128] [lt_paths_per_pixel=256] [scene name prefix]
+//   build/bench/light_volumes_bench compare [size=128] [lt_paths_per_pixel=256] [scene name prefix] [methods=all|light_volumes] [max_subdivision_beams]
 // Scenes (a Lambertian floor, albedo 0.5, seen from straight above by an orthographic camera that sits
 // below every scatterer, so that the light tracer's camera connections see the floor directly):
 //   ring    the paper's cardioid (Fig. 2): a half ring of mirror (radius 0.5 m, 0.2 m tall, roughness
@@ -157,11 +157,14 @@ Scene windowScene(float roughness) {
   return b.build("bench:light_volumes:window:" + std::to_string(roughness));
 }
 
+long gSubdivisionBeams = -1;  // compare's light_volumes max_subdivision_beams; < 0: the schema's default
+
 api::RenderRequest request(int width, int height, const std::string& traversal) {
   api::RenderRequest r;
   r.width = width;
   r.height = height;
   r.passes["light_volumes"] = {{"traversal", traversal}};
+  if (gSubdivisionBeams >= 0) r.passes["light_volumes"]["max_subdivision_beams"] = gSubdivisionBeams;
   r.disabledPasses.insert("photon_gi");
   r.disabledPasses.insert("caustics");
   r.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty", "light_volumes"}, false}};
@@ -177,7 +180,7 @@ const api::PassStats& passOf(const RenderOutput& out, const std::string& name) {
 struct Timed {
   double gpuMs = 0.0, firstCpuMs = 0.0;
   Image image;
-  double beams = 0.0, segments = 0.0, setupMs = 0.0, bvhMs = 0.0, fallbacks = 0.0;
+  double beams = 0.0, segments = 0.0, setupMs = 0.0, bvhMs = 0.0, fallbacks = 0.0, added = 0.0, exhausted = 0.0;
 };
 
 // The pass `pass` of `r` on `scene`: a first frame (which builds and caches the pass's derived data),
@@ -202,6 +205,8 @@ Timed timedPass(const Scene& scene, const api::RenderRequest& r, const std::stri
         t.beams = passOf(out, pass).counters.at("beams");
         t.segments = passOf(out, pass).counters.at("bvh_segments");
         t.fallbacks = passOf(out, pass).counters.at("tessellation_specular_fallbacks");
+        t.added = passOf(out, pass).counters.at("subdivision_beams_added");
+        t.exhausted = passOf(out, pass).counters.at("subdivision_budget_exhausted");
       }
     }
   }
@@ -262,7 +267,7 @@ void timing(int width, int height, int maxLinear, int maxBvh, int frames) {
 }
 
 // One scene of the comparison: every technique that applies against the light tracer.
-void compare(const char* name, const Scene& scene, int size, int ltPaths, bool specular) {
+void compare(const char* name, const Scene& scene, int size, int ltPaths, bool specular, bool othersToo) {
   double ltMs = 0.0, ms2 = 0.0;
   const Image ref = lightTraced(scene, size, ltPaths, ltMs);
   // The light tracer's own noise: the relative L1 between two seeds (their difference has sqrt(2) times
@@ -277,10 +282,13 @@ void compare(const char* name, const Scene& scene, int size, int ltPaths, bool s
   };
   {
     const Timed lv = timed(scene, size, size, "bvh", 3);
-    char d[96];
-    std::snprintf(d, sizeof d, " (%.0f beams%s)", lv.beams, lv.fallbacks > 0 ? ", specular fallback" : "");
+    char d[160];
+    std::snprintf(d, sizeof d, " (%.0f beams%s%s%s)", lv.beams,
+                  lv.added > 0 ? (", " + std::to_string(long(lv.added)) + " by subdivision").c_str() : "",
+                  lv.exhausted > 0 ? ", subdivision budget exhausted" : "", lv.fallbacks > 0 ? ", specular fallback" : "");
     row("light_volumes", lv, d);
   }
+  if (!othersToo) return;
   if (specular) {
     for (int P : {64, 128, 256}) {
       api::RenderRequest r;
@@ -328,18 +336,20 @@ int main(int argc, char** argv) {
   const int size = arg(2, 128), paths = arg(3, 256);
   const std::string only = argc > 4 ? argv[4] : "";  // run only the scenes whose name starts with this
   auto wanted = [&](const char* name) { return std::string(name).rfind(only, 0) == 0; };
+  const bool others = !(argc > 5 && std::string(argv[5]) == "light_volumes");  // the other techniques' rows too
+  if (argc > 6) gSubdivisionBeams = std::atol(argv[6]);
   std::printf("%dx%d; ms = the pass's GPU ms, caches warm (median of 3); first-frame CPU ms includes building "
               "beams, photon images or photon maps\n\n",
               size, size);
   std::printf("| scene | method | ms | first-frame CPU ms | relL1 | energy |\n|---|---|---|---|---|---|\n");
-  if (wanted("ring (80)")) compare("ring (80)", ringScene(40, 1), size, paths, true);
-  if (wanted("ring (5120)")) compare("ring (5120)", ringScene(320, 8), size, paths, true);
-  if (wanted("water")) compare("water", waterScene(), size, paths, true);
+  if (wanted("ring (80)")) compare("ring (80)", ringScene(40, 1), size, paths, true, others);
+  if (wanted("ring (5120)")) compare("ring (5120)", ringScene(320, 8), size, paths, true, others);
+  if (wanted("water")) compare("water", waterScene(), size, paths, true, others);
   for (float r : {0.1f, 0.2f, 0.3f, 0.4f}) {
     char name[48];
     std::snprintf(name, sizeof name, "window r %.1f", r);
-    if (wanted(name)) compare(name, windowScene(r), size, paths, false);
+    if (wanted(name)) compare(name, windowScene(r), size, paths, false, others);
   }
-  if (wanted("plate")) compare("plate", plateScene(), size, paths, false);
+  if (wanted("plate")) compare("plate", plateScene(), size, paths, false, others);
   return 0;
 }

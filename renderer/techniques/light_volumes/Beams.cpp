@@ -9,6 +9,7 @@
 
 #include "renderer/raytracing/Bsdf.h"
 #include "renderer/raytracing/Lights.h"
+#include "renderer/raytracing/VolumeInterior.h"
 
 namespace radiant::light_volumes {
 namespace {
@@ -224,7 +225,7 @@ bool appendTriangleBeams(const Light& light, const TriangleInput& t, const BeamO
     if (!t.refract && rt::maxComponent(weight) > 0.f) {
       glm::vec3 d[3];
       for (int k = 0; k < 3; ++k) d[k] = rt::reflect(-w[k], n[k]);
-      const float sigma = sigmaFromRoughness(m.roughnessFactor, cosIn, o.sigmaScale);
+      const float sigma = o.sigmaOverride > 0.f ? o.sigmaOverride : sigmaFromRoughness(m.roughnessFactor, cosIn, o.sigmaScale);
       push(d, flux * weight, sigma, nLit, false);
       ++out.scattered;
       out.glossy += sigma > 0.f ? 1 : 0;
@@ -245,7 +246,9 @@ bool appendTriangleBeams(const Light& light, const TriangleInput& t, const BeamO
       // A microfacet tilted by theta_h turns the reflected ray by 2 theta_h but the refracted one by
       // theta_h |eta - 1| / eta (small angles at normal incidence; Walter et al. 2007's half vector
       // h ~ eta wi + wo): the transmitted lobe is narrower by |eta - 1| / (2 eta), 1/6 for glass.
-      const float sigma = sigmaFromRoughness(m.roughnessFactor, cosIn, o.sigmaScale) * std::abs(eta - 1.f) / (2.f * eta);
+      const float sigma = o.sigmaOverride > 0.f
+                              ? o.sigmaOverride
+                              : sigmaFromRoughness(m.roughnessFactor, cosIn, o.sigmaScale) * std::abs(eta - 1.f) / (2.f * eta);
       push(d, flux * weight, sigma, -nLit, false);
       ++out.scattered;
       out.glossy += sigma > 0.f ? 1 : 0;
@@ -263,15 +266,306 @@ bool appendTriangleBeams(const Light& light, const TriangleInput& t, const BeamO
   return any;
 }
 
+float tessellationRatio(const Beam& b, const ReceiverDistance& receiverDistance) {
+  const float sigma = b.fluxSigma.w;
+  if (!(sigma > 0.f) || !receiverDistance) return -1.f;
+  const glm::vec3 V[3] = {glm::vec3(b.vertexA), glm::vec3(b.vertexB), glm::vec3(b.vertexC)};
+  const glm::vec3 d[3] = {glm::vec3(b.dirA), glm::vec3(b.dirB), glm::vec3(b.dirC)};
+  const glm::vec3 N = glm::normalize(d[0] + d[1] + d[2]);
+  // The receiver distance d of notes A5, bounded from below by the nearest of the four rays that span
+  // the beam's specular footprint: a receiver tilted against the beam is nearer at one corner than at
+  // the centroid, and the condition must hold where the footprint is nearest.
+  float dist = -1.f;
+  auto nearest = [&](const glm::vec3& origin, const glm::vec3& dir) {
+    if (!finite(dir) || !(glm::dot(dir, dir) > 0.f)) return;
+    const float t = receiverDistance(origin, glm::normalize(dir));
+    if (t > 0.f && (dist < 0.f || t < dist)) dist = t;
+  };
+  nearest((V[0] + V[1] + V[2]) / 3.f, N);
+  for (int k = 0; k < 3; ++k) nearest(V[k], d[k]);
+  if (!(dist > 0.f)) return -1.f;
+  const float edge = std::max({glm::length(V[1] - V[0]), glm::length(V[2] - V[1]), glm::length(V[0] - V[2])});
+  return edge / dist / sigma;
+}
+
+namespace {
+
+// The light's measure of a triangle: the solid angle it subtends from a point or spot light, its area
+// (the projected area over a constant cosine) under a directional light.
+float lightMeasure(const Light& light, const glm::vec3 p[3]) {
+  if (light.type == LightType::Directional) return 0.5f * glm::length(glm::cross(p[1] - p[0], p[2] - p[0]));
+  return solidAngle(p[0] - light.position, p[1] - light.position, p[2] - light.position);
+}
+
+// The 1-to-4 levels a triangle needs to meet the condition at its own receiver distance (each level
+// halves the edges).
+int subdivisionLevel(float ratio, float maxTriangleSigma) {
+  return std::clamp(int(std::ceil(std::log2(ratio / maxTriangleSigma))), 1, kMaxSubdivisionLevel);
+}
+
+// One glossy beam of a scatterer and where it came from.
+struct GlossySource {
+  std::size_t beam;
+  std::size_t triangle;
+  bool refract;
+  float ratio;  // tessellationRatio; < 0 unchecked
+};
+
+// Splits the glossy beam of `parent` (triangle t, its scattered beam `parentBeam`) into children until
+// each meets the condition or kMaxSubdivisionLevel. Child triangles are 1-to-4 midpoint splits of the
+// flat triangle; their vertex normals are the parent's interpolated barycentrically and renormalised
+// (the warped volume's normals between its vertices), their vertex rays reflected or refracted as the
+// parent's (appendTriangleBeams). A child keeps the parent's sigma and its flux is the parent's times
+// Omega_child / Omega_parent: the split refines where the light lands, not how much there is (the
+// children's solid angles add up to the parent's). Returns false when `budget` would be exceeded.
+class Subdivider {
+public:
+  Subdivider(const Light& light, const BeamOptions& o, const ReceiverDistance& rd, std::size_t budget)
+      : light_(light), o_(o), rd_(rd), budget_(budget) {
+    childOptions_ = o;
+    childOptions_.negativeBeams = false;  // shadow beams stay one per original triangle
+  }
+
+  // Appends the children of `parentBeam` to `children`; false when the beams added so far (over every
+  // call) would exceed the budget.
+  bool split(const TriangleInput& t, const Beam& parentBeam, float ratio, std::vector<Beam>& children) {
+    parent_ = &t;
+    parentBeam_ = &parentBeam;
+    parentMeasure_ = lightMeasure(light_, t.p);
+    base_ = children.size();
+    if (!(parentMeasure_ > 0.f)) return true;
+    // The level the parent's own bound asks for: each level halves the edges at about the same
+    // receiver distance; children that still fail (a nearer receiver under them) split again.
+    const int level = subdivisionLevel(ratio, o_.maxTriangleSigma);
+    const glm::vec3 bary[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    if (!recurse(bary, level, 0, children)) return false;
+    const std::size_t made = children.size() - base_;
+    if (made > 0) used_ += made - 1;  // the children replace one beam
+    return true;
+  }
+  std::size_t used() const { return used_; }
+  std::size_t stillFailing = 0, tirDropped = 0;
+
+private:
+  glm::vec3 at(const glm::vec3& b) const { return b.x * parent_->p[0] + b.y * parent_->p[1] + b.z * parent_->p[2]; }
+  glm::vec3 normalAt(const glm::vec3& b) const {
+    const glm::vec3 n = b.x * parent_->n[0] + b.y * parent_->n[1] + b.z * parent_->n[2];
+    const float len = glm::length(n);
+    return len > 0.f ? n / len : parent_->n[0];
+  }
+  // Beams added if the parent's children were `extra` more than now.
+  bool fits(std::size_t extra, const std::vector<Beam>& children) const {
+    return used_ + (children.size() - base_) + extra <= budget_ + 1;
+  }
+
+  // The triangle with barycentric corners `b` (in the parent), split `levels` more times; `depth` splits
+  // made so far.
+  bool recurse(const glm::vec3 b[3], int levels, int depth, std::vector<Beam>& children) {
+    if (levels > 0) {
+      const glm::vec3 m01 = 0.5f * (b[0] + b[1]), m12 = 0.5f * (b[1] + b[2]), m20 = 0.5f * (b[2] + b[0]);
+      const glm::vec3 sub[4][3] = {{b[0], m01, m20}, {m01, b[1], m12}, {m20, m12, b[2]}, {m01, m12, m20}};
+      for (const auto& c : sub)
+        if (!recurse(c, levels - 1, depth + 1, children)) return false;
+      return true;
+    }
+    TriangleInput in = *parent_;
+    for (int k = 0; k < 3; ++k) {
+      in.p[k] = at(b[k]);
+      in.n[k] = normalAt(b[k]);
+    }
+    BeamSet one;
+    appendTriangleBeams(light_, in, childOptions_, one);
+    if (one.beams.empty()) {  // a child vertex past the critical angle, or degenerate: its light is dropped
+      tirDropped += one.tirDropped;
+      return true;
+    }
+    Beam child = one.beams.front();  // one scattered beam: shadow beams off, `refract` picks the one
+    const float share = lightMeasure(light_, in.p) / parentMeasure_;
+    child.fluxSigma = v4(glm::vec3(parentBeam_->fluxSigma) * share, parentBeam_->fluxSigma.w);
+    if (tessellationRatio(child, rd_) > o_.maxTriangleSigma) {
+      // A nearer receiver under this child: split it once more.
+      if (depth < kMaxSubdivisionLevel) return fits(4, children) && recurse(b, 1, depth, children);
+      ++stillFailing;
+    }
+    if (!fits(1, children)) return false;
+    children.push_back(child);
+    return true;
+  }
+
+  const Light& light_;
+  const BeamOptions& o_;
+  BeamOptions childOptions_;
+  const ReceiverDistance& rd_;
+  std::size_t budget_, used_ = 0, base_ = 0;
+  const TriangleInput* parent_ = nullptr;
+  const Beam* parentBeam_ = nullptr;
+  float parentMeasure_ = 0.f;
+};
+
+}  // namespace
+
+namespace {
+
+// KHR_materials_volume: a beam leaving a scatterer with a medium against its geometric normal (the
+// outward side is the front face) travels inside the closed mesh, as rt::VolumeInterior decides for the
+// CPU tracers: refracted into it, or reflected inside it. Its flux is multiplied by the Beer-Lambert
+// transmittance exp(-sigma_t t) over its chord t inside, the distance from its centroid along its mean
+// direction to the first surface (the exit face; no hit: an open mesh, t = infinity, as the tracers
+// take it). The beam keeps going after that face (one interface: it is not refracted again).
+void attenuateInsideVolume(const std::vector<TriangleInput>& triangles, const ReceiverDistance& receiverDistance,
+                           std::size_t first, BeamSet& out) {
+  if (triangles.empty() || !triangles.front().material.hasVolume()) return;
+  const rt::VolumeInterior inside{triangles.front().material.attenuationCoefficient()};
+  if (!inside.absorbs()) return;
+  for (std::size_t i = first; i < out.beams.size(); ++i) {
+    Beam& b = out.beams[i];
+    if (b.vertexB.w == 1.f) continue;  // shadow beams: the unscattered light, outside
+    const glm::vec3 V[3] = {glm::vec3(b.vertexA), glm::vec3(b.vertexB), glm::vec3(b.vertexC)};
+    const glm::vec3 N = glm::normalize(glm::vec3(b.dirA) + glm::vec3(b.dirB) + glm::vec3(b.dirC));
+    const glm::vec3 ng = glm::cross(V[1] - V[0], V[2] - V[0]);
+    if (!(glm::dot(N, ng) < 0.f)) continue;
+    const float chord = receiverDistance((V[0] + V[1] + V[2]) / 3.f, N);
+    const glm::vec3 T = inside.transmittance(chord > 0.f ? chord : rt::kInf);
+    out.flux += glm::dvec3(glm::vec3(b.fluxSigma) * (T - glm::vec3(1.f))) * double(planeGain(b.fluxSigma.w));
+    b.fluxSigma = v4(glm::vec3(b.fluxSigma) * T, b.fluxSigma.w);
+    ++out.volumeAttenuated;
+  }
+}
+
+}  // namespace
+
+void appendScattererBeams(const Light& light, const std::vector<TriangleInput>& triangles, const BeamOptions& o,
+                          const ReceiverDistance& receiverDistance, BeamSet& out, std::size_t mesh,
+                          std::size_t lightIndex, const std::string& name) {
+  const std::size_t first = out.beams.size();
+  std::vector<GlossySource> glossy;
+  for (std::size_t ti = 0; ti < triangles.size(); ++ti) {
+    TriangleInput in = triangles[ti];
+    for (const bool refract : {false, true}) {
+      if (refract && !in.material.isTransmissive()) break;
+      in.refract = refract;
+      const std::size_t before = out.beams.size();
+      appendTriangleBeams(light, in, o, out);
+      for (std::size_t i = before; i < out.beams.size(); ++i)
+        if (out.beams[i].vertexB.w != 1.f && out.beams[i].fluxSigma.w > 0.f) glossy.push_back({i, ti, refract, -1.f});
+    }
+  }
+  if (!receiverDistance) return;
+  attenuateInsideVolume(triangles, receiverDistance, first, out);
+  // The tessellation condition for this scatterer and light.
+  std::size_t checked = 0, failed = 0;
+  float worst = 0.f;
+  for (GlossySource& g : glossy) {
+    g.ratio = tessellationRatio(out.beams[g.beam], receiverDistance);
+    if (!(g.ratio >= 0.f)) continue;
+    ++checked;
+    if (g.ratio > o.maxTriangleSigma) ++failed;
+    worst = std::max(worst, g.ratio);
+  }
+  out.worstTriangleSigma = std::max(out.worstTriangleSigma, worst);
+  out.tessellationChecked += checked;
+  out.tessellationFailed += failed;
+  if (checked == 0) return;
+  BeamSet::Scatterer record{mesh, lightIndex, name, checked, failed, worst, false};
+
+  // Subdivision of the failing triangles, all of them or (budget exceeded) none.
+  std::size_t failingAfter = failed;
+  const std::size_t left = o.maxSubdivisionBeams > out.subdivisionBeamsAdded ? o.maxSubdivisionBeams - out.subdivisionBeamsAdded : 0;
+  // What the parents' own bounds ask for is a lower bound of the beams the subdivision adds (children
+  // with a nearer receiver split further): when it exceeds the budget, do not start.
+  double leastAdded = 0.0;
+  for (const GlossySource& g : glossy)
+    if (g.ratio > o.maxTriangleSigma)
+      leastAdded += std::pow(4.0, subdivisionLevel(g.ratio, o.maxTriangleSigma)) - 1.0;
+  if (failed > 0 && left > 0 && leastAdded > double(left)) {
+    record.budgetExhausted = true;
+    ++out.subdivisionBudgetExhausted;
+  } else if (failed > 0 && left > 0) {
+    Subdivider subdivider(light, o, receiverDistance, left);
+    std::vector<Beam> children;
+    std::vector<std::pair<std::size_t, std::pair<std::size_t, std::size_t>>> replaced;  // beam, [begin, end)
+    bool fits = true;
+    for (const GlossySource& g : glossy) {
+      if (!(g.ratio > o.maxTriangleSigma)) continue;
+      TriangleInput in = triangles[g.triangle];
+      in.refract = g.refract;
+      const std::size_t begin = children.size();
+      if (!subdivider.split(in, out.beams[g.beam], g.ratio, children)) {
+        fits = false;
+        break;
+      }
+      replaced.push_back({g.beam, {begin, children.size()}});
+    }
+    if (!fits) {
+      record.budgetExhausted = true;
+      ++out.subdivisionBudgetExhausted;
+    } else {
+      // The first child takes its parent's slot, the others go to the end.
+      std::vector<bool> dropped(out.beams.size(), false);
+      for (const auto& [beam, range] : replaced) {
+        const Beam parent = out.beams[beam];
+        glm::dvec3 childFlux(0.0);
+        for (std::size_t c = range.first; c < range.second; ++c) childFlux += glm::dvec3(glm::vec3(children[c].fluxSigma));
+        // The stored flux is divided by planeGain(sigma); the children share the parent's sigma.
+        out.flux += (childFlux - glm::dvec3(glm::vec3(parent.fluxSigma))) * double(planeGain(parent.fluxSigma.w));
+        if (range.first == range.second) {
+          dropped[beam] = true;
+          continue;
+        }
+        out.beams[beam] = children[range.first];
+        out.cones[beam] = beamCone(children[range.first], o.cullSigmas);
+        for (std::size_t c = range.first + 1; c < range.second; ++c) {
+          out.beams.push_back(children[c]);
+          out.cones.push_back(beamCone(children[c], o.cullSigmas));
+        }
+      }
+      for (std::size_t i = dropped.size(); i-- > first;)
+        if (dropped[i]) {
+          out.beams.erase(out.beams.begin() + std::ptrdiff_t(i));
+          out.cones.erase(out.cones.begin() + std::ptrdiff_t(i));
+        }
+      // Children replace their parents (a parent without children, all its children past the critical
+      // angle, is removed).
+      out.scattered += children.size();
+      out.scattered -= replaced.size();
+      out.glossy += children.size();
+      out.glossy -= replaced.size();
+      out.tirDropped += subdivider.tirDropped;
+      out.subdivisionBeamsAdded += subdivider.used();
+      out.subdividedBeams += replaced.size();
+      out.subdivisionStillFailing += subdivider.stillFailing;
+      ++out.subdividedScatterers;
+      record.subdividedBeams = replaced.size();
+      record.beamsAdded = subdivider.used();
+      record.stillFailing = subdivider.stillFailing;
+      failingAfter = subdivider.stillFailing;
+    }
+  }
+
+  const bool fallback = o.specularFallback && float(failingAfter) > kFallbackFraction * float(checked);
+  record.specularFallback = fallback;
+  out.scatterers.push_back(record);
+  if (fallback) {
+    ++out.specularFallbacks;
+    for (std::size_t i = first; i < out.beams.size(); ++i) {
+      if (out.beams[i].fluxSigma.w > 0.f) --out.glossy;
+      const glm::vec3 phi = glm::vec3(out.beams[i].fluxSigma) * planeGain(out.beams[i].fluxSigma.w);
+      out.beams[i].fluxSigma = v4(phi, 0.f);
+      out.cones[i] = beamCone(out.beams[i], o.cullSigmas);
+    }
+  }
+}
+
 BeamSet buildBeams(const Scene& scene, const BeamOptions& o, const ReceiverDistance& receiverDistance) {
   BeamSet out;
+  std::vector<TriangleInput> triangles;
   for (std::size_t li = 0; li < scene.lights.size(); ++li) {
     const Light& light = scene.lights[li];
     for (std::size_t mi = 0; mi < scene.meshes.size(); ++mi) {
       const MeshInstance& mesh = scene.meshes[mi];
       const Material& mat = scene.material(mesh.material);
       if (!mat.scattersNarrowLobe()) continue;
-      const std::size_t first = out.beams.size();
+      triangles.clear();
       TriangleInput in;
       in.material = mat;
       for (std::size_t tri = 0; tri < mesh.triangleCount(); ++tri) {
@@ -283,46 +577,9 @@ BeamSet buildBeams(const Scene& scene, const BeamOptions& o, const ReceiverDista
         const glm::vec3 ng = glm::cross(in.p[1] - in.p[0], in.p[2] - in.p[0]);
         for (auto& nk : in.n)
           if (!(glm::dot(nk, nk) > 0.f)) nk = ng;
-        in.refract = false;
-        appendTriangleBeams(light, in, o, out);
-        if (mat.isTransmissive()) {
-          in.refract = true;
-          appendTriangleBeams(light, in, o, out);
-        }
+        triangles.push_back(in);
       }
-      // The tessellation condition for this scatterer and light.
-      if (!receiverDistance) continue;
-      std::size_t checked = 0, failed = 0;
-      float worst = 0.f;
-      for (std::size_t i = first; i < out.beams.size(); ++i) {
-        Beam& b = out.beams[i];
-        const float sigma = b.fluxSigma.w;
-        if (!(sigma > 0.f)) continue;
-        const glm::vec3 V[3] = {glm::vec3(b.vertexA), glm::vec3(b.vertexB), glm::vec3(b.vertexC)};
-        const glm::vec3 C = (V[0] + V[1] + V[2]) / 3.f;
-        const glm::vec3 N = glm::vec3(out.cones[i].axisSlope);
-        const float dist = receiverDistance(C, N);
-        if (!(dist > 0.f)) continue;
-        const float edge = std::max({glm::length(V[1] - V[0]), glm::length(V[2] - V[1]), glm::length(V[0] - V[2])});
-        const float ratio = edge / dist / sigma;
-        ++checked;
-        if (ratio > o.maxTriangleSigma) ++failed;
-        worst = std::max(worst, ratio);
-      }
-      out.worstTriangleSigma = std::max(out.worstTriangleSigma, worst);
-      out.tessellationChecked += checked;
-      out.tessellationFailed += failed;
-      const bool fallback = o.specularFallback && checked > 0 && float(failed) > kFallbackFraction * float(checked);
-      if (checked > 0) out.scatterers.push_back({mi, li, mesh.name, checked, failed, worst, fallback});
-      if (fallback) {
-        ++out.specularFallbacks;
-        for (std::size_t i = first; i < out.beams.size(); ++i) {
-          if (out.beams[i].fluxSigma.w > 0.f) --out.glossy;
-          const glm::vec3 phi = glm::vec3(out.beams[i].fluxSigma) * planeGain(out.beams[i].fluxSigma.w);
-          out.beams[i].fluxSigma = v4(phi, 0.f);
-          out.cones[i] = beamCone(out.beams[i], o.cullSigmas);
-        }
-      }
+      appendScattererBeams(light, triangles, o, receiverDistance, out, mi, li, mesh.name);
     }
   }
   return out;

@@ -53,6 +53,14 @@ struct BeamOptions {
   float maxTriangleSigma = 0.5f;  // tessellation condition: triangle edge / receiver distance <= this * sigma
   bool specularFallback = true;   // a scatterer failing the condition gets specular beams
   float cullSigmas = 4.f;         // glossy culling bounds are padded by this many sigma
+  // Subdivision of glossy scatterer triangles that fail the tessellation condition (1-to-4 midpoint
+  // splits until every child meets it), up to this many beams added over the whole beam set (children
+  // minus the beams they replace). A scatterer whose subdivision would exceed what is left of it is not
+  // subdivided and falls back (specularFallback) as before. 0: never subdivide.
+  std::size_t maxSubdivisionBeams = 65536;
+  // > 0: every scattered beam gets this sigma (a Gaussian-lobe debug BSDF, notes A6: it separates the
+  // algorithm's error from the GGX fit's). Tests only; not a request knob.
+  float sigmaOverride = 0.f;
 };
 
 // Distance from `origin` along the unit `dir` to the first receiver (negative: none). The technique
@@ -66,18 +74,27 @@ struct BeamSet {
   std::size_t backfacing = 0;   // triangles facing away from a light (not scattering)
   std::size_t tirDropped = 0;   // refracted beams dropped for total internal reflection at a vertex
   std::size_t degenerate = 0;   // zero-area triangles or zero solid angle
+  std::size_t volumeAttenuated = 0;  // beams travelling inside a KHR_materials_volume medium (Beer-Lambert)
   // The tessellation condition (notes A5: a glossy beam conserves energy when its triangle subtends
   // at most about sigma / 2 from the receiver): glossy beams checked, those that fail it, the worst
   // (edge / distance) / sigma, and the scatterers (mesh x light) that fell back to specular beams.
   std::size_t tessellationChecked = 0, tessellationFailed = 0, specularFallbacks = 0;
   float worstTriangleSigma = 0.f;
-  // The same per scatterer (mesh x light) with glossy beams checked, in scene order.
+  // Subdivision (BeamOptions::maxSubdivisionBeams): scatterers subdivided, beams added (children minus
+  // the beams they replaced), glossy beams split, children that still fail at kMaxSubdivisionLevel,
+  // and scatterers that were not subdivided because the budget would have been exceeded.
+  std::size_t subdividedScatterers = 0, subdivisionBeamsAdded = 0, subdividedBeams = 0;
+  std::size_t subdivisionStillFailing = 0, subdivisionBudgetExhausted = 0;
+  // The same per scatterer (mesh x light) with glossy beams checked, in scene order. checked, failed and
+  // worstTriangleSigma describe the scatterer's own triangles (before any subdivision).
   struct Scatterer {
     std::size_t mesh = 0, light = 0;
     std::string meshName;
     std::size_t checked = 0, failed = 0;
     float worstTriangleSigma = 0.f;
     bool specularFallback = false;
+    std::size_t subdividedBeams = 0, beamsAdded = 0, stillFailing = 0;
+    bool budgetExhausted = false;
   };
   std::vector<Scatterer> scatterers;
   glm::dvec3 flux{0.0};  // sum of the scattered beams' flux (W)
@@ -101,6 +118,10 @@ float sigmaFromRoughness(float roughness, float cosIncidence, float scale);
 // first use (jittered stratified VNDF sampling, 64 x 64 samples at 33 values of mu, fixed seed), linear in between.
 glm::vec2 ggxReflectionAlbedo(float mu, float alpha);
 
+// Children of one glossy beam split 1-to-4 at its edges' midpoints, level after level, stop at this level
+// (4^8 = 65536 children of one triangle).
+constexpr int kMaxSubdivisionLevel = 8;
+
 // Beams of every scatterer (Material::scattersNarrowLobe()) for every light of the scene.
 BeamSet buildBeams(const Scene& scene, const BeamOptions& options, const ReceiverDistance& receiverDistance = {});
 
@@ -114,6 +135,19 @@ struct TriangleInput {
   bool refract = false;
 };
 bool appendTriangleBeams(const Light& light, const TriangleInput& t, const BeamOptions& options, BeamSet& out);
+
+// The beams of one scatterer (the triangles of one mesh, `refract` unset: glass gets both beams) under
+// one light, as buildBeams makes them: with `receiverDistance`, the tessellation condition checked per
+// glossy beam, failing triangles subdivided within the budget, else the specular fallback; the
+// scatterer's record is appended to out.scatterers under (mesh, lightIndex, name).
+void appendScattererBeams(const Light& light, const std::vector<TriangleInput>& triangles, const BeamOptions& options,
+                          const ReceiverDistance& receiverDistance, BeamSet& out, std::size_t mesh = 0,
+                          std::size_t lightIndex = 0, const std::string& name = {});
+
+// The tessellation condition's ratio of a glossy beam: its longest edge over the nearest receiver
+// distance, in units of its sigma; the distance is the nearest hit of four rays (the centroid's along
+// the mean direction N and each vertex's along its d_k); negative when none hits a receiver.
+float tessellationRatio(const Beam& beam, const ReceiverDistance& receiverDistance);
 
 // The culling bound of a beam (see BeamCone), padded by cullSigmas * sigma for glossy beams.
 BeamCone beamCone(const Beam& beam, float cullSigmas);

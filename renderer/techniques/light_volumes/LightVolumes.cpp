@@ -82,6 +82,7 @@ void LightVolumesPass::prepare(const Scene& scene, const Params& params, FrameRe
   o.maxTriangleSigma = params.get<float>("max_triangle_sigma", 0.5f);
   o.specularFallback = params.get<std::string>("tessellation_fallback", "specular") == "specular";
   o.cullSigmas = params.get<float>("cull_sigmas", 4.f);
+  o.maxSubdivisionBeams = static_cast<std::size_t>(std::max(0, params.get<int>("max_subdivision_beams", 65536)));
   split_ = params.get<std::string>("split", "2d") == "paper" ? light_volumes::Split::Paper : light_volumes::Split::TwoD;
   bvh_ = params.get<std::string>("traversal", "bvh") == "bvh";
   // Every light path is counted once: without LS+DE and LG+DE (another technique owns them) the pass
@@ -92,7 +93,7 @@ void LightVolumesPass::prepare(const Scene& scene, const Params& params, FrameRe
                               {"lights", lightsKey(scene)},
                               {"params", nlohmann::json::parse(params.subsetKey(
                                              {"sigma_scale", "shadows", "max_concentration", "max_triangle_sigma",
-                                              "tessellation_fallback", "cull_sigmas"}))}};
+                                              "tessellation_fallback", "cull_sigmas", "max_subdivision_beams"}))}};
   built_ = false;
   const Cache& cache = res.cached<Cache>("light_volumes_beams", key.dump(), [&] {
     built_ = true;
@@ -197,10 +198,16 @@ void LightVolumesPass::execute(PassContext& ctx) {
   s["triangles_backfacing"] = static_cast<double>(b.backfacing);
   s["beams_tir_dropped"] = static_cast<double>(b.tirDropped);
   s["triangles_degenerate"] = static_cast<double>(b.degenerate);
+  s["beams_volume_attenuated"] = static_cast<double>(b.volumeAttenuated);
   s["tessellation_checked"] = static_cast<double>(b.tessellationChecked);
   s["tessellation_failed"] = static_cast<double>(b.tessellationFailed);
   s["tessellation_worst_triangle_sigma"] = b.worstTriangleSigma;
   s["tessellation_specular_fallbacks"] = static_cast<double>(b.specularFallbacks);
+  s["subdivision_scatterers"] = static_cast<double>(b.subdividedScatterers);
+  s["subdivision_beams_split"] = static_cast<double>(b.subdividedBeams);
+  s["subdivision_beams_added"] = static_cast<double>(b.subdivisionBeamsAdded);
+  s["subdivision_still_failing"] = static_cast<double>(b.subdivisionStillFailing);
+  s["subdivision_budget_exhausted"] = static_cast<double>(b.subdivisionBudgetExhausted);
   // The condition per scatterer, "tessellation/<mesh index>:<mesh name>/light<index>/...", for the
   // first kReportedScatterers (the totals above count them all).
   for (std::size_t k = 0; k < std::min(b.scatterers.size(), kReportedScatterers); ++k) {
@@ -211,6 +218,9 @@ void LightVolumesPass::execute(PassContext& ctx) {
     s[key + "failed"] = static_cast<double>(r.failed);
     s[key + "worst_triangle_sigma"] = r.worstTriangleSigma;
     s[key + "specular_fallback"] = r.specularFallback ? 1.0 : 0.0;
+    s[key + "subdivided_beams"] = static_cast<double>(r.subdividedBeams);
+    s[key + "beams_added"] = static_cast<double>(r.beamsAdded);
+    s[key + "budget_exhausted"] = r.budgetExhausted ? 1.0 : 0.0;
   }
   s["beam_flux"] = b.flux.x + b.flux.y + b.flux.z;
   s["setup_ms"] = built_ ? c.setupMs : 0.0;

@@ -8,7 +8,8 @@
 // Derived data, cached by exactly its inputs (stats.cache):
 //   light_volumes_beams  beams, cones and BVH, by scene, lights and the parameters that shape them
 //                        (sigma_scale, shadows, max_concentration, max_triangle_sigma,
-//                        tessellation_fallback, cull_sigmas); never by the camera, split or traversal.
+//                        tessellation_fallback, cull_sigmas, max_subdivision_beams); never by the
+//                        camera, split or traversal.
 #include <string>
 
 #include "renderer/frame/Technique.h"

@@ -8,7 +8,8 @@
 //   it drops is the energy light_volumes adds (within the two estimators' agreement);
 // - negative beams: direct + negative beams = 0 in the scatterer's umbra, with the scatterer out of
 //   the shadow maps;
-// - the tessellation report, the cache, and why it is skipped.
+// - the tessellation report; a coarse glossy plate subdivided renders like a fine one, and falls back
+//   when the budget is too small; the cache, and why it is skipped.
 #include <cmath>
 #include <cstdio>
 
@@ -139,9 +140,9 @@ TEST(LightVolumes, CulledAndLinearTraversalsGiveTheSameGlossyImage) {
 }
 
 TEST(LightVolumes, CoarseGlossyScattererFallsBackToSpecularBeams) {
-  // 2 x 2 x 2 facets of 0.3 m at 1.2 m (0.25 rad against sigma ~0.12): the condition fails and the
-  // scatterer gets specular beams (stats say so).
-  const RenderOutput out = renderer().render(glossyScene(2), request(32));
+  // 2 x 2 x 2 facets of 0.3 m at 1.2 m (0.25 rad against sigma ~0.12): the condition fails and, with
+  // subdivision off, the scatterer gets specular beams (stats say so).
+  const RenderOutput out = renderer().render(glossyScene(2), request(32, {{"max_subdivision_beams", 0}}));
   const auto& c = pass(out, "light_volumes")->counters;
   EXPECT_GE(c.at("tessellation_failed"), 6.0) << "of 8 (two centroid rays reach the floor far out)";
   EXPECT_GT(c.at("tessellation_worst_triangle_sigma"), 2.0);
@@ -152,6 +153,55 @@ TEST(LightVolumes, CoarseGlossyScattererFallsBackToSpecularBeams) {
   EXPECT_EQ(c.at("tessellation/1:plate/light0/failed"), c.at("tessellation_failed"));
   EXPECT_EQ(c.at("tessellation/1:plate/light0/worst_triangle_sigma"), c.at("tessellation_worst_triangle_sigma"));
   EXPECT_EQ(c.at("tessellation/1:plate/light0/specular_fallback"), 1.0);
+  EXPECT_EQ(c.at("subdivision_scatterers"), 0.0);
+  EXPECT_EQ(c.at("subdivision_budget_exhausted"), 0.0) << "a budget of 0 asks for no subdivision";
+}
+
+TEST(LightVolumes, CoarseGlossyScattererIsSubdividedAndRendersLikeAFineOne) {
+  // The same 2 x 2 x 2 plate with the default budget: its triangles are split (positions on the flat
+  // facets, normals interpolated) until every child meets the condition, so it renders glossy and gives
+  // the image of the 16 x 16 x 2 plate, which meets the condition by itself. What remains between them:
+  // sigma and the GGX albedo are evaluated at each original triangle's centroid (incidence 0.6-0.95 over
+  // the plate: sigma ~ sqrt(cos theta_i) varies by +-12%, so a coarse triangle's children share its mean).
+  const int size = 48;
+  const RenderOutput coarse = renderer().render(glossyScene(2), request(size));
+  const RenderOutput fallback = renderer().render(glossyScene(2), request(size, {{"max_subdivision_beams", 0}}));
+  const RenderOutput fine = renderer().render(glossyScene(16), request(size));
+  const auto& c = pass(coarse, "light_volumes")->counters;
+  EXPECT_EQ(c.at("subdivision_scatterers"), 1.0);
+  EXPECT_GE(c.at("subdivision_beams_split"), 6.0);
+  EXPECT_GT(c.at("subdivision_beams_added"), 0.0);
+  EXPECT_EQ(c.at("subdivision_still_failing"), 0.0);
+  EXPECT_EQ(c.at("subdivision_budget_exhausted"), 0.0);
+  EXPECT_EQ(c.at("tessellation_specular_fallbacks"), 0.0);
+  EXPECT_EQ(c.at("beams_glossy"), c.at("beams"));
+  EXPECT_EQ(c.at("tessellation/1:plate/light0/beams_added"), c.at("subdivision_beams_added"));
+  const Image& a = aov(coarse, "light_volumes");
+  const Image& f = aov(fine, "light_volumes");
+  const Image& s0 = aov(fallback, "light_volumes");
+  auto relL1 = [](const Image& x, const Image& y) {
+    double d = 0.0, t = 0.0;
+    for (std::size_t i = 0; i < x.pixels.size(); i += x.channels) {
+      d += std::abs(double(x.pixels[i]) - y.pixels[i]);
+      t += std::abs(double(y.pixels[i]));
+    }
+    return d / t;
+  };
+  const double l1 = relL1(a, f), l1Fallback = relL1(s0, f);
+  std::printf("coarse plate against the fine one: subdivided relL1 %.4f energy %.4f (%.0f beams); specular fallback "
+              "relL1 %.4f energy %.4f\n",
+              l1, sum(a) / sum(f), c.at("beams"), l1Fallback, sum(s0) / sum(f));
+  EXPECT_LT(l1, 0.04) << "measured 0.012";
+  EXPECT_NEAR(sum(a) / sum(f), 1.0, 0.03);
+  EXPECT_GT(l1Fallback, 3.0 * l1) << "the fallback's sharp beams are what subdivision replaces";
+  // A budget below what the plate needs: not subdivided, falls back, and says why.
+  const RenderOutput small = renderer().render(glossyScene(2), request(32, {{"max_subdivision_beams", 10}}));
+  const auto& cs = pass(small, "light_volumes")->counters;
+  EXPECT_EQ(cs.at("subdivision_budget_exhausted"), 1.0);
+  EXPECT_EQ(cs.at("tessellation/1:plate/light0/budget_exhausted"), 1.0);
+  EXPECT_EQ(cs.at("subdivision_beams_added"), 0.0);
+  EXPECT_EQ(cs.at("tessellation_specular_fallbacks"), 1.0);
+  EXPECT_EQ(cs.at("beams_glossy"), 0.0);
 }
 
 TEST(LightVolumes, PathsThroughTheGlossyPlateAreCountedOnceWithPhotonGi) {

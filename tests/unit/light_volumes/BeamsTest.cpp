@@ -12,11 +12,16 @@
 // - P_E against the exact integral of the Gaussian over small triangles (<= 1.5%);
 // - a glossy plate against numerical quadrature of the single-scatter integral (relative L1 5%,
 //   energy 3%) when its triangles subtend at most sigma / 3;
+// - a coarse glossy plate (triangles 1.2-1.4 sigma) subdivided until every child meets the condition
+//   matches the same quadrature; the children carry their triangle's flux (1e-3) and the negative beams
+//   stay one per triangle (umbra still 0); a budget too small for a scatterer makes it fall back;
+// - refracted beams inside a KHR_materials_volume slab carry attenuationColor^(chord / distance);
 // - a cylindrical mirror under collimated light focuses at R/2, and the irradiance clamp holds;
 // - degenerate input gives finite, non-negative irradiance.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -369,6 +374,231 @@ TEST(LightVolumesMath, GlossyPlateMatchesQuadratureWhenTrianglesSubtendAThirdOfS
   std::printf("glossy plate: relative L1 %.4f, energy ratio %.4f\n", l1 / exactSum, beamSum / exactSum);
   EXPECT_LT(l1 / exactSum, 0.05);
   EXPECT_NEAR(beamSum / exactSum, 1.0, 0.03);
+}
+
+// The receiver plane y = 2 of notes A5's set-up, as buildBeams' Embree ray would find it.
+float ceilingAt2(const glm::vec3& o, const glm::vec3& d) { return d.y > 0.f ? (2.f - o.y) / d.y : -1.f; }
+
+// relative L1 and energy ratio of the beams against the quadrature over the A5 receiver grid.
+std::pair<double, double> againstPlateQuadrature(const BeamSet& s, glm::vec3 L, float half, float sigma) {
+  const int g = 40;
+  const float rx0 = -0.2f, rx1 = 2.2f, rz = 1.2f;
+  double l1 = 0.0, exactSum = 0.0, beamSum = 0.0;
+  for (int i = 0; i < g; ++i)
+    for (int j = 0; j < g; ++j) {
+      const glm::vec3 F(rx0 + (rx1 - rx0) * (i + 0.5f) / g, 2.f, -rz + 2.f * rz * (j + 0.5f) / g);
+      const double exact = plateQuadrature(L, 1.f, half, sigma, F, 100);
+      const double beams = E(s, F, {0, -1, 0});
+      l1 += std::abs(beams - exact);
+      exactSum += exact;
+      beamSum += beams;
+    }
+  return {l1 / exactSum, beamSum / exactSum};
+}
+
+TEST(LightVolumesMath, CoarseGlossyPlateIsSubdividedUntilItMatchesQuadrature) {
+  // The A5 plate as 2 x 2 x 2 triangles: legs of 0.2 m, edges (diagonals) of 0.28 m over 2-2.3 m,
+  // 1.2-1.4 sigma at sigma = 0.1: every triangle fails the condition (0.5 sigma). Unsubdivided and kept
+  // glossy (tessellation_fallback none) the beams double-count their tents (notes A5: energy x1.5-2.5);
+  // subdivided (2-3 levels, children's edges below sigma / 2) they match the quadrature like a fine
+  // plate does (the GlossyPlate test: relative L1 5%, energy 3%).
+  const glm::vec3 L(-1.f, 1.5f, 0.f);
+  const float sigma = 0.1f, half = 0.2f;
+  const auto tris = plate(2, -half, half, -half, half, 0.f, mirror());
+  BeamOptions o;
+  o.sigmaOverride = sigma;
+  o.specularFallback = false;
+  o.maxSubdivisionBeams = 0;
+  BeamSet coarse;
+  appendScattererBeams(pointLight(L, 1.f), tris, o, ceilingAt2, coarse);
+  EXPECT_EQ(coarse.tessellationChecked, 8u);
+  EXPECT_EQ(coarse.tessellationFailed, 8u);
+  const auto [coarseL1, coarseEnergy] = againstPlateQuadrature(coarse, L, half, sigma);
+
+  o.maxSubdivisionBeams = 65536;
+  BeamSet fine;
+  appendScattererBeams(pointLight(L, 1.f), tris, o, ceilingAt2, fine);
+  const auto [l1, energy] = againstPlateQuadrature(fine, L, half, sigma);
+  std::printf("coarse glossy plate: unsubdivided relative L1 %.4f energy %.4f (worst edge/d %.2f sigma); subdivided "
+              "into %zu beams (+%zu): relative L1 %.4f, energy %.4f\n",
+              coarseL1, coarseEnergy, coarse.worstTriangleSigma, fine.beams.size(), fine.subdivisionBeamsAdded, l1,
+              energy);
+  EXPECT_GT(coarseL1, 0.1) << "the coarse plate must fail without subdivision, or this test shows nothing";
+  EXPECT_GT(coarseL1, 3.0 * l1);
+  EXPECT_LT(l1, 0.05);
+  EXPECT_NEAR(energy, 1.0, 0.03);
+  EXPECT_EQ(fine.subdividedScatterers, 1u);
+  EXPECT_EQ(fine.subdividedBeams, 8u);
+  EXPECT_EQ(fine.subdivisionBeamsAdded + 8u, fine.beams.size());
+  EXPECT_EQ(fine.glossy, fine.beams.size());
+  EXPECT_EQ(fine.subdivisionStillFailing, 0u);
+  EXPECT_EQ(fine.specularFallbacks, 0u);
+  ASSERT_EQ(fine.scatterers.size(), 1u);
+  EXPECT_EQ(fine.scatterers[0].failed, 8u) << "the record counts the scatterer's own triangles";
+  EXPECT_EQ(fine.scatterers[0].beamsAdded, fine.subdivisionBeamsAdded);
+  // Every child meets the condition.
+  for (const Beam& b : fine.beams) EXPECT_LE(tessellationRatio(b, ceilingAt2), o.maxTriangleSigma);
+}
+
+TEST(LightVolumesMath, SubdividedBeamsCarryTheTrianglesFluxAndOneShadowBeamEach) {
+  // Rough metal (GGX roughness 0.2, its own sigma ~0.06 and Smith albedo) and rough glass (roughness
+  // 0.3: reflected and refracted beams, refracted sigma ~0.02) under a point light, 8 x 8 x 2 triangles
+  // (edges 0.07 m at ~1 m: metal's 1.2 sigma and the refracted 3 sigma fail): the children's flux adds up to their triangle's
+  // (solid angles partition it), sigma is kept, and the negative beams stay one per original triangle,
+  // unchanged, so direct light + negative beams is still 0 in the umbra below the plate.
+  const glm::vec3 L(-0.3f, 1.5f, 0.1f);
+  const float I = 2.f;
+  Material glass = mirror(0.3f, glm::vec3(0.9f, 0.8f, 1.f));
+  glass.metallicFactor = 0.f;
+  glass.transmissionFactor = 1.f;
+  glass.doubleSided = true;
+  // Receivers: a ceiling at y = 1 and a floor at y = -1.
+  auto receivers = [](const glm::vec3& o, const glm::vec3& d) {
+    return d.y > 0.f ? (1.f - o.y) / d.y : d.y < 0.f ? (-1.f - o.y) / d.y : -1.f;
+  };
+  for (const Material& m : {mirror(0.2f, glm::vec3(0.95f, 0.7f, 0.5f)), glass}) {
+    const auto tris = plate(8, -0.2f, 0.2f, -0.2f, 0.2f, 0.f, m);
+    BeamOptions o;
+    o.negativeBeams = true;
+    o.specularFallback = false;
+    o.maxSubdivisionBeams = 0;
+    BeamSet before, after;
+    appendScattererBeams(pointLight(L, I), tris, o, receivers, before);
+    o.maxSubdivisionBeams = 1 << 20;
+    appendScattererBeams(pointLight(L, I), tris, o, receivers, after);
+    ASSERT_GT(before.tessellationFailed, 0u);
+    ASSERT_EQ(after.subdividedScatterers, 1u);
+    // Per beam kind (reflected, refracted, shadow): the stored flux summed (stored flux is Phi over
+    // the sigma's plane gain, and children keep their parent's sigma).
+    auto fluxOf = [](const BeamSet& s, int kind) {
+      glm::dvec3 f(0.0);
+      for (const Beam& b : s.beams) {
+        const bool shadow = b.vertexB.w == 1.f;
+        const bool up = glm::dot(glm::vec3(b.dirA) + glm::vec3(b.dirB) + glm::vec3(b.dirC), glm::vec3(0, 1, 0)) > 0.f;
+        if ((kind == 2) == shadow && (shadow || (kind == 0) == up)) f += glm::dvec3(glm::vec3(b.fluxSigma));
+      }
+      return f;
+    };
+    for (int kind = 0; kind < 3; ++kind) {
+      const glm::dvec3 a = fluxOf(before, kind), b = fluxOf(after, kind);
+      for (int c = 0; c < 3; ++c) {
+        if (a[c] == 0.0) EXPECT_EQ(b[c], 0.0);
+        else EXPECT_NEAR(b[c] / a[c], 1.0, 1e-3) << "kind " << kind << " channel " << c;
+      }
+    }
+    EXPECT_NEAR(after.flux.x / before.flux.x, 1.0, 1e-3);
+    EXPECT_EQ(after.shadow, 128u);
+    EXPECT_EQ(before.shadow, 128u);
+    EXPECT_EQ(after.subdividedBeams, after.tessellationFailed);
+    std::printf("%s: %zu beams -> %zu (+%zu), flux ratio %.6f\n", m.isTransmissive() ? "rough glass" : "rough metal",
+                before.beams.size(), after.beams.size(), after.subdivisionBeamsAdded, after.flux.x / before.flux.x);
+    // The umbra on the floor y = -1: direct + negative beams = 0, with the same shadow beams as before.
+    BeamSet shadow, shadowBefore;
+    for (const Beam& b : after.beams)
+      if (b.vertexB.w == 1.f) shadow.beams.push_back(b);
+    for (const Beam& b : before.beams)
+      if (b.vertexB.w == 1.f) shadowBefore.beams.push_back(b);
+    ASSERT_EQ(shadow.beams.size(), shadowBefore.beams.size());
+    for (std::size_t i = 0; i < shadow.beams.size(); ++i)
+      EXPECT_EQ(std::memcmp(&shadow.beams[i], &shadowBefore.beams[i], sizeof(Beam)), 0) << "shadow beam " << i;
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> u(-0.5f, 0.5f);
+    double worst = 0.0;
+    int inside = 0;
+    for (int i = 0; i < 300; ++i) {
+      const glm::vec3 F(u(rng), -1.f, u(rng));
+      const glm::vec3 d = F - L;
+      const float r = glm::length(d);
+      const float direct = I * (-d.y / r) / (r * r);
+      const glm::vec3 hit = L + d * ((0.f - L.y) / d.y);
+      if (std::abs(hit.x) < 0.19f && std::abs(hit.z) < 0.19f) {
+        worst = std::max(worst, std::abs(double(direct + E(shadow, F, {0, 1, 0}))) / direct);
+        ++inside;
+      }
+    }
+    EXPECT_GT(inside, 20);
+    EXPECT_LT(worst, 0.01) << "|direct + negative beams| / direct in the umbra";
+  }
+}
+
+TEST(LightVolumesMath, SubdivisionBudgetExhaustedFallsBackToSpecularAndSaysSo) {
+  // Two coarse glossy plates (8 failing triangles each) share one budget that holds the first plate's
+  // subdivision but not the second's: the second is not subdivided, falls back to specular beams and
+  // says why; with a budget of 0 nothing is subdivided.
+  const glm::vec3 L(-1.f, 1.5f, 0.f);
+  const auto tris = plate(2, -0.2f, 0.2f, -0.2f, 0.2f, 0.f, mirror());
+  BeamOptions o;
+  o.sigmaOverride = 0.1f;
+  BeamSet probe;
+  appendScattererBeams(pointLight(L, 1.f), tris, o, ceilingAt2, probe);
+  const std::size_t need = probe.subdivisionBeamsAdded;
+  ASSERT_GT(need, 8u);
+  o.maxSubdivisionBeams = need + need / 2;
+  BeamSet s;
+  appendScattererBeams(pointLight(L, 1.f), tris, o, ceilingAt2, s, 0, 0, "first");
+  appendScattererBeams(pointLight(L, 1.f), tris, o, ceilingAt2, s, 1, 0, "second");
+  EXPECT_EQ(s.subdividedScatterers, 1u);
+  EXPECT_EQ(s.subdivisionBeamsAdded, need);
+  EXPECT_EQ(s.subdivisionBudgetExhausted, 1u);
+  EXPECT_EQ(s.specularFallbacks, 1u);
+  ASSERT_EQ(s.scatterers.size(), 2u);
+  EXPECT_FALSE(s.scatterers[0].budgetExhausted);
+  EXPECT_FALSE(s.scatterers[0].specularFallback);
+  EXPECT_TRUE(s.scatterers[1].budgetExhausted);
+  EXPECT_TRUE(s.scatterers[1].specularFallback);
+  EXPECT_EQ(s.scatterers[1].beamsAdded, 0u);
+  EXPECT_EQ(s.beams.size(), need + 8u + 8u);
+  EXPECT_EQ(s.glossy, need + 8u) << "the second plate's 8 beams are specular";
+  o.maxSubdivisionBeams = 0;
+  BeamSet none;
+  appendScattererBeams(pointLight(L, 1.f), tris, o, ceilingAt2, none);
+  EXPECT_EQ(none.subdividedScatterers, 0u);
+  EXPECT_EQ(none.subdivisionBudgetExhausted, 0u) << "budget 0 means no subdivision asked, not an exhausted budget";
+  EXPECT_EQ(none.specularFallbacks, 1u);
+  EXPECT_EQ(none.glossy, 0u);
+}
+
+TEST(LightVolumesMath, RefractedBeamsInsideAVolumeAreAttenuatedByBeerLambert) {
+  // KHR_materials_volume: a glass slab 0.3 m thick (its top face 4 x 4 x 2 triangles at y = 0, its
+  // bottom at y = -0.3), attenuationColor (0.5, 0.8, 1) at attenuationDistance 0.5 m, under a point
+  // light. A refracted beam with mean direction N crosses the slab over the chord t = 0.3 / |N.y|, so
+  // its flux is the volume-less slab's times attenuationColor^(t / 0.5) per channel (the closed form of
+  // exp(-sigma_t t), sigma_t = -ln(color) / distance); reflected and shadow beams are not attenuated.
+  const glm::vec3 L(0.05f, 1.5f, 0.02f), color(0.5f, 0.8f, 1.f);
+  Material clear = mirror(0.f);
+  clear.metallicFactor = 0.f;
+  clear.transmissionFactor = 1.f;
+  clear.doubleSided = true;
+  Material tinted = clear;
+  tinted.thicknessFactor = 1.f;
+  tinted.attenuationDistance = 0.5f;
+  tinted.attenuationColor = color;
+  auto bottom = [](const glm::vec3& o, const glm::vec3& d) { return d.y < 0.f ? (-0.3f - o.y) / d.y : -1.f; };
+  BeamOptions o;
+  o.negativeBeams = true;
+  BeamSet a, b;
+  appendScattererBeams(pointLight(L, 1.f), plate(4, -0.2f, 0.2f, -0.2f, 0.2f, 0.f, clear), o, bottom, a);
+  appendScattererBeams(pointLight(L, 1.f), plate(4, -0.2f, 0.2f, -0.2f, 0.2f, 0.f, tinted), o, bottom, b);
+  ASSERT_EQ(a.beams.size(), b.beams.size());
+  EXPECT_EQ(a.volumeAttenuated, 0u);
+  EXPECT_EQ(b.volumeAttenuated, 32u) << "one refracted beam per triangle";
+  int refracted = 0;
+  double worst = 0.0;
+  for (std::size_t i = 0; i < a.beams.size(); ++i) {
+    const Beam& x = a.beams[i];
+    const Beam& y = b.beams[i];
+    const glm::vec3 N = glm::normalize(glm::vec3(x.dirA) + glm::vec3(x.dirB) + glm::vec3(x.dirC));
+    const bool inside = x.vertexB.w != 1.f && N.y < 0.f;
+    for (int c = 0; c < 3; ++c) {
+      const double expected = inside ? std::pow(double(color[c]), 0.3 / std::abs(N.y) / 0.5) : 1.0;
+      worst = std::max(worst, std::abs(double(y.fluxSigma[c]) / x.fluxSigma[c] / expected - 1.0));
+    }
+    refracted += inside ? 1 : 0;
+  }
+  EXPECT_EQ(refracted, 32);
+  EXPECT_LT(worst, 1e-5) << "largest relative error against color^(t / distance)";
+  EXPECT_LT(b.flux.x, a.flux.x);
+  EXPECT_EQ(b.flux.z, a.flux.z) << "attenuationColor 1 in blue: no absorption";
 }
 
 TEST(LightVolumesMath, CylindricalMirrorFocusesAtHalfItsRadius) {

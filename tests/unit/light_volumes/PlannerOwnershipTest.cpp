@@ -4,6 +4,7 @@
 // the caustics technique (branch `caustics`), registered before light_volumes as the rule expects.
 #include <gtest/gtest.h>
 
+#include "api/Validate.h"
 #include "renderer/frame/FramePlanner.h"
 #include "renderer/techniques/gbuffer/GBuffer.h"
 #include "renderer/techniques/light_volumes/LightVolumes.h"
@@ -67,6 +68,31 @@ TEST(LightPathOwnership, CausticsOwnsByDefaultLightVolumesWhenNamed) {
   p = planFrame(registry, scene, plain);
   EXPECT_EQ(p.lightPaths.at("LG+DE"), "caustics");
   EXPECT_EQ(p.passes.size(), 1u);  // caustics alone (its stand-in reads no G-buffer)
+}
+
+// The subdivision budget is a request knob: validated by the schema (422 naming it) and capped by the
+// server's photon-count limit (x-cost "photons", radiantd --max-photons).
+TEST(LightVolumesKnobs, SubdivisionBudgetIsValidatedAndCapped) {
+  auto errorOf = [](const nlohmann::json& value, const api::RequestLimits& limits = {}) -> std::pair<int, std::string> {
+    const nlohmann::json body{{"scene", {{"builtin", "cornell_box"}}},
+                              {"passes", {{"light_volumes", {{"max_subdivision_beams", value}}}}}};
+    try {
+      api::parseRenderRequest(body, limits);
+    } catch (const api::ApiError& e) {
+      return {e.status, e.pointer};
+    }
+    return {0, ""};
+  };
+  const std::string pointer = "/passes/light_volumes/max_subdivision_beams";
+  EXPECT_EQ(errorOf(-1), std::make_pair(422, pointer));
+  EXPECT_EQ(errorOf(2000000), std::make_pair(422, pointer));
+  EXPECT_EQ(errorOf(1.5).second, pointer);
+  EXPECT_EQ(errorOf(0).first, 0);
+  EXPECT_EQ(errorOf(1048576).first, 0);
+  api::RequestLimits limits;
+  limits.maxPhotons = 1000;
+  EXPECT_EQ(errorOf(1001, limits), std::make_pair(422, pointer));
+  EXPECT_EQ(errorOf(1000, limits).first, 0);
 }
 
 }  // namespace
