@@ -1,7 +1,7 @@
 // Hierarchical depth impostors (issue 17): milliseconds of the depth_impostors pass against the
 // particles per block b at N = 8000 (thesis Fig. 8.6: the optimum near 40 blocks), with the
 // spherical_billboards pass on the same cloud as the per-particle baseline.
-//   build/bench/depth_impostors_bench [size=256] [repeats=5] [N=8000] [error_size=64]
+//   build/bench/depth_impostors_bench [size=256] [repeats=5] [N=8000] [error_size=64] [fourier_b=200]
 // Two timings per b, each the median of `repeats` frames after one warm-up:
 //   static:   the same cloud, camera and light every frame: blocks and impostors come from the cache,
 //             the pass only gathers (one quad per block);
@@ -11,10 +11,14 @@
 // GPU is the CPU, so the sum is the cost). rel_rmse: the media AOV at error_size^2 against the
 // volumetric reference in single_scatter mode (rendered once), RMSE over the reference's mean: a time
 // optimum means nothing without it (one block of 8000 particles is cheap and wrong).
+// Then the opacity-shadow-map comparison at b = fourier_b: the light's transmittance from K slices
+// against Fourier opacity maps (light_transmittance: fourier) of equal texture memory, K = 4, 8, 12, 16
+// against M = 1, 3, 5, 7 (K/4 RGBA textures each), the same two timings and rel_rmse.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <utility>
 #include <vector>
 
 #include "api/Validate.h"
@@ -121,6 +125,24 @@ int main(int argc, char** argv) {
       if (t.gpuMs + t.cpuMs < best) best = t.gpuMs + t.cpuMs, bestB = b, bestBlocks = t.blocks;
     }
     std::printf("%s optimum: b = %.0f (%.0f blocks), %.1f ms\n", animate ? "animated" : "static", bestB, bestBlocks, best);
+  }
+
+  const int fourierB = argc > 5 ? std::atoi(argv[5]) : 200;
+  std::printf("\nlight transmittance at equal texture memory, b = %d: slices against Fourier opacity maps\n", fourierB);
+  std::printf("%9s %6s %6s %10s %10s %12s %12s %9s\n", "source", "knob", "RGBA", "static_gpu", "static_cpu", "static_total",
+              "animated_ms", "rel_rmse");
+  for (auto [K, M] : {std::pair{4, 1}, std::pair{8, 3}, std::pair{12, 5}, std::pair{16, 7}}) {
+    for (bool fourier : {false, true}) {
+      json body = base;
+      json p = {{"particles_per_block", fourierB}, {"slices", K}};
+      if (fourier) p["light_transmittance"] = "fourier", p["fourier_terms"] = M;
+      body["passes"]["depth_impostors"] = p;
+      const Timing st = timePass(renderer, scene, body, "depth_impostors", repeats, false, n);
+      const Timing an = timePass(renderer, scene, body, "depth_impostors", repeats, true, n);
+      std::printf("%9s %4s%2d %6d %10.1f %10.1f %12.1f %12.1f %9.3f\n", fourier ? "fourier" : "slices", fourier ? "M=" : "K=",
+                  fourier ? M : K, (K + 3) / 4, st.gpuMs, st.cpuMs, st.gpuMs + st.cpuMs, an.gpuMs + an.cpuMs,
+                  errorOf(body["passes"]));
+    }
   }
   return 0;
 }

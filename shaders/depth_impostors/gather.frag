@@ -5,7 +5,8 @@
 //   objects in clouds: the part of [Z_f, Z_b] in front of the scene depth and behind the near plane,
 //   the fraction f of it, scales the opacity: linear alpha' = (1 - T) f (the thesis), or
 //   exponential alpha' = 1 - T^f (exact when the density is uniform along the interval);
-//   light: the shadowed light's transmittance interpolated between the enclosing light slices
+//   light: the shadowed light's transmittance interpolated between the enclosing light slices, or
+//   reconstructed from the Fourier opacity maps (light_transmittance: fourier),
 //   (optionally the forward-scatter heuristic) at both ends of the visible interval, integrated over
 //   it with the in-scattering's weight (shadowOverInterval); the lights' direction and intensity at
 //   its middle; the other lights unshadowed;
@@ -44,6 +45,10 @@ uniform float u_sliceDmin;
 uniform float u_sliceDmax;
 uniform int u_forwardScatter;
 uniform float u_sliceTexel;  // one slice texel in uv
+uniform int u_fourierTerms;  // M > 0: Fourier opacity maps in the slice textures instead of slices
+uniform float u_fourierNear;  // the cloud's near and far planes along the light (normalised depth 0, 1)
+uniform float u_fourierFar;
+uniform float u_fourierDamping[8];  // g_k, k = 1..M (Jackson kernel; impostors::fourierDamping)
 
 flat in int v_block;
 layout(location = 0) out vec4 o_color;
@@ -82,7 +87,54 @@ float knotValueFiltered(int j, vec2 uv, int model, float g, vec3 dir) {
   return sum / wsum;
 }
 
+// Fourier opacity maps (Jansen and Bavoil 2010; impostors::fourierTransmittance in Blocks.h is the C++
+// twin): the optical depth to normalised depth d is the truncated series' integral,
+//   D(d) = a_0 d / 2 + sum_k g_k (a_k sin(2 pi k d) + b_k (1 - cos(2 pi k d))) / (2 pi k),
+// with the Jackson damping g_k, whose kernel is non-negative: D is non-decreasing in d, in [0, a_0 / 2],
+// and the transmittance exp(-D) non-increasing along the light (clamped too, against rounding).
+float fourierTransmittanceAt(vec2 uv, float d) {
+  const float TWO_PI = 6.28318530717958648;
+  float c[16];  // the 2M + 1 coefficients, one fetch per RGBA texture in use
+  const vec4 c0 = texture(t_slices0, uv);
+  c[0] = c0.x, c[1] = c0.y, c[2] = c0.z, c[3] = c0.w;
+  const vec4 c1 = u_fourierTerms >= 2 ? texture(t_slices1, uv) : vec4(0.0);
+  c[4] = c1.x, c[5] = c1.y, c[6] = c1.z, c[7] = c1.w;
+  const vec4 c2 = u_fourierTerms >= 4 ? texture(t_slices2, uv) : vec4(0.0);
+  c[8] = c2.x, c[9] = c2.y, c[10] = c2.z, c[11] = c2.w;
+  const vec4 c3 = u_fourierTerms >= 6 ? texture(t_slices3, uv) : vec4(0.0);
+  c[12] = c3.x, c[13] = c3.y, c[14] = c3.z, c[15] = c3.w;
+  const float a0 = c[0];
+  float D = 0.5 * a0 * d;
+  for (int k = 1; k <= u_fourierTerms; ++k) {
+    const float o = TWO_PI * float(k);
+    D += u_fourierDamping[k - 1] * (c[2 * k - 1] * sin(o * d) + c[2 * k] * (1.0 - cos(o * d))) / o;
+  }
+  return clamp(exp(-clamp(D, 0.0, max(0.5 * a0, 0.0))), 0.0, 1.0);
+}
+
+float fourierTransmittance(vec3 x, int model, float g) {
+  const vec3 rel = x - u_sliceCenter;
+  const vec2 uv = vec2(dot(rel, u_sliceU), dot(rel, u_sliceV)) / u_sliceHalf * 0.5 + 0.5;
+  const float d = clamp((dot(rel, u_sliceAxis) - u_fourierNear) / max(u_fourierFar - u_fourierNear, 1e-30), 0.0, 1.0);
+  if (u_forwardScatter == 0) return fourierTransmittanceAt(uv, d);
+  // The forward-scatter heuristic as for the slices (knotValueFiltered): the 3 x 3 slice texels' values,
+  // each weighted by the phase function towards the light from one slice thickness away (here the
+  // thickness of the K = 4 ceil((2M + 1) / 4) slices of equal memory).
+  const float thickness = (u_sliceDmax - u_sliceDmin) / float(4 * ((2 * u_fourierTerms + 4) / 4));
+  float sum = 0.0, wsum = 0.0;
+  for (int y = -1; y <= 1; ++y)
+    for (int x = -1; x <= 1; ++x) {
+      const vec2 offset = vec2(x, y) * u_sliceTexel;
+      const vec3 lateral = (offset.x * u_sliceU + offset.y * u_sliceV) * (2.0 * u_sliceHalf);
+      const float w = phaseValue(model, g, dot(normalize(u_sliceAxis * thickness - lateral), u_sliceAxis));
+      sum += w * fourierTransmittanceAt(uv + offset, d);
+      wsum += w;
+    }
+  return sum / wsum;
+}
+
 float lightTransmittance(vec3 x, int model, float g, vec3 dir) {
+  if (u_fourierTerms > 0) return fourierTransmittance(x, model, g);
   const vec3 rel = x - u_sliceCenter;
   const vec2 uv = vec2(dot(rel, u_sliceU), dot(rel, u_sliceV)) / u_sliceHalf * 0.5 + 0.5;
   const float s = clamp((dot(rel, u_sliceAxis) - u_sliceDmin) / max(u_sliceDmax - u_sliceDmin, 1e-30) * float(u_slices),

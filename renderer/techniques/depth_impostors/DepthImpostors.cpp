@@ -42,6 +42,7 @@ void DepthImpostorsPass::prepare(const Scene& scene, const Params& params, Frame
   const int sliceRes = params.get<int>("slice_resolution", 128);
   clipScaling_ = params.get<std::string>("clip_scaling", "exponential") == "linear" ? 0 : 1;
   forwardScatter_ = params.get<bool>("forward_scatter", false) ? 1 : 0;
+  fourierTerms_ = params.get<std::string>("light_transmittance", "slices") == "fourier" ? params.get<int>("fourier_terms", 3) : 0;
   const glm::vec3 forward = -glm::normalize(glm::vec3(view.camera.world[2]));
   const bool ortho = view.camera.projection == ProjectionType::Orthographic;
 
@@ -87,12 +88,13 @@ void DepthImpostorsPass::prepare(const Scene& scene, const Params& params, Frame
   const nlohmann::json key = {{"blocks", blockKey},
                               {"res", layout.res},
                               {"slices", K},
+                              {"fourier_terms", fourierTerms_},
                               {"slice_res", sliceRes},
                               {"view", {viewAxis_.mode, f3(viewAxis_.axis)}},
                               {"light", hasLight_ ? nlohmann::json{lightAxis_.mode, f3(lightAxis_.axis), f3(sliceAxis)}
                                                   : nlohmann::json(nullptr)}};
   set_ = &res.cached<impostors::ImpostorSet>("depth_impostors.impostors", key.dump(), [&] {
-    return std::make_unique<impostors::ImpostorSet>(blocks, layout, K, sliceRes);
+    return std::make_unique<impostors::ImpostorSet>(blocks, layout, K, sliceRes, fourierTerms_);
   });
 
   // Back to front (a few thousand blocks at most: sorted on the CPU every frame).
@@ -148,6 +150,12 @@ void DepthImpostorsPass::execute(PassContext& ctx) {
   prog.set("u_sliceDmax", f.dmax);
   prog.set("u_forwardScatter", forwardScatter_);
   prog.set("u_sliceTexel", 1.f / static_cast<float>(set.sliceResolution()));
+  prog.set("u_fourierTerms", set.fourierTerms());
+  prog.set("u_fourierNear", f.zNear);
+  prog.set("u_fourierFar", f.zFar);
+  for (int k = 1; k <= set.fourierTerms(); ++k)
+    prog.set(("u_fourierDamping[" + std::to_string(k - 1) + "]").c_str(),
+             static_cast<float>(impostors::fourierDamping(k, set.fourierTerms())));
   if (blocks > 0) glDrawArraysInstanced(GL_TRIANGLES, 0, 6, blocks);
   glDisable(GL_BLEND);
   res.markWritten("media");
@@ -158,7 +166,9 @@ void DepthImpostorsPass::execute(PassContext& ctx) {
   ctx.stats.counters["blocks"] = blocks;
   ctx.stats.counters["particles_per_block"] = particlesPerBlock_;
   ctx.stats.counters["impostor_resolution"] = set.layout().res;  // may be below the requested one (atlas limit)
-  ctx.stats.counters["slices"] = set.slices();
+  ctx.stats.counters["slices"] = set.fourierTerms() > 0 ? 0 : set.slices();
+  ctx.stats.counters["fourier_terms"] = set.fourierTerms();
+  ctx.stats.counters["light_channels"] = set.channels();  // slice-texture channels in use: K or 2M + 1
   ctx.stats.counters["shadowed_lights"] = hasLight_ ? 1 : 0;
   ctx.stats.counters["impostors_rebuilt"] = rebuilt ? 1 : 0;
 }

@@ -6,6 +6,8 @@
 // slices, 4 per RGBA texture, by commutative multiplicative blending (no sorting); and the blocks are
 // gathered back to front, their opacity scaled where the scene depth lies inside the block, the
 // light's transmittance interpolated between the enclosing slices (Impostors.h, shaders/depth_impostors).
+// `light_transmittance: fourier` replaces the slices by Fourier opacity maps (Jansen and Bavoil 2010,
+// Blocks.h): the same light impostors and block pass, 2M + 1 coefficients in the slice textures.
 //
 // Owns the media AOV when the request names it (TechniqueInfo::exclusive, claimsWhenNamed), otherwise
 // spherical_billboards does. The first punctual light of the scene is shadowed by the slices, the
@@ -36,6 +38,7 @@ private:
   std::vector<int> order_;  // blocks back to front
   gl::VertexArray vao_;
   int clipScaling_ = 1, forwardScatter_ = 0, particlesPerBlock_ = 0, requestedRes_ = 0;
+  int fourierTerms_ = 0;  // 0: slices
 };
 
 }  // namespace radiant

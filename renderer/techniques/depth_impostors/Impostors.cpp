@@ -15,8 +15,10 @@ AtlasLayout atlasLayout(int blocks, int requestedRes) {
   return l;
 }
 
-ImpostorSet::ImpostorSet(const BlockSet& blocks, const AtlasLayout& layout, int slices, int sliceResolution)
-    : blocks_(blocks), layout_(layout), slices_(std::clamp(slices, 1, gpu::kMaxImpostorSlices)), sliceRes_(sliceResolution) {
+ImpostorSet::ImpostorSet(const BlockSet& blocks, const AtlasLayout& layout, int slices, int sliceResolution,
+                         int fourierTerms)
+    : blocks_(blocks), layout_(layout), slices_(std::clamp(slices, 1, gpu::kMaxImpostorSlices)), sliceRes_(sliceResolution),
+      fourierTerms_(std::clamp(fourierTerms, 0, kMaxFourierTerms)) {
   const std::size_t nb = std::max<std::size_t>(1, blocks_.blocks.size());
   const std::size_t np = std::max<std::size_t>(1, blocks_.particles.size());
   particleBuffer = gl::Buffer("depth_impostors.particles", np * sizeof(gpu::MediaParticle));
@@ -38,7 +40,16 @@ ImpostorSet::ImpostorSet(const BlockSet& blocks, const AtlasLayout& layout, int 
   viewFb_.checkComplete("ImpostorSet (view)");
   lightFb_ = gl::Framebuffer("depth_impostors.light");
   lightFb_.attach(GL_COLOR_ATTACHMENT2, lightTransmittance);
-  lightFb_.setDrawBuffers({GL_NONE, GL_NONE, GL_COLOR_ATTACHMENT2});
+  if (fourierTerms_ > 0) {
+    lightFront = gl::Texture("depth_impostors.light_front", GL_TEXTURE_2D, GL_R32F, w, h);
+    lightBack = gl::Texture("depth_impostors.light_back", GL_TEXTURE_2D, GL_R32F, w, h);
+    for (gl::Texture* t : {&lightFront, &lightBack}) t->setFilter(GL_NEAREST, GL_NEAREST);
+    lightFb_.attach(GL_COLOR_ATTACHMENT0, lightFront);
+    lightFb_.attach(GL_COLOR_ATTACHMENT1, lightBack);
+    lightFb_.setDrawBuffers({GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2});
+  } else {
+    lightFb_.setDrawBuffers({GL_NONE, GL_NONE, GL_COLOR_ATTACHMENT2});
+  }
   lightFb_.checkComplete("ImpostorSet (light)");
   sliceFb_ = gl::Framebuffer("depth_impostors.slices");
   for (int i = 0; i < 4; ++i) {
@@ -56,7 +67,7 @@ void ImpostorSet::drawImpostors(gl::ShaderLibrary& shaders, const ImpostorAxis& 
   fb.bind();
   glViewport(0, 0, layout_.width(), layout_.height());
   const float far[4] = {1e30f, 0.f, 0.f, 0.f}, near[4] = {-1e30f, 0.f, 0.f, 0.f}, one[4] = {1.f, 1.f, 1.f, 1.f};
-  if (&fb == &viewFb_) {
+  if (&fb == &viewFb_ || fourierTerms_ > 0) {
     glClearNamedFramebufferfv(fb.id(), GL_COLOR, 0, far);
     glClearNamedFramebufferfv(fb.id(), GL_COLOR, 1, near);
   }
@@ -101,17 +112,21 @@ void ImpostorSet::build(gl::ShaderLibrary& shaders, const ImpostorAxis& view, co
   // 1. View impostors: front MIN, back MAX, transmittance multiplied (thesis Fig. 8.1).
   drawImpostors(shaders, view, viewFb_);
 
-  // 2. Light impostors and the slices (cleared to 1; blended dst (1 - src), in any order).
-  const float one[4] = {1.f, 1.f, 1.f, 1.f};
-  for (int i = 0; i < 4; ++i) glClearNamedFramebufferfv(sliceFb_.id(), GL_COLOR, i, one);
+  // 2. Light impostors and the slices (cleared to 1; blended dst (1 - src), in any order), or the
+  // Fourier coefficients (cleared to 0; added, in any order).
+  const bool fourier = fourierTerms_ > 0;
+  const float one[4] = {1.f, 1.f, 1.f, 1.f}, zero[4] = {0.f, 0.f, 0.f, 0.f};
+  for (int i = 0; i < 4; ++i) glClearNamedFramebufferfv(sliceFb_.id(), GL_COLOR, i, fourier ? zero : one);
   if (light && !gpuBlocks_.empty()) {
     drawImpostors(shaders, *light, lightFb_);
     sliceFb_.bind();
     glViewport(0, 0, sliceRes_, sliceRes_);
     glEnable(GL_BLEND);
     glBlendEquation(GL_FUNC_ADD);
-    glBlendFuncSeparate(GL_ZERO, GL_ONE_MINUS_SRC_COLOR, GL_ZERO, GL_ONE_MINUS_SRC_ALPHA);
+    if (fourier) glBlendFunc(GL_ONE, GL_ONE);
+    else glBlendFuncSeparate(GL_ZERO, GL_ONE_MINUS_SRC_COLOR, GL_ZERO, GL_ONE_MINUS_SRC_ALPHA);
     lightTransmittance.bindUnit(0);
+    if (fourier) lightFront.bindUnit(1), lightBack.bindUnit(2);
     const gl::Program& prog = shaders.program({"depth_impostors/slices.vert", "depth_impostors/slices.frag"});
     prog.use();
     prog.set("u_sliceCenter", &frame.center.x, 3);
@@ -123,6 +138,10 @@ void ImpostorSet::build(gl::ShaderLibrary& shaders, const ImpostorAxis& view, co
     prog.set("u_res", layout_.res);
     prog.set("u_tilesX", layout_.tilesX);
     prog.set("u_slices", slices_);
+    prog.set("u_fourierTerms", fourierTerms_);
+    prog.set("u_sliceAxis", &frame.axis.x, 3);
+    prog.set("u_zNear", frame.zNear);
+    prog.set("u_zFar", frame.zFar);
     glDrawArraysInstanced(GL_TRIANGLES, 0, 6, static_cast<GLsizei>(gpuBlocks_.size()));
     glDisable(GL_BLEND);
     glBlendFunc(GL_ONE, GL_ZERO);
@@ -134,10 +153,11 @@ void ImpostorSet::build(gl::ShaderLibrary& shaders, const ImpostorAxis& view, co
 
 std::vector<float> ImpostorSet::downloadSlices() const {
   const std::size_t n = static_cast<std::size_t>(sliceRes_) * sliceRes_;
-  std::vector<float> rgba(n * 4), out(n * slices_);
-  for (int t = 0; t * 4 < slices_; ++t) {
+  const int channels = this->channels();
+  std::vector<float> rgba(n * 4), out(n * channels);
+  for (int t = 0; t * 4 < channels; ++t) {
     sliceTextures[t].download(0, GL_RGBA, GL_FLOAT, rgba.data(), rgba.size() * sizeof(float));
-    for (int c = 0; c < 4 && t * 4 + c < slices_; ++c)
+    for (int c = 0; c < 4 && t * 4 + c < channels; ++c)
       for (std::size_t p = 0; p < n; ++p) out[(t * 4 + c) * n + p] = rgba[p * 4 + c];
   }
   return out;

@@ -33,7 +33,9 @@ AtlasLayout atlasLayout(int blocks, int requestedRes);
 class ImpostorSet {
 public:
   // Allocates every buffer, texture and framebuffer (no drawing). `slices` K in [1, 16].
-  ImpostorSet(const BlockSet& blocks, const AtlasLayout& layout, int slices, int sliceResolution);
+  // `fourierTerms` M in [1, 7]: the light's transmittance comes from Fourier opacity maps (Blocks.h)
+  // in the slice textures instead of K slices; 0: the slices.
+  ImpostorSet(const BlockSet& blocks, const AtlasLayout& layout, int slices, int sliceResolution, int fourierTerms = 0);
   // Draws the view impostors, the light impostors and the slices (each block's group from `frame`).
   // `light` null: no shadowed light (the slices stay 1).
   void build(gl::ShaderLibrary& shaders, const ImpostorAxis& view, const ImpostorAxis* light, const SliceFrame& frame);
@@ -42,24 +44,29 @@ public:
   const BlockSet& blocks() const { return blocks_; }
   const AtlasLayout& layout() const { return layout_; }
   int slices() const { return slices_; }
+  int fourierTerms() const { return fourierTerms_; }
+  // Channels of the slice textures in use: K slices, or the 2M + 1 Fourier coefficients.
+  int channels() const { return fourierTerms_ > 0 ? fourierChannels(fourierTerms_) : slices_; }
   int sliceResolution() const { return sliceRes_; }
   const SliceFrame& frame() const { return frame_; }
   const std::vector<gpu::ImpostorBlock>& gpuBlocks() const { return gpuBlocks_; }
 
-  // Slice k at texel (x, y) is out[(k * res + y) * res + x] (K slices; GL rows, bottom first).
+  // Channel k (slice k, or Fourier coefficient k) at texel (x, y) is out[(k * res + y) * res + x]
+  // (channels() of them; GL rows, bottom first).
   std::vector<float> downloadSlices() const;
   // The view atlas: front, back and transmittance, each width() x height() (GL rows).
   void downloadView(std::vector<float>& front, std::vector<float>& back, std::vector<float>& transmittance) const;
 
   gl::Buffer particleBuffer, blockBuffer, orderBuffer;
   gl::Texture front, back, transmittance, lightTransmittance;
+  gl::Texture lightFront, lightBack;  // Fourier only: the light impostors' depths (each block's box)
   gl::Texture sliceTextures[4];
 
 private:
   void drawImpostors(gl::ShaderLibrary& shaders, const ImpostorAxis& axis, gl::Framebuffer& fb);
   BlockSet blocks_;
   AtlasLayout layout_;
-  int slices_, sliceRes_;
+  int slices_, sliceRes_, fourierTerms_;
   SliceFrame frame_;
   std::vector<gpu::ImpostorBlock> gpuBlocks_;
   gl::Framebuffer viewFb_, lightFb_, sliceFb_;
