@@ -2,6 +2,7 @@
 // (the paper's loop over every beam) and the culled one (BVH over the beams' cones), the error against
 // the reference light tracer, and the comparison with caustic triangles and photon splatting.
 //   build/bench/light_volumes_bench timing <width> <height> [max_linear_beams=5120] [max_bvh_beams=81920] [frames=3]
+//     [min_beams=0] (rows with fewer beams are skipped: extend a run without repeating it)
 //   build/bench/light_volumes_bench compare [size=128] [lt_paths_per_pixel=256] [scene name prefix] [methods=all|light_volumes] [max_subdivision_beams]
 // Scenes (a Lambertian floor, albedo 0.5, seen from straight above by an orthographic camera that sits
 // below every scatterer, so that the light tracer's camera connections see the floor directly):
@@ -248,10 +249,11 @@ Image lightTraced(const Scene& scene, int size, int pathsPerPixel, double& ms, s
   return img;
 }
 
-void timing(int width, int height, int maxLinear, int maxBvh, int frames) {
+void timing(int width, int height, int maxLinear, int maxBvh, int frames, int minBeams) {
   const int grid[][2] = {{40, 1}, {80, 2}, {160, 4}, {320, 8}, {640, 16}, {1280, 32}};
   for (const auto& g : grid) {
     if (2 * g[0] * g[1] > maxBvh) break;
+    if (2 * g[0] * g[1] < minBeams) continue;
     const Scene scene = ringScene(g[0], g[1]);
     const Timed bvh = timed(scene, width, height, "bvh", frames);
     std::printf("ring %dx%d beams=%.0f traversal=bvh gpu_ms=%.2f segments=%.0f setup_ms=%.1f bvh_ms=%.1f\n", width,
@@ -326,11 +328,11 @@ int main(int argc, char** argv) {
   auto arg = [&](int i, int fallback) { return argc > i ? std::atoi(argv[i]) : fallback; };
   std::printf("GL_RENDERER %s\n", renderer().device().renderer.c_str());
   if (mode == "timing") {
-    timing(arg(2, 256), arg(3, 256), arg(4, 5120), arg(5, 81920), arg(6, 3));
+    timing(arg(2, 256), arg(3, 256), arg(4, 5120), arg(5, 81920), arg(6, 3), arg(7, 0));
     return 0;
   }
   if (mode != "compare") {
-    std::fprintf(stderr, "usage: %s timing <w> <h> [max_linear] [max_bvh] [frames] | compare [size] [paths]\n", argv[0]);
+    std::fprintf(stderr, "usage: %s timing <w> <h> [max_linear] [max_bvh] [frames] [min_beams] | compare [size] [paths]\n", argv[0]);
     return 2;
   }
   const int size = arg(2, 128), paths = arg(3, 256);
