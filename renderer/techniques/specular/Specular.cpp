@@ -24,6 +24,12 @@ namespace {
 constexpr float kMinBranchWeight = 1e-3f;
 
 constexpr int kMapTextureUnitPeel = gpu::kUnitPeel;
+// Indirect light in the maps (shaders/specular/map_indirect.comp): one photon gather per block of
+// texels, kMapIndirectSamples x kMapIndirectSamples blocks per face, spread over the block's texels on
+// the same surface (the rest gather themselves). photon_gi's estimate is smooth over its kernel radius;
+// a gather at every texel of a 256 x 256 face cost 13 s per photon set on llvmpipe (docs/PERFORMANCE.md).
+constexpr int kMapIndirectSamples = 64;
+int mapIndirectBlock(int resolution) { return std::max(1, resolution / kMapIndirectSamples); }
 constexpr float kEmptyDistance = 3.0e38f;  // shaders/specular/ldm.glsl
 
 }  // namespace
@@ -102,6 +108,11 @@ void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResour
   res.framebuffer("specular_ldm");
   // One face's photon sums over the gather's slices (shaders/specular/map_indirect.comp).
   res.texture("specular_ldm_indirect", GL_TEXTURE_2D, GL_RGBA32F, resolution_, resolution_)
+      .setFilter(GL_NEAREST, GL_NEAREST);
+  const int blocks = (resolution_ + mapIndirectBlock(resolution_) - 1) / mapIndirectBlock(resolution_);
+  res.texture("specular_ldm_indirect_blocks", GL_TEXTURE_2D, GL_RGBA32F, blocks, blocks)
+      .setFilter(GL_NEAREST, GL_NEAREST);
+  res.texture("specular_ldm_indirect_fixup", GL_TEXTURE_2D, GL_R32F, resolution_, resolution_)
       .setFilter(GL_NEAREST, GL_NEAREST);
   res.buffer("specular_objects", std::max<std::size_t>(1, objects_.size()) * sizeof(GpuObject));
   res.buffer("specular_minmax", static_cast<std::size_t>(cubes) * 2 * sizeof(std::uint32_t));
@@ -224,6 +235,11 @@ void SpecularPass::execute(PassContext& ctx) {
       albedo.bindImage(1, GL_READ_ONLY, 0, true, 0);
       material.bindImage(2, GL_READ_WRITE, 0, true, 0);
       res.texture("specular_ldm_indirect").bindImage(3, GL_READ_WRITE);
+      res.texture("specular_ldm_indirect_blocks").bindImage(4, GL_READ_WRITE);
+      res.texture("specular_ldm_indirect_fixup").bindImage(5, GL_READ_WRITE);
+      const int block = mapIndirectBlock(resolution_);
+      const int blocks = (resolution_ + block - 1) / block;
+      gather.set("u_block", block);
       gather.set("u_kernel", photons->kernel);
       gather.set("u_planeTolerance", kPhotonPlaneTolerance);
       gather.set("u_normalCosine", kPhotonNormalCosine);
@@ -245,17 +261,33 @@ void SpecularPass::execute(PassContext& ctx) {
           for (int f = 0; f < 6; ++f) {
             gather.set("u_layerFace", (k * layers_ + l) * 6 + f);
             gather.set("u_face", f);
-            for (std::uint32_t sl = 0; sl < slices; ++sl) {
-              glProgramUniform1ui(gather.id(), gather.uniformLocation("u_sliceBegin"), sl * kPhotonGatherSlice);
-              gather.set("u_first", sl == 0 ? 1 : 0);
-              gather.set("u_last", sl + 1 == slices ? 1 : 0);
+            // mode 1 (blocks > 1): the block samples; 2: spread them, mark the texels none fits; 0: gather
+            // at every texel (blocks of 1) or at the marked ones.
+            auto gatherSlices = [&](int mode, int fixupOnly, int size) {
+              gather.set("u_mode", mode);
+              gather.set("u_fixupOnly", fixupOnly);
+              for (std::uint32_t sl = 0; sl < slices; ++sl) {
+                glProgramUniform1ui(gather.id(), gather.uniformLocation("u_sliceBegin"), sl * kPhotonGatherSlice);
+                gather.set("u_first", sl == 0 ? 1 : 0);
+                gather.set("u_last", sl + 1 == slices ? 1 : 0);
+                glDispatchCompute((size + 7) / 8, (size + 7) / 8, 1);
+                glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+                ++dispatches;
+              }
+            };
+            if (block > 1) {
+              gatherSlices(1, 0, blocks);
+              gather.set("u_mode", 2);
               glDispatchCompute((resolution_ + 7) / 8, (resolution_ + 7) / 8, 1);
               glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-              ++dispatches;
+              gatherSlices(0, 1, resolution_);
+            } else {
+              gatherSlices(0, 0, resolution_);
             }
           }
       }
       ctx.stats.counters["maps_indirect_dispatches"] = dispatches;
+      ctx.stats.counters["maps_indirect_block"] = block;
     }
     // Min-max distance per layer (thesis Fig. 5.3).
     std::vector<std::uint32_t> init(static_cast<std::size_t>(objectCount) * layers_ * 2);
