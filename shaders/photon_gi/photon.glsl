@@ -43,15 +43,22 @@ struct SplatSurface {
   MaterialParams p;  // the G-buffer's material with its layers (clear coat, sheen, specular)
 };
 
+// k((x - x_j) / h_j) / h_j^2 of photon j at a surface point x whose geometric normal ng faces the
+// viewer: 0 when the point fails the surface test (not in the photon's plane, or facing elsewhere).
+// Shared by the splats, the gather and the specular pass's distance maps (shaders/specular/map_indirect.comp).
+float photonKernel(GpuPhoton p, vec3 x, vec3 ng) {
+  float h = p.positionRadius.w;
+  vec3 d = x - p.positionRadius.xyz;
+  float planeDistance = dot(d, p.normal.xyz);
+  if (abs(planeDistance) > u_planeTolerance * h) return 0.0;
+  if (dot(ng, p.normal.xyz) < u_normalCosine) return 0.0;
+  vec3 inPlane = d - planeDistance * p.normal.xyz;
+  return kernel2d(dot(inPlane, inPlane) / (h * h)) / (h * h);
+}
+
 // phi_j f_r k / h^2 of photon j at the surface s (0 when it fails the surface test).
 vec3 photonContribution(GpuPhoton p, SplatSurface s) {
-  float h = p.positionRadius.w;
-  vec3 d = s.x - p.positionRadius.xyz;
-  float planeDistance = dot(d, p.normal.xyz);
-  if (abs(planeDistance) > u_planeTolerance * h) return vec3(0.0);
-  if (dot(s.ng, p.normal.xyz) < u_normalCosine) return vec3(0.0);
-  vec3 inPlane = d - planeDistance * p.normal.xyz;
-  float k = kernel2d(dot(inPlane, inPlane) / (h * h));
+  float k = photonKernel(p, s.x, s.ng);
   if (k <= 0.0) return vec3(0.0);
   vec3 wi = p.wi.xyz;
   float NdotL = dot(s.n, wi);
@@ -67,19 +74,20 @@ vec3 photonContribution(GpuPhoton p, SplatSurface s) {
   if (diffuseOnly || m.surface.y < u_minGlossyRoughness) m.surface.y = 0.0;
   if (diffuseOnly || m.clearcoat.y < u_minGlossyRoughness) m.clearcoat.y = 0.0;
   vec3 f = gltfBsdfCos(s.n, s.nc, s.wo, wi, m, m.surface.w) / NdotL;
-  return p.power.rgb * f * (k / (h * h));
+  return p.power.rgb * f * k;
 }
 
 // A coverage point (uniform by area over its surface, weight A / n): w k / h^2 at s, where s passes the
 // same surface test regardless of which side the surface is seen from. Summed over a surface's points
 // this estimates the kernel mass that lies on the surface around s (1 in the interior).
-float coverageContribution(GpuPhoton p, SplatSurface s) {
+float coverageKernel(GpuPhoton p, vec3 x, vec3 ng) {
   float h = p.positionRadius.w;
-  vec3 d = s.x - p.positionRadius.xyz;
+  vec3 d = x - p.positionRadius.xyz;
   float planeDistance = dot(d, p.normal.xyz);
   if (abs(planeDistance) > u_planeTolerance * h) return 0.0;
-  if (abs(dot(s.ng, p.normal.xyz)) < u_normalCosine) return 0.0;
+  if (abs(dot(ng, p.normal.xyz)) < u_normalCosine) return 0.0;
   vec3 inPlane = d - planeDistance * p.normal.xyz;
   return p.power.a * kernel2d(dot(inPlane, inPlane) / (h * h)) / (h * h);
 }
+float coverageContribution(GpuPhoton p, SplatSurface s) { return coverageKernel(p, s.x, s.ng); }
 #endif

@@ -9,6 +9,7 @@
 #include "renderer/frame/PassContext.h"
 #include "renderer/frame/RayScenes.h"
 #include "renderer/raytracing/PhotonTracer.h"
+#include "renderer/shading/PhotonGrid.h"
 
 namespace radiant {
 namespace {
@@ -51,7 +52,9 @@ const TechniqueInfo& PhotonGiPass::info() const {
                                {"gbuffer_position", "normal", "albedo", "material", "emission", "geometric_normal",
                                 "gbuffer_layers", "gbuffer_specular"},
                                {"direct"},  // runs after direct, which initialises beauty
-                               {"indirect"},
+                               // photon_grid: the uploaded splat grid (internal, read by specular's
+                               // distance maps; renderer/shading/PhotonGrid.h).
+                               {"indirect", "photon_grid"},
                                true,
                                true,
                                // LS+DE: punctual light through near-mirrors (isSpecular() with a glossy
@@ -217,16 +220,32 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   hMax_ = splats.hMax;
   photon_gi::declareSplatResources(res, *grid_, splat_);
   splatDigest_ = splatDigest;
+  // Uploaded here, not in execute(), and published: specular, earlier in the frame, shades its distance
+  // maps' diffuse texels from the same splats (the path L D+ D S+ E, docs/TECHNIQUES.md).
+  if (upload_) {
+    photon_gi::uploadSplatGrid(res, *grid_);
+    // The GPU holds the splats now: the CPU copy would double the memory of every cached photon set. A
+    // lost GL context clears the cache entry too (FrameResources::clear), so it is rebuilt, not re-uploaded.
+    std::vector<photon_gi::GpuSplat>().swap(grid_->splats);
+    res.setHolds("photon_gi_splats", splatDigest_);  // after the upload
+  }
+  PhotonGrid published;
+  published.digest = splatDigest_ + "|kernel=" + std::to_string(static_cast<int>(splat_.kernel));
+  published.count = grid_->count;
+  published.origin = grid_->origin;
+  published.cellSize = grid_->cellSize;
+  published.dims = grid_->dims;
+  published.maxPerCell = grid_->maxPerCell;
+  published.kernel = static_cast<int>(splat_.kernel);
+  published.renormalize = splat_.renormalize;
+  publishPhotonGrid(res, published);
 }
 
 void PhotonGiPass::execute(PassContext& ctx) {
   // The receivers' layered BSDF reads the sheen directional-albedo table (common/brdf.glsl).
   ctx.gpu.sheenAlbedo.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingSheenAlbedo);
-  photon_gi::splatAndResolve(ctx.resources, ctx.shaders, ctx.view, splat_, *grid_, upload_, true);
-  // The GPU holds the splats now: the CPU copy would double the memory of every cached photon set. A
-  // lost GL context clears the cache entry too (FrameResources::clear), so it is rebuilt, not re-uploaded.
-  if (upload_) std::vector<photon_gi::GpuSplat>().swap(grid_->splats);
-  if (upload_) ctx.resources.setHolds("photon_gi_splats", splatDigest_);  // after the upload
+  // prepare() uploaded the grid.
+  photon_gi::splatAndResolve(ctx.resources, ctx.shaders, ctx.view, splat_, *grid_, false, true);
   auto& c = ctx.stats.counters;
   c["photons"] = static_cast<double>(settings_.photons);
   c["photons_traced"] = static_cast<double>(traced_);

@@ -8,23 +8,19 @@
 
 #include "renderer/frame/GpuTypes.h"
 #include "renderer/raytracing/Bsdf.h"
+#include "renderer/shading/PhotonGrid.h"
 
 namespace radiant::photon_gi {
 namespace {
 
-constexpr GLuint kSplatBinding = 5, kCellBinding = 6;
+// Bindings, the surface test, the renormalisation floor and the gather's slice length are shared with
+// the readers of the published grid (renderer/shading/PhotonGrid.h).
+constexpr GLuint kSplatBinding = kPhotonSplatBinding, kCellBinding = kPhotonCellBinding;
 constexpr int kMaxCellsPerAxis = 128;
-// Candidates per cell and dispatch of the gather: 27 cells x 2000 = 54000 loop iterations per pixel,
-// under llvmpipe's limit of 65535 per invocation.
-constexpr std::uint32_t kGatherSlice = 2000;
-// The surface test (shaders/photon_gi/photon.glsl): a pixel's surface must lie within this fraction of
-// h of the photon's plane (a curved surface deviates from its tangent plane by r^2 / 2R) and its
-// geometric normal within acos(0.7) = 45.6 degrees of the photon's (creases between walls are 90).
-constexpr float kPlaneTolerance = 0.25f;
-constexpr float kNormalCosine = 0.7f;
-// Renormalised pixels divide by the kernel mass on their surface, at least this much (a right-angled
-// corner has 1/4; thin features much less, where dividing would only amplify noise).
-constexpr float kMinKernelMass = 0.2f;
+constexpr std::uint32_t kGatherSlice = kPhotonGatherSlice;
+constexpr float kPlaneTolerance = kPhotonPlaneTolerance;
+constexpr float kNormalCosine = kPhotonNormalCosine;
+constexpr float kMinKernelMass = kPhotonMinKernelMass;
 
 std::size_t capacity(std::size_t bytes) {
   std::size_t c = 4096;
@@ -142,16 +138,19 @@ void declareSplatResources(FrameResources& res, const SplatGrid& grid, const Spl
   resolveFb.checkComplete("photon_gi::declareSplatResources");
 }
 
+void uploadSplatGrid(FrameResources& res, const SplatGrid& grid) {
+  if (grid.splats.size() != grid.count)
+    throw std::logic_error("photon_gi::uploadSplatGrid: the grid's splats were released before upload");
+  if (!grid.splats.empty())
+    res.buffer("photon_gi_splats").upload(grid.splats.data(), grid.splats.size() * sizeof(GpuSplat));
+  res.buffer("photon_gi_cells").upload(grid.cellStart.data(), grid.cellStart.size() * sizeof(std::uint32_t));
+}
+
 void splatAndResolve(FrameResources& res, gl::ShaderLibrary& shaders, const FrameView& view,
                      const SplatSettings& settings, const SplatGrid& grid, bool upload, bool addToBeauty) {
   gl::Buffer& splats = res.buffer("photon_gi_splats");
   gl::Buffer& cells = res.buffer("photon_gi_cells");
-  if (upload) {
-    if (grid.splats.size() != grid.count)
-      throw std::logic_error("photon_gi::splatAndResolve: the grid's splats were released before upload");
-    if (!grid.splats.empty()) splats.upload(grid.splats.data(), grid.splats.size() * sizeof(GpuSplat));
-    cells.upload(grid.cellStart.data(), grid.cellStart.size() * sizeof(std::uint32_t));
-  }
+  if (upload) uploadSplatGrid(res, grid);
   const char* inputs[] = {"gbuffer_position", "normal", "albedo", "material", "emission"};
   for (GLuint i = 0; i < std::size(inputs); ++i) res.texture(inputs[i]).bindUnit(i);
   res.texture("geometric_normal").bindUnit(6);

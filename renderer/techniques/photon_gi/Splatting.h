@@ -68,6 +68,8 @@ SplatGrid buildSplatGrid(std::vector<GpuSplat> splats);
 
 // Declares the splat buffers (capacity in powers of two), the accumulation targets and `indirect`.
 void declareSplatResources(FrameResources& res, const SplatGrid& grid, const SplatSettings& settings);
+// Uploads `grid` into the splat buffers (its CPU splats must still be there).
+void uploadSplatGrid(FrameResources& res, const SplatGrid& grid);
 // Uploads `grid` when `upload` (else the buffers hold it already), accumulates into the target and
 // resolves into `indirect`, adding it to `beauty` when addToBeauty. Reads the G-buffer resources.
 void splatAndResolve(FrameResources& res, gl::ShaderLibrary& shaders, const FrameView& view,

@@ -11,6 +11,7 @@
 #include "renderer/frame/PassContext.h"
 #include "renderer/shading/CubeFaces.h"
 #include "renderer/shading/DirectLighting.h"
+#include "renderer/shading/PhotonGrid.h"
 #include "renderer/shading/SpecularObjects.h"
 
 namespace radiant {
@@ -23,6 +24,12 @@ namespace {
 constexpr float kMinBranchWeight = 1e-3f;
 
 constexpr int kMapTextureUnitPeel = gpu::kUnitPeel;
+// Indirect light in the maps (shaders/specular/map_indirect.comp): one photon gather per block of
+// texels, kMapIndirectSamples x kMapIndirectSamples blocks per face, spread over the block's texels on
+// the same surface (the rest gather themselves). photon_gi's estimate is smooth over its kernel radius;
+// a gather at every texel of a 256 x 256 face cost 13 s per photon set on llvmpipe (docs/PERFORMANCE.md).
+constexpr int kMapIndirectSamples = 64;
+int mapIndirectBlock(int resolution) { return std::max(1, resolution / kMapIndirectSamples); }
 constexpr float kEmptyDistance = 3.0e38f;  // shaders/specular/ldm.glsl
 
 }  // namespace
@@ -32,11 +39,13 @@ const TechniqueInfo& SpecularPass::info() const {
       "specular",
       "Multiple specular reflections and refractions traced in layered distance maps (thesis ch. 5)",
       {"gbuffer_position", "normal", "albedo", "material", "emission"},
-      {"shadow_maps", "environment_map"},  // rays that leave the scene see the environment map
+      // rays that leave the scene see the environment map; photon_grid: photon_gi's splat grid, which
+      // lights the maps' diffuse texels with indirect light (L D+ D S+ E) when photon_gi is planned.
+      {"shadow_maps", "environment_map", "photon_grid"},
       {"specular", "specular_maps"},  // specular_maps: the layered distance maps (internal, read by caustics)
       true,
       true,
-      {"LS+E", "LDS+E"}};
+      {"LS+E", "LDS+E", "LD+DS+E"}};
   return i;
 }
 
@@ -97,6 +106,14 @@ void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResour
   gl::Texture& peel = res.texture("specular_ldm_peel", GL_TEXTURE_2D, GL_RGBA32F, resolution_, resolution_);
   peel.setFilter(GL_NEAREST, GL_NEAREST);
   res.framebuffer("specular_ldm");
+  // One face's photon sums over the gather's slices (shaders/specular/map_indirect.comp).
+  res.texture("specular_ldm_indirect", GL_TEXTURE_2D, GL_RGBA32F, resolution_, resolution_)
+      .setFilter(GL_NEAREST, GL_NEAREST);
+  const int blocks = (resolution_ + mapIndirectBlock(resolution_) - 1) / mapIndirectBlock(resolution_);
+  res.texture("specular_ldm_indirect_blocks", GL_TEXTURE_2D, GL_RGBA32F, blocks, blocks)
+      .setFilter(GL_NEAREST, GL_NEAREST);
+  res.texture("specular_ldm_indirect_fixup", GL_TEXTURE_2D, GL_R32F, resolution_, resolution_)
+      .setFilter(GL_NEAREST, GL_NEAREST);
   res.buffer("specular_objects", std::max<std::size_t>(1, objects_.size()) * sizeof(GpuObject));
   res.buffer("specular_minmax", static_cast<std::size_t>(cubes) * 2 * sizeof(std::uint32_t));
 
@@ -114,12 +131,11 @@ void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResour
   declareDirectLightingResources(res);
 
   // The maps depend on the geometry, materials and lights (the uploaded scene's key) and on the map
-  // shape. Not on the tracing knobs (steps, depth, minmax): a sweep over those reuses them.
-  const std::string digest = res.sceneKey() + "|res=" + std::to_string(resolution_) +
-                             "|layers=" + std::to_string(layers_) + "|objects=" + std::to_string(objects_.size());
-  // The maps live in the shared specular_ldm_* textures (FrameResources::holds).
-  mapsValid_ = res.holds("specular_ldm_distance", digest, "specular_maps");
-  digest_ = digest;
+  // shape, and on the photons that light their diffuse texels (execute(): photon_gi publishes its grid
+  // in its prepare, after this one). Not on the tracing knobs (steps, depth, minmax): a sweep over
+  // those reuses them.
+  digest_ = res.sceneKey() + "|res=" + std::to_string(resolution_) + "|layers=" + std::to_string(layers_) +
+            "|objects=" + std::to_string(objects_.size());
 }
 
 void SpecularPass::execute(PassContext& ctx) {
@@ -139,6 +155,13 @@ void SpecularPass::execute(PassContext& ctx) {
 
   ctx.stats.counters["objects"] = objectCount;
   ctx.stats.counters["maps_rendered"] = 0;
+  // Indirect light on the maps' diffuse texels: photon_gi's photons when it is planned (its grid is
+  // uploaded by now), else none (the maps then hold emission and direct light only).
+  const PhotonGrid* photons = publishedPhotonGrid(res);
+  ctx.stats.counters["maps_indirect"] = photons ? 1 : 0;
+  const std::string digest = digest_ + "|photons=" + (photons ? photons->digest : std::string("none"));
+  // The maps live in the shared specular_ldm_* textures (FrameResources::holds).
+  mapsValid_ = res.holds("specular_ldm_distance", digest, "specular_maps");
   if (!mapsValid_ && objectCount > 0) {
     // Layered distance maps (thesis 5.1.1): per object and face, its front faces, its back faces, the
     // environment (everything else, closest surface) and depth-peeled environment layers.
@@ -201,6 +224,71 @@ void SpecularPass::execute(PassContext& ctx) {
           ++draws;
         }
     }
+    if (photons && photons->count > 0) {
+      // L D+ D S+ E: photon_gi's estimate at every diffuse texel of the environment layers (layer >= 2;
+      // layers 0 and 1 hold the object itself), one face at a time, in slices (llvmpipe's loop limit).
+      glMemoryBarrier(GL_ALL_BARRIER_BITS);
+      const gl::Program& gather = ctx.shaders.program({"specular/map_indirect.comp"});
+      gather.use();
+      photons->bind(res);
+      geometry.bindImage(0, GL_READ_ONLY, 0, true, 0);
+      albedo.bindImage(1, GL_READ_ONLY, 0, true, 0);
+      material.bindImage(2, GL_READ_WRITE, 0, true, 0);
+      res.texture("specular_ldm_indirect").bindImage(3, GL_READ_WRITE);
+      res.texture("specular_ldm_indirect_blocks").bindImage(4, GL_READ_WRITE);
+      res.texture("specular_ldm_indirect_fixup").bindImage(5, GL_READ_WRITE);
+      const int block = mapIndirectBlock(resolution_);
+      const int blocks = (resolution_ + block - 1) / block;
+      gather.set("u_block", block);
+      gather.set("u_kernel", photons->kernel);
+      gather.set("u_planeTolerance", kPhotonPlaneTolerance);
+      gather.set("u_normalCosine", kPhotonNormalCosine);
+      gather.set("u_renormalize", photons->renormalize ? 1 : 0);
+      gather.set("u_minKernelMass", kPhotonMinKernelMass);
+      gather.set("u_size", resolution_);
+      gather.set("u_gridOrigin", &photons->origin[0], 3);
+      gather.set("u_cellSize", photons->cellSize);
+      const int dims[3] = {photons->dims.x, photons->dims.y, photons->dims.z};
+      glProgramUniform3iv(gather.id(), gather.uniformLocation("u_gridDims"), 1, dims);
+      glProgramUniform1ui(gather.id(), gather.uniformLocation("u_sliceLength"), kPhotonGatherSlice);
+      const std::uint32_t slices =
+          std::max<std::uint32_t>(1, (photons->maxPerCell + kPhotonGatherSlice - 1) / kPhotonGatherSlice);
+      int dispatches = 0;
+      for (int k = 0; k < objectCount; ++k) {
+        const glm::vec3 ref(objects_[k].gpu.referenceRadius);
+        gather.set("u_reference", &ref[0], 3);
+        for (int l = 2; l < layers_; ++l)
+          for (int f = 0; f < 6; ++f) {
+            gather.set("u_layerFace", (k * layers_ + l) * 6 + f);
+            gather.set("u_face", f);
+            // mode 1 (blocks > 1): the block samples; 2: spread them, mark the texels none fits; 0: gather
+            // at every texel (blocks of 1) or at the marked ones.
+            auto gatherSlices = [&](int mode, int fixupOnly, int size) {
+              gather.set("u_mode", mode);
+              gather.set("u_fixupOnly", fixupOnly);
+              for (std::uint32_t sl = 0; sl < slices; ++sl) {
+                glProgramUniform1ui(gather.id(), gather.uniformLocation("u_sliceBegin"), sl * kPhotonGatherSlice);
+                gather.set("u_first", sl == 0 ? 1 : 0);
+                gather.set("u_last", sl + 1 == slices ? 1 : 0);
+                glDispatchCompute((size + 7) / 8, (size + 7) / 8, 1);
+                glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+                ++dispatches;
+              }
+            };
+            if (block > 1) {
+              gatherSlices(1, 0, blocks);
+              gather.set("u_mode", 2);
+              glDispatchCompute((resolution_ + 7) / 8, (resolution_ + 7) / 8, 1);
+              glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+              gatherSlices(0, 1, resolution_);
+            } else {
+              gatherSlices(0, 0, resolution_);
+            }
+          }
+      }
+      ctx.stats.counters["maps_indirect_dispatches"] = dispatches;
+      ctx.stats.counters["maps_indirect_block"] = block;
+    }
     // Min-max distance per layer (thesis Fig. 5.3).
     std::vector<std::uint32_t> init(static_cast<std::size_t>(objectCount) * layers_ * 2);
     for (std::size_t i = 0; i < init.size(); i += 2) {
@@ -221,7 +309,7 @@ void SpecularPass::execute(PassContext& ctx) {
     }
     glMemoryBarrier(GL_ALL_BARRIER_BITS);
     ctx.stats.counters["maps_rendered"] = draws;
-    res.setHolds("specular_ldm_distance", digest_);  // after writing them
+    res.setHolds("specular_ldm_distance", digest);  // after writing them
   }
   res.markWritten("specular_maps");
   ctx.stats.counters["cube_resolution"] = resolution_;

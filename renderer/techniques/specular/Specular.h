@@ -4,9 +4,11 @@
 // prepare(): finds the specular objects (meshes whose material is Material::isSpecular()), declares
 // their layered distance maps (cube-map arrays of material, geometry and filtered distance, `layers`
 // cubes per object; layout in shaders/specular/ldm.glsl) and looks the maps up
-// in the derived-data cache (scene digest, GPU scene, cube_resolution, layers).
-// execute(): on a cache miss renders every layer of every face of every object and reduces each layer
-// to its min-max distances; then rasterises the specular objects, traces their reflected/refracted
+// in the derived-data cache (scene digest, GPU scene, cube_resolution, layers, and in execute() the
+// photon set of photon_gi's published grid, renderer/shading/PhotonGrid.h).
+// execute(): on a cache miss renders every layer of every face of every object, adds photon_gi's
+// indirect light to the environment layers' diffuse texels when photon_gi is planned
+// (shaders/specular/map_indirect.comp) and reduces each layer to its min-max distances; then rasterises the specular objects, traces their reflected/refracted
 // rays in the maps (shaders/specular/specular.frag) into the `specular` AOV, and adds it to beauty.
 #include <string>
 #include <vector>
@@ -49,7 +51,7 @@ private:
   int maxDepth_ = 4, linearSteps_ = 32, secantSteps_ = 4, resolution_ = 256, layers_ = 3;
   bool minmax_ = true;
   bool mapsValid_ = false;
-  std::string digest_;  // what the maps hold once execute() rendered them (FrameResources::holds)
+  std::string digest_;  // the maps' key without the photon set (execute() appends it; FrameResources::holds)
 };
 
 }  // namespace radiant

@@ -1,0 +1,164 @@
+// Indirect light on the diffuse texels of one face of one layered-distance-map cube (issue 14: the
+// light path L D+ D S+ E, indirect diffuse light seen through or in a specular object): photon_gi's
+// photons, gathered at the texel's surface point with photon_gi's kernel and surface test
+// (photon_gi/photon.glsl: photonKernel, coverageKernel, the 27 grid cells of gather.comp), times the
+// texel's diffuse albedo / pi (its Lambertian term, specular_ldm_albedo), added to the texel's
+// reflected radiance (specular_ldm_material rgb, which map.frag filled with emission + direct light).
+// The surface point is the reference point plus the texel's centre direction times its stored
+// distance; its normal faces the reference point (the map's viewer, as map.frag shades it). One gather
+// per block of texels, spread over the block's texels on the same surface (u_mode below).
+#include "common/octahedral.glsl"
+#include "photon_gi/photon.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(std430, binding = 6) readonly buffer Cells { uint cellStart[]; };
+layout(binding = 0, rgba32f) readonly uniform imageCubeArray i_geometry;  // oct normal, distance, object
+layout(binding = 1, rgba8) readonly uniform imageCubeArray i_albedo;      // rgb albedo, a 1 = lit diffuse
+layout(binding = 2, rgba16f) uniform imageCubeArray i_material;           // rgb radiance of diffuse texels
+layout(binding = 3, rgba32f) uniform image2D i_accum;                     // this face's sums over slices
+layout(binding = 4, rgba32f) uniform image2D i_blocks;  // mode 1: the block samples' E (a 1) or none (a -1)
+layout(binding = 5, r32f) uniform image2D i_fixup;      // mode 2 writes 1 where no block sample fits
+
+uniform vec3 u_reference;
+uniform int u_layerFace;  // cube * 6 + face
+uniform int u_face;
+uniform int u_size;
+uniform vec3 u_gridOrigin;
+uniform float u_cellSize;
+uniform ivec3 u_gridDims;
+uniform uint u_sliceBegin;  // as gather.comp: llvmpipe's loop limit, one dispatch per slice
+uniform uint u_sliceLength;
+uniform int u_first;        // first slice: start the sums at 0
+uniform int u_last;         // last slice: add the estimate to the material texel
+uniform int u_renormalize;
+uniform float u_minKernelMass;
+// u_mode 0: every texel gathers (u_fixupOnly 1: only the texels mode 2 marked); 1: one gather per
+// u_block x u_block block, at its centre texel, into i_blocks; 2: every diffuse texel takes the block
+// samples of its own and the 8 neighbouring blocks that lie on its surface (same object code, normal
+// within 25 degrees, within 0.1 of the distance between them off its plane: the gather's estimate is
+// smooth over a kernel radius, the block is 1/64 of a face), weighted by a tent over their texel
+// distance; where none fits it is marked for mode 0.
+uniform int u_mode;
+uniform int u_block;
+uniform int u_fixupOnly;
+
+// Direction of the point (s, t) in [-1, 1]^2 of cube face `face` (GL 4.5 table 8.19, inverted).
+vec3 faceDirection(int face, vec2 st) {
+  if (face == 0) return vec3(1.0, -st.y, -st.x);
+  if (face == 1) return vec3(-1.0, -st.y, st.x);
+  if (face == 2) return vec3(st.x, 1.0, st.y);
+  if (face == 3) return vec3(st.x, -1.0, -st.y);
+  if (face == 4) return vec3(st.x, -st.y, 1.0);
+  return vec3(-st.x, -st.y, -1.0);
+}
+
+vec3 texelPoint(ivec2 px, vec4 g) {
+  return u_reference + normalize(faceDirection(u_face, (vec2(px) + 0.5) / float(u_size) * 2.0 - 1.0)) * g.z;
+}
+vec3 texelNormal(vec4 g, vec3 x) {
+  vec3 n = normalize(octDecode(g.xy));
+  return dot(n, x - u_reference) > 0.0 ? -n : n;  // facing the reference point, the map's viewer
+}
+
+// The photon sums at texel px (rgb sum phi k / h^2 of this slice, a the coverage points' kernel mass).
+vec4 gatherAt(ivec2 px, vec4 acc) {
+  vec4 g = imageLoad(i_geometry, ivec3(px, u_layerFace));
+  vec3 x = texelPoint(px, g);
+  vec3 n = texelNormal(g, x);
+  ivec3 c = ivec3(floor((x - u_gridOrigin) / u_cellSize));
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        ivec3 q = c + ivec3(dx, dy, dz);
+        if (any(lessThan(q, ivec3(0))) || any(greaterThanEqual(q, u_gridDims))) continue;
+        int cell = (q.z * u_gridDims.y + q.y) * u_gridDims.x + q.x;
+        uint begin = cellStart[cell] + u_sliceBegin, end = min(cellStart[cell + 1], begin + u_sliceLength);
+        for (uint i = begin; i < end; ++i) {
+          GpuPhoton p = photons[i];
+          if (p.power.a > 0.0) {
+            acc.a += coverageKernel(p, x, n);
+          } else if (dot(n, p.wi.xyz) > 0.0) {
+            acc.rgb += p.power.rgb * photonKernel(p, x, n);
+          }
+        }
+      }
+  return acc;
+}
+
+bool lit(vec4 albedo) { return albedo.a > 0.0 && any(greaterThan(albedo.rgb, vec3(0.0))); }
+
+vec3 irradiance(vec4 acc) {
+  vec3 E = acc.rgb;  // sum phi k / h^2: the irradiance estimate
+  if (u_renormalize != 0 && acc.a > 0.0) E /= max(acc.a, u_minKernelMass);
+  return E;
+}
+
+void addToTexel(ivec3 t, vec4 albedo, vec3 E) {
+  vec4 m = imageLoad(i_material, t);
+  imageStore(i_material, t, vec4(m.rgb + albedo.rgb * INV_PI * E, m.a));
+}
+
+void main() {
+  ivec2 id = ivec2(gl_GlobalInvocationID.xy);
+  if (u_mode == 1) {
+    int blocks = (u_size + u_block - 1) / u_block;
+    if (id.x >= blocks || id.y >= blocks) return;
+    ivec2 px = min(id * u_block + u_block / 2, ivec2(u_size - 1));
+    vec4 albedo = imageLoad(i_albedo, ivec3(px, u_layerFace));
+    vec4 acc = u_first != 0 ? vec4(0.0) : imageLoad(i_accum, id);
+    if (lit(albedo)) acc = gatherAt(px, acc);
+    if (u_last == 0) imageStore(i_accum, id, acc);
+    else imageStore(i_blocks, id, lit(albedo) ? vec4(irradiance(acc), 1.0) : vec4(0.0, 0.0, 0.0, -1.0));
+    return;
+  }
+  ivec2 px = id;
+  if (px.x >= u_size || px.y >= u_size) return;
+  ivec3 t = ivec3(px, u_layerFace);
+  vec4 albedo = imageLoad(i_albedo, t);
+  if (u_mode == 2) {
+    if (!lit(albedo)) { imageStore(i_fixup, px, vec4(0.0)); return; }
+    vec4 g = imageLoad(i_geometry, t);
+    vec3 x = texelPoint(px, g);
+    vec3 n = texelNormal(g, x);
+    ivec2 b0 = px / u_block;
+    int blocks = (u_size + u_block - 1) / u_block;
+    vec3 sum = vec3(0.0);
+    float wsum = 0.0;
+    for (int by = -1; by <= 1; ++by)
+      for (int bx = -1; bx <= 1; ++bx) {
+        ivec2 b = b0 + ivec2(bx, by);
+        if (any(lessThan(b, ivec2(0))) || any(greaterThanEqual(b, ivec2(blocks)))) continue;
+        vec4 e = imageLoad(i_blocks, b);
+        if (e.a < 0.0) continue;
+        ivec2 sp = min(b * u_block + u_block / 2, ivec2(u_size - 1));
+        vec4 gs = imageLoad(i_geometry, ivec3(sp, u_layerFace));
+        if (gs.w != g.w) continue;
+        vec3 xs = texelPoint(sp, gs);
+        vec3 ns = texelNormal(gs, xs);
+        if (dot(ns, n) < 0.9) continue;
+        vec3 d = xs - x;
+        if (abs(dot(d, n)) > 0.1 * length(d) + 1e-4 * g.z) continue;
+        vec2 o = abs(vec2(sp - px)) / float(u_block);
+        float w = max(1.0 - o.x, 0.0) * max(1.0 - o.y, 0.0);
+        if (sp == px) w = 1.0;
+        if (w <= 0.0) continue;
+        sum += w * e.rgb;
+        wsum += w;
+      }
+    if (wsum > 0.0) {
+      addToTexel(t, albedo, sum / wsum);
+      imageStore(i_fixup, px, vec4(0.0));
+    } else {
+      imageStore(i_fixup, px, vec4(1.0));
+    }
+    return;
+  }
+  if (u_fixupOnly != 0 && imageLoad(i_fixup, px).r != 1.0) return;
+  vec4 acc = u_first != 0 ? vec4(0.0) : imageLoad(i_accum, px);
+  if (lit(albedo)) acc = gatherAt(px, acc);
+  if (u_last == 0) {
+    imageStore(i_accum, px, acc);
+    return;
+  }
+  if (lit(albedo)) addToTexel(t, albedo, irradiance(acc));
+}
