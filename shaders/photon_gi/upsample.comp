@@ -1,17 +1,19 @@
 // gather_step > 1: the gather ran on one pixel per step x step block (its centre pixel); this pass gives
 // every pixel the photon estimate of the nearby block samples that lie on its own surface, bilinear
 // weights times a surface test (the estimator's own: within planeTolerance h_min of the pixel's plane,
-// normals within acos(0.9), and closer than h_min / 2, so borrowing blurs less than half the smallest
-// kernel). The diffuse albedo is re-modulated per pixel, (albedo + 0.02) / (albedo_sample + 0.02), so
+// normals within acos(0.9), and closer than h_min: every estimate is a kernel mean over a disc of radius
+// h >= h_min, so it is smooth over h_min, and the bilinear mix of samples within it adds a blur below the
+// smallest kernel's). The diffuse albedo is re-modulated per pixel, (albedo + 0.02) / (albedo_sample + 0.02), so
 // texture detail survives. Pixels without a matching sample are marked for a full-resolution gather
-// (i_fixup = 1), which the next dispatch of gather.comp does for them alone: no pixel is left dark.
+// (i_fixup = 1), which a later dispatch of gather.comp does for them alone (the fix-up list,
+// fixup_list.comp): no pixel is left dark.
 // u_refine = 1 (the fix-up cascade of a supersampled frame): only the marked pixels, from block samples
 // of a finer step taken at marked block centres (alpha -1: no sample there); a pixel that finds one is
 // unmarked, the others stay marked for the full gather.
 // u_refine = 2 (the neighbour fill, before the cascade): a marked pixel takes the mean of the pixels
 // within u_fillRadius that the block samples filled (i_fixup 0) and that pass the same surface test
-// (a block sample's estimate may thus reach a pixel up to h_min from where it was gathered: h_min / 2
-// to the neighbour, h_min / 2 more to this pixel); it is then marked 2, which no pass
+// (a block sample's estimate may thus reach a pixel up to 2 h_min from where it was gathered, h_min to
+// the neighbour and h_min more, though the neighbour is a pixel or two away); it is then marked 2, which no pass
 // reads from or gathers for. Edge pixels usually have such a neighbour on their own surface one or two
 // pixels inwards, so only thin features and isolated triangles are left for the full gather. Race-free:
 // it reads only pixels marked 0, which it never writes, and writes only pixels marked 1 (as 2).
@@ -32,11 +34,13 @@ uniform float u_minKernelMass;
 uniform int u_refine;
 uniform int u_fillRadius;
 
-// The surface test of a borrowed estimate: o's value may stand for s's (module comment).
+// The surface test of a borrowed estimate: o's value may stand for s's (module comment). The distance
+// bound was h_min / 2 until 2026-12-02: on the Cornell boxes' walls seen at a grazing angle, block samples
+// two pixels apart are farther than that, so every other pixel there was gathered again (21% of the
+// 128 px cornell_glass frame at k = 1); at h_min the frame's error is unchanged (docs/PERFORMANCE.md).
 bool sameSurface(SplatSurface s, SplatSurface o) {
   vec3 d = s.x - o.x;
-  return abs(dot(d, o.ng)) <= u_planeTolerance * u_hMin && dot(s.ng, o.ng) >= 0.9 &&
-         dot(d, d) <= 0.25 * u_hMin * u_hMin;
+  return abs(dot(d, o.ng)) <= u_planeTolerance * u_hMin && dot(s.ng, o.ng) >= 0.9 && dot(d, d) <= u_hMin * u_hMin;
 }
 
 // The diffuse albedo re-modulation of a borrowed estimate (module comment).

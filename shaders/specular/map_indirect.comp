@@ -1,17 +1,17 @@
 // Indirect light on the diffuse texels of one face of one layered-distance-map cube (issue 14: the
 // light path L D+ D S+ E, indirect diffuse light seen through or in a specular object): photon_gi's
 // photons, gathered at the texel's surface point with photon_gi's kernel and surface test
-// (photon_gi/photon.glsl: photonKernel, coverageKernel, the 27 grid cells of gather.comp), times the
+// (photon_gi/photon.glsl: photonKernel, coverageKernel; photon_gi/grid.glsl: the 27 grid cells), times the
 // texel's diffuse albedo / pi (its Lambertian term, specular_ldm_albedo), added to the texel's
 // reflected radiance (specular_ldm_material rgb, which map.frag filled with emission + direct light).
 // The surface point is the reference point plus the texel's centre direction times its stored
 // distance; its normal faces the reference point (the map's viewer, as map.frag shades it). One gather
 // per block of texels, spread over the block's texels on the same surface (u_mode below).
 #include "common/octahedral.glsl"
+#include "photon_gi/grid.glsl"
 #include "photon_gi/photon.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(std430, binding = 6) readonly buffer Cells { uint cellStart[]; };
 layout(binding = 0, rgba32f) readonly uniform imageCubeArray i_geometry;  // oct normal, distance, object
 layout(binding = 1, rgba8) readonly uniform imageCubeArray i_albedo;      // rgb albedo, a 1 = lit diffuse
 layout(binding = 2, rgba16f) uniform imageCubeArray i_material;           // rgb radiance of diffuse texels
@@ -23,11 +23,6 @@ uniform vec3 u_reference;
 uniform int u_layerFace;  // cube * 6 + face
 uniform int u_face;
 uniform int u_size;
-uniform vec3 u_gridOrigin;
-uniform float u_cellSize;
-uniform ivec3 u_gridDims;
-uniform uint u_sliceBegin;  // as gather.comp: llvmpipe's loop limit, one dispatch per slice
-uniform uint u_sliceLength;
 uniform int u_first;        // first slice: start the sums at 0
 uniform int u_last;         // last slice: add the estimate to the material texel
 uniform int u_renormalize;
@@ -65,23 +60,19 @@ vec4 gatherAt(ivec2 px, vec4 acc) {
   vec4 g = imageLoad(i_geometry, ivec3(px, u_layerFace));
   vec3 x = texelPoint(px, g);
   vec3 n = texelNormal(g, x);
-  ivec3 c = ivec3(floor((x - u_gridOrigin) / u_cellSize));
-  for (int dz = -1; dz <= 1; ++dz)
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dx = -1; dx <= 1; ++dx) {
-        ivec3 q = c + ivec3(dx, dy, dz);
-        if (any(lessThan(q, ivec3(0))) || any(greaterThanEqual(q, u_gridDims))) continue;
-        int cell = (q.z * u_gridDims.y + q.y) * u_gridDims.x + q.x;
-        uint begin = cellStart[cell] + u_sliceBegin, end = min(cellStart[cell + 1], begin + u_sliceLength);
-        for (uint i = begin; i < end; ++i) {
-          GpuPhoton p = photons[i];
-          if (p.power.a > 0.0) {
-            acc.a += coverageKernel(p, x, n);
-          } else if (dot(n, p.wi.xyz) > 0.0) {
-            acc.rgb += p.power.rgb * photonKernel(p, x, n);
-          }
-        }
+  ivec3 c = photonCellOf(x);
+  for (int k = 0; k < 27; ++k) {
+    uint begin, end;
+    if (!photonCellSlice(c, k, begin, end)) continue;
+    for (uint i = begin; i < end; ++i) {
+      GpuPhoton p = photons[i];
+      if (p.power.a > 0.0) {
+        acc.a += coverageKernel(p, x, n);
+      } else if (dot(n, p.wi.xyz) > 0.0) {
+        acc.rgb += p.power.rgb * photonKernel(p, x, n);
       }
+    }
+  }
   return acc;
 }
 

@@ -16,6 +16,8 @@ namespace {
 // Bindings, the surface test, the renormalisation floor and the gather's slice length are shared with
 // the readers of the published grid (renderer/shading/PhotonGrid.h).
 constexpr GLuint kSplatBinding = kPhotonSplatBinding, kCellBinding = kPhotonCellBinding;
+// gather.comp and fixup_list.comp: the fix-up list (binding 4 is free in photon_gi's shaders).
+constexpr GLuint kFixupListBinding = 4;
 constexpr int kMaxCellsPerAxis = 128;
 constexpr std::uint32_t kGatherSlice = kPhotonGatherSlice;
 constexpr float kPlaneTolerance = kPhotonPlaneTolerance;
@@ -119,6 +121,10 @@ void declareSplatResources(FrameResources& res, const SplatGrid& grid, const Spl
     res.texture("photon_gi_accum_low", GL_TEXTURE_2D, GL_RGBA32F, (w + step - 1) / step, (h + step - 1) / step)
         .setFilter(GL_NEAREST, GL_NEAREST);
     res.texture("photon_gi_fixup", GL_TEXTURE_2D, GL_R32F, w, h).setFilter(GL_NEAREST, GL_NEAREST);
+    // The fix-up list (fixup_list.comp): a 16-byte header and one packed point per pixel at most.
+    const std::size_t listBytes = 16 + 4 * static_cast<std::size_t>(w) * h;
+    if (!res.hasBuffer("photon_gi_fixup_list") || res.buffer("photon_gi_fixup_list").size() < listBytes)
+      res.buffer("photon_gi_fixup_list", capacity(listBytes));
     // The fix-up cascade's block samples (steps step / 2, step / 4, ... down to 2), one texture sized
     // for the finest of them.
     if (step >= 4)
@@ -197,24 +203,48 @@ void splatAndResolve(FrameResources& res, gl::ShaderLibrary& shaders, const Fram
     const int size[2] = {view.width, view.height};
     glUniform2iv(glGetUniformLocation(prog.id(), "u_size"), 1, size);
     const std::uint32_t slices = std::max<std::uint32_t>(1, (grid.maxPerCell + kGatherSlice - 1) / kGatherSlice);
-    // One gather over an output grid (full resolution, the block samples, or the marked pixels).
-    // fixup: 0 every output pixel, 1 the marked pixels (full resolution), 2 the block samples whose
-    // centre pixel is marked (gather.comp).
+    // One gather over an output grid (full resolution or the block samples; fixup 0), or over the
+    // fix-up list of its points that upsample.comp left without a value: fixup 1 the marked pixels (full
+    // resolution), 2 the blocks whose centre pixel is marked (the cascade; the others get alpha -1, no
+    // sample). The list is built on the GPU (fixup_list.comp) and gathered with an indirect dispatch of
+    // as many workgroups as it has entries / 64.
+    const gl::Program& listProg = shaders.program({"photon_gi/fixup_list.comp"});
     auto gather = [&](gl::Texture& target, int step, int outW, int outH, int fixup) {
-      prog.use();
       const int out[2] = {outW, outH};
+      if (fixup) {
+        gl::Buffer& list = res.buffer("photon_gi_fixup_list");
+        const std::uint32_t header[4] = {0, 1, 1, 0};
+        list.upload(header, sizeof header);
+        list.bindBase(GL_SHADER_STORAGE_BUFFER, kFixupListBinding);
+        listProg.use();
+        glUniform2iv(glGetUniformLocation(listProg.id(), "u_size"), 1, size);
+        glUniform2iv(glGetUniformLocation(listProg.id(), "u_outSize"), 1, out);
+        listProg.set("u_step", step);
+        res.texture("photon_gi_fixup").bindImage(1, GL_READ_ONLY);
+        glDispatchCompute((outW + 7) / 8, (outH + 7) / 8, 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
+        glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, list.id());
+        if (fixup == 2) {
+          const float none[4] = {0.f, 0.f, 0.f, -1.f};
+          glClearTexImage(target.id(), 0, GL_RGBA, GL_FLOAT, none);
+        }
+      }
+      prog.use();
       glUniform2iv(glGetUniformLocation(prog.id(), "u_outSize"), 1, out);
       prog.set("u_step", step);
-      prog.set("u_fixup", fixup);
+      prog.set("u_list", fixup ? 1 : 0);
       target.bindImage(0, GL_READ_WRITE);
-      if (fixup) res.texture("photon_gi_fixup").bindImage(1, GL_READ_ONLY);
       for (std::uint32_t k = 0; k < slices; ++k) {
         glUniform1ui(glGetUniformLocation(prog.id(), "u_sliceBegin"), k * kGatherSlice);
         glUniform1ui(glGetUniformLocation(prog.id(), "u_sliceLength"), kGatherSlice);
         prog.set("u_accumulate", k > 0 ? 1 : 0);
-        glDispatchCompute((outW + 7) / 8, (outH + 7) / 8, 1);
+        if (fixup)
+          glDispatchComputeIndirect(0);
+        else
+          glDispatchCompute((outW + 7) / 8, (outH + 7) / 8, 1);
         glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
       }
+      if (fixup) glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, 0);
     };
     const int step = settings.gatherStep;
     if (step <= 1) {
@@ -248,10 +278,10 @@ void splatAndResolve(FrameResources& res, gl::ShaderLibrary& shaders, const Fram
       };
       upsample(low, step, 0);
       // The neighbour fill (upsample.comp, u_refine = 2): a marked pixel borrows from the pixels within
-      // max(2, step / 2) that were matched on its own surface (the same test, within h_min / 2), instead
+      // max(2, step / 2) that were matched on its own surface (the same test, within h_min), instead
       // of gathering. On a supersampled frame the marked pixels are mostly edge samples with such a
-      // neighbour: cornell_box at 256 px, k = 2, it fills 9416 of 10431 (the cascade and the full gather
-      // then run on 1015 and 1); at k = 1 the samples are twice as far apart and it fills 56 of 4710.
+      // neighbour: cornell_glass at 128 px, k = 2, it fills 1533 of 1886 (the cascade and the full gather
+      // then run on 353 and 174).
       upsample(low, step, 2);
       // The fix-up cascade: the marked pixels are edge pixels, k^2 times as many on a frame supersampled
       // k times (whose step is k gather_step), so before the full gather they try block samples of half
