@@ -73,6 +73,12 @@ public:
   // clear(), forget what it held.
   bool holds(const std::string& resource, const std::string& digest, const std::string& logKey = "");
   void setHolds(const std::string& resource, std::string digest) { holds_[resource] = std::move(digest); }
+  // What `resource` holds (the digest of its last setHolds), "" when nothing: data derived from it (the
+  // caustic cubes from the specular maps) keys its own cache on it.
+  std::string heldDigest(const std::string& resource) const {
+    auto it = holds_.find(resource);
+    return it == holds_.end() ? std::string() : it->second;
+  }
 
   // Which technique owns each light-path class this frame (FramePlan::lightPaths).
   void setLightPathOwners(std::map<std::string, std::string> owners) { lightPaths_ = std::move(owners); }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -239,134 +240,154 @@ void CausticsPass::execute(PassContext& ctx) {
   gl::Texture& cube = res.texture("caustics_cube");
   gl::Framebuffer& cubeFb = res.framebuffer("caustics_cube");
   const float zero[4] = {0.f, 0.f, 0.f, 0.f};
-  glClearNamedFramebufferfv(cubeFb.id(), GL_COLOR, 0, zero);
-
-  // Face transforms around the origin: hit positions are relative to the reference point.
-  std::vector<glm::mat4> faces(6);
-  const float sceneRadius = std::max(ctx.scene.features.bounds.radius(), 1e-6f);
-  for (int f = 0; f < 6; ++f) faces[f] = cubeFaceViewProj(glm::vec3(0.f), f, sceneRadius * 1e-6f);
-
-  gl::Framebuffer& photonFb = res.framebuffer("caustics_photons");
-  gl::Texture& hit = res.texture("caustics_hit");
-  gl::Texture& power = res.texture("caustics_power");
-  gl::Texture& hitNormal = res.texture("caustics_hit_normal");
-  gl::Texture& vertex = res.texture("caustics_vertex");
-  gl::Buffer& powerSums = res.buffer("caustics_power_sums");
-  const int groupsX = (P + kGroup - 1) / kGroup;
-  std::vector<glm::vec4> sums(static_cast<std::size_t>(groupsX) * groupsX * 2);
-  double photonPower = 0.0, lostPower = 0.0;
-  double validPhotons = 0.0;
-
-  const gl::Program& photonProg = ctx.shaders.program({"specular/map.vert", "caustics/photon.frag"});
-  const gl::Program& areaProg = ctx.shaders.program({"caustics/area.comp"});
-  const gl::Program& drawProg = method_ == Method::Triangles
-                                    ? ctx.shaders.program({"caustics/grid.vert", "caustics/triangles.geom", "caustics/deposit.frag"})
-                                    : ctx.shaders.program({"caustics/grid.vert", "caustics/splat.geom", "caustics/deposit.frag"});
-  for (const Pair& pair : pairs_) {
-    // (1) Photon tracing pass: the generator seen from the light, negative power where it is not.
-    photonFb.bind();
-    glViewport(0, 0, P, P);
-    const float invalid[4] = {0.f, 0.f, 0.f, -1.f};
-    const float depthClear = 0.f;
-    for (int i = 0; i < 3; ++i) glClearNamedFramebufferfv(photonFb.id(), GL_COLOR, i, i == 1 ? invalid : zero);
-    glClearNamedFramebufferfv(photonFb.id(), GL_DEPTH, 0, &depthClear);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_GREATER);  // reversed-Z: the surface nearest the light
-    glDepthMask(GL_TRUE);
-    glDisable(GL_CULL_FACE);
-    glDisable(GL_BLEND);
-    photonProg.use();
-    bindDirectLighting(photonProg, res, ctx.gpu, static_cast<int>(ctx.scene.lights.size()), 0);
-    bindMaps(photonProg);
-    photonProg.setMat4("u_viewProj", &pair.camera.viewProj[0][0]);
-    photonProg.set("u_object", pair.generator);
-    photonProg.set("u_light", pair.light);
-    photonProg.set("u_orthographic", pair.camera.orthographic ? 1 : 0);
-    photonProg.set("u_halfExtent", pair.camera.halfExtent);
-    photonProg.set("u_maxDepth", maxDepth_);
-    photonProg.set("u_reflectFirst", pair.reflectFirst ? 1 : 0);
-    photonProg.set("u_photonResolution", P);
-    const std::size_t mesh = generators_[pair.generator];
-    ctx.gpu.drawMeshes(photonProg, true, [&](std::size_t m) { return m == mesh; });
-    glDisable(GL_DEPTH_TEST);
-    glMemoryBarrier(GL_ALL_BARRIER_BITS);
-
-    // (2) Vertex areas and irradiance.
-    areaProg.use();
-    hit.bindUnit(0);
-    power.bindUnit(1);
-    hitNormal.bindUnit(2);
-    vertex.bindImage(0, GL_WRITE_ONLY);
-    powerSums.bindBase(GL_SHADER_STORAGE_BUFFER, 5);
-    areaProg.set("u_photonResolution", P);
-    areaProg.set("u_areaWeight", areaWeight_);
-    glDispatchCompute(groupsX, groupsX, 1);
-    glMemoryBarrier(GL_ALL_BARRIER_BITS);
-    if (energyCheck_) {
-      powerSums.download(sums.data(), sums.size() * sizeof(glm::vec4));
-      for (std::size_t g = 0; g < sums.size(); g += 2) {
-        photonPower += 0.2126 * sums[g].x + 0.7152 * sums[g].y + 0.0722 * sums[g].z;
-        validPhotons += sums[g].w;
-        lostPower += 0.2126 * sums[g + 1].x + 0.7152 * sums[g + 1].y + 0.0722 * sums[g + 1].z;
-      }
-    }
-
-    // (3) Reconstruction into the generator's caustic cube, additively.
-    cubeFb.bind();
-    glViewport(0, 0, C, C);
-    glEnable(GL_BLEND);
-    glBlendEquation(GL_FUNC_ADD);
-    glBlendFunc(GL_ONE, GL_ONE);
-    drawProg.use();
-    hit.bindUnit(0);
-    power.bindUnit(1);
-    hitNormal.bindUnit(2);
-    vertex.bindUnit(3);
-    drawProg.set("u_photonResolution", P);
-    drawProg.set("u_gridResolution", P);
-    drawProg.set("u_areaWeight", areaWeight_);
-    drawProg.set("u_cubeLayer", 6 * pair.generator);
-    drawProg.set("u_causticResolution", static_cast<float>(C));
-    drawProg.set("u_splatRadius", splatRadius_);
-    glProgramUniformMatrix4fv(drawProg.id(), drawProg.uniformLocation("u_faceViewProj"), 6, GL_FALSE, &faces[0][0][0]);
-    if (method_ == Method::Triangles) {
-      drawProg.set("u_gridMode", 0);
-      glDrawArrays(GL_TRIANGLES, 0, 6 * (P - 1) * (P - 1));
-    } else {
-      drawProg.set("u_gridMode", 1);
-      glDrawArrays(GL_POINTS, 0, P * P);
-    }
-    glDisable(GL_BLEND);
-    glMemoryBarrier(GL_ALL_BARRIER_BITS);
+  // Steps (1) to (3) and the cube's mip chain do not depend on the camera: they are functions of the
+  // specular maps (which hold the scene's geometry, materials and lights, and their own shape) and of
+  // the knobs below. The cubes are kept in caustics_cube and redrawn only when one of those changed; a
+  // frame from another camera runs the camera passes (4) and (5) alone. energy_check recomputes (its
+  // sums are counters of the drawing).
+  const std::string maps = res.heldDigest("specular_ldm_distance");
+  std::string cubeDigest;
+  if (!maps.empty() && !energyCheck_) {
+    std::ostringstream key;
+    key << maps << "|caustics method=" << static_cast<int>(method_) << " P=" << P << " C=" << C
+        << " w=" << areaWeight_ << " depth=" << maxDepth_ << " steps=" << linearSteps_ << "," << secantSteps_
+        << " r=" << splatRadius_ << " fresnel=" << fresnelReflection_ << " mips=" << footprintFilter_
+        << " pairs=" << pairs_.size();
+    cubeDigest = key.str();
   }
+  const bool cubeCached = !cubeDigest.empty() && res.holds("caustics_cube", cubeDigest, "caustics_cube");
+  counters["cube_cached"] = cubeCached ? 1.0 : 0.0;
+  if (!cubeCached) {
+    glClearNamedFramebufferfv(cubeFb.id(), GL_COLOR, 0, zero);
 
-  double deposited = 0.0;
-  if (energyCheck_ && !pairs_.empty()) {
-    const gl::Program& energyProg = ctx.shaders.program({"caustics/energy.comp"});
-    energyProg.use();
-    bindMaps(energyProg);
-    cube.bindImage(1, GL_READ_ONLY, 0, true, 0);
-    gl::Buffer& depositSums = res.buffer("caustics_deposit_sums");
-    depositSums.bindBase(GL_SHADER_STORAGE_BUFFER, 5);
-    energyProg.set("u_causticResolution", static_cast<float>(C));
-    const int cg = (C + kGroup - 1) / kGroup;
-    std::vector<glm::vec4> dep(static_cast<std::size_t>(cg) * cg * 6);
-    for (int g = 0; g < G; ++g) {
-      energyProg.set("u_generator", g);
-      glDispatchCompute(cg, cg, 6);
+    // Face transforms around the origin: hit positions are relative to the reference point.
+    std::vector<glm::mat4> faces(6);
+    const float sceneRadius = std::max(ctx.scene.features.bounds.radius(), 1e-6f);
+    for (int f = 0; f < 6; ++f) faces[f] = cubeFaceViewProj(glm::vec3(0.f), f, sceneRadius * 1e-6f);
+
+    gl::Framebuffer& photonFb = res.framebuffer("caustics_photons");
+    gl::Texture& hit = res.texture("caustics_hit");
+    gl::Texture& power = res.texture("caustics_power");
+    gl::Texture& hitNormal = res.texture("caustics_hit_normal");
+    gl::Texture& vertex = res.texture("caustics_vertex");
+    gl::Buffer& powerSums = res.buffer("caustics_power_sums");
+    const int groupsX = (P + kGroup - 1) / kGroup;
+    std::vector<glm::vec4> sums(static_cast<std::size_t>(groupsX) * groupsX * 2);
+    double photonPower = 0.0, lostPower = 0.0;
+    double validPhotons = 0.0;
+
+    const gl::Program& photonProg = ctx.shaders.program({"specular/map.vert", "caustics/photon.frag"});
+    const gl::Program& areaProg = ctx.shaders.program({"caustics/area.comp"});
+    const gl::Program& drawProg = method_ == Method::Triangles
+                                      ? ctx.shaders.program({"caustics/grid.vert", "caustics/triangles.geom", "caustics/deposit.frag"})
+                                      : ctx.shaders.program({"caustics/grid.vert", "caustics/splat.geom", "caustics/deposit.frag"});
+    for (const Pair& pair : pairs_) {
+      // (1) Photon tracing pass: the generator seen from the light, negative power where it is not.
+      photonFb.bind();
+      glViewport(0, 0, P, P);
+      const float invalid[4] = {0.f, 0.f, 0.f, -1.f};
+      const float depthClear = 0.f;
+      for (int i = 0; i < 3; ++i) glClearNamedFramebufferfv(photonFb.id(), GL_COLOR, i, i == 1 ? invalid : zero);
+      glClearNamedFramebufferfv(photonFb.id(), GL_DEPTH, 0, &depthClear);
+      glEnable(GL_DEPTH_TEST);
+      glDepthFunc(GL_GREATER);  // reversed-Z: the surface nearest the light
+      glDepthMask(GL_TRUE);
+      glDisable(GL_CULL_FACE);
+      glDisable(GL_BLEND);
+      photonProg.use();
+      bindDirectLighting(photonProg, res, ctx.gpu, static_cast<int>(ctx.scene.lights.size()), 0);
+      bindMaps(photonProg);
+      photonProg.setMat4("u_viewProj", &pair.camera.viewProj[0][0]);
+      photonProg.set("u_object", pair.generator);
+      photonProg.set("u_light", pair.light);
+      photonProg.set("u_orthographic", pair.camera.orthographic ? 1 : 0);
+      photonProg.set("u_halfExtent", pair.camera.halfExtent);
+      photonProg.set("u_maxDepth", maxDepth_);
+      photonProg.set("u_reflectFirst", pair.reflectFirst ? 1 : 0);
+      photonProg.set("u_photonResolution", P);
+      const std::size_t mesh = generators_[pair.generator];
+      ctx.gpu.drawMeshes(photonProg, true, [&](std::size_t m) { return m == mesh; });
+      glDisable(GL_DEPTH_TEST);
       glMemoryBarrier(GL_ALL_BARRIER_BITS);
-      depositSums.download(dep.data(), dep.size() * sizeof(glm::vec4));
-      for (const glm::vec4& d : dep) deposited += 0.2126 * d.x + 0.7152 * d.y + 0.0722 * d.z;
-    }
-    counters["photon_power"] = photonPower;
-    counters["valid_photons"] = validPhotons;
-    counters["lost_power"] = lostPower;
-    counters["deposited_power"] = deposited;
-  }
 
-  // The mip chain for the camera pass's footprint filter: box-filtered levels keep each region's power
-  // (irradiance and the alpha depth weight average alike, so the mean deposit depth stays a ratio).
-  if (footprintFilter_ && !pairs_.empty()) cube.generateMipmaps();
+      // (2) Vertex areas and irradiance.
+      areaProg.use();
+      hit.bindUnit(0);
+      power.bindUnit(1);
+      hitNormal.bindUnit(2);
+      vertex.bindImage(0, GL_WRITE_ONLY);
+      powerSums.bindBase(GL_SHADER_STORAGE_BUFFER, 5);
+      areaProg.set("u_photonResolution", P);
+      areaProg.set("u_areaWeight", areaWeight_);
+      glDispatchCompute(groupsX, groupsX, 1);
+      glMemoryBarrier(GL_ALL_BARRIER_BITS);
+      if (energyCheck_) {
+        powerSums.download(sums.data(), sums.size() * sizeof(glm::vec4));
+        for (std::size_t g = 0; g < sums.size(); g += 2) {
+          photonPower += 0.2126 * sums[g].x + 0.7152 * sums[g].y + 0.0722 * sums[g].z;
+          validPhotons += sums[g].w;
+          lostPower += 0.2126 * sums[g + 1].x + 0.7152 * sums[g + 1].y + 0.0722 * sums[g + 1].z;
+        }
+      }
+
+      // (3) Reconstruction into the generator's caustic cube, additively.
+      cubeFb.bind();
+      glViewport(0, 0, C, C);
+      glEnable(GL_BLEND);
+      glBlendEquation(GL_FUNC_ADD);
+      glBlendFunc(GL_ONE, GL_ONE);
+      drawProg.use();
+      hit.bindUnit(0);
+      power.bindUnit(1);
+      hitNormal.bindUnit(2);
+      vertex.bindUnit(3);
+      drawProg.set("u_photonResolution", P);
+      drawProg.set("u_gridResolution", P);
+      drawProg.set("u_areaWeight", areaWeight_);
+      drawProg.set("u_cubeLayer", 6 * pair.generator);
+      drawProg.set("u_causticResolution", static_cast<float>(C));
+      drawProg.set("u_splatRadius", splatRadius_);
+      glProgramUniformMatrix4fv(drawProg.id(), drawProg.uniformLocation("u_faceViewProj"), 6, GL_FALSE, &faces[0][0][0]);
+      if (method_ == Method::Triangles) {
+        drawProg.set("u_gridMode", 0);
+        glDrawArrays(GL_TRIANGLES, 0, 6 * (P - 1) * (P - 1));
+      } else {
+        drawProg.set("u_gridMode", 1);
+        glDrawArrays(GL_POINTS, 0, P * P);
+      }
+      glDisable(GL_BLEND);
+      glMemoryBarrier(GL_ALL_BARRIER_BITS);
+    }
+
+    double deposited = 0.0;
+    if (energyCheck_ && !pairs_.empty()) {
+      const gl::Program& energyProg = ctx.shaders.program({"caustics/energy.comp"});
+      energyProg.use();
+      bindMaps(energyProg);
+      cube.bindImage(1, GL_READ_ONLY, 0, true, 0);
+      gl::Buffer& depositSums = res.buffer("caustics_deposit_sums");
+      depositSums.bindBase(GL_SHADER_STORAGE_BUFFER, 5);
+      energyProg.set("u_causticResolution", static_cast<float>(C));
+      const int cg = (C + kGroup - 1) / kGroup;
+      std::vector<glm::vec4> dep(static_cast<std::size_t>(cg) * cg * 6);
+      for (int g = 0; g < G; ++g) {
+        energyProg.set("u_generator", g);
+        glDispatchCompute(cg, cg, 6);
+        glMemoryBarrier(GL_ALL_BARRIER_BITS);
+        depositSums.download(dep.data(), dep.size() * sizeof(glm::vec4));
+        for (const glm::vec4& d : dep) deposited += 0.2126 * d.x + 0.7152 * d.y + 0.0722 * d.z;
+      }
+      counters["photon_power"] = photonPower;
+      counters["valid_photons"] = validPhotons;
+      counters["lost_power"] = lostPower;
+      counters["deposited_power"] = deposited;
+    }
+
+    // The mip chain for the camera pass's footprint filter: box-filtered levels keep each region's power
+    // (irradiance and the alpha depth weight average alike, so the mean deposit depth stays a ratio).
+    if (footprintFilter_ && !pairs_.empty()) cube.generateMipmaps();
+    if (!cubeDigest.empty()) res.setHolds("caustics_cube", cubeDigest);  // after drawing it
+  }  // !cubeCached
 
   // (4) Camera pass: caustics AOV, and beauty += caustics when this pass owns LS+DE (a request that
   // names light_volumes gives the class to it: then the AOV is written but not added, counted once).

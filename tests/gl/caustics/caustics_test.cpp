@@ -816,5 +816,37 @@ TEST(Caustics, FloorInTheGlassSpheresShadowGetsTheCeilingsLightThroughIt) {
   EXPECT_NEAR(sumFrame / sumRef, 1.0, 0.12);
 }
 
+// The caustic cubes (steps 1 to 3 and their mips) do not depend on the camera: a frame from another
+// camera reuses them (cube_cached 1) and its caustics are those of a frame that drew them (energy_check
+// redraws: its sums are counters of the drawing), to float rounding; a knob of the drawing (P) or a
+// change of the specular maps (another scene) draws them again.
+TEST(Caustics, CubesAreDrawnOncePerSceneAndKnobsNotPerCamera) {
+  Scene scene = loadBuiltinScene("cornell_glass");
+  const int n = 32;
+  auto frame = [&](nlohmann::json caustics, bool moved) {
+    api::RenderRequest req = request(n, std::move(caustics));
+    if (moved) req.camera = api::CameraOverride{{0.25f, 0.55f, 1.7f}, {0.f, 0.45f, 0.f}, {0.f, 1.f, 0.f}, 42.f};
+    return renderer().render(scene, req);
+  };
+  RenderOutput first = frame(nlohmann::json::object(), false);
+  RenderOutput moved = frame(nlohmann::json::object(), true);
+  EXPECT_EQ(counter(moved, "caustics", "cube_cached"), 1.0);
+  RenderOutput drawn = frame({{"energy_check", true}}, true);
+  EXPECT_EQ(counter(drawn, "caustics", "cube_cached"), 0.0);
+  const Image& a = findAov(moved, "caustics");
+  const Image& b = findAov(drawn, "caustics");
+  ASSERT_EQ(a.pixels.size(), b.pixels.size());
+  double sum = 0.0, maxDiff = 0.0;
+  for (std::size_t i = 0; i < a.pixels.size(); ++i) {
+    sum += b.pixels[i];
+    maxDiff = std::max<double>(maxDiff, std::abs(a.pixels[i] - b.pixels[i]));
+  }
+  ASSERT_GT(sum, 0.0);  // the moved camera sees the caustic
+  EXPECT_LE(maxDiff, 1e-5 * sum / double(a.pixels.size()) + 1e-6);
+  EXPECT_EQ(counter(frame({{"photon_resolution", 64}}, true), "caustics", "cube_cached"), 0.0);
+  EXPECT_EQ(counter(frame(nlohmann::json::object(), false), "caustics", "cube_cached"), 0.0);  // P changed back
+  EXPECT_EQ(counter(frame(nlohmann::json::object(), true), "caustics", "cube_cached"), 1.0);
+}
+
 }  // namespace
 }  // namespace radiant
