@@ -64,9 +64,9 @@ def upload_ground_truth(server, base, truth_spp, truth_file=None, save_truth=Non
     return digest
 
 
-def reference_256(server, base, digest):
+def reference_256(server, base, digest, seed=5):
     """The reference at 256 spp (seed 5) scored against the ground truth: (its pass ms, RMSE, table row)."""
-    ref, _ = render(server, dict(base, seed=5, passes={"reference": {"spp": 256}, "photon_gi": False},
+    ref, _ = render(server, dict(base, seed=seed, passes={"reference": {"spp": 256}, "photon_gi": False},
                                  compare={"against": digest, "aov": "reference"},
                                  outputs=[{"format": "exr", "aovs": ["reference"]}]))
     ref_ms = next(p["cpu_ms"] for p in ref["stats"]["passes"] if p["name"] == "reference")
