@@ -425,6 +425,16 @@ TEST(Presets, EveryPassOfTheBuiltinScenesIsChargedAndLargerBudgetsNeverRaiseAnEr
     for (const auto& name : f.planned)
       EXPECT_TRUE(cheapest.stats["techniques"][name]["predicted_ms"].is_number()) << f.what << ": " << name << " not charged";
     const double lo = cheapest.stats["predicted_ms"], hi = dearest.stats["predicted_ms"];
+    // A front of one point: the sweep measured no configuration both dearer and more accurate than the
+    // cheapest (depth_impostors on explosion at 64 px since 2026-12-02: 0.0925-0.0927 over slices 2-16 and
+    // slice_resolution 64-256, docs/PERFORMANCE.md); the budget then has nothing to buy.
+    bool climbable = false;
+    for (const auto& name : f.planned)
+      climbable = climbable || (t.hasFront(name) && t.data()["techniques"][name]["front"].size() > 1);
+    if (!climbable) {
+      EXPECT_EQ(hi, lo) << f.what;
+      continue;
+    }
     ASSERT_GT(hi, lo) << f.what << ": no front to climb";
     std::map<std::string, double> last;
     double lastMs = 0;
