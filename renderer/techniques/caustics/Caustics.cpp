@@ -143,6 +143,7 @@ void CausticsPass::prepare(const Scene& scene, const Params& params, FrameResour
   areaWeight_ = std::clamp(params.get<float>("area_weight", 1.f / 3.f), 0.1f, 1.f);
   visibilityTolerance_ = std::clamp(params.get<float>("visibility_tolerance", 2.f), 0.f, 64.f);
   maxDepth_ = std::clamp(params.get<int>("max_depth", 4), 1, 8);
+  secondaryMaxDepth_ = std::clamp(params.get<int>("secondary_max_depth", 2), 1, 8);
   linearSteps_ = std::clamp(params.get<int>("linear_steps", 32), 1, 256);
   secantSteps_ = std::clamp(params.get<int>("secant_steps", 4), 0, 32);
   splatRadius_ = std::clamp(params.get<float>("splat_radius", 0.02f), 1e-4f, 10.f);
@@ -453,7 +454,7 @@ void CausticsPass::execute(PassContext& ctx) {
     bindMaps(prog);
     setLookup(prog);
     prog.setMat4("u_viewProj", &ctx.view.viewProj[0][0]);
-    prog.set("u_maxDepth", maxDepth_);
+    prog.set("u_maxDepth", secondaryMaxDepth_);
     prog.set("u_minWeight", kMinBranchWeight);
     const GLint objectLoc = prog.uniformLocation("u_object");
     ctx.gpu.drawMeshes(prog, false, [&](std::size_t mesh) {
@@ -466,6 +467,7 @@ void CausticsPass::execute(PassContext& ctx) {
     res.markWritten("beauty");
   }
   counters["specular_lookup"] = secondary ? 1.0 : 0.0;
+  counters["secondary_max_depth"] = secondaryMaxDepth_;
 
   counters["generators"] = G;
   counters["pairs"] = static_cast<double>(pairs_.size());  // (light, generator, branch) hit images

@@ -60,6 +60,7 @@ private:
   enum class Method { Triangles, Splat };
   Method method_ = Method::Triangles;
   int photonResolution_ = 128, cubeResolution_ = 256, maxDepth_ = 4, linearSteps_ = 32, secantSteps_ = 4;
+  int secondaryMaxDepth_ = 2;  // specular_lookup's trees
   float areaWeight_ = 1.f / 3.f, visibilityTolerance_ = 2.f, splatRadius_ = 0.02f;
   bool energyCheck_ = false, fresnelReflection_ = true, footprintFilter_ = true, specularLookup_ = true;
   std::vector<std::size_t> generators_;  // mesh index per generator (= specular object index)
