@@ -175,8 +175,9 @@ int PresetTable::presetIndex(const std::string& technique, const std::string& qu
 
 BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std::string>& planned,
                                  const RenderRequest& request, const RequestLimits* limits,
-                                 const SceneCounts& counts) {
+                                 const SceneCounts& counts, double speed) {
   BudgetChoice c;
+  if (!(speed > 0.0) || !std::isfinite(speed)) speed = 1.0;
   for (const auto& t : planned) c.params[t] = paramsOf(request, t);
   // A default the request does not set (or a pass the planner added) still above this server's caps
   // once the preset or budget has chosen runs at the cap: validation refuses only values the request
@@ -203,6 +204,14 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
   if (!request.quality.empty()) c.stats["quality"] = request.quality;
   else c.stats["time_budget_ms"] = request.timeBudgetMs;
 
+  // This machine's ms: the table's prediction times the speed factor (MachineSpeed).
+  auto predict = [&](const std::string& t, const json& p) {
+    const double ms = table.predictMs(t, p, pixels, counts);
+    return ms < 0 ? ms : ms * speed;
+  };
+  const double overheadMs = table.predictOverheadMs(pixels) * speed;
+  c.stats["speed_factor"] = speed;
+
   auto explicitOf = [&](const std::string& t) {
     auto it = request.explicitParams.find(t);
     return it == request.explicitParams.end() ? std::set<std::string>{} : it->second;
@@ -215,7 +224,7 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
   };
 
   json techniques = json::object();
-  double fixedMs = table.predictOverheadMs(pixels);
+  double fixedMs = overheadMs;
   // One candidate list per modelled technique with a front: (params, predicted ms, error, point index).
   struct Candidate {
     json params;
@@ -264,7 +273,7 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
           continue;
         }
         json p = techniqueParams(t, merged(c.params[t], front[i]["params"], given));
-        const double ms = table.predictMs(t, p, pixels, counts);
+        const double ms = predict(t, p);
         all.push_back({std::move(p), ms, front[i]["error"].get<double>(), int(i)});
       }
       if (!excluded.empty()) {
@@ -275,7 +284,7 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
       if (all.empty()) {
         const json lowered = clampedToCaps(t, front[0]["params"], capsExceeded(t, front[0]["params"], given, limits));
         json p = techniqueParams(t, merged(c.params[t], lowered, given));
-        const double ms = table.predictMs(t, p, pixels, counts);
+        const double ms = predict(t, p);
         all.push_back({std::move(p), ms, std::numeric_limits<double>::quiet_NaN(), -1});
       }
       // The front at this frame's pixel count: by predicted cost, then only points that lower the error.
@@ -287,7 +296,7 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
       techniques[t] = entry;
       continue;
     }
-    const double ms = table.predictMs(t, c.params[t], pixels, counts);
+    const double ms = predict(t, c.params[t]);
     entry["predicted_ms"] = ms >= 0 ? json(ms) : json(nullptr);
     if (ms >= 0) fixedMs += ms;
     techniques[t] = entry;
@@ -335,19 +344,69 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
     }
   }
   lowerDefaultsToCaps();
-  double total = table.predictOverheadMs(pixels);
+  double total = overheadMs;
   for (const auto& t : planned) {
     if (!techniques[t].contains("predicted_ms")) {
-      const double ms = table.predictMs(t, c.params[t], pixels, counts);
+      const double ms = predict(t, c.params[t]);
       techniques[t]["predicted_ms"] = ms >= 0 ? json(ms) : json(nullptr);
     }
     if (techniques[t]["predicted_ms"].is_number()) total += techniques[t]["predicted_ms"].get<double>();
   }
   c.stats["techniques"] = techniques;
   c.stats["scene_counts"] = counts.toJson();
-  c.stats["predicted_overhead_ms"] = table.predictOverheadMs(pixels);
+  c.stats["predicted_overhead_ms"] = overheadMs;
   c.stats["predicted_ms"] = total;
   return c;
+}
+
+double predictFrameMs(const PresetTable& table, const std::vector<std::string>& planned,
+                      const std::map<std::string, json>& params, double pixels, const SceneCounts& counts) {
+  double ms = table.predictOverheadMs(pixels);
+  for (const auto& t : planned) {
+    auto it = params.find(t);
+    const double m = it == params.end() ? -1.0 : table.predictMs(t, it->second, pixels, counts);
+    if (m < 0) return -1.0;
+    ms += m;
+  }
+  return ms;
+}
+
+double MachineSpeed::ratio(double measuredMs, double predictedMs) {
+  if (!(measuredMs > 0) || !(predictedMs > 0) || !std::isfinite(measuredMs) || !std::isfinite(predictedMs)) return 0.0;
+  return std::clamp(measuredMs / predictedMs, kMinRatio, kMaxRatio);
+}
+
+void MachineSpeed::pin(double factor) {
+  pinned_ = factor > 0 && std::isfinite(factor) ? std::clamp(factor, kMinRatio, kMaxRatio) : 0.0;
+}
+
+void MachineSpeed::calibrate(double measuredMs, double predictedMs) {
+  if (const double r = ratio(measuredMs, predictedMs); r > 0) calibration_ = r;
+}
+
+void MachineSpeed::observe(double measuredMs, double predictedMs) {
+  const double r = ratio(measuredMs, predictedMs);
+  if (!(r > 0)) return;
+  recent_.push_back(r);
+  if (recent_.size() > kWindow) recent_.erase(recent_.begin());
+}
+
+double MachineSpeed::factor() const {
+  if (pinned()) return pinned_;
+  std::vector<double> v = recent_;
+  if (calibration_ > 0) v.push_back(calibration_);
+  if (v.empty()) return 1.0;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+json MachineSpeed::toJson() const {
+  const bool measured = calibration_ > 0 || !recent_.empty();
+  return {{"factor", factor()},
+          {"source", pinned() ? "pinned" : measured ? "measured" : "table"},
+          {"calibration", calibration_ > 0 ? json(calibration_) : json(nullptr)},
+          {"recent", recent_}};
 }
 
 void recordMeasured(json& budget, const FrameStats& stats, double frameMs) {

@@ -97,9 +97,58 @@ struct BudgetChoice {
 // "clamped"}), and a warning says it in words.
 //
 // `counts`: the frame's scene counts (the models' "particles" and "beams"); stats.scene_counts echoes them.
+//
+// `speed`: this machine's measured time over the table's prediction (MachineSpeed::factor): every
+// predicted ms (the techniques', the overhead's, the frame's) is the table's times `speed`, so that a
+// budget is met on a machine slower or faster than the one the table was measured on. Budget B at
+// speed s chooses what budget B / s chooses at speed 1. stats.speed_factor echoes it.
 BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std::string>& planned,
                                  const RenderRequest& request, const RequestLimits* limits = nullptr,
-                                 const SceneCounts& counts = {});
+                                 const SceneCounts& counts = {}, double speed = 1.0);
+
+// Predicted ms of a whole frame in the table's units (speed 1): the overhead plus every planned
+// technique's model with `params` (technique -> complete parameters); < 0 when a planned technique has
+// no model (the frame cannot be compared with the table).
+double predictFrameMs(const PresetTable& table, const std::vector<std::string>& planned,
+                      const std::map<std::string, nlohmann::json>& params, double pixels, const SceneCounts& counts);
+
+// How fast this machine runs the preset table's frames: measured frame ms over the table's prediction
+// for the same frame (both without a compare block's reference). The budget chooser multiplies every
+// prediction by factor(), so that a budget holds on a machine that is loaded, slower or faster than the
+// one the table was measured on (the table's own load is in its "runs").
+//
+// Sources, in order: a pinned factor (radiantd --speed-factor); else the median of the calibration's
+// ratio and the ratios of the last kWindow observed frames; else 1 (nothing measured yet). The median
+// keeps one stray frame (a page-in, a burst of load) from moving the chooser; the window lets the
+// factor follow the machine's load within a few frames. The Renderer decides which frames are
+// comparable with the table (a frame compiling shaders or uploading its scene is not, nor one reusing
+// seed-keyed derived data the table's cost sweeps traced cold): see Renderer.cpp, observeSpeed.
+class MachineSpeed {
+public:
+  static constexpr std::size_t kWindow = 9;
+  // Ratios outside [kMinRatio, kMaxRatio] are clamped: a frame that took 100x its prediction says the
+  // frame was unusual, not that the machine is 100x slower.
+  static constexpr double kMinRatio = 1.0 / 64.0, kMaxRatio = 64.0;
+
+  // factor > 0: every budget uses it, nothing is measured; 0: measured (the default).
+  void pin(double factor);
+  bool pinned() const { return pinned_ > 0; }
+  // The calibration frame's ratio (measured / predicted ms); needsCalibration() until one is recorded.
+  void calibrate(double measuredMs, double predictedMs);
+  bool needsCalibration() const { return !pinned() && calibration_ <= 0; }
+  // A frame comparable with the table: its ratio joins the window (the oldest leaves). Ignored when
+  // either time is not a positive finite number.
+  void observe(double measuredMs, double predictedMs);
+  double factor() const;
+  // {"factor", "source": "pinned" | "measured" | "table", "calibration": ratio or null,
+  //  "recent": [ratios, oldest first]}
+  nlohmann::json toJson() const;
+
+private:
+  static double ratio(double measuredMs, double predictedMs);
+  double pinned_ = 0.0, calibration_ = 0.0;
+  std::vector<double> recent_;
+};
 
 // Adds measured_ms per technique (passCostMs) and for the frame (`frameMs`: the render up to readback,
 // without a compare block's reference) to choice.stats.

@@ -20,6 +20,7 @@
 #include "renderer/frame/PassContext.h"
 #include "renderer/gl/ShaderLibrary.h"
 #include "renderer/metrics/Metrics.h"
+#include "renderer/scene/BuiltinScenes.h"
 #include "renderer/scene/CostCounts.h"
 #include "renderer/scene/StudioEnvironment.h"
 #include "renderer/techniques/reference/ReferencePass.h"
@@ -203,6 +204,28 @@ std::string blackFrameWarning(const RenderOutput& out, const api::FrameStats& st
   return "black frame: the beauty's brightest pixel is below 1e-6; " + cause;
 }
 
+// Whether a frame's time says how fast this machine runs the preset table's frames (api::MachineSpeed).
+// The table's costs are those of a first render with its own seed on a warm daemon (bench/presets.py):
+// shaders compiled, the scene uploaded, its scene-keyed maps (shadow maps, the image-based lighting's
+// tables) reused, the seed-keyed and knob-keyed derived data (photons, splats, networks, beams,
+// caustic cubes, specular maps, reference images) built. A frame that compiled a program, uploaded its
+// scene or reused any other derived data is faster or slower than the table for reasons that are not the
+// machine's.
+static bool comparableWithPresetTable(const api::FrameStats& stats, bool compiledPrograms) {
+  if (compiledPrograms) return false;
+  // Derived data keyed on the scene and its environment only (never on the seed or a quality knob):
+  // the preset table's timing frames found these warm as well. Any other hit is reused work.
+  static const std::set<std::string> kSceneKeyed{"ray_scene",       "shadow_maps", "ibl_dfg", "ibl_prefiltered",
+                                                 "ibl_sh",          "environment_distribution",
+                                                 "photon_grid"};  // the grid's slot; its contents are rebuilt
+  bool sceneResident = false;
+  for (const api::CacheEvent& e : stats.cache) {
+    if (e.what == "gpu_scene") sceneResident = e.hit;
+    else if (e.hit && !kSceneKeyed.count(e.what)) return false;
+  }
+  return sceneResident;
+}
+
 int rasterSupersampling(int requested, int width, int height, bool runsReference) {
   if (runsReference) return 1;
   constexpr double kMaxPixels = 4096.0 * 4096.0;
@@ -220,6 +243,13 @@ struct Renderer::Impl {
   // GPU copies of recently used scenes, most recent last; keyed by digest (or address when unnamed).
   std::vector<std::pair<std::string, std::unique_ptr<GpuScene>>> gpuScenes;
   std::size_t gpuSceneCapacity = 4;
+  // The budget chooser's speed factor, and the last frame's times for the calibration (observeSpeed).
+  api::MachineSpeed speed;
+  bool calibrating = false;
+  struct FrameTimes {
+    double measuredMs = 0, predictedMs = -1;
+  } lastFrame;
+  std::unique_ptr<Scene> calibrationScene;
 
   const GpuScene& gpuScene(const Scene& scene, api::FrameStats& stats) {
     const std::string key = scene.digest.empty() ? "addr:" + std::to_string(reinterpret_cast<std::uintptr_t>(&scene))
@@ -249,6 +279,36 @@ Renderer::Renderer(const DeviceOptions& options) : impl_(std::make_unique<Impl>(
 }
 
 Renderer::~Renderer() = default;
+
+void Renderer::setSpeedFactor(double factor) { impl_->speed.pin(factor); }
+
+nlohmann::json Renderer::speed() const { return impl_->speed.toJson(); }
+
+// The speed factor's calibration (api::MachineSpeed): the preset table's canonical frame, the built-in
+// Cornell box at the table's error size with photon_gi's cheapest front point, rendered twice with
+// fresh seeds: the first compiles the shaders and uploads the scene, the second is timed against the
+// table's prediction for it. A few hundred ms on llvmpipe, once per daemon, before its first frame with
+// a time budget (a daemon that never gets one never pays it).
+void Renderer::calibrateSpeed() {
+  Impl& im = *impl_;
+  const api::PresetTable& table = api::PresetTable::builtin();
+  const int size = table.data()["generated"].value("error_size", 64);
+  nlohmann::json body{{"scene", {{"builtin", "cornell_box"}}}, {"width", size}, {"height", size}, {"supersampling", 1}};
+  if (table.hasFront("photon_gi")) body["passes"] = {{"photon_gi", table.front("photon_gi")[0]["params"]}};
+  if (!im.calibrationScene) im.calibrationScene = std::make_unique<Scene>(loadBuiltinScene("cornell_box"));
+  im.calibrating = true;
+  try {
+    for (std::uint64_t seed : {0xCA11B000ull, 0xCA11B001ull}) {
+      body["seed"] = seed;
+      render(*im.calibrationScene, api::parseRenderRequest(body));
+    }
+  } catch (...) {
+    im.calibrating = false;
+    throw;
+  }
+  im.calibrating = false;
+  im.speed.calibrate(im.lastFrame.measuredMs, im.lastFrame.predictedMs);
+}
 
 void Renderer::setGpuSceneCapacity(std::size_t scenes) {
   impl_->gpuSceneCapacity = std::max<std::size_t>(1, scenes);
@@ -343,9 +403,11 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     stats.lighting = "none";
   }
   const api::RenderRequest& request = effective;
+  if (request.timeBudgetMs > 0 && im.speed.needsCalibration() && !im.calibrating) calibrateSpeed();
 
   try {
     const auto frameStart = Clock::now();
+    const std::size_t programsBefore = im.shaders.cachedPrograms();
     if (!request.environment.empty() && !inputs.environment)
       throw api::ApiError(422, "invalid-value", "Environment not supplied",
                           "the environment image " + request.environment + " was not supplied", "/environment");
@@ -395,8 +457,9 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     // The supersampled request: the cost models' `pixels` are the raster's (the table was measured at
     // k = 1, so a request that keeps its own supersampling under a budget is charged k^2 the pixels:
     // conservative for passes whose work follows the output size, as photon_gi's gather_step does).
-    api::BudgetChoice choice =
-        api::chooseConfiguration(api::PresetTable::builtin(), planned, supersampled, inputs.limits, counts);
+    const nlohmann::json speedState = im.speed.toJson();  // what this frame's choice used
+    api::BudgetChoice choice = api::chooseConfiguration(api::PresetTable::builtin(), planned, supersampled,
+                                                        inputs.limits, counts, im.speed.factor());
     for (auto& w : choice.warnings) stats.warnings.push_back(std::move(w));
     std::set<int> shadowMapExclusions;  // meshes whose shadows a pass supplies itself (light_volumes)
     for (std::size_t i = 0; i < plan.passes.size(); ++i) {
@@ -476,10 +539,19 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     im.profiler.resolve();
     report(0.95);
     if (const std::string w = blackFrameWarning(out, stats, scene, request); !w.empty()) stats.warnings.push_back(w);
+    // This frame's time against the table's prediction (before compare's reference, which the table
+    // does not model): the speed factor's evidence when the frame is comparable with the table.
+    im.lastFrame = {msSince(frameStart), api::predictFrameMs(api::PresetTable::builtin(), planned, choice.params,
+                                                             double(supersampled.width) * supersampled.height, counts)};
     if (choice.active) {
       stats.budget = std::move(choice.stats);
-      api::recordMeasured(stats.budget, stats, msSince(frameStart));  // before compare's reference
+      stats.budget["speed"] = speedState;
+      api::recordMeasured(stats.budget, stats, im.lastFrame.measuredMs);
     }
+    const bool observed = !im.calibrating && !im.speed.pinned() && im.lastFrame.predictedMs > 0 &&
+                          comparableWithPresetTable(stats, programsBefore != im.shaders.cachedPrograms());
+    if (observed) im.speed.observe(im.lastFrame.measuredMs, im.lastFrame.predictedMs);
+    if (choice.active) stats.budget["speed"]["observed"] = observed;  // this frame joined the window
     if (request.compare)
       compare(im.resources, scene, outView, request, inputs.compareTarget, im.techniques, plan.passes, out);
     stats.renderMs = msSince(frameStart);

@@ -76,8 +76,15 @@ public:
   // resources (shadow and cube maps) hold the last scene rendered (FrameResources::holds).
   // Default 4; radiantd --gpu-scenes.
   void setGpuSceneCapacity(std::size_t scenes);
+  // The budget chooser's speed factor (api::MachineSpeed): > 0 pins it (radiantd --speed-factor),
+  // 0 measures it: a calibration frame before the first frame with a time budget, then the ratio of
+  // measured to predicted time of recent frames comparable with the preset table. Default 0.
+  void setSpeedFactor(double factor);
+  // What the chooser's speed factor is now and what it was measured from (MachineSpeed::toJson).
+  nlohmann::json speed() const;
 
 private:
+  void calibrateSpeed();
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

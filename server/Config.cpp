@@ -48,6 +48,10 @@ std::string usage() {
   --scene-cache-bytes N     decoded scenes kept in memory, in bytes (default 1073741824)
   --gpu-scenes N            scenes kept uploaded to the GPU with their derived data (BVH, shadow maps,
                             photon maps), least recently used evicted (default 4, at most 256)
+  --speed-factor F|auto      this machine's frame time over the preset table's prediction, which time
+                            budgets scale every predicted cost by; auto (the default) measures it: a
+                            calibration frame before the first budgeted frame, then recent frames
+                            (docs/API.md, "Presets and budgets"); a number pins it
   --read-timeout S          seconds to receive one request, headers and body (default 30)
   --keep-alive-timeout S    seconds an idle keep-alive connection stays open (default 2)
   --shutdown-grace S        after SIGTERM, seconds frame and job GETs are still served (default 10)
@@ -126,6 +130,11 @@ void apply(ServerConfig& c, const std::string& name, const std::string& v, std::
   else if (name == "max-json-depth") c.limits.maxJsonDepth = static_cast<std::size_t>(toInt(flag, v, 8, 1000));
   else if (name == "max-decode-bytes") c.maxDecodeBytes = static_cast<std::size_t>(toInt(flag, v, 1 << 20, 1ll << 40));
   else if (name == "gpu-scenes") c.gpuScenes = static_cast<int>(toInt(flag, v, 1, 256));
+  else if (name == "speed-factor") {
+    c.speedFactor = v == "auto" ? 0.0 : toDouble(flag, v);
+    if (c.speedFactor > 64.0 || (c.speedFactor > 0 && c.speedFactor < 1.0 / 64.0))
+      throw std::invalid_argument(flag + ": " + v + " is outside [1/64, 64]");
+  }
   else if (name == "scene-cache-bytes") c.sceneCacheBytes = static_cast<std::size_t>(toInt(flag, v, 1 << 20, 1ll << 40));
   else if (name == "read-timeout") c.readTimeoutS = toDouble(flag, v);
   else if (name == "keep-alive-timeout") c.keepAliveTimeoutS = toDouble(flag, v);

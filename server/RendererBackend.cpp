@@ -16,8 +16,9 @@ namespace {
 
 class RendererBackend final : public RenderBackend {
 public:
-  RendererBackend(const DeviceOptions& options, int gpuScenes) : renderer_(options) {
+  RendererBackend(const DeviceOptions& options, int gpuScenes, double speedFactor) : renderer_(options) {
     renderer_.setGpuSceneCapacity(static_cast<std::size_t>(gpuScenes));
+    renderer_.setSpeedFactor(speedFactor);
   }
   DeviceInfo device() const override { return renderer_.device(); }
   RenderOutput render(const Scene& scene, const api::RenderRequest& request, const std::atomic<bool>* cancel,
@@ -40,7 +41,10 @@ BackendHooks rendererHooks(const ServerConfig& config) {
 
   BackendHooks h;
   const int gpuScenes = config.gpuScenes;
-  h.createBackend = [device, gpuScenes] { return std::make_unique<RendererBackend>(device, gpuScenes); };
+  const double speedFactor = config.speedFactor;
+  h.createBackend = [device, gpuScenes, speedFactor] {
+    return std::make_unique<RendererBackend>(device, gpuScenes, speedFactor);
+  };
   const std::size_t maxBytes = config.maxBodyBytes;
   const std::size_t maxDecoded = config.maxDecodeBytes;
   const std::size_t maxDepth = config.limits.maxJsonDepth;

@@ -2,8 +2,10 @@
 //  - quality presets run the preset table's front points, and at the table's error size and seed the
 //    measured error is the table's (error against the reference is deterministic for a fixed seed);
 //  - a larger time_budget_ms never gives a larger predicted or measured error, the predicted cost fits
-//    the budget, and the measured frame time fits it in most runs (the rate is printed and asserted
-//    loosely: the machine is shared, timings are never asserted tightly);
+//    the budget, and the daemon runs what api::chooseConfiguration chooses at the speed factor it
+//    reports; the measured frame times are printed, never asserted (issue 31: on a loaded or slower
+//    machine they are not the model's to guarantee: the speed factor adapts the choice instead);
+//  - the speed factor: measured by a calibration frame and then recent comparable frames, or pinned;
 //  - a daemon's caps (--max-photons) bound what a preset or budget picks;
 //  - progressive refinement of the reference: the estimated error of the batches' mean tracks its true
 //    error against a high-spp ground truth within a factor; with a compare block the mean is scored.
@@ -57,10 +59,47 @@ const json& tableEntry(const std::string& technique) {
 }
 
 // One daemon for the preset and budget tests, so that the compare block's reference (1024 spp) is
-// rendered once.
+// rendered once. Its speed factor is pinned to 1 (radiantd --speed-factor): the budget ladders below
+// assert the chooser's choices in the table's own units (a larger budget never a larger error), which a
+// factor measured between two frames of a ladder would move; the measured factor has its own test
+// (TheChooserMeasuresTheMachineAndScalesItsPredictions).
 RealDaemon& sharedDaemon() {
-  static RealDaemon d("budgets");
+  static RealDaemon d("budgets", {"--speed-factor", "1"});
   return d;
+}
+
+// What the daemon chose for `body` is what api::chooseConfiguration chooses for the same request at
+// the speed factor, scene counts and planned passes its stats report: the choice follows the model,
+// whatever the frame then measured.
+void expectTheChoosersChoice(const json& body, const json& response) {
+  const json& stats = response["stats"];
+  const json& b = stats["budget"];
+  ASSERT_TRUE(b.is_object()) << stats.dump();
+  api::RenderRequest request = api::parseRenderRequest(body);
+  const int k = stats["supersampling"];
+  request.width *= k;
+  request.height *= k;
+  std::vector<std::string> planned;
+  for (const auto& p : stats["passes"]) planned.push_back(p["name"]);
+  api::SceneCounts counts;
+  counts.particles = b["scene_counts"]["particles"];
+  counts.beams = b["scene_counts"]["beams"];
+  const double speed = b["speed_factor"];
+  EXPECT_EQ(speed, b["speed"]["factor"].get<double>()) << b.dump();
+  const api::BudgetChoice local = api::chooseConfiguration(api::PresetTable::builtin(), planned, request, nullptr, counts, speed);
+  // Every technique the chooser configured or charged, with the same knobs and the same prediction
+  // (the daemon adds each pass's measured time to the same objects).
+  for (const auto& [name, l] : local.stats["techniques"].items()) {
+    ASSERT_TRUE(b["techniques"].contains(name)) << name << " " << b.dump();
+    const json& t = b["techniques"][name];
+    EXPECT_EQ(t.value("params", json()), l.value("params", json())) << name;
+    if (l.contains("predicted_ms") && l["predicted_ms"].is_number()) {
+      ASSERT_TRUE(t.contains("predicted_ms")) << name;
+      EXPECT_NEAR(t["predicted_ms"].get<double>(), l["predicted_ms"].get<double>(), 1e-9 * l["predicted_ms"].get<double>())
+          << name;
+    }
+  }
+  EXPECT_NEAR(b["predicted_ms"].get<double>(), local.stats["predicted_ms"].get<double>(), 1e-9 * b["predicted_ms"].get<double>());
 }
 
 // The table's error sweep scored photon_gi's indirect against the reference at this many spp.
@@ -112,7 +151,7 @@ TEST(Budgets, QualityPresetsRunTheTablesPointsAndMeasureTheirError) {
   }
 }
 
-TEST(Budgets, LargerBudgetsNeverGiveLargerErrorsAndMostRunsFit) {
+TEST(Budgets, LargerBudgetsNeverGiveLargerErrorsAndRunTheChoosersChoice) {
   const json& front = tableEntry("photon_gi")["front"];
   ASSERT_TRUE(front.is_array() && front.size() >= 3);
   const int size = api::PresetTable::builtin().data()["generated"]["error_size"];
@@ -149,6 +188,7 @@ TEST(Budgets, LargerBudgetsNeverGiveLargerErrorsAndMostRunsFit) {
     body["compare"] = photonGiCompare();
     const json r = d.render(body);
     ASSERT_FALSE(r.contains("http_status")) << r.dump();
+    expectTheChoosersChoice(body, r);
     const json& b = r["stats"]["budget"];
     const double predictedMs = b["predicted_ms"], predicted = b["techniques"]["photon_gi"]["predicted_error"]["value"];
     const double measured = r["stats"]["metrics"]["rmse"];
@@ -170,10 +210,10 @@ TEST(Budgets, LargerBudgetsNeverGiveLargerErrorsAndMostRunsFit) {
                 t["stats"]["budget"]["techniques"]["photon_gi"]["params"]["C"].get<double>(), predicted, measured);
   }
   EXPECT_LT(lastPredicted, front[0]["error"].get<double>());  // the budgets did buy accuracy
+  // The measured frame times are reported, not asserted (issue 31: a budget test asserts the choice and
+  // the model, not wall-clock luck; at speed factor 1 they say how well the table fits this machine now).
   ::testing::Test::RecordProperty("within_budget", std::to_string(fits) + "/" + std::to_string(runs));
-  std::printf("measured frame time within the budget in %d of %d runs\n", fits, runs);
-  // Loose on purpose (a shared, loaded machine): at least 2 of the 5.
-  EXPECT_GE(fits, 2);
+  std::printf("measured frame time within the budget in %d of %d runs (speed factor pinned to 1)\n", fits, runs);
 }
 
 // A daemon capped below the table's dearer photon_gi points (radiantd --max-photons): the preset and
@@ -238,8 +278,8 @@ TEST(Budgets, PresetsAndBudgetsStayWithinTheDaemonsCaps) {
 // a built-in scene; `technique` the pass whose front the budgets climb, scored by `compare` (its AOV
 // against the reference in the table's mode and spp). Budgets of 1, 1.5, 2.5, 4 and 8 times the cheapest
 // frame's predicted ms: every planned pass is charged (predicted_ms a number), a larger budget never gives
-// a larger predicted or measured error, the prediction fits the budget, and the measured frame time
-// (a fresh seed each) fits it in most runs, which the caller asserts loosely.
+// a larger predicted or measured error, the prediction fits the budget, the daemon runs the chooser's
+// choice, and the measured frame time (a fresh seed each) is reported.
 struct Ladder {
   int fits = 0, runs = 0;
   double firstError = 0, lastError = 0;
@@ -270,6 +310,7 @@ Ladder climbBudgets(RealDaemon& d, const json& base, const std::string& techniqu
     const json r = d.render(body);
     EXPECT_FALSE(r.contains("http_status")) << r.dump();
     if (r.contains("http_status")) return out;
+    expectTheChoosersChoice(body, r);
     const json& b = r["stats"]["budget"];
     const double predictedMs = b["predicted_ms"], predicted = b["techniques"][technique]["predicted_error"]["value"];
     const double measured = r["stats"]["metrics"]["rmse"];
@@ -301,7 +342,7 @@ Ladder climbBudgets(RealDaemon& d, const json& base, const std::string& techniqu
   return out;
 }
 
-TEST(Budgets, BudgetsOnTheCausticsSceneChargeEveryPassAndMostRunsFit) {
+TEST(Budgets, BudgetsOnTheCausticsSceneChargeEveryPass) {
   ASSERT_TRUE(tableEntry("caustics").contains("front")) << "api/presets.json has no caustics front";
   RealDaemon& d = sharedDaemon();
   ASSERT_TRUE(d.ready()) << testing::slurp(d.dir / "stderr.log");
@@ -312,10 +353,9 @@ TEST(Budgets, BudgetsOnTheCausticsSceneChargeEveryPassAndMostRunsFit) {
   // The caustic triangles are deterministic: the table's error up to llvmpipe's rounding (2%).
   const Ladder l = climbBudgets(d, base, "caustics", 0.02);
   EXPECT_LT(l.lastError, l.firstError);  // the budgets bought caustics accuracy
-  EXPECT_GE(l.fits, 2);  // loose on purpose (a shared, loaded machine): at least 2 of the 5
 }
 
-TEST(Budgets, BudgetsOnTheMediaSceneChargeEveryPassAndMostRunsFit) {
+TEST(Budgets, BudgetsOnTheMediaSceneChargeEveryPass) {
   ASSERT_TRUE(tableEntry("illumination_network").contains("front")) << "api/presets.json has no illumination_network front";
   RealDaemon& d = sharedDaemon();
   ASSERT_TRUE(d.ready()) << testing::slurp(d.dir / "stderr.log");
@@ -328,18 +368,17 @@ TEST(Budgets, BudgetsOnTheMediaSceneChargeEveryPassAndMostRunsFit) {
   // Without a warm start the frame is the table's error frame: its error up to llvmpipe's rounding.
   const Ladder l = climbBudgets(d, base, "illumination_network", 0.02);
   EXPECT_LT(l.lastError, l.firstError);
-  EXPECT_GE(l.fits, 2);
 }
 
 // Issue 19, the scene variables: the media scene with ten times its particles (the request's `media`: a
 // smoke of 1440 generated particles over explosion's own 159). The budget chooser sees the frame's
 // particles (stats.budget.scene_counts, exactly the scene's plus the request's), charges the media pass
 // more for them than on the bare scene, and over budgets of 1 to 8 times the cheapest frame's prediction
-// a larger budget never gives a larger predicted error and the measured frame time (a fresh seed and
-// a cold network each) fits the budget in most runs: the rate is printed and asserted loosely (a shared,
-// loaded machine), as for the other ladders. Without the particles in the model the prediction was that
-// of 159 particles, and the frames of 1599 ran over.
-TEST(Budgets, BudgetsOnTheMediaSceneWithTenTimesTheParticlesChargeThemAndMostRunsFit) {
+// a larger budget never gives a larger predicted error, the daemon runs the chooser's choice, and the
+// measured frame time (a fresh seed and a cold network each) is reported, as for the other ladders.
+// Without the particles in the model the prediction was that of 159 particles, and the frames of 1599
+// ran over.
+TEST(Budgets, BudgetsOnTheMediaSceneWithTenTimesTheParticlesChargeThem) {
   ASSERT_TRUE(tableEntry("illumination_network").contains("front")) << "api/presets.json has no illumination_network front";
   RealDaemon& d = sharedDaemon();
   ASSERT_TRUE(d.ready()) << testing::slurp(d.dir / "stderr.log");
@@ -377,6 +416,7 @@ TEST(Budgets, BudgetsOnTheMediaSceneWithTenTimesTheParticlesChargeThemAndMostRun
     timed["time_budget_ms"] = budget;
     const json r = d.render(timed);
     ASSERT_FALSE(r.contains("http_status")) << r.dump();
+    expectTheChoosersChoice(timed, r);
     const json& b = r["stats"]["budget"];
     const double predictedMs = b["predicted_ms"], ms = b["measured_ms"];
     const double error = b["techniques"]["illumination_network"]["predicted_error"]["value"];
@@ -393,7 +433,88 @@ TEST(Budgets, BudgetsOnTheMediaSceneWithTenTimesTheParticlesChargeThemAndMostRun
   }
   std::printf("1599 particles: measured frame time within the budget in %d of %d runs\n", fits, runs);
   ::testing::Test::RecordProperty("within_budget_1599_particles", std::to_string(fits) + "/" + std::to_string(runs));
-  EXPECT_GE(fits, 2);  // loose on purpose (a shared, loaded machine): at least 2 of the 5
+}
+
+// Issue 31, budgets that hold on a loaded machine. A daemon that measures its speed (the default):
+//  - its first budgeted frame is preceded by the calibration frame, whose ratio of measured to
+//    predicted time is the factor that frame's choice used (stats.budget.speed: source "measured");
+//  - every budgeted frame's predictions are the table's times the factor, and the choice is the
+//    chooser's at that factor (whatever this machine's load made it);
+//  - frames comparable with the table's cost sweeps (a fresh seed: photons traced cold, as in the table)
+//    join the recent window, the factor being the median of the window and the calibration; a frame
+//    that reuses the photons of an earlier one (the same seed and parameters) does not join it.
+// A daemon pinned with --speed-factor 4 scales by exactly 4 and never calibrates.
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+TEST(Budgets, TheChooserMeasuresTheMachineAndScalesItsPredictions) {
+  RealDaemon d("speed");
+  ASSERT_TRUE(d.ready()) << testing::slurp(d.dir / "stderr.log");
+  const api::PresetTable& table = api::PresetTable::builtin();
+  const int size = table.data()["generated"]["error_size"];
+  auto budgeted = [&](std::uint64_t seed) {
+    json body = cornell(size, seed);
+    body["time_budget_ms"] = 400;
+    return body;
+  };
+  json body = budgeted(11);
+  json r = d.render(body);
+  ASSERT_FALSE(r.contains("http_status")) << r.dump();
+  json speed = r["stats"]["budget"]["speed"];
+  EXPECT_EQ(speed["source"], "measured") << speed.dump();
+  ASSERT_TRUE(speed["calibration"].is_number()) << speed.dump();
+  EXPECT_EQ(speed["recent"].size(), 0u) << "the calibration frames are not observed as frames";
+  EXPECT_DOUBLE_EQ(speed["factor"].get<double>(), speed["calibration"].get<double>());
+  EXPECT_GT(speed["factor"].get<double>(), api::MachineSpeed::kMinRatio);
+  EXPECT_LT(speed["factor"].get<double>(), api::MachineSpeed::kMaxRatio);
+  expectTheChoosersChoice(body, r);
+  // direct's model at the frame's pixels times the factor (supersampling 1 under a budget).
+  const double px = double(size) * size;
+  EXPECT_NEAR(r["stats"]["budget"]["techniques"]["direct"]["predicted_ms"].get<double>(),
+              speed["factor"].get<double>() * table.predictMs("direct", json::object(), px), 1e-9);
+
+  // Fresh seeds: comparable frames join the window (the first budgeted frame may have compiled its
+  // point's shaders, so count from the second), and the factor is the median of window and calibration.
+  int observed = r["stats"]["budget"]["speed"]["observed"].get<bool>();
+  for (std::uint64_t seed = 12; seed < 16; ++seed) {
+    body = budgeted(seed);
+    r = d.render(body);
+    ASSERT_FALSE(r.contains("http_status")) << r.dump();
+    expectTheChoosersChoice(body, r);
+    speed = r["stats"]["budget"]["speed"];
+    std::vector<double> all = speed["recent"].get<std::vector<double>>();
+    all.push_back(speed["calibration"].get<double>());
+    EXPECT_DOUBLE_EQ(speed["factor"].get<double>(), median(all)) << speed.dump();
+    observed += speed["observed"].get<bool>();
+    std::printf("seed %llu: speed %s, predicted %.1f ms, measured %.1f ms\n", static_cast<unsigned long long>(seed),
+                speed.dump().c_str(), r["stats"]["budget"]["predicted_ms"].get<double>(),
+                r["stats"]["budget"]["measured_ms"].get<double>());
+  }
+  EXPECT_GE(observed, 2) << "frames with fresh seeds are comparable with the table";
+  EXPECT_EQ(r["stats"]["budget"]["speed"]["recent"].size(), std::size_t(observed) - r["stats"]["budget"]["speed"]["observed"].get<bool>())
+      << "the window holds the observed frames before this one";
+  // The same seed and point again: its photons are reused, so the frame is not observed.
+  const json again = d.render(budgeted(15));
+  if (again["stats"]["budget"]["techniques"]["photon_gi"]["params"] == r["stats"]["budget"]["techniques"]["photon_gi"]["params"])
+    EXPECT_FALSE(again["stats"]["budget"]["speed"]["observed"].get<bool>()) << again["stats"]["cache"].dump();
+
+  // Pinned: exactly 4x the table, no calibration.
+  RealDaemon pinned("speed-pinned", {"--speed-factor", "4"});
+  ASSERT_TRUE(pinned.ready()) << testing::slurp(pinned.dir / "stderr.log");
+  body = budgeted(11);
+  body["width"] = body["height"] = 32;
+  r = pinned.render(body);
+  ASSERT_FALSE(r.contains("http_status")) << r.dump();
+  speed = r["stats"]["budget"]["speed"];
+  EXPECT_EQ(speed["source"], "pinned");
+  EXPECT_EQ(speed["factor"], 4.0);
+  EXPECT_TRUE(speed["calibration"].is_null());
+  expectTheChoosersChoice(body, r);
+  EXPECT_NEAR(r["stats"]["budget"]["techniques"]["direct"]["predicted_ms"].get<double>(),
+              4.0 * table.predictMs("direct", json::object(), 32.0 * 32.0), 1e-9);
 }
 
 double rmse(const Image& a, const Image& b) {

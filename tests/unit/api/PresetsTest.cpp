@@ -460,3 +460,82 @@ TEST(Presets, EveryPassOfTheBuiltinScenesIsChargedAndLargerBudgetsNeverRaiseAnEr
       EXPECT_DOUBLE_EQ(v, t.front(name).back()["error"].get<double>()) << f.what << ": " << name;
   }
 }
+
+// Issue 31, budgets that hold on a loaded machine: every prediction is the table's times the machine's
+// speed factor, so budget B at speed s chooses exactly what budget B / s chooses at speed 1, and the
+// stats' predicted times are s times the table's.
+TEST(Presets, ASpeedFactorScalesEveryPredictionAndTheBudgetWithIt) {
+  const PresetTable t(syntheticTable());
+  for (double s : {0.25, 1.0, 2.0, 3.7}) {
+    for (double budget = 22; budget <= 400; budget += 7.0) {
+      const BudgetChoice slow = chooseConfiguration(t, kPlanned, request({{"time_budget_ms", budget * s}}), nullptr, {}, s);
+      const BudgetChoice unit = chooseConfiguration(t, kPlanned, request({{"time_budget_ms", budget}}));
+      for (const auto& name : kPlanned) {
+        EXPECT_EQ(slow.params.at(name), unit.params.at(name)) << name << " s " << s << " budget " << budget;
+        const json& a = slow.stats["techniques"][name]["predicted_ms"];
+        const json& b = unit.stats["techniques"][name]["predicted_ms"];
+        ASSERT_EQ(a.is_number(), b.is_number()) << name;
+        if (a.is_number()) EXPECT_NEAR(a.get<double>(), s * b.get<double>(), 1e-9 * a.get<double>()) << name;
+      }
+      EXPECT_NEAR(slow.stats["predicted_ms"].get<double>(), s * unit.stats["predicted_ms"].get<double>(), 1e-9 * budget * s);
+      EXPECT_NEAR(slow.stats["predicted_overhead_ms"].get<double>(), 3.0 * s, 1e-12);
+      EXPECT_EQ(slow.stats["speed_factor"], s);
+      EXPECT_EQ(slow.warnings.size(), unit.warnings.size());
+    }
+  }
+  // A factor that is not a positive finite number is the table's own (1).
+  for (double bad : {0.0, -2.0, std::nan(""), double(INFINITY)}) {
+    const BudgetChoice c = chooseConfiguration(t, kPlanned, request({{"time_budget_ms", 100}}), nullptr, {}, bad);
+    EXPECT_EQ(c.stats["speed_factor"], 1.0);
+  }
+  // The whole frame's prediction in the table's units: overhead + every planned model, or < 0 when one
+  // planned technique has none (gbuffer here).
+  const BudgetChoice c = chooseConfiguration(t, kPlanned, request({{"time_budget_ms", 100}}));
+  const std::vector<std::string> modelled{"direct", "photon_gi", "ambient_occlusion"};
+  double sum = 3.0;
+  for (const auto& name : modelled) sum += t.predictMs(name, c.params.at(name), 1e4);
+  EXPECT_DOUBLE_EQ(predictFrameMs(t, modelled, c.params, 1e4, {}), sum);
+  EXPECT_LT(predictFrameMs(t, kPlanned, c.params, 1e4, {}), 0.0);
+}
+
+// The speed factor's estimate: pinned wins; else the median of the calibration and the last kWindow
+// frames (one stray frame does not move it, a lasting change of load does within half the window);
+// ratios are clamped to [1/64, 64] and times that are not positive finite numbers are ignored.
+TEST(Presets, MachineSpeedIsTheMedianOfTheCalibrationAndRecentFrames) {
+  MachineSpeed m;
+  EXPECT_DOUBLE_EQ(m.factor(), 1.0);
+  EXPECT_EQ(m.toJson()["source"], "table");
+  EXPECT_TRUE(m.needsCalibration());
+  m.calibrate(300, 100);  // 3x the table
+  EXPECT_FALSE(m.needsCalibration());
+  EXPECT_DOUBLE_EQ(m.factor(), 3.0);
+  EXPECT_EQ(m.toJson()["source"], "measured");
+  m.observe(200, 100);
+  EXPECT_DOUBLE_EQ(m.factor(), 2.5);  // median of {2, 3}
+  m.observe(5000, 100);               // a stray frame: 50x
+  EXPECT_DOUBLE_EQ(m.factor(), 3.0);  // median of {2, 3, 50}
+  for (double bad : {0.0, -1.0, std::nan(""), double(INFINITY)}) {
+    m.observe(bad, 100);
+    m.observe(100, bad);
+  }
+  EXPECT_EQ(m.toJson()["recent"].size(), 2u);
+  // The machine gets lighter: 1x from now on. After half the window plus one frames the median follows.
+  for (std::size_t i = 0; i < MachineSpeed::kWindow; ++i) m.observe(100, 100);
+  EXPECT_DOUBLE_EQ(m.factor(), 1.0);
+  EXPECT_EQ(m.toJson()["recent"].size(), MachineSpeed::kWindow);
+  // Clamped ratios.
+  MachineSpeed c;
+  c.calibrate(1e9, 1);
+  EXPECT_DOUBLE_EQ(c.factor(), MachineSpeed::kMaxRatio);
+  c.pin(1e-9);  // outside the range: clamped too
+  EXPECT_DOUBLE_EQ(c.factor(), MachineSpeed::kMinRatio);
+  // Pinned: measurements are kept but not used, and no calibration is needed.
+  MachineSpeed p;
+  p.pin(2.0);
+  EXPECT_FALSE(p.needsCalibration());
+  p.observe(500, 100);
+  EXPECT_DOUBLE_EQ(p.factor(), 2.0);
+  EXPECT_EQ(p.toJson()["source"], "pinned");
+  p.pin(0);  // back to measuring
+  EXPECT_DOUBLE_EQ(p.factor(), 5.0);
+}
