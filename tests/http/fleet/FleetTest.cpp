@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <arpa/inet.h>
+#include <signal.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
 
@@ -406,10 +407,14 @@ TEST_F(Fleet, ZFailoverADaemonKilledMidSweepLosesNoPoint) {
   const pid_t client = spawn({RADIANT_CLIENT_PATH, "--server", proxyUrl(), "sweep", (d / "failover.json").string(), "-o",
                               out.string(), "--inflight", "2"},
                              d / "failover.out", d / "failover.err");
-  // Kill the daemon that rendered the first recorded point, once 10 points are in.
-  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(180);
+  // Kill the daemon that rendered the first recorded point, once 10 points are in. The client is
+  // stopped (SIGSTOP) around the kill, so that on a machine fast enough to finish the sweep between two
+  // polls the kill still lands mid-sweep: what is recorded at the stop is all there is until SIGCONT.
+  // The deadlines (100 s + 170 s) stay within the test's CTest timeout (300 s).
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(100);
   while (std::chrono::steady_clock::now() < end && (!fs::exists(out) || records(out).size() < 10))
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  ::kill(client, SIGSTOP);
   const auto early = records(out);
   ASSERT_GE(early.size(), 10u) << slurp(d / "failover.err");
   const std::string victim = early[0]["daemons"][0];
@@ -417,8 +422,9 @@ TEST_F(Fleet, ZFailoverADaemonKilledMidSweepLosesNoPoint) {
   dead->signal(SIGKILL);
   dead->wait();
   const std::size_t atKill = records(out).size();
+  ::kill(client, SIGCONT);
   ASSERT_LT(atKill, 24u) << "the sweep finished before the kill: nothing tested";
-  ASSERT_EQ(waitExit(client, std::chrono::seconds(280)), 0) << slurp(d / "failover.err");
+  ASSERT_EQ(waitExit(client, std::chrono::seconds(170)), 0) << slurp(d / "failover.err");
   const std::string err = slurp(d / "failover.err");
   const auto recs = records(out);
   ASSERT_EQ(recs.size(), 24u) << err;
