@@ -44,6 +44,12 @@ struct CameraOverride {
   glm::vec3 up{0.f, 1.f, 0.f};
   float yfovDegrees = 40.f;
   bool hasPosition = true, hasTarget = true, hasUp = true, hasYfov = true;
+  // camera.orbit (instead of position): the eye at target + radius (sin phi sin theta, cos phi,
+  // sin phi cos theta), model-viewer's camera-orbit convention; radius 0 = the scene camera's distance.
+  struct Orbit {
+    double thetaDeg = 0, phiDeg = 90, radius = 0;
+  };
+  std::optional<Orbit> orbit;
 };
 
 enum class ImageFormat { Exr, Png };

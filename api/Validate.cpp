@@ -158,6 +158,9 @@ json validate(const json& schema, const json& input, const std::string& pointer)
     if (auto m = schema.find("minimum"); m != schema.end() && d < m->get<double>())
       throw ApiError(422, "out-of-range", "Value out of range",
                      at(pointer) + ": " + shown(value) + " is below the minimum " + number(m->get<double>()), pointer);
+    if (auto m = schema.find("exclusiveMinimum"); m != schema.end() && !(d > m->get<double>()))
+      throw ApiError(422, "out-of-range", "Value out of range",
+                     at(pointer) + ": " + shown(value) + " is not above " + number(m->get<double>()), pointer);
     if (auto m = schema.find("maximum"); m != schema.end() && d > m->get<double>())
       throw ApiError(422, "out-of-range", "Value out of range",
                      at(pointer) + ": " + shown(value) + " is above the maximum " + number(m->get<double>()), pointer);
@@ -392,6 +395,13 @@ RenderRequest parseRenderRequest(const json& body, const RequestLimits& limits) 
     if (cam.hasPosition) cam.position = vec3(c["position"]);
     if (cam.hasTarget) cam.target = vec3(c["target"]);
     if (cam.hasYfov) cam.yfovDegrees = c["yfov_deg"].get<float>();
+    if (c.contains("orbit")) {
+      if (cam.hasPosition)
+        throw ApiError(422, "invalid-value", "Invalid value",
+                       "/camera/orbit: give the eye either as position or as orbit, not both", "/camera/orbit");
+      const json& o = c["orbit"];
+      cam.orbit = CameraOverride::Orbit{o["theta_deg"].get<double>(), o["phi_deg"].get<double>(), o.value("radius", 0.0)};
+    }
     // In double and relative to the vectors' own lengths: the schema bounds coordinates to
     // [-1e9, 1e9], so an up vector of length 1e-30 is a direction like any other.
     if (cam.hasUp) {

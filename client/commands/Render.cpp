@@ -70,11 +70,20 @@ nlohmann::json cameraOption(const std::string& text) {
       } catch (const std::exception&) {
         throw UsageError("--camera yfov expects degrees, got \"" + value + "\"");
       }
+    } else if (key == "orbit") {
+      // model-viewer's camera-orbit: theta and phi in degrees, then the radius (optional).
+      double v[3];
+      char tail = 0;
+      const int n = std::sscanf(value.c_str(), "%lf,%lf,%lf%c", &v[0], &v[1], &v[2], &tail);
+      if ((n != 2 && n != 3) || !std::isfinite(v[0]) || !std::isfinite(v[1]) || (n == 3 && !std::isfinite(v[2])))
+        throw UsageError("--camera orbit expects THETA_DEG,PHI_DEG[,RADIUS], got \"" + value + "\"");
+      cam["orbit"] = {{"theta_deg", v[0]}, {"phi_deg", v[1]}};
+      if (n == 3) cam["orbit"]["radius"] = v[2];
     } else {
-      throw UsageError("--camera: unknown key \"" + key + "\" (position, target, up, yfov)");
+      throw UsageError("--camera: unknown key \"" + key + "\" (position, target, up, yfov, orbit)");
     }
   }
-  if (cam.empty()) throw UsageError("--camera needs at least one of position=, target=, up=, yfov=");
+  if (cam.empty()) throw UsageError("--camera needs at least one of position=, target=, up=, yfov=, orbit=");
   return cam;
 }
 
@@ -489,7 +498,7 @@ void addRenderCommand(CLI::App& root, const GlobalOptions& g, Action& action) {
       ->type_name("MAP.hdr|MAP.exr")
       ->check(CLI::ExistingFile);
   c->add_flag("--no-default-lighting", o->noDefaultLighting, "render an unlit scene black instead of studio-lit");
-  c->add_option("--camera", o->camera, "any subset of the camera's keys")->type_name("position=X,Y,Z;target=X,Y,Z;up=X,Y,Z;yfov=DEG");
+  c->add_option("--camera", o->camera, "any subset of the camera's keys")->type_name("position=X,Y,Z;target=X,Y,Z;up=X,Y,Z;yfov=DEG;orbit=THETA,PHI[,R]");
   c->add_option("--request", o->requestFile, "send REQUEST.json with the other options applied on top")
       ->type_name("REQUEST.json");
   c->add_flag("--dry-run", o->dryRun, "print the request instead of sending it (uploads nothing)");

@@ -61,14 +61,31 @@ FrameView makeFrameView(const Scene& scene, const api::RenderRequest& request, c
   v.target = targetOf(cam);
   if (request.camera) {
     const auto& o = *request.camera;
-    const bool whole = o.hasPosition && o.hasTarget && o.hasUp && o.hasYfov;
+    const bool whole = (o.hasPosition || o.orbit) && o.hasTarget && o.hasUp && o.hasYfov;
     const float baseYfov = scene.camera.projection == ProjectionType::Perspective ? scene.camera.yfov : 0.6911f;
     const float yfov = o.hasYfov ? glm::radians(o.yfovDegrees) : baseYfov;
     // The camera whose fields the override keeps: the file's, or the automatic framing for this
     // image's aspect and field of view (so a narrower yfov alone moves the camera back to keep the fit).
     const Camera base = scene.camera.fromFile ? scene.camera : defaultCameraFor(bounds, aspect, yfov);
-    const glm::vec3 position = o.hasPosition ? o.position : glm::vec3(base.world[3]);
     const glm::vec3 target = o.hasTarget ? o.target : targetOf(base);
+    glm::vec3 position = o.hasPosition ? o.position : glm::vec3(base.world[3]);
+    if (o.orbit) {
+      // model-viewer's camera-orbit (three.js Spherical.setFromSphericalCoords): theta about +Y from +Z
+      // towards +X, phi from +Y. Computed in double: a small radius around a far target stays exact.
+      const double theta = glm::radians(o.orbit->thetaDeg), phi = glm::radians(o.orbit->phiDeg);
+      const double radius = o.orbit->radius > 0 ? o.orbit->radius : glm::length(glm::dvec3(position) - glm::dvec3(target));
+      const glm::dvec3 dir(std::sin(phi) * std::sin(theta), std::cos(phi), std::sin(phi) * std::cos(theta));
+      position = glm::vec3(glm::dvec3(target) + radius * dir);
+      // The eye is stored in single precision: a radius below the target's rounding step would put
+      // it on the target, or (one axis surviving) somewhere else on the sphere. Refuse an orbit the
+      // stored eye misses by more than 1% of its radius.
+      const double reached = glm::length(glm::dvec3(position) - glm::dvec3(target));
+      if (!(std::abs(reached - radius) <= 0.01 * radius))
+        throw api::ApiError(422, "invalid-value", "Invalid value",
+                            "/camera/orbit/radius: too small for the target's single-precision coordinates (the eye "
+                            "would land " + std::to_string(reached) + " from the target instead of " + std::to_string(radius) + ")",
+                            "/camera/orbit/radius");
+    }
     glm::vec3 up = o.hasUp ? o.up : glm::normalize(glm::vec3(base.world[1]));
     if (!(glm::length(target - position) > 0.f))
       throw api::ApiError(422, "invalid-value", "Invalid value",

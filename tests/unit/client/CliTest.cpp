@@ -169,5 +169,19 @@ TEST(Cli, RenderPassesQualityAndTimeBudgetIntoTheRequest) {
   EXPECT_EQ(fr["outputs"][0]["half"], true);
 }
 
+// --camera orbit=THETA,PHI[,R]: model-viewer's camera-orbit into the request's camera.orbit; anything
+// but two or three finite numbers is a usage error (exit 2).
+TEST(Cli, RenderPassesAnOrbitCamera) {
+  const ProcessRun r = radiant("render --builtin cornell_box -o a.png --camera \"orbit=30,75.5,3;target=0,1,0\" --dry-run");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json cam = json::parse(r.out)["camera"];
+  EXPECT_EQ(cam["orbit"], (json{{"theta_deg", 30.0}, {"phi_deg", 75.5}, {"radius", 3.0}}));
+  EXPECT_EQ(cam["target"], (json{0.0, 1.0, 0.0}));
+  const json two = json::parse(radiant("render --builtin cornell_box -o a.png --camera orbit=-90,10 --dry-run").out);
+  EXPECT_EQ(two["camera"]["orbit"], (json{{"theta_deg", -90.0}, {"phi_deg", 10.0}}));
+  for (const char* bad : {"orbit=30", "orbit=30,75,3,4", "orbit=a,b", "orbit=30,nan", "orbit=inf,10"})
+    EXPECT_EQ(radiant(std::string("render --builtin cornell_box -o a.png --camera \"") + bad + "\" --dry-run").code, 2) << bad;
+}
+
 }  // namespace
 }  // namespace radiant
