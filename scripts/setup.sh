@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake pkg-config
   libepoxy-dev libglm-dev libtinygltf-dev libstb-dev libcpp-httplib-dev nlohmann-json3-dev
-  libopenimageio-dev openimageio-tools libembree-dev libtbb-dev libdraco-dev libmeshoptimizer-dev
+  libopenimageio-dev openimageio-tools libwebp-dev libembree-dev libtbb-dev libdraco-dev libmeshoptimizer-dev
   libegl-dev libegl-mesa0 libgl1-mesa-dri libgbm1 mesa-utils
   libgtest-dev libgmock-dev googletest libbenchmark-dev
   clang libclang-rt-14-dev  # the libFuzzer harnesses (scripts/fuzz.sh); the runtime is only recommended by clang

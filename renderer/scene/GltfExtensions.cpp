@@ -21,6 +21,7 @@ const std::vector<std::string>& supportedExtensions() {
       "KHR_materials_volume",     // Beer-Lambert absorption over the traced path (thickness: see Scene.h)
       "KHR_mesh_quantization",  // any component type is read and normalised
       "KHR_texture_transform",
+      "EXT_texture_webp",       // decoded with libwebp (GltfLoader.cpp); its image wins over `source`
       "KHR_materials_unlit",
       "KHR_draco_mesh_compression",  // decoded at load (GltfCompression.cpp)
       "EXT_meshopt_compression",     // decoded at load (GltfCompression.cpp)
@@ -37,7 +38,7 @@ bool isSupportedExtension(const std::string& name) {
 namespace {
 // How to get a file with an unsupported required extension rendered.
 std::string conversionHint(const std::string& name) {
-  if (name == "KHR_texture_basisu" || name == "EXT_texture_webp" || name == "MSFT_texture_dds")
+  if (name == "KHR_texture_basisu" || name == "MSFT_texture_dds")
     return ": its textures are in a format this server cannot decode (no Debian package decodes "
            "KTX2/Basis Universal); re-encode them as PNG or JPEG (for example decode each .ktx2 with "
            "KTX-Software's `ktx extract`, point the images at the PNGs) and remove " + name +

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include <stb/stb_image.h>  // declarations only: libstb (the library tinygltf decodes with) implements them
+#include <webp/decode.h>
 
 #include "api/JsonLimits.h"
 
@@ -270,9 +271,23 @@ void DecodeBudget::charge(std::size_t bytes, const std::string& pointer, const s
   remaining_ -= bytes;
 }
 
+bool isWebp(const unsigned char* bytes, std::size_t size) {
+  return size >= 12 && std::memcmp(bytes, "RIFF", 4) == 0 && std::memcmp(bytes + 8, "WEBP", 4) == 0;
+}
+
 std::optional<ImageHeader> readImageHeader(const unsigned char* bytes, std::size_t size) {
   if (size == 0 || size > std::size_t(std::numeric_limits<int>::max())) return std::nullopt;
   ImageHeader h;
+  if (isWebp(bytes, size)) {
+    // Still images only: an animated WebP has no single texture to show.
+    WebPBitstreamFeatures f;
+    if (WebPGetFeatures(bytes, size, &f) != VP8_STATUS_OK || f.has_animation || f.width <= 0 || f.height <= 0)
+      return std::nullopt;
+    h.width = f.width;
+    h.height = f.height;
+    h.channels = 4;
+    return h;
+  }
   if (!stbi_info_from_memory(bytes, int(size), &h.width, &h.height, &h.channels)) return std::nullopt;
   if (h.width <= 0 || h.height <= 0) return std::nullopt;
   h.sixteenBit = stbi_is_16_bit_from_memory(bytes, int(size)) != 0;
@@ -295,7 +310,7 @@ bool DecodeBudget::chargeImage(const unsigned char* bytes, std::size_t size, int
                               std::to_string(limit_) + " bytes (radiantd " + kDecodeFlag + ")",
                           kDecodeFlag);
     else
-      imageError_.emplace(ptr, ptr + ": not an image this loader decodes (PNG, JPEG, BMP, TGA, GIF, PSD, HDR, PIC, PNM)", "");
+      imageError_.emplace(ptr, ptr + ": not an image this loader decodes (PNG, JPEG, WebP (still), BMP, TGA, GIF, PSD, HDR, PIC, PNM)", "");
     if (err) *err += imageError_->what() + std::string("\n");
     return false;
   }

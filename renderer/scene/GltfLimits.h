@@ -65,6 +65,9 @@ struct ImageHeader {
   bool sixteenBit = false;
 };
 std::optional<ImageHeader> readImageHeader(const unsigned char* bytes, std::size_t size);
+// A WebP file (RIFF container, "WEBP" form type: EXT_texture_webp). stb_image does not decode WebP;
+// libwebp does (GltfLoader.cpp), 8-bit RGBA.
+bool isWebp(const unsigned char* bytes, std::size_t size);
 
 void checkGltfText(std::string_view jsonText, const LoadOptions& options);
 // Returns the budget left for images once accessor expansion is charged.

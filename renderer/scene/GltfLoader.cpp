@@ -15,6 +15,7 @@
 #include <glm/gtc/type_ptr.hpp>
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>  // Debian ships tinygltf as a shared library: no TINYGLTF_IMPLEMENTATION here
+#include <webp/decode.h>
 
 #include "api/Media.h"
 #include "api/Types.h"
@@ -128,6 +129,23 @@ bool loadImageData(tinygltf::Image* image, const int index, std::string* err, st
                    int reqWidth, int reqHeight, const unsigned char* bytes, int size, void* user) {
   auto& budget = *static_cast<DecodeBudget*>(user);
   if (!budget.chargeImage(bytes, std::size_t(std::max(size, 0)), index, err)) return false;
+  // EXT_texture_webp: libwebp decodes to 8-bit RGBA (the header, read above, was a still image).
+  if (isWebp(bytes, std::size_t(std::max(size, 0)))) {
+    int w = 0, h = 0;
+    std::uint8_t* rgba = WebPDecodeRGBA(bytes, std::size_t(size), &w, &h);
+    if (!rgba) {
+      if (err) *err += "/images/" + std::to_string(index) + ": the WebP image could not be decoded\n";
+      return false;
+    }
+    image->width = w;
+    image->height = h;
+    image->component = 4;
+    image->bits = 8;
+    image->pixel_type = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
+    image->image.assign(rgba, rgba + std::size_t(w) * std::size_t(h) * 4);
+    WebPFree(rgba);
+    return true;
+  }
   // nullptr options: expand every image to RGBA (8 or 16 bit per channel).
   return tinygltf::LoadImageData(image, index, err, warn, reqWidth, reqHeight, bytes, size, nullptr);
 }
@@ -575,8 +593,20 @@ private:
 
   void convertTextures() {
     for (std::size_t i = 0; i < m_.textures.size(); ++i) {
-      const auto& t = m_.textures[i];
+      tinygltf::Texture t = m_.textures[i];
       const std::string ptr = pointer("/textures", i);
+      // EXT_texture_webp: its image wins over `source`, which is then an optional PNG/JPEG fallback
+      // for viewers without WebP (the extension's README, "glTF Schema Updates").
+      if (const auto e = t.extensions.find("EXT_texture_webp"); e != t.extensions.end()) {
+        const tinygltf::Value& src = e->second.Get("source");
+        if (!src.IsInt() && !src.IsNumber())
+          throw SceneError(ptr + "/extensions/EXT_texture_webp/source", "texture " + std::to_string(i) +
+                                                                          ": EXT_texture_webp needs an image index");
+        t.source = src.GetNumberAsInt();
+        if (t.source < 0)
+          throw SceneError(ptr + "/extensions/EXT_texture_webp/source",
+                           "texture " + std::to_string(i) + ": EXT_texture_webp names image " + std::to_string(t.source));
+      }
       if (t.source < 0) {
         // Valid glTF (source is optional; an extension such as KHR_texture_basisu may name the only
         // image): the materials render without this texture, and the frame says so.

@@ -1,4 +1,5 @@
 #include <gtest/gtest.h>
+#include <webp/encode.h>
 
 #include <cmath>
 
@@ -600,6 +601,61 @@ TEST(GltfLoader, ImageInGlbBufferView) {
   EXPECT_EQ(s.textures[0].rgba8, texels);
   EXPECT_EQ(s.textures[0].colorSpace, TextureColorSpace::SRGB);  // emissive is colour
   EXPECT_EQ(s.features.emissiveTriangles, 1);
+}
+
+// EXT_texture_webp: a lossless WebP (encoded here with libwebp) decodes to exactly its texels; the
+// extension's image wins over a PNG fallback in `source`; an undecodable WebP is refused at its image.
+std::string encodeWebpLossless(int w, int h, const std::vector<std::uint8_t>& rgba) {
+  std::uint8_t* out = nullptr;
+  const std::size_t n = WebPEncodeLosslessRGBA(rgba.data(), w, h, w * 4, &out);
+  std::string bytes(reinterpret_cast<const char*>(out), n);
+  WebPFree(out);
+  return bytes;
+}
+
+TEST(GltfLoader, WebpTexturesDecodeExactlyAndWinOverTheirFallback) {
+  const std::vector<std::uint8_t> texels = {250, 0, 10, 255, 0, 240, 20, 255, 5, 6, 230, 255};
+  const std::string webp = encodeWebpLossless(3, 1, texels);
+  ASSERT_GT(webp.size(), 12u);
+  for (const bool fallback : {false, true}) {
+    GltfBuilder b;
+    b.doc["extensionsUsed"] = {"EXT_texture_webp"};
+    if (!fallback) b.doc["extensionsRequired"] = {"EXT_texture_webp"};
+    const int wv = b.view(webp.data(), webp.size());
+    b.push("images", {{"bufferView", wv}, {"mimeType", "image/webp"}});
+    json texture{{"extensions", {{"EXT_texture_webp", {{"source", 0}}}}}};
+    if (fallback) {
+      const std::string png = test::encodePng(1, 1, {1, 2, 3, 255});
+      const int pv = b.view(png.data(), png.size());
+      b.push("images", {{"bufferView", pv}, {"mimeType", "image/png"}});
+      texture["source"] = 1;
+    }
+    b.push("textures", texture);
+    const int mat = b.material({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}});
+    const int m = b.mesh(json::array({trianglePrimitive<std::uint8_t>(b, kTri, {0, 1, 2}, {}, {{0, 0}, {1, 0}, {0, 1}}, mat)}));
+    b.scene({b.node({{"mesh", m}})});
+    const Scene s = loadSceneFromMemory(b.glb());
+    ASSERT_EQ(s.textures.size(), 1u) << fallback;
+    EXPECT_EQ(s.textures[0].width, 3);
+    EXPECT_EQ(s.textures[0].height, 1);
+    EXPECT_EQ(s.textures[0].rgba8, texels) << "fallback " << fallback;
+    EXPECT_TRUE(s.warnings.empty()) << s.warnings.front();
+  }
+  // A truncated WebP (the RIFF header without its image): refused at the image, naming it.
+  GltfBuilder b;
+  const std::string broken = webp.substr(0, 20);
+  const int wv = b.view(broken.data(), broken.size());
+  b.push("images", {{"bufferView", wv}, {"mimeType", "image/webp"}});
+  b.push("textures", {{"extensions", {{"EXT_texture_webp", {{"source", 0}}}}}});
+  const int mat = b.material({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}});
+  const int m = b.mesh(json::array({trianglePrimitive<std::uint8_t>(b, kTri, {0, 1, 2}, {}, {}, mat)}));
+  b.scene({b.node({{"mesh", m}})});
+  try {
+    loadSceneFromMemory(b.glb());
+    ADD_FAILURE() << "a truncated WebP was accepted";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.pointer.rfind("/images/0", 0), 0u) << e.pointer << ": " << e.what();
+  }
 }
 
 TEST(GltfLoader, ExternalImageInsideRoot) {
