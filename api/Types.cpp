@@ -29,6 +29,11 @@ void to_json(nlohmann::json& j, const FrameStats& s) {
                      {"camera", s.camera},
                      {"scene", s.scene},
                      {"warnings", s.warnings}};
+  if (!s.clampedValues.empty()) {
+    nlohmann::json& c = j["clamped_values"] = nlohmann::json::array();
+    for (const auto& v : s.clampedValues)
+      c.push_back({{"output", v.output}, {"aov", v.aov}, {"count", v.count}, {"limit", v.limit}});
+  }
   if (!s.budget.is_null()) j["budget"] = s.budget;
   if (!s.refinement.is_null()) j["refinement"] = s.refinement;
 }

@@ -124,6 +124,15 @@ struct CacheEvent {
   bool hit = false;
 };
 
+// Values an output's pixel type cannot hold, written as its largest finite value instead of Inf (a
+// half-float EXR: |v| > 65504). Serialised as stats.clamped_values.
+struct ClampedValues {
+  std::size_t output = 0;  // index in request.outputs
+  std::string aov;
+  std::size_t count = 0;   // values (pixels x channels) clamped
+  double limit = 0;        // the largest finite value of the output's type
+};
+
 struct FrameStats {
   std::vector<PassStats> passes;
   std::map<std::string, std::string> skipped;  // pass name -> reason
@@ -141,6 +150,7 @@ struct FrameStats {
   nlohmann::json camera;  // the camera used: position, target, up, yfov_deg, source
   nlohmann::json scene;   // name, digest, bounds {min, max}, node names
   std::vector<std::string> warnings;  // things the scene has that this frame could not honour
+  std::vector<ClampedValues> clampedValues;  // empty when every output holds every value
   // With quality or time_budget_ms: what the preset table chose per technique, predicted and measured
   // ms, predicted error (api/Presets.h, chooseConfiguration); null otherwise. With refine: also "refinement".
   nlohmann::json budget;

@@ -19,6 +19,7 @@
 #include "renderer/frame/GpuScene.h"
 #include "renderer/frame/PassContext.h"
 #include "renderer/gl/ShaderLibrary.h"
+#include "renderer/io/ImageIO.h"
 #include "renderer/metrics/Metrics.h"
 #include "renderer/scene/BuiltinScenes.h"
 #include "renderer/scene/CostCounts.h"
@@ -69,6 +70,17 @@ std::size_t sanitize(std::vector<float>& v) {
   for (float& x : v)
     if (!std::isfinite(x)) { x = 0.f; ++bad; }
   return bad;
+}
+
+// The passes of the frame that write `aov`: its declared writers, or for beauty those that add to it.
+std::vector<std::string> writersOf(const std::string& aov, const std::vector<Technique*>& passes) {
+  std::vector<std::string> names;
+  for (const Technique* t : passes) {
+    const TechniqueInfo& info = t->info();
+    if (aov == "beauty" ? info.addsToBeauty : std::count(info.outputs.begin(), info.outputs.end(), aov) > 0)
+      names.push_back(info.name);
+  }
+  return names;
 }
 
 // The seed of every ground truth compare() renders (see there).
@@ -224,6 +236,30 @@ static bool comparableWithPresetTable(const api::FrameStats& stats, bool compile
     else if (e.hit && !kSceneKeyed.count(e.what)) return false;
   }
   return sceneResident;
+}
+
+void reportOutputRange(RenderOutput& out, const std::vector<ZeroedValues>& zeroed, const api::RenderRequest& request) {
+  api::FrameStats& stats = out.stats;
+  for (const ZeroedValues& z : zeroed) {
+    if (z.count == 0) continue;
+    std::string writers;
+    for (const std::string& w : z.writers) writers += (writers.empty() ? "" : ", ") + w;
+    stats.warnings.push_back(z.aov + ": " + std::to_string(z.count) + " NaN or infinite values were written as 0; " +
+                             (writers.empty() ? std::string("no pass of this frame writes it")
+                                              : "passes that wrote it: " + writers));
+  }
+  for (std::size_t o = 0; o < request.outputs.size(); ++o) {
+    const api::OutputSpec& spec = request.outputs[o];
+    if (spec.format != api::ImageFormat::Exr || !spec.halfFloat) continue;
+    for (const std::string& aov : spec.aovs) {
+      const auto img = std::find_if(out.aovs.begin(), out.aovs.end(), [&](const Image& i) { return i.aov == aov; });
+      const std::size_t n = img == out.aovs.end() ? 0 : io::valuesBeyondHalf(*img);
+      if (n == 0) continue;
+      stats.clampedValues.push_back({o, aov, n, double(io::kHalfMax)});
+      stats.warnings.push_back("output " + std::to_string(o) + " (half-float EXR): " + std::to_string(n) + " values of " +
+                               aov + " beyond +-65504 were written as +-65504 (\"half\": false keeps them)");
+    }
+  }
 }
 
 int rasterSupersampling(int requested, int width, int height, bool runsReference) {
@@ -521,6 +557,7 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
       aovs.push_back(request.compare->aov);
     std::vector<float> rgba(static_cast<std::size_t>(view.width) * view.height * 4);
     std::size_t nonFinite = 0;
+    std::vector<ZeroedValues> zeroed;
     for (const std::string& aov : aovs) {
       const AovSource src = aovSource(aov);
       Image img = Image::make(aov, outView.width, outView.height, src.channels);
@@ -532,7 +569,10 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
         for (int i = 0; i < outView.width * outView.height; ++i)
           for (int c = 0; c < 3; ++c) img.pixels[static_cast<std::size_t>(i) * 3 + c] = view.ambient[c];
       }
-      nonFinite += sanitize(img.pixels);
+      if (const std::size_t bad = sanitize(img.pixels)) {
+        nonFinite += bad;
+        zeroed.push_back({aov, bad, writersOf(aov, plan.passes)});
+      }
       out.aovs.push_back(std::move(img));
     }
     stats.readbackMs = msSince(readStart);
@@ -557,6 +597,7 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     stats.renderMs = msSince(frameStart);
     report(1.0);
     if (nonFinite) stats.passes.back().counters["non_finite_pixels_zeroed"] = static_cast<double>(nonFinite);
+    reportOutputRange(out, zeroed, request);  // after compare: its error and reference AOVs are outputs too
     return out;
   } catch (const api::ApiError&) {
     im.profiler.beginFrame();

@@ -56,6 +56,17 @@ struct TechniqueDescription {
 // may already ask for. stats.supersampling reports it.
 int rasterSupersampling(int requested, int width, int height, bool runsReference);
 
+// Finite output (docs/API.md, "Outputs"). Readback sets every NaN and Inf to 0; `zeroed` lists the
+// AOVs that had any, with the passes of the frame that write each (a warning per AOV names them: such
+// values are those passes' bug). Each half-float EXR output's values beyond +-65504, which
+// io::encodeExr writes as +-65504, are counted per AOV in out.stats.clampedValues, with a warning.
+struct ZeroedValues {
+  std::string aov;
+  std::size_t count = 0;
+  std::vector<std::string> writers;  // the frame's passes that write the AOV (beauty: those adding to it)
+};
+void reportOutputRange(RenderOutput& out, const std::vector<ZeroedValues>& zeroed, const api::RenderRequest& request);
+
 class Renderer {
 public:
   explicit Renderer(const DeviceOptions& options = {});

@@ -55,7 +55,12 @@ std::vector<std::string> channelNames(const Image& img) {
 
 }  // namespace
 
-std::string encodeExr(const std::vector<Image>& aovs, bool halfFloat) {
+std::size_t valuesBeyondHalf(const Image& image) {
+  return static_cast<std::size_t>(
+      std::count_if(image.pixels.begin(), image.pixels.end(), [](float v) { return std::fabs(v) > kHalfMax; }));
+}
+
+std::string encodeExr(const std::vector<Image>& aovs, bool halfFloat, std::vector<std::size_t>* clampedPerAov) {
   if (aovs.empty()) throw std::invalid_argument("encodeExr: no AOVs");
   const int w = aovs[0].width, h = aovs[0].height;
   int channels = 0;
@@ -68,15 +73,27 @@ std::string encodeExr(const std::vector<Image>& aovs, bool halfFloat) {
   OIIO::ImageSpec spec(w, h, channels, halfFloat ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
   spec.channelnames = names;
   spec.attribute("compression", "zip");
-  // Interleave every AOV's channels into one pixel.
+  // Interleave every AOV's channels into one pixel. OpenImageIO converts a float beyond the half range
+  // to +-Inf (radiance above 65504 is within the API's ranges: ambient 1e6, a 1e15 light), so a half
+  // file gets the largest finite half instead, and the clamps are counted.
   std::vector<float> data(static_cast<std::size_t>(w) * h * channels);
+  std::vector<std::size_t> clamped(aovs.size(), 0);
   for (std::size_t p = 0; p < static_cast<std::size_t>(w) * h; ++p) {
     int off = 0;
-    for (const Image& a : aovs) {
-      for (int c = 0; c < a.channels; ++c) data[p * channels + off + c] = a.pixels[p * a.channels + c];
+    for (std::size_t i = 0; i < aovs.size(); ++i) {
+      const Image& a = aovs[i];
+      for (int c = 0; c < a.channels; ++c) {
+        float v = a.pixels[p * a.channels + c];
+        if (halfFloat && std::fabs(v) > kHalfMax) {
+          v = std::copysign(kHalfMax, v);
+          ++clamped[i];
+        }
+        data[p * channels + off + c] = v;
+      }
       off += a.channels;
     }
   }
+  if (clampedPerAov) *clampedPerAov = std::move(clamped);
   return writeToMemory("frame.exr", spec, OIIO::TypeDesc::FLOAT, data.data());
 }
 

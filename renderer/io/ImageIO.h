@@ -12,8 +12,15 @@
 namespace radiant::io {
 
 // A multi-AOV OpenEXR file: each AOV becomes a channel group ("beauty.R", "depth.Z", ...), with
-// beauty as the unprefixed default layer (R, G, B) so viewers show it first. halfFloat selects HALF.
-std::string encodeExr(const std::vector<Image>& aovs, bool halfFloat);
+// beauty as the unprefixed default layer (R, G, B) so viewers show it first. halfFloat selects HALF,
+// whose values beyond +-kHalfMax (+-Inf included) are written as +-kHalfMax, never as Inf; then
+// `clampedPerAov` (when given) receives how many values of each AOV were clamped, in `aovs`' order.
+std::string encodeExr(const std::vector<Image>& aovs, bool halfFloat, std::vector<std::size_t>* clampedPerAov = nullptr);
+// The largest finite IEEE 754 binary16 value: (2 - 2^-10) x 2^15.
+inline constexpr float kHalfMax = 65504.f;
+// Values of `image` that a half-float EXR cannot hold (|v| > kHalfMax): the ones encodeExr(.., true)
+// clamps. NaN is not counted (the renderer has zeroed every NaN before any output is encoded).
+std::size_t valuesBeyondHalf(const Image& image);
 // 8-bit sRGB PNG of one AOV: value * 2^exposure, clamped to [0,1] (never wrapped), sRGB transfer.
 // zlibLevel 0 (stored) .. 9; 1 is the service's default (see docs/PERFORMANCE.md).
 std::string encodePng(const Image& image, float exposureEV, int zlibLevel = 1);

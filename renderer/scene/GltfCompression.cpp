@@ -1,5 +1,6 @@
 #include "renderer/scene/GltfCompression.h"
 
+#include <cstdint>
 #include <cstring>
 #include <vector>
 
@@ -7,6 +8,8 @@
 #include <meshoptimizer.h>
 #include <tiny_gltf.h>  // shared library: no TINYGLTF_IMPLEMENTATION
 
+#include "api/JsonLimits.h"
+#include "renderer/scene/GltfLimits.h"
 #include "renderer/scene/GltfLoader.h"
 
 namespace radiant::gltf {
@@ -93,62 +96,143 @@ bool usesMeshopt(const json& doc) {
   return false;
 }
 
-std::string decodeMeshopt(std::string_view glb, std::size_t maxBytes) {
+namespace {
+
+enum class MeshoptMode { Attributes, Triangles, Indices };
+enum class MeshoptFilter { None, Octahedral, Quaternion, Exponential };
+
+// One EXT_meshopt_compression bufferView, every field meshoptimizer relies on checked.
+struct MeshoptView {
+  std::size_t index = 0;
+  std::string ptr;  // "/bufferViews/<index>/extensions/EXT_meshopt_compression"
+  std::uint64_t offset = 0, length = 0, stride = 0, count = 0;
+  MeshoptMode mode = MeshoptMode::Attributes;
+  MeshoptFilter filter = MeshoptFilter::None;
+};
+
+// The extension's validity rules (EXT_meshopt_compression README, "JSON schema updates") are also
+// meshoptimizer 0.18's preconditions, which Debian builds with assert() enabled: a stride that does
+// not fit the mode or the filter aborts the process (meshopt_decodeFilterQuat: 'stride == 8'), so every
+// one is checked here, before any meshopt_decode* call.
+MeshoptView readMeshoptView(const json& v, std::size_t index, std::size_t binSize) {
+  MeshoptView m;
+  m.index = index;
+  const std::string viewPtr = "/bufferViews/" + std::to_string(index);
+  m.ptr = viewPtr + "/extensions/EXT_meshopt_compression";
+  const json& e = v.at("extensions").at("EXT_meshopt_compression");
+  if (!e.is_object()) throw SceneError(m.ptr, "EXT_meshopt_compression must be an object");
+  if (unsignedAt(e, "buffer", m.ptr) != 0)
+    throw SceneError(m.ptr + "/buffer", "the compressed bytes must be in a buffer with data");
+  m.offset = unsignedAt(e, "byteOffset", m.ptr, false);
+  m.length = unsignedAt(e, "byteLength", m.ptr);
+  m.stride = unsignedAt(e, "byteStride", m.ptr);
+  m.count = unsignedAt(e, "count", m.ptr);
+
+  const auto mode = e.find("mode");
+  if (mode == e.end() || !mode->is_string())
+    throw SceneError(m.ptr + "/mode", "mode must be one of the strings ATTRIBUTES, TRIANGLES, INDICES");
+  const std::string& modeName = mode->get_ref<const std::string&>();
+  if (modeName == "ATTRIBUTES") m.mode = MeshoptMode::Attributes;
+  else if (modeName == "TRIANGLES") m.mode = MeshoptMode::Triangles;
+  else if (modeName == "INDICES") m.mode = MeshoptMode::Indices;
+  else throw SceneError(m.ptr + "/mode", "unknown mode \"" + api::truncateUtf8(modeName, 40) + "\" (ATTRIBUTES, TRIANGLES or INDICES)");
+
+  std::string filterName = "NONE";
+  if (const auto filter = e.find("filter"); filter != e.end()) {
+    if (!filter->is_string())
+      throw SceneError(m.ptr + "/filter", "filter must be one of the strings NONE, OCTAHEDRAL, QUATERNION, EXPONENTIAL");
+    filterName = filter->get<std::string>();
+  }
+  if (filterName == "NONE") m.filter = MeshoptFilter::None;
+  else if (filterName == "OCTAHEDRAL") m.filter = MeshoptFilter::Octahedral;
+  else if (filterName == "QUATERNION") m.filter = MeshoptFilter::Quaternion;
+  else if (filterName == "EXPONENTIAL") m.filter = MeshoptFilter::Exponential;
+  else throw SceneError(m.ptr + "/filter", "unknown filter \"" + api::truncateUtf8(filterName, 40) + "\" (NONE, OCTAHEDRAL, QUATERNION or EXPONENTIAL)");
+
+  const std::string stride = std::to_string(m.stride);
+  if (m.mode == MeshoptMode::Attributes) {
+    if (m.stride == 0 || m.stride > 256 || m.stride % 4 != 0)  // meshopt_decodeVertexBuffer: 'vertex_size % 4 == 0'
+      throw SceneError(m.ptr + "/byteStride", "ATTRIBUTES needs a byteStride that is a multiple of 4 from 4 to 256, not " + stride);
+  } else {
+    if (m.stride != 2 && m.stride != 4)  // meshopt_decodeIndex*: 'index_size == 2 || index_size == 4'
+      throw SceneError(m.ptr + "/byteStride", modeName + " needs a byteStride of 2 or 4, not " + stride);
+    if (m.filter != MeshoptFilter::None)
+      throw SceneError(m.ptr + "/filter", "filter " + filterName + " applies to ATTRIBUTES only; " + modeName + " needs NONE");
+    if (m.mode == MeshoptMode::Triangles && m.count % 3 != 0)  // meshopt_decodeIndexBuffer: 'index_count % 3 == 0'
+      throw SceneError(m.ptr + "/count", "TRIANGLES needs a count that is a multiple of 3, not " + std::to_string(m.count));
+  }
+  // meshopt_decodeFilterOct: 'stride == 4 || stride == 8'; Quat: 'stride == 8'; Exp: 'stride % 4 == 0'.
+  if ((m.filter == MeshoptFilter::Octahedral && m.stride != 4 && m.stride != 8) ||
+      (m.filter == MeshoptFilter::Quaternion && m.stride != 8))
+    throw SceneError(m.ptr + "/byteStride", "filter " + filterName + " needs a byteStride of " +
+                                                (m.filter == MeshoptFilter::Quaternion ? "8" : "4 or 8") + ", not " + stride);
+  if (m.count == 0) throw SceneError(m.ptr + "/count", "count must be at least 1");
+
+  if (m.offset > binSize || m.length > binSize - m.offset)
+    throw SceneError(m.ptr, "the compressed bytes [" + std::to_string(m.offset) + ", " + std::to_string(m.offset + m.length) +
+                                ") lie outside the buffer of " + std::to_string(binSize) + " bytes");
+  // The parent view must describe the decoded layout (the README's first two rules); count x stride
+  // cannot overflow once byteLength equals it.
+  const auto parentLength = v.find("byteLength");
+  if (parentLength == v.end() || !parentLength->is_number_unsigned() || m.count > UINT64_MAX / m.stride ||
+      parentLength->get<std::uint64_t>() != m.count * m.stride)
+    throw SceneError(viewPtr + "/byteLength", "the bufferView's byteLength must be count x byteStride = " +
+                                                  std::to_string(m.count) + " x " + stride);
+  if (const auto parentStride = v.find("byteStride");
+      parentStride != v.end() && !(parentStride->is_number_unsigned() && parentStride->get<std::uint64_t>() == m.stride))
+    throw SceneError(viewPtr + "/byteStride", "the bufferView's byteStride must equal the extension's byteStride " + stride);
+  return m;
+}
+
+std::vector<unsigned char> decode(const MeshoptView& m, const unsigned char* src) {
+  std::vector<unsigned char> decoded(m.count * m.stride);
+  const int rc = m.mode == MeshoptMode::Attributes ? meshopt_decodeVertexBuffer(decoded.data(), m.count, m.stride, src, m.length)
+                 : m.mode == MeshoptMode::Triangles ? meshopt_decodeIndexBuffer(decoded.data(), m.count, m.stride, src, m.length)
+                                                    : meshopt_decodeIndexSequence(decoded.data(), m.count, m.stride, src, m.length);
+  if (rc != 0) throw SceneError(m.ptr, "the meshopt stream is corrupt (meshoptimizer error " + std::to_string(rc) + ")");
+  switch (m.filter) {
+    case MeshoptFilter::None: break;
+    case MeshoptFilter::Octahedral: meshopt_decodeFilterOct(decoded.data(), m.count, m.stride); break;
+    case MeshoptFilter::Quaternion: meshopt_decodeFilterQuat(decoded.data(), m.count, m.stride); break;
+    case MeshoptFilter::Exponential: meshopt_decodeFilterExp(decoded.data(), m.count, m.stride); break;
+  }
+  return decoded;
+}
+
+}  // namespace
+
+std::string decodeMeshopt(std::string_view glb, DecodeBudget& budget) {
   if (glb.size() < 20 || glb.substr(0, 4) != "glTF") throw SceneError("", "EXT_meshopt_compression: expected a GLB");
   const std::uint32_t jsonLength = le32(glb.data() + 12);
   json doc = json::parse(glb.substr(20, jsonLength));
   const std::size_t binHeader = 20 + ((jsonLength + 3) & ~3u);
   std::string_view bin;
   if (binHeader + 8 <= glb.size()) bin = glb.substr(binHeader + 8, std::min<std::size_t>(le32(glb.data() + binHeader), glb.size() - binHeader - 8));
-  std::string out(bin);
-  std::size_t budget = maxBytes;
   json& views = doc["bufferViews"];
+  // Every view is checked and its decoded size charged before the first is decoded.
+  std::vector<MeshoptView> compressed;
   for (std::size_t i = 0; i < views.size(); ++i) {
-    json& v = views[i];
-    if (!v.is_object() || !v.contains("extensions") || !v["extensions"].contains("EXT_meshopt_compression")) continue;
-    const std::string ptr = "/bufferViews/" + std::to_string(i) + "/extensions/EXT_meshopt_compression";
-    const json& e = v["extensions"]["EXT_meshopt_compression"];
-    if (unsignedAt(e, "buffer", ptr) != 0)
-      throw SceneError(ptr + "/buffer", "the compressed bytes must be in a buffer with data");
-    const std::uint64_t offset = unsignedAt(e, "byteOffset", ptr, false), length = unsignedAt(e, "byteLength", ptr);
-    const std::uint64_t stride = unsignedAt(e, "byteStride", ptr), count = unsignedAt(e, "count", ptr);
-    const std::string mode = e.value("mode", ""), filter = e.value("filter", "NONE");
-    if (offset > bin.size() || length > bin.size() - offset)
-      throw SceneError(ptr, "the compressed bytes [" + std::to_string(offset) + ", " + std::to_string(offset + length) +
-                                ") lie outside the buffer of " + std::to_string(bin.size()) + " bytes");
-    if (stride == 0 || stride > 256 || count > budget / stride)
-      throw SceneError(ptr, "count " + std::to_string(count) + " x byteStride " + std::to_string(stride) +
-                                " is outside the limits (stride 1..256, total within the size limit)");
-    budget -= count * stride;
-    std::vector<unsigned char> decoded(count * stride);
-    const auto* src = reinterpret_cast<const unsigned char*>(bin.data() + offset);
-    int rc = -1;
-    if (mode == "ATTRIBUTES") {
-      if (stride % 4 != 0) throw SceneError(ptr + "/byteStride", "ATTRIBUTES needs a byteStride that is a multiple of 4");
-      rc = meshopt_decodeVertexBuffer(decoded.data(), count, stride, src, length);
-    } else if (mode == "TRIANGLES" || mode == "INDICES") {
-      if (stride != 2 && stride != 4) throw SceneError(ptr + "/byteStride", mode + " needs a byteStride of 2 or 4");
-      if (mode == "TRIANGLES" && count % 3 != 0) throw SceneError(ptr + "/count", "TRIANGLES needs a count that is a multiple of 3");
-      rc = mode == "TRIANGLES" ? meshopt_decodeIndexBuffer(decoded.data(), count, stride, src, length)
-                               : meshopt_decodeIndexSequence(decoded.data(), count, stride, src, length);
-    } else {
-      throw SceneError(ptr + "/mode", "unknown mode \"" + mode + "\" (ATTRIBUTES, TRIANGLES or INDICES)");
-    }
-    if (rc != 0) throw SceneError(ptr, "the meshopt stream is corrupt (meshoptimizer error " + std::to_string(rc) + ")");
-    if (filter == "OCTAHEDRAL") meshopt_decodeFilterOct(decoded.data(), count, stride);
-    else if (filter == "QUATERNION") meshopt_decodeFilterQuat(decoded.data(), count, stride);
-    else if (filter == "EXPONENTIAL") meshopt_decodeFilterExp(decoded.data(), count, stride);
-    else if (filter != "NONE") throw SceneError(ptr + "/filter", "unknown filter \"" + filter + "\"");
-    if ((filter == "OCTAHEDRAL" && stride != 4 && stride != 8) || (filter == "QUATERNION" && stride != 8) ||
-        (filter == "EXPONENTIAL" && stride % 4 != 0))
-      throw SceneError(ptr + "/filter", "filter " + filter + " does not fit byteStride " + std::to_string(stride));
+    const json& v = views[i];
+    if (!v.is_object() || !v.contains("extensions") || !v["extensions"].is_object() ||
+        !v["extensions"].contains("EXT_meshopt_compression"))
+      continue;
+    compressed.push_back(readMeshoptView(v, i, bin.size()));
+    const MeshoptView& m = compressed.back();
+    budget.charge(std::size_t(m.count * m.stride), m.ptr + "/count",
+                  "EXT_meshopt_compression bufferView " + std::to_string(i) + " decodes to " + std::to_string(m.count) +
+                      " x " + std::to_string(m.stride) + " bytes");
+  }
+  std::string out(bin);
+  for (const MeshoptView& m : compressed) {
+    const std::vector<unsigned char> decoded = decode(m, reinterpret_cast<const unsigned char*>(bin.data() + m.offset));
+    json& v = views[m.index];
     out.resize((out.size() + 15) & ~std::size_t(15), '\0');
     const std::size_t at = out.size();
     out.append(reinterpret_cast<const char*>(decoded.data()), decoded.size());
     v["buffer"] = 0;
     v["byteOffset"] = at;
     v["byteLength"] = decoded.size();
-    if (mode == "ATTRIBUTES") v["byteStride"] = stride;
+    if (m.mode == MeshoptMode::Attributes) v["byteStride"] = m.stride;
     else v.erase("byteStride");
     v["extensions"].erase("EXT_meshopt_compression");
     if (v["extensions"].empty()) v.erase("extensions");
@@ -163,18 +247,7 @@ std::string decodeMeshopt(std::string_view glb, std::size_t maxBytes) {
         if (e != "EXT_meshopt_compression") kept.push_back(e);
       doc[key] = kept;
     }
-  std::string text = doc.dump();
-  text.resize((text.size() + 3) & ~std::size_t(3), ' ');
-  std::string result = "glTF";
-  put32(result, 2);
-  put32(result, std::uint32_t(28 + text.size() + out.size()));
-  put32(result, std::uint32_t(text.size()));
-  put32(result, 0x4E4F534Au);
-  result += text;
-  put32(result, std::uint32_t(out.size()));
-  put32(result, 0x004E4942u);
-  result += out;
-  return result;
+  return joinGlb(doc, std::move(out));
 }
 
 void decodeDraco(tinygltf::Model& model, std::size_t maxBytes) {

@@ -1185,7 +1185,7 @@ Scene load(std::string_view bytes, const fs::path& baseDir, const fs::path& root
     } catch (const PackError& e) {
       throw SceneError(e.pointer, e.what());
     }
-    if (meshopt) decodedBytes = gltf::decodeMeshopt(decodedBytes, options.maxBytes);
+    if (meshopt) decodedBytes = gltf::decodeMeshopt(decodedBytes, budget);  // charged against --max-decode-bytes
     if (draco) decodedBytes = gltf::prepareDraco(decodedBytes);
     source = decodedBytes;
     sourceGlb = true;

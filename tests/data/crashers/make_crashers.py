@@ -65,6 +65,44 @@ write("gltf", "jpeg_16384_squared.glb", image_glb(jpeg, "image/jpeg"))
 json_ff = glb({"asset": {"version": "2.0"}, "nodes": [{"name": "NAME"}]}, b"").replace(b"NAME", b"N\xffME")
 write("gltf", "glb_json_chunk_0xff.glb", json_ff)
 
+# EXT_meshopt_compression (issue 30): a filter whose stride does not fit aborted radiantd inside
+# meshoptimizer (Debian keeps its asserts); "mode": 5 and "filter": [] gave no pointer; a view that
+# decodes to 1 GiB from 64 bytes was not charged against --max-decode-bytes.
+def meshopt_zero_attributes(count, stride):
+    """A valid mode-0 (ATTRIBUTES) stream of `count` zero elements (the README's Appendix A): header
+    0xa0, per block one all-zero group header per byte of the element, then the tail (baseline)."""
+    out = b"\xa0"
+    block = min((8192 // stride) & ~15, 256)
+    for start in range(0, count, block):
+        groups = (min(block, count - start) + 15) // 16
+        out += b"\0" * (stride * ((groups + 3) // 4))
+    return out + b"\0" * max(stride, 32)
+
+# meshopt_encodeIndexBuffer / meshopt_encodeIndexSequence of the indices (0, 1, 2)
+triangles_012 = bytes.fromhex("e0f0007687566778a9866589689801690000")
+indices_012 = bytes.fromhex("d000040400000000")
+
+def meshopt_glb(stream, count, stride, fields):
+    ext = {"buffer": 0, "byteOffset": 0, "byteLength": len(stream), "byteStride": stride, "count": count}
+    ext.update(fields)
+    doc = {"asset": {"version": "2.0"}, "extensionsUsed": ["EXT_meshopt_compression"],
+           "extensionsRequired": ["EXT_meshopt_compression"],
+           "buffers": [{"byteLength": len(stream)},
+                       {"byteLength": count * stride, "extensions": {"EXT_meshopt_compression": {"fallback": True}}}],
+           "bufferViews": [{"buffer": 1, "byteOffset": 0, "byteLength": count * stride,
+                            "extensions": {"EXT_meshopt_compression": ext}}]}
+    return glb(doc, stream)
+
+write("gltf", "meshopt_quaternion_stride4.glb", meshopt_glb(meshopt_zero_attributes(3, 4), 3, 4, {"mode": "ATTRIBUTES", "filter": "QUATERNION"}))
+write("gltf", "meshopt_octahedral_stride12.glb", meshopt_glb(meshopt_zero_attributes(3, 12), 3, 12, {"mode": "ATTRIBUTES", "filter": "OCTAHEDRAL"}))
+write("gltf", "meshopt_octahedral_stride16.glb", meshopt_glb(meshopt_zero_attributes(3, 16), 3, 16, {"mode": "ATTRIBUTES", "filter": "OCTAHEDRAL"}))
+write("gltf", "meshopt_exponential_triangles_stride2.glb", meshopt_glb(triangles_012, 3, 2, {"mode": "TRIANGLES", "filter": "EXPONENTIAL"}))
+write("gltf", "meshopt_octahedral_triangles_stride2.glb", meshopt_glb(triangles_012, 3, 2, {"mode": "TRIANGLES", "filter": "OCTAHEDRAL"}))
+write("gltf", "meshopt_quaternion_indices_stride4.glb", meshopt_glb(indices_012, 3, 4, {"mode": "INDICES", "filter": "QUATERNION"}))
+write("gltf", "meshopt_mode_5.glb", meshopt_glb(meshopt_zero_attributes(3, 8), 3, 8, {"mode": 5}))
+write("gltf", "meshopt_filter_array.glb", meshopt_glb(meshopt_zero_attributes(3, 8), 3, 8, {"mode": "ATTRIBUTES", "filter": []}))
+write("gltf", "meshopt_decodes_1gib.glb", meshopt_glb(b"\x55" * 64, 1 << 22, 256, {"mode": "ATTRIBUTES"}))
+
 # ---- raw HTTP
 write("http", "path_0xff.txt", "GET /%ff HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n")
 write("http", "path_overlong_slash.txt", "GET /v1/scenes/%c0%af HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n")

@@ -658,5 +658,51 @@ TEST(RenderCore, SupersamplingIsCappedByTheFrameMemoryAndOffForTheReferencePass)
   EXPECT_EQ(rasterSupersampling(9, 16, 16, false), 4);
 }
 
+// Finite output (issue 30), the stats half of it (no GL: readback's results are given): an AOV whose
+// NaN/Inf values readback zeroed is warned of with the passes that wrote it; every half-float EXR
+// output counts, per AOV, the values beyond 65504 that io::encodeExr writes as 65504; a float EXR or a
+// PNG of the same AOV counts nothing.
+TEST(RenderCore, ZeroedValuesNameTheirPassesAndHalfExrClampsAreCountedPerOutputAndAov) {
+  RenderOutput out;
+  Image beauty = Image::make("beauty", 2, 2, 3);
+  beauty.pixels = {1e6f, 2.f, 3.f, 70000.f, 65504.f, -65505.f, 0.f, 1.f, 1e15f, 5.f, 6.f, 7.f};  // 4 beyond
+  Image direct = Image::make("direct", 2, 2, 3);
+  direct.pixels = {1.f, 2.f, 3.f, 4.f, 5.f, 6.f, 7.f, 8.f, 9.f, 10.f, 11.f, 1e5f};  // 1 beyond
+  Image depth = Image::make("depth", 2, 2, 1);
+  depth.pixels = {1.f, 2.f, 3.f, 4.f};
+  out.aovs = {beauty, direct, depth};
+  api::RenderRequest req;
+  req.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty", "direct", "depth"}, true},
+                 api::OutputSpec{api::ImageFormat::Exr, {"beauty"}, false},
+                 api::OutputSpec{api::ImageFormat::Png, {"beauty"}, true},
+                 api::OutputSpec{api::ImageFormat::Exr, {"direct"}, true}};
+  const std::vector<ZeroedValues> zeroed = {{"beauty", 39, {"direct", "specular"}}, {"depth", 2, {}}};
+  reportOutputRange(out, zeroed, req);
+
+  ASSERT_EQ(out.stats.clampedValues.size(), 3u);
+  const auto is = [](const api::ClampedValues& c, std::size_t output, const char* aov, std::size_t count) {
+    return c.output == output && c.aov == aov && c.count == count && c.limit == 65504.0;
+  };
+  EXPECT_TRUE(is(out.stats.clampedValues[0], 0, "beauty", 4));
+  EXPECT_TRUE(is(out.stats.clampedValues[1], 0, "direct", 1));
+  EXPECT_TRUE(is(out.stats.clampedValues[2], 3, "direct", 1));
+  ASSERT_EQ(out.stats.warnings.size(), 5u);
+  EXPECT_EQ(out.stats.warnings[0], "beauty: 39 NaN or infinite values were written as 0; passes that wrote it: direct, specular");
+  EXPECT_EQ(out.stats.warnings[1], "depth: 2 NaN or infinite values were written as 0; no pass of this frame writes it");
+  EXPECT_EQ(out.stats.warnings[2],
+            "output 0 (half-float EXR): 4 values of beauty beyond +-65504 were written as +-65504 (\"half\": false keeps them)");
+  const nlohmann::json j = out.stats;
+  ASSERT_EQ(j["clamped_values"].size(), 3u);
+  EXPECT_EQ(j["clamped_values"][0], (nlohmann::json{{"output", 0}, {"aov", "beauty"}, {"count", 4}, {"limit", 65504.0}}));
+  // Nothing beyond range, nothing zeroed: no key, no warning.
+  RenderOutput calm;
+  calm.aovs = {direct};
+  calm.aovs[0].pixels.back() = 12.f;
+  reportOutputRange(calm, {}, req);
+  EXPECT_TRUE(calm.stats.clampedValues.empty());
+  EXPECT_TRUE(calm.stats.warnings.empty());
+  EXPECT_FALSE(nlohmann::json(calm.stats).contains("clamped_values"));
+}
+
 }  // namespace
 }  // namespace radiant

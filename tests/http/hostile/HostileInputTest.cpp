@@ -13,6 +13,7 @@
 #include <zlib.h>
 
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <future>
 #include <thread>
@@ -21,6 +22,7 @@
 #include <nlohmann/json.hpp>
 
 #include "api/Sha256.h"
+#include "renderer/io/ImageIO.h"
 #include "tests/support/DaemonProcess.h"
 #include "tests/unit/scene/GltfTestBuilder.h"
 
@@ -358,6 +360,94 @@ TEST_F(Hostile, DuplicateAovsAndOutputsAreRefused) {
   expectProblem(post("/v1/renders", twice.dump()), 422, "invalid-value", "/outputs/1");
   const json compare = {{"scene", {{"builtin", "cornell_box"}}}, {"compare", {{"aov", "anything"}}}};
   expectProblem(post("/v1/renders", compare.dump()), 422, "invalid-value", "/compare/aov");
+}
+
+// ---- issue 30: meshopt streams that aborted radiantd; radiance beyond a half float ---------------
+
+TEST_F(Hostile, MeshoptFieldsThatDoNotFitAre422AtTheirPointerBeforeAnyDecode) {
+  // The recorded crashers (make_crashers.py): each one compressed bufferView 0, a valid stream.
+  const fs::path dir = fs::path(RADIANT_SOURCE_DIR) / "tests/data/crashers/gltf";
+  const std::string ext = "/bufferViews/0/extensions/EXT_meshopt_compression";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"meshopt_quaternion_stride4.glb", "/byteStride"},          // SIGABRT: meshopt_decodeFilterQuat 'stride == 8'
+      {"meshopt_octahedral_stride12.glb", "/byteStride"},         // SIGABRT: meshopt_decodeFilterOct
+      {"meshopt_octahedral_stride16.glb", "/byteStride"},         // SIGABRT
+      {"meshopt_exponential_triangles_stride2.glb", "/filter"},   // SIGABRT: meshopt_decodeFilterExp
+      {"meshopt_octahedral_triangles_stride2.glb", "/filter"},    // SIGABRT
+      {"meshopt_quaternion_indices_stride4.glb", "/filter"},      // SIGABRT
+      {"meshopt_mode_5.glb", "/mode"},                            // 422 with a JSON-library message, no pointer
+      {"meshopt_filter_array.glb", "/filter"}};
+  for (const auto& [file, pointer] : cases) {
+    SCOPED_TRACE(file);
+    expectProblem(put(radiant::testing::slurp(dir / file), "model/gltf-binary"), 422, "invalid-scene", ext + pointer);
+  }
+  // As an inline scene of a render, the request field is named and the detail carries the glTF's pointer.
+  const std::string inlineGlb = R"({"scene":{"inline_glb":")" +
+                                radiant::test::base64(radiant::testing::slurp(dir / "meshopt_quaternion_stride4.glb")) +
+                                R"("},"width":8,"height":8})";
+  expectProblem(post("/v1/renders", inlineGlb), 422, "invalid-scene", "/scene/inline_glb", ext + "/byteStride");
+  // 64 bytes that claim to decode to 1 GiB (4194304 x 256): over --max-decode-bytes (256 MiB here), refused
+  // before anything is decoded or allocated.
+  auto r = put(radiant::testing::slurp(dir / "meshopt_decodes_1gib.glb"), "model/gltf-binary");
+  expectProblem(r, 422, "limit-exceeded", ext + "/count", "--max-decode-bytes");
+  EXPECT_NE(r->body.find("1073741824 bytes"), std::string::npos) << r->body;
+  EXPECT_LT(peakRssMiB(daemon_->pid()), 1024.0);
+}
+
+// Every value of a half-float EXR frame is finite (issue 30: ambient 1e6 or a 1e15 light, both within the
+// API's ranges, gave +Inf), the values clamped to 65504 are exactly those beyond it in the float frame of
+// the same render, and stats.clamped_values and a warning say so.
+TEST_F(Hostile, RadianceBeyondAHalfFloatIsClampedToItsLargestFiniteValueAndCounted) {
+  GltfBuilder lit = triangle();
+  lit.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+  lit.doc["extensions"] = {{"KHR_lights_punctual", {{"lights", {{{"type", "point"}, {"intensity", 1e15}}}}}}};
+  lit.node({{"translation", {0.25, 0.25, 1.0}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+  lit.scene({0, 1});
+  const std::vector<std::pair<std::string, json>> scenes = {
+      {"ambient 1e6", {{"scene", {{"builtin", "cornell_box"}}}, {"ambient", {1e6, 1e6, 1e6}}}},
+      {"a 1e15 light", {{"scene", {{"inline_glb", radiant::test::base64(lit.glb())}}}}}};
+  for (const auto& [what, base] : scenes) {
+    SCOPED_TRACE(what);
+    auto frame = [&](bool half) {
+      json body = base;
+      body["width"] = 16;
+      body["height"] = 16;
+      body["outputs"] = {{{"format", "exr"}, {"aovs", {"beauty"}}, {"half", half}}};
+      auto r = post("/v1/renders", body.dump());
+      EXPECT_TRUE(r && r->status == 200) << (r ? r->body.substr(0, 600) : "no response");
+      if (!r || r->status != 200) return std::pair{json(), radiant::Image{}};
+      const json out = json::parse(r->body);
+      auto f = daemon_->client().Get(out["frames"][0]["url"].get<std::string>().c_str());
+      EXPECT_TRUE(f && f->status == 200);
+      return std::pair{out, radiant::io::decodeImage(f ? f->body : "", "beauty")};
+    };
+    const auto [halfOut, half] = frame(true);
+    const auto [floatOut, full] = frame(false);
+    ASSERT_EQ(half.pixels.size(), 16u * 16u * 3u);
+    ASSERT_EQ(full.pixels.size(), half.pixels.size());
+    std::size_t beyond = 0, clampedSeen = 0;
+    for (std::size_t i = 0; i < half.pixels.size(); ++i) {
+      ASSERT_TRUE(std::isfinite(half.pixels[i])) << "value " << i << " of the half EXR is " << half.pixels[i];
+      EXPECT_LE(std::fabs(half.pixels[i]), 65504.f);
+      if (std::fabs(full.pixels[i]) > 65504.f) {
+        ++beyond;
+        clampedSeen += half.pixels[i] == std::copysign(65504.f, full.pixels[i]);
+      }
+    }
+    EXPECT_GT(beyond, 0u) << "the scene is not bright enough to test anything";
+    EXPECT_EQ(clampedSeen, beyond);
+    const json& clamped = halfOut["stats"]["clamped_values"];
+    ASSERT_EQ(clamped.size(), 1u) << halfOut["stats"].dump();
+    EXPECT_EQ(clamped[0]["output"], 0);
+    EXPECT_EQ(clamped[0]["aov"], "beauty");
+    EXPECT_EQ(clamped[0]["count"], beyond);
+    EXPECT_EQ(clamped[0]["limit"], 65504.0);
+    const std::string warnings = halfOut["stats"]["warnings"].dump();
+    EXPECT_NE(warnings.find(std::to_string(beyond) + " values of beauty beyond +-65504"), std::string::npos) << warnings;
+    // A float EXR holds them: nothing is clamped, nothing is warned of.
+    EXPECT_FALSE(floatOut["stats"].contains("clamped_values"));
+    EXPECT_EQ(floatOut["stats"]["warnings"].dump().find("65504"), std::string::npos);
+  }
 }
 
 // ---- service behaviour -------------------------------------------------------------------------

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <limits>
 
 #include <gtest/gtest.h>
@@ -11,6 +13,8 @@
 #include <draco/mesh/triangle_soup_mesh_builder.h>
 #include <meshoptimizer.h>
 
+#include "renderer/scene/GltfCompression.h"
+#include "renderer/scene/GltfLimits.h"
 #include "renderer/scene/GltfLoader.h"
 #include "tests/unit/scene/GltfTestBuilder.h"
 
@@ -102,69 +106,282 @@ TEST(GltfCompression, DracoPrimitiveDecodesToTheEncodedMesh) {
   }
 }
 
-TEST(GltfCompression, MeshoptBufferViewsDecodeToTheEncodedBytes) {
-  const Cube cube;
-  std::vector<unsigned char> vbuf(meshopt_encodeVertexBufferBound(cube.p.size(), 12));
-  vbuf.resize(meshopt_encodeVertexBuffer(vbuf.data(), vbuf.size(), cube.p.data(), cube.p.size(), 12));
-  std::vector<unsigned char> ibuf(meshopt_encodeIndexBufferBound(cube.idx.size(), cube.p.size()));
-  ibuf.resize(meshopt_encodeIndexBuffer(ibuf.data(), ibuf.size(), cube.idx.data(), cube.idx.size()));
+std::string encodeVertices(const void* data, std::size_t count, std::size_t stride) {
+  std::string out(meshopt_encodeVertexBufferBound(count, stride), '\0');
+  out.resize(meshopt_encodeVertexBuffer(reinterpret_cast<unsigned char*>(out.data()), out.size(), data, count, stride));
+  return out;
+}
+std::string encodeIndexSequence(const std::vector<std::uint32_t>& idx, std::size_t vertexCount) {
+  std::string out(meshopt_encodeIndexSequenceBound(idx.size(), vertexCount), '\0');
+  out.resize(meshopt_encodeIndexSequence(reinterpret_cast<unsigned char*>(out.data()), out.size(), idx.data(), idx.size()));
+  return out;
+}
+std::string encodeTriangles(const std::vector<std::uint32_t>& idx, std::size_t vertexCount) {
+  std::string out(meshopt_encodeIndexBufferBound(idx.size(), vertexCount), '\0');
+  out.resize(meshopt_encodeIndexBuffer(reinterpret_cast<unsigned char*>(out.data()), out.size(), idx.data(), idx.size()));
+  return out;
+}
 
+// The cube's positions (ATTRIBUTES, stride 12) and indices (TRIANGLES, stride 4) as meshopt streams.
+struct MeshoptCube {
+  Cube cube;
   GltfBuilder b;
-  const int vData = b.view(vbuf.data(), vbuf.size()), iData = b.view(ibuf.data(), ibuf.size());
-  auto compressed = [&](int dataView, std::size_t count, int stride, const char* mode, bool attributes) {
-    const json& d = b.doc["bufferViews"][dataView];
-    json v = {{"buffer", 1}, {"byteOffset", 0}, {"byteLength", count * stride},
-              {"extensions", {{"EXT_meshopt_compression", {{"buffer", 0}, {"byteOffset", d["byteOffset"]},
-                                                           {"byteLength", d["byteLength"]}, {"byteStride", stride},
-                                                           {"count", count}, {"mode", mode}}}}}};
-    if (attributes) v["byteStride"] = stride;
-    return b.push("bufferViews", v);
-  };
-  const int pv = compressed(vData, cube.p.size(), 12, "ATTRIBUTES", true);
-  const int iv = compressed(iData, cube.idx.size(), 4, "TRIANGLES", false);
-  const int posAcc = b.push("accessors", {{"bufferView", pv}, {"componentType", 5126}, {"count", cube.p.size()}, {"type", "VEC3"},
-                                          {"min", {-0.5, -0.5, -0.5}}, {"max", {0.5, 0.5, 0.5}}});
-  const int idxAcc = b.push("accessors", {{"bufferView", iv}, {"componentType", 5125}, {"count", cube.idx.size()}, {"type", "SCALAR"}});
-  const int m = b.mesh(json::array({{{"attributes", {{"POSITION", posAcc}}}, {"indices", idxAcc}}}));
-  b.scene({b.node({{"name", "cube"}, {"mesh", m}})});
-  b.doc["extensionsUsed"] = {"EXT_meshopt_compression"};
-  b.doc["extensionsRequired"] = {"EXT_meshopt_compression"};
-  // GLB: buffer 0 is the BIN chunk with the compressed streams, buffer 1 the uri-less fallback.
-  std::string glb;
-  {
-    json d = b.doc;
-    std::string bin = b.bin;
-    while (bin.size() % 4) bin.push_back('\0');
-    d["buffers"] = json::array({{{"byteLength", bin.size()}},
-                                {{"byteLength", 4096}, {"extensions", {{"EXT_meshopt_compression", {{"fallback", true}}}}}}});
-    std::string j = d.dump();
-    while (j.size() % 4) j.push_back(' ');
-    auto le32 = [&](std::uint32_t v) { for (int i = 0; i < 4; ++i) glb.push_back(char((v >> (8 * i)) & 255)); };
-    glb += "glTF";
-    le32(2);
-    le32(std::uint32_t(28 + j.size() + bin.size()));
-    le32(std::uint32_t(j.size()));
-    le32(0x4E4F534Au);
-    glb += j;
-    le32(std::uint32_t(bin.size()));
-    le32(0x004E4942u);
-    glb += bin;
+  int positions = -1, indices = -1;
+  MeshoptCube() {
+    positions = b.meshoptView(encodeVertices(cube.p.data(), cube.p.size(), 12), cube.p.size(), 12, {{"mode", "ATTRIBUTES"}}, true);
+    indices = b.meshoptView(encodeTriangles(cube.idx, cube.p.size()), cube.idx.size(), 4, {{"mode", "TRIANGLES"}});
+    const int posAcc = b.push("accessors", {{"bufferView", positions}, {"componentType", 5126}, {"count", cube.p.size()},
+                                            {"type", "VEC3"}, {"min", {-0.5, -0.5, -0.5}}, {"max", {0.5, 0.5, 0.5}}});
+    const int idxAcc = b.push("accessors", {{"bufferView", indices}, {"componentType", 5125}, {"count", cube.idx.size()}, {"type", "SCALAR"}});
+    const int m = b.mesh(json::array({{{"attributes", {{"POSITION", posAcc}}}, {"indices", idxAcc}}}));
+    b.scene({b.node({{"name", "cube"}, {"mesh", m}})});
   }
+};
+
+TEST(GltfCompression, MeshoptBufferViewsDecodeToTheEncodedBytes) {
+  MeshoptCube c;
+  // GLB: buffer 0 is the BIN chunk with the compressed streams, buffer 1 the uri-less fallback.
+  const std::string glb = c.b.glb();
   const Scene s = loadSceneFromMemory(glb);
   ASSERT_EQ(s.meshes.size(), 1u);
-  EXPECT_EQ(s.meshes[0].positions, cube.p);  // meshopt is lossless: bit-exact
-  EXPECT_EQ(s.meshes[0].indices, cube.idx);
+  EXPECT_EQ(s.meshes[0].positions, c.cube.p);  // meshopt is lossless: bit-exact
+  EXPECT_EQ(s.meshes[0].indices, c.cube.idx);
   EXPECT_FALSE(s.digest.empty());
 
   // A corrupt stream is a SceneError naming the bufferView's extension.
   std::string broken = glb;
-  const std::size_t binStart = broken.size() - ((b.bin.size() + 3) & ~std::size_t(3));
-  for (std::size_t i = 0; i < vbuf.size(); ++i) broken[binStart + i] = char(0xA5);
+  const std::size_t binStart = broken.size() - ((c.b.bin.size() + 3) & ~std::size_t(3));
+  const json& stream = c.b.doc["bufferViews"][c.positions]["extensions"]["EXT_meshopt_compression"];
+  for (std::size_t i = 0; i < stream["byteLength"].get<std::size_t>(); ++i)
+    broken[binStart + stream["byteOffset"].get<std::size_t>() + i] = char(0xA5);
   try {
     loadSceneFromMemory(broken);
     ADD_FAILURE() << "a corrupt meshopt stream loaded";
   } catch (const SceneError& e) {
-    EXPECT_EQ(e.pointer, "/bufferViews/" + std::to_string(pv) + "/extensions/EXT_meshopt_compression");
+    EXPECT_EQ(e.pointer, "/bufferViews/" + std::to_string(c.positions) + "/extensions/EXT_meshopt_compression");
+  }
+}
+
+// The bytes of bufferView `view` of a GLB whose data all lie in its BIN chunk.
+std::string glbViewBytes(const std::string& glb, int view) {
+  auto le32 = [&](std::size_t at) {
+    std::uint32_t v = 0;
+    for (int i = 0; i < 4; ++i) v |= std::uint32_t(std::uint8_t(glb[at + i])) << (8 * i);
+    return std::size_t(v);
+  };
+  const std::size_t jsonLength = le32(12);
+  const json doc = json::parse(glb.substr(20, jsonLength));
+  const json& v = doc["bufferViews"][std::size_t(view)];
+  EXPECT_EQ(v.value("buffer", -1), 0);
+  return glb.substr(20 + jsonLength + 8 + v["byteOffset"].get<std::size_t>(), v["byteLength"].get<std::size_t>());
+}
+
+// Filters whose stride fits decode as the spec's Appendix B says: values encoded with meshoptimizer's
+// own filter encoders come back (octahedral normals and quaternions to their quantisation, exponential
+// values exactly), and each view's count x byteStride is charged against the budget.
+TEST(GltfCompression, MeshoptFiltersWithAFittingStrideDecode) {
+  const std::vector<float> normals = {0.f, 0.f, 1.f, 0.f, 1.f, 0.f, 0.f, 0.f};  // +z and +x, (x, y, z, w) each
+  std::vector<std::int8_t> oct(8);
+  meshopt_encodeFilterOct(oct.data(), 2, 4, 8, normals.data());
+  const std::vector<float> quats = {0.f, 0.f, 0.f, 1.f, 0.f, 0.70710678f, 0.f, 0.70710678f};
+  std::vector<std::int16_t> quat(8);
+  meshopt_encodeFilterQuat(quat.data(), 2, 8, 16, quats.data());
+  const std::vector<float> values = {1.5f, -256.f, 0.f, 3.f};
+  std::vector<std::uint32_t> exp(4);
+  meshopt_encodeFilterExp(exp.data(), 4, 4, 24, values.data());
+  GltfBuilder b;
+  const int octView = b.meshoptView(encodeVertices(oct.data(), 2, 4), 2, 4, {{"mode", "ATTRIBUTES"}, {"filter", "OCTAHEDRAL"}});
+  const int quatView = b.meshoptView(encodeVertices(quat.data(), 2, 8), 2, 8, {{"mode", "ATTRIBUTES"}, {"filter", "QUATERNION"}}, true);
+  const int expView = b.meshoptView(encodeVertices(exp.data(), 4, 4), 4, 4, {{"mode", "ATTRIBUTES"}, {"filter", "EXPONENTIAL"}});
+  DecodeBudget budget(1 << 20);
+  const std::string decoded = gltf::decodeMeshopt(b.glb(), budget);
+  EXPECT_EQ(budget.remaining(), (1u << 20) - 2 * 4 - 2 * 8 - 4 * 4);
+  EXPECT_EQ(decoded.find("EXT_meshopt_compression"), std::string::npos);
+
+  const std::string o = glbViewBytes(decoded, octView);
+  ASSERT_EQ(o.size(), 8u);
+  const std::vector<int> octExpected = {0, 0, 127, 0, 127, 0, 0, 0};  // snorm8 (x, y, z), w kept
+  for (int i = 0; i < 8; ++i) EXPECT_EQ(int(std::int8_t(o[std::size_t(i)])), octExpected[std::size_t(i)]) << i;
+  const std::string q = glbViewBytes(decoded, quatView);
+  ASSERT_EQ(q.size(), 16u);
+  for (int i = 0; i < 8; ++i) {
+    std::int16_t v;
+    std::memcpy(&v, q.data() + 2 * i, 2);
+    EXPECT_NEAR(v / 32767.0, quats[std::size_t(i)], 1e-4) << i;
+  }
+  const std::string e = glbViewBytes(decoded, expView);
+  ASSERT_EQ(e.size(), 16u);
+  std::vector<float> back(4);
+  std::memcpy(back.data(), e.data(), 16);
+  EXPECT_EQ(back, values);
+}
+
+// Every field meshoptimizer's decoders rely on is checked before they run: Debian's meshoptimizer
+// keeps its asserts, so a filter that does not fit its stride used to abort radiantd (issue 30). Each
+// case runs first in a child process (a SIGABRT fails that check instead of the whole suite), then
+// in-process for its JSON pointer.
+struct BadMeshopt {
+  const char* name;
+  const char* mode;
+  json filter;  // null: omitted
+  std::size_t stride;
+  const char* pointer;  // after "/bufferViews/1/extensions/EXT_meshopt_compression"
+};
+
+class MeshoptValidation : public ::testing::TestWithParam<BadMeshopt> {};
+
+std::string badMeshoptGlb(const BadMeshopt& c) {
+  GltfBuilder b;
+  json fields = {{"mode", c.mode}};
+  if (!c.filter.is_null()) fields["filter"] = c.filter;
+  // A valid stream of the mode and stride where meshoptimizer can encode one, so that a filter the old
+  // loader applied before checking the stride did run (and abort).
+  const std::string mode = c.mode;
+  const std::size_t count = 3;
+  std::string stream(32, '\x55');
+  if ((mode == "TRIANGLES" || mode == "INDICES") && (c.stride == 2 || c.stride == 4)) {
+    stream = mode == "TRIANGLES" ? encodeTriangles({0, 1, 2}, 3) : encodeIndexSequence({0, 1, 2}, 3);
+  } else if (c.stride % 4 == 0 && c.stride <= 256) {
+    const std::vector<unsigned char> zeros(count * c.stride, 0);
+    stream = encodeVertices(zeros.data(), count, c.stride);
+  }
+  b.meshoptView(stream, count, c.stride, fields);
+  return b.glb();
+}
+
+TEST_P(MeshoptValidation, IsASceneErrorAtItsPointerBeforeAnyDecode) {
+  const BadMeshopt& c = GetParam();
+  const std::string glb = badMeshoptGlb(c);
+  EXPECT_EXIT(
+      {
+        try {
+          loadSceneFromMemory(glb);
+        } catch (const SceneError&) {
+          std::_Exit(0);
+        }
+        std::_Exit(1);
+      },
+      ::testing::ExitedWithCode(0), "");
+  if (HasFailure()) return;
+  try {
+    loadSceneFromMemory(glb);
+    ADD_FAILURE() << "loaded";
+  } catch (const SceneLimitError& e) {
+    ADD_FAILURE() << "a limit error: " << e.what();
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.pointer, std::string("/bufferViews/1/extensions/EXT_meshopt_compression") + c.pointer) << e.what();
+  }
+}
+
+// The five that aborted radiantd in issue 30's hostile round, then the mode and filter of the wrong
+// type (which gave a raw JSON-library message and no pointer), then the spec's other rules.
+INSTANTIATE_TEST_SUITE_P(
+    GltfCompression, MeshoptValidation,
+    ::testing::Values(BadMeshopt{"QuaternionStride4", "ATTRIBUTES", "QUATERNION", 4, "/byteStride"},
+                      BadMeshopt{"OctahedralStride12", "ATTRIBUTES", "OCTAHEDRAL", 12, "/byteStride"},
+                      BadMeshopt{"OctahedralStride16", "ATTRIBUTES", "OCTAHEDRAL", 16, "/byteStride"},
+                      BadMeshopt{"ExponentialOnTriangles", "TRIANGLES", "EXPONENTIAL", 2, "/filter"},
+                      BadMeshopt{"OctahedralOnTriangles", "TRIANGLES", "OCTAHEDRAL", 2, "/filter"},
+                      BadMeshopt{"QuaternionOnIndices", "INDICES", "QUATERNION", 4, "/filter"},
+                      BadMeshopt{"FilterAnArray", "ATTRIBUTES", json::array(), 4, "/filter"},
+                      BadMeshopt{"FilterANumber", "ATTRIBUTES", 1, 8, "/filter"},
+                      BadMeshopt{"FilterUnknown", "ATTRIBUTES", "SPHERICAL", 8, "/filter"},
+                      BadMeshopt{"ModeUnknown", "VERTICES", nullptr, 4, "/mode"},
+                      BadMeshopt{"AttributesStride6", "ATTRIBUTES", nullptr, 6, "/byteStride"},
+                      BadMeshopt{"AttributesStride260", "ATTRIBUTES", nullptr, 260, "/byteStride"},
+                      BadMeshopt{"TrianglesStride8", "TRIANGLES", nullptr, 8, "/byteStride"},
+                      BadMeshopt{"IndicesStride1", "INDICES", nullptr, 1, "/byteStride"}),
+    [](const auto& info) { return std::string(info.param.name); });
+
+// Fields of the wrong type or that contradict the parent view, each at its own pointer.
+TEST(GltfCompression, MeshoptFieldsOfTheWrongKindAreSceneErrorsAtTheirPointer) {
+  const std::string ext = "/bufferViews/1/extensions/EXT_meshopt_compression";
+  std::string detail;  // the last error's message, for the failure output
+  auto pointerOf = [&detail](const GltfBuilder& b) -> std::string {
+    try {
+      loadSceneFromMemory(b.glb());
+    } catch (const SceneError& e) {
+      detail = e.what();
+      return e.pointer;
+    }
+    return "(loaded)";
+  };
+  const std::vector<unsigned char> zeros(3 * 8, 0);
+  const std::string stream = encodeVertices(zeros.data(), 3, 8);
+  auto build = [&](const json& fields, bool parentStride = false) {
+    GltfBuilder b;
+    b.meshoptView(stream, 3, 8, fields, parentStride);
+    return b;
+  };
+  EXPECT_EQ(pointerOf(build({{"mode", 5}})), ext + "/mode");  // "mode": 5 gave nlohmann's type_error text
+  EXPECT_EQ(pointerOf(build({{"mode", nullptr}})), ext + "/mode");
+  EXPECT_EQ(pointerOf(build({{"mode", "ATTRIBUTES"}, {"count", -3}})), ext + "/count");
+  EXPECT_EQ(pointerOf(build({{"mode", "ATTRIBUTES"}, {"count", 1.5}})), ext + "/count");
+  EXPECT_EQ(pointerOf(build({{"mode", "ATTRIBUTES"}, {"byteStride", "8"}})), ext + "/byteStride");
+  EXPECT_EQ(pointerOf(build({{"mode", "ATTRIBUTES"}, {"byteStride", 0}})), ext + "/byteStride");
+  EXPECT_EQ(pointerOf(build({{"mode", "ATTRIBUTES"}, {"byteLength", -1}})), ext + "/byteLength");
+  EXPECT_EQ(pointerOf(build({{"mode", "TRIANGLES"}, {"byteStride", 4}, {"count", 4}})), ext + "/count");  // not a multiple of 3
+  // The parent view must hold count x byteStride bytes and, when it has a stride, the same one.
+  GltfBuilder longer = build({{"mode", "ATTRIBUTES"}});
+  longer.doc["bufferViews"][1]["byteLength"] = 3 * 8 - 4;
+  EXPECT_EQ(pointerOf(longer), "/bufferViews/1/byteLength") << detail;
+  GltfBuilder strided = build({{"mode", "ATTRIBUTES"}}, true);
+  strided.doc["bufferViews"][1]["byteStride"] = 12;
+  EXPECT_EQ(pointerOf(strided), "/bufferViews/1/byteStride");
+  // A count far beyond the parent view (2^32 x 8 bytes) is refused before anything is allocated
+  // (integers above 2^32 are refused by checkGltfDocument already).
+  GltfBuilder huge = build({{"mode", "ATTRIBUTES"}, {"count", std::uint64_t(1) << 32}});
+  EXPECT_EQ(pointerOf(huge), "/bufferViews/1/byteLength") << detail;
+  // And the valid stream under the same builder loads.
+  EXPECT_EQ(pointerOf(build({{"mode", "ATTRIBUTES"}})), "(loaded)");
+}
+
+// Meshopt decoding is charged against --max-decode-bytes (it was not: 3 uploads of 4 MB decoding
+// 256 MiB each took radiantd to 1.8 GB), summed over views and refused before the first decode.
+TEST(GltfCompression, MeshoptDecodedSizeIsChargedAgainstTheDecodeBudgetBeforeDecoding) {
+  LoadOptions options;
+  options.maxDecodedBytes = std::size_t(1) << 20;
+  // One view of 2 MiB decoded (count x byteStride = 8192 x 256) from 64 bytes that are no stream at
+  // all: refused as over the limit, not as corrupt, so nothing was decoded.
+  {
+    GltfBuilder b;
+    b.meshoptView(std::string(64, '\x55'), 8192, 256, {{"mode", "ATTRIBUTES"}});
+    try {
+      loadSceneFromMemory(b.glb(), options);
+      ADD_FAILURE() << "loaded";
+    } catch (const SceneLimitError& e) {
+      EXPECT_EQ(e.flag, "--max-decode-bytes");
+      EXPECT_EQ(e.pointer, "/bufferViews/1/extensions/EXT_meshopt_compression/count");
+      EXPECT_NE(std::string(e.what()).find("2097152 bytes"), std::string::npos) << e.what();
+    } catch (const SceneError& e) {
+      ADD_FAILURE() << "not a limit error: " << e.pointer << ": " << e.what();
+    }
+  }
+  // Two views of 600 KiB each fit one by one, not together: the second is refused.
+  {
+    GltfBuilder b;
+    const std::vector<unsigned char> zeros(600 * 1024, 0);
+    b.meshoptView(encodeVertices(zeros.data(), zeros.size() / 4, 4), zeros.size() / 4, 4, {{"mode", "ATTRIBUTES"}});
+    b.meshoptView(std::string(64, '\x55'), zeros.size() / 4, 4, {{"mode", "ATTRIBUTES"}});
+    try {
+      loadSceneFromMemory(b.glb(), options);
+      ADD_FAILURE() << "loaded";
+    } catch (const SceneLimitError& e) {
+      EXPECT_EQ(e.pointer, "/bufferViews/3/extensions/EXT_meshopt_compression/count");
+      EXPECT_NE(std::string(e.what()).find("614400 bytes"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(std::to_string((1u << 20) - 614400) + " of"), std::string::npos) << e.what();
+    }
+  }
+  // Within the budget the cube loads exactly, and exactly its views' decoded bytes were charged.
+  {
+    MeshoptCube c;
+    const std::size_t views = 24 * 12 + 36 * 4;  // count x byteStride of positions and indices
+    DecodeBudget exact(views);
+    EXPECT_NO_THROW(gltf::decodeMeshopt(c.b.glb(), exact));
+    EXPECT_EQ(exact.remaining(), 0u);
+    DecodeBudget short_(views - 1);
+    EXPECT_THROW(gltf::decodeMeshopt(c.b.glb(), short_), SceneLimitError);
+    EXPECT_EQ(loadSceneFromMemory(c.b.glb(), options).meshes[0].positions, c.cube.p);
   }
 }
 

@@ -149,11 +149,33 @@ public:
     d["buffers"] = json::array({{{"byteLength", bin.size()}, {"uri", uri}}});
     return d.dump();
   }
+  // EXT_meshopt_compression: `stream` (count x stride bytes compressed) goes into buffer 0 and a
+  // bufferView on the uri-less fallback buffer 1 (which glb() then writes) points at it. `fields`
+  // ("mode", "filter", or overrides of "byteStride", "count") are merged into the extension object;
+  // the parent view gets byteStride too when `parentStride`.
+  int meshoptView(const std::string& stream, std::size_t count, std::size_t stride, const json& fields,
+                  bool parentStride = false) {
+    const json& data = doc["bufferViews"][std::size_t(view(stream.data(), stream.size()))];
+    json ext = {{"buffer", 0}, {"byteOffset", data["byteOffset"]}, {"byteLength", stream.size()},
+                {"byteStride", stride}, {"count", count}};
+    ext.update(fields);
+    json v = {{"buffer", 1}, {"byteOffset", fallbackBytes}, {"byteLength", count * stride},
+              {"extensions", {{"EXT_meshopt_compression", ext}}}};
+    if (parentStride) v["byteStride"] = stride;
+    fallbackBytes += (count * stride + 3) & ~std::size_t(3);
+    doc["extensionsUsed"] = {"EXT_meshopt_compression"};
+    doc["extensionsRequired"] = {"EXT_meshopt_compression"};
+    return push("bufferViews", v);
+  }
+  std::size_t fallbackBytes = 0;  // the size of meshoptView()'s fallback buffer 1
+
   std::string glb() const {
     json d = doc;
     std::string b = bin;
     while (b.size() % 4) b.push_back('\0');
     if (!b.empty()) d["buffers"] = json::array({{{"byteLength", bin.size()}}});
+    if (fallbackBytes)
+      d["buffers"].push_back({{"byteLength", fallbackBytes}, {"extensions", {{"EXT_meshopt_compression", {{"fallback", true}}}}}});
     std::string j = d.dump();
     while (j.size() % 4) j.push_back(' ');
     std::string out;

@@ -1,0 +1,63 @@
+// Image encoding without GL: a half-float EXR holds only |v| <= 65504, and OpenImageIO writes a float
+// beyond that as Inf. radiantd's default EXR is half float and radiance within the API's ranges exceeds
+// it (ambient 1e6, a 1e15 light: issue 30), so encodeExr writes the largest finite half and counts.
+#include <cfloat>
+#include <cmath>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "renderer/io/ImageIO.h"
+
+namespace radiant {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+Image row(const std::string& aov, int channels, const std::vector<float>& values) {
+  Image img = Image::make(aov, int(values.size()) / channels, 1, channels);
+  img.pixels = values;
+  return img;
+}
+
+TEST(ImageIO, HalfExrWritesValuesBeyondItsRangeAsTheLargestFiniteHalfAndCountsThem) {
+  // 12 beauty values: 6 beyond +-65504 (1e6, -1e6, FLT_MAX, 65505, -70000, +Inf), the rest kept.
+  const Image beauty = row("beauty", 3, {1e6f, -1e6f, FLT_MAX, 1.5f, 65504.f, -65504.f, 65505.f, -70000.f, kInf, 0.f, 1e-3f, 2.f});
+  const Image ao = row("ao", 1, {FLT_MAX, 3.f, -FLT_MAX, 0.25f});
+  EXPECT_EQ(io::valuesBeyondHalf(beauty), 6u);
+  EXPECT_EQ(io::valuesBeyondHalf(ao), 2u);
+  std::vector<std::size_t> clamped;
+  const std::string exr = io::encodeExr({beauty, ao}, true, &clamped);
+  EXPECT_EQ(clamped, (std::vector<std::size_t>{6, 2}));
+
+  const Image b = io::decodeImage(exr, "beauty");
+  ASSERT_EQ(b.pixels.size(), 12u);
+  const std::vector<float> want = {65504.f, -65504.f, 65504.f, 1.5f, 65504.f, -65504.f,
+                                   65504.f, -65504.f, 65504.f, 0.f, 0.f, 2.f};
+  for (std::size_t i = 0; i < want.size(); ++i) {
+    EXPECT_TRUE(std::isfinite(b.pixels[i])) << i << ": " << b.pixels[i];
+    if (i == 10) EXPECT_NEAR(b.pixels[i], 1e-3f, 1e-6f);  // a half's precision at 1e-3
+    else EXPECT_EQ(b.pixels[i], want[i]) << i;
+  }
+  const Image d = io::decodeImage(exr, "ao");
+  EXPECT_EQ(d.pixels, (std::vector<float>{65504.f, 3.f, -65504.f, 0.25f}));
+}
+
+TEST(ImageIO, FloatExrKeepsEveryValueAndClampsNothing) {
+  const Image beauty = row("beauty", 3, {1e6f, -1e6f, FLT_MAX, 1.5f, 65505.f, 1e15f});
+  std::vector<std::size_t> clamped = {99};
+  const std::string exr = io::encodeExr({beauty}, false, &clamped);
+  EXPECT_EQ(clamped, (std::vector<std::size_t>{0}));
+  EXPECT_EQ(io::decodeImage(exr, "beauty").pixels, beauty.pixels);
+}
+
+TEST(ImageIO, HalfExrWithinRangeIsUnchangedAndCountsNothing) {
+  const Image beauty = row("beauty", 3, {0.f, 0.5f, 1.f, 65504.f, -2.f, 1024.f});
+  std::vector<std::size_t> clamped;
+  const std::string exr = io::encodeExr({beauty}, true, &clamped);
+  EXPECT_EQ(clamped, (std::vector<std::size_t>{0}));
+  EXPECT_EQ(io::decodeImage(exr, "beauty").pixels, beauty.pixels);  // each exactly representable
+}
+
+}  // namespace
+}  // namespace radiant
