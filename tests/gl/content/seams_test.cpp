@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <iostream>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,7 @@
 
 #include "renderer/Renderer.h"
 #include "renderer/io/ImageIO.h"
+#include "renderer/raytracing/RayScene.h"
 #include "renderer/scene/GltfLoader.h"
 #include "tests/support/RenderTestSupport.h"
 #include "tests/unit/scene/GltfTestBuilder.h"
@@ -167,7 +169,8 @@ TEST(TextureSeams, AlbedoOnBothSidesOfEverySharedEdgeIsItsTexelsColour) {
   b.doc["images"] = json::array({{{"uri", "data:image/png;base64," + test::base64(test::encodePng(kAtlas, kAtlas, atlasTexels()))}}});
   const Scene scene = loadSceneFromMemory(b.gltf());
   ASSERT_TRUE(scene.warnings.empty()) << scene.warnings[0];
-  const Image& albedo = aov(renderGridCard(scene, "albedo"), "albedo");
+  const RenderOutput out = renderGridCard(scene, "albedo");
+  const Image& albedo = aov(out, "albedo");
 
   // Every pixel against the colour of the triangle under its centre, in 8-bit sRGB units; pixels within
   // 1.5 pixels of a shared edge are the edge pixels (both sides of it).
@@ -227,7 +230,8 @@ TEST(TextureSeams, MinifiedTextureTakesTheSameMipLevelNextToEdgesAsInside) {
   b.doc["images"] = json::array({{{"uri", "data:image/png;base64," + test::base64(test::encodePng(kChecker, kChecker, texels))}}});
   const Scene scene = loadSceneFromMemory(b.gltf());
   ASSERT_TRUE(scene.warnings.empty()) << scene.warnings[0];
-  const Image& albedo = aov(renderGridCard(scene, "albedo"), "albedo");
+  const RenderOutput out = renderGridCard(scene, "albedo");
+  const Image& albedo = aov(out, "albedo");
   float edgeError = 0.f, interiorError = 0.f;
   for (int y = 0; y < kSize; ++y)
     for (int x = 0; x < kSize; ++x) {
@@ -242,6 +246,207 @@ TEST(TextureSeams, MinifiedTextureTakesTheSameMipLevelNextToEdgesAsInside) {
   // Levels 1-2 of the checker are 0.5 up to the 8-bit rounding of the mip chain.
   EXPECT_LE(edgeError, 2.f);
   EXPECT_LE(interiorError, 2.f);
+}
+
+// ---- 2. normal maps: the normal AOV against the reference's shading normal ---------------------------
+
+// The reference path tracer's shading normal (RayScene::shade: the interpolated, normal-mapped normal)
+// at the surface under each pixel centre, seen from the fill camera.
+std::vector<glm::vec3> referenceShadingNormals(const Scene& scene) {
+  const rt::RayScene rays(scene);
+  std::vector<glm::vec3> out(std::size_t(kSize) * kSize, glm::vec3(0.f));
+  const glm::vec3 eye(0.f, 0.f, 2.f);
+  for (int y = 0; y < kSize; ++y)
+    for (int x = 0; x < kSize; ++x) {
+      rt::Ray ray;
+      ray.org = eye;
+      ray.dir = glm::normalize(glm::vec3(pixelCentreWorld(x, y), 0.f) - eye);
+      rt::SurfaceHit hit;
+      rt::Sampler sampler(std::uint64_t(y * kSize + x), 0, 1);
+      rt::RayCounter counter;
+      if (rays.intersect(ray, hit, sampler, counter)) out[std::size_t(y * kSize + x)] = rays.shade(hit, -ray.dir).frame.n;
+    }
+  return out;
+}
+
+// glTF's tangent-space normal of an 8-bit texel (2 texel / 255 - 1) in the frame (t, b, n), as
+// material.glsl's mapTangentNormal maps it.
+glm::vec3 mappedNormal(const std::array<std::uint8_t, 3>& texel, glm::vec3 t, glm::vec3 b, glm::vec3 n) {
+  const glm::vec3 tn = glm::vec3(texel[0], texel[1], texel[2]) * (2.f / 255.f) - 1.f;
+  return glm::normalize(tn.x * t + tn.y * b + tn.z * n);
+}
+
+float angleDegrees(glm::vec3 a, glm::vec3 b) {
+  const float la = glm::length(a), lb = glm::length(b);
+  if (!(la > 0.f) || !(lb > 0.f)) return 180.f;
+  return glm::degrees(std::acos(std::clamp(glm::dot(a / la, b / lb), -1.f, 1.f)));
+}
+
+// How far the raster's normal AOV and the reference's shading normal are from each other and from the
+// closed form, pixel by pixel (the closed form of either triangle for a centre on an edge), split into
+// pixels within 1.5 pixels of a shared edge (both sides of it) and the rest.
+struct NormalErrors {
+  float rasterReferenceEdge = 0.f, rasterReferenceInterior = 0.f;
+  float rasterExactEdge = 0.f, rasterExactInterior = 0.f, referenceExact = 0.f;
+  int edgePixels = 0;
+};
+
+template <class Expected>
+NormalErrors normalErrors(const GridCard& card, const Image& normal, const std::vector<glm::vec3>& reference,
+                          Expected&& expected) {
+  NormalErrors e;
+  for (int y = 0; y < kSize; ++y)
+    for (int x = 0; x < kSize; ++x) {
+      const glm::vec2 c = pixelCentreWorld(x, y);
+      const glm::vec3 raster(normal.at(x, y)[0], normal.at(x, y)[1], normal.at(x, y)[2]);
+      EXPECT_TRUE(std::isfinite(raster.x) && std::isfinite(raster.y) && std::isfinite(raster.z));
+      const glm::vec3 ref = reference[std::size_t(y * kSize + x)];
+      float toRaster = 180.f, toReference = 180.f;
+      const std::vector<int> under = trianglesAt(card, c);
+      for (int t : under) {
+        toRaster = std::min(toRaster, angleDegrees(raster, expected(t, c)));
+        toReference = std::min(toReference, angleDegrees(ref, expected(t, c)));
+      }
+      // A centre on an edge belongs to either triangle (the rasteriser's tie rule and the ray's may pick
+      // different ones): there both are held to the closed form only.
+      const float between = under.size() == 1 ? angleDegrees(raster, ref) : 0.f;
+          const bool edge = sharedEdgeDistance(card, c) <= 1.5f;
+      e.edgePixels += edge;
+      (edge ? e.rasterReferenceEdge : e.rasterReferenceInterior) =
+          std::max(edge ? e.rasterReferenceEdge : e.rasterReferenceInterior, between);
+      (edge ? e.rasterExactEdge : e.rasterExactInterior) = std::max(edge ? e.rasterExactEdge : e.rasterExactInterior, toRaster);
+      e.referenceExact = std::max(e.referenceExact, toReference);
+    }
+  return e;
+}
+
+void printNormalErrors(const char* what, const NormalErrors& e) {
+  std::cout << what << ": raster normal against the reference's shading normal, largest angle " << e.rasterReferenceEdge
+            << " degrees next to a shared edge (" << e.edgePixels << " pixels), " << e.rasterReferenceInterior
+            << " inside; against the closed form " << e.rasterExactEdge << " / " << e.rasterExactInterior
+            << " (raster), " << e.referenceExact << " (reference)\n";
+}
+
+// A 16 x 16 normal-map atlas of 4 x 4 regions, each one tilt: 16 directions around the normal, tilted
+// by 20-35 degrees.
+std::array<std::uint8_t, 3> regionTilt(int region) {
+  const float phi = 2.f * std::numbers::pi_v<float> * float(region) / 16.f;
+  const float s = 0.35f + 0.1f * float(region % 3);
+  const glm::vec3 tn(s * std::cos(phi), s * std::sin(phi), std::sqrt(1.f - s * s));
+  std::array<std::uint8_t, 3> texel{};
+  for (int c = 0; c < 3; ++c) texel[std::size_t(c)] = std::uint8_t(std::lround((tn[c] + 1.f) * 0.5f * 255.f));
+  return texel;
+}
+
+std::string normalAtlasPng() {
+  std::vector<std::uint8_t> t(kAtlas * kAtlas * 4);
+  for (int y = 0; y < kAtlas; ++y)
+    for (int x = 0; x < kAtlas; ++x) {
+      const auto c = regionTilt((y / kRegion) * (kAtlas / kRegion) + x / kRegion);
+      std::uint8_t* p = &t[std::size_t(y * kAtlas + x) * 4];
+      p[0] = c[0], p[1] = c[1], p[2] = c[2], p[3] = 255;
+    }
+  return "data:image/png;base64," + test::base64(test::encodePng(kAtlas, kAtlas, t));
+}
+
+// The atlas card with a normal map instead of a base colour: each triangle reads its own region's tilt,
+// and every other triangle mirrors its uvs in u (its tangent is -x, its handedness -1), so the frames of
+// neighbours differ as well as their texels. No TANGENT in the file: the loader's MikkTSpace frames. The
+// closed form: tangent +-x (the way u runs), bitangent +y (the way v falls: up the image), normal +z.
+// Before the explicit texture derivatives (docs/GBUFFER.md) the raster's edge pixels read a coarse mip of
+// the normal map: 33.5 degrees off the reference next to the edges (0.02 inside); now 0.02 everywhere.
+TEST(NormalMapSeams, NormalAovMatchesTheReferencesShadingNormalOnBothSidesOfEveryEdge) {
+  test::GltfBuilder b;
+  const int m = b.material({{"normalTexture", {{"index", 0}}}, {"pbrMetallicRoughness", {{"metallicFactor", 0.0}}}});
+  auto mirrored = [](int t) { return t % 2 == 1; };
+  const GridCard card = gridCard(b, m, [&](int t, glm::vec2, glm::vec2 place) {
+    if (mirrored(t)) place.x = 1.f - place.x;
+    return atlasUv(t, {}, place);
+  });
+  b.doc["samplers"] = json::array({{{"magFilter", 9729}, {"minFilter", 9987}}});
+  b.doc["textures"] = json::array({{{"source", 0}, {"sampler", 0}}});
+  b.doc["images"] = json::array({{{"uri", normalAtlasPng()}}});
+  const Scene scene = loadSceneFromMemory(b.gltf());
+  ASSERT_TRUE(scene.warnings.empty()) << scene.warnings[0];
+  ASSERT_FALSE(scene.meshes[0].tangents.empty());
+
+  const RenderOutput out = renderGridCard(scene, "normal");
+  const Image& normal = aov(out, "normal");
+  const NormalErrors e = normalErrors(card, normal, referenceShadingNormals(scene), [&](int t, glm::vec2) {
+    return mappedNormal(regionTilt(atlasRegion(t)), glm::vec3(mirrored(t) ? -1.f : 1.f, 0.f, 0.f), {0, 1, 0}, {0, 0, 1});
+  });
+  printNormalErrors("normal-map atlas card", e);
+  // Bounds: the normal AOV is stored in half floats (11-bit mantissa: 0.03 degrees), the texels are the
+  // same bytes in both languages; 0.25 degrees leaves room for the texture unit's filtering arithmetic.
+  // A neighbouring region's tilt is 15 degrees or more away.
+  EXPECT_GT(e.edgePixels, kSize * kSize / 2);
+  EXPECT_LT(e.rasterReferenceEdge, 0.25f);
+  EXPECT_LT(e.rasterReferenceInterior, 0.25f);
+  EXPECT_LT(e.rasterExactEdge, 0.25f);
+  EXPECT_LT(e.rasterExactInterior, 0.25f);
+  EXPECT_LT(e.referenceExact, 0.25f);
+}
+
+// Mirrored uvs on shared vertices (the modelling trick of symmetric models): one 1x1 normal map, u = |x| / 2
+// on a 4 x 4 grid whose vertices on x = 0 are shared by both halves, no TANGENT. MikkTSpace gives each half
+// its own frame (the loader splits the seam's vertices); the normal AOV and the reference must show the
+// texel's tilt mapped with tangent +x on the right, -x on the left, on both sides of the seam and of every
+// other edge. Lengyel's per-vertex tangents cancelled on the seam (+x + -x) and bent the frames of the
+// triangles next to it, in the raster and in the reference alike: 50.4 degrees off the closed form in
+// both (the 1x1 map has no mip to get wrong); now 0.
+TEST(NormalMapSeams, MirroredUvsOnSharedVerticesMapTheNormalInEachHalfsOwnFrame) {
+  const std::array<std::uint8_t, 3> texel{200, 90, 230};
+  test::GltfBuilder b;
+  const int m = b.material({{"normalTexture", {{"index", 0}}}, {"pbrMetallicRoughness", {{"metallicFactor", 0.0}}}});
+  constexpr int kCells = 4;
+  std::vector<glm::vec3> p, n;
+  std::vector<glm::vec2> uv;
+  std::vector<std::uint16_t> idx;
+  GridCard card;
+  for (int j = 0; j <= kCells; ++j)
+    for (int i = 0; i <= kCells; ++i) {
+      const glm::vec2 w(-1.f + 2.f * i / kCells, -1.f + 2.f * j / kCells);
+      p.emplace_back(w, 0.f);
+      n.emplace_back(0.f, 0.f, 1.f);
+      uv.emplace_back(0.5f * std::abs(w.x), 0.5f * (1.f - w.y));
+    }
+  auto at = [](int i, int j) { return static_cast<std::uint16_t>(j * (kCells + 1) + i); };
+  for (int j = 0; j < kCells; ++j)
+    for (int i = 0; i < kCells; ++i) {
+      const std::array<std::uint16_t, 4> q{at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)};
+      const bool flip = (i + j) % 2 == 1;
+      const std::array<std::array<int, 3>, 2> tris = flip ? std::array<std::array<int, 3>, 2>{{{0, 1, 3}, {1, 2, 3}}}
+                                                          : std::array<std::array<int, 3>, 2>{{{0, 1, 2}, {0, 2, 3}}};
+      for (const auto& tri : tris) {
+        std::array<glm::vec2, 3> world{};
+        for (int k = 0; k < 3; ++k) {
+          idx.push_back(q[std::size_t(tri[std::size_t(k)])]);
+          world[std::size_t(k)] = glm::vec2(p[idx.back()]);
+        }
+        card.triangles.push_back(world);
+      }
+    }
+  const int mesh = b.mesh(json::array({test::trianglePrimitive<std::uint16_t>(b, p, idx, n, uv, m)}));
+  b.scene({b.node({{"name", "mirrored card"}, {"mesh", mesh}})});
+  b.doc["textures"] = json::array({{{"source", 0}}});
+  b.doc["images"] = json::array(
+      {{{"uri", "data:image/png;base64," + test::base64(test::encodePng(1, 1, {texel[0], texel[1], texel[2], 255}))}}});
+  const Scene scene = loadSceneFromMemory(b.gltf());
+  ASSERT_TRUE(scene.warnings.empty()) << scene.warnings[0];
+
+  const RenderOutput out = renderGridCard(scene, "normal");
+  const Image& normal = aov(out, "normal");
+  const NormalErrors e = normalErrors(card, normal, referenceShadingNormals(scene), [&](int t, glm::vec2) {
+    const auto& w = card.triangles[std::size_t(t)];
+    const bool right = w[0].x + w[1].x + w[2].x > 0.f;
+    return mappedNormal(texel, glm::vec3(right ? 1.f : -1.f, 0.f, 0.f), {0, 1, 0}, {0, 0, 1});
+  });
+  printNormalErrors("mirrored-uv card", e);
+  EXPECT_LT(e.rasterReferenceEdge, 0.25f);
+  EXPECT_LT(e.rasterReferenceInterior, 0.25f);
+  EXPECT_LT(e.rasterExactEdge, 0.25f);
+  EXPECT_LT(e.rasterExactInterior, 0.25f);
+  EXPECT_LT(e.referenceExact, 0.25f);
 }
 
 }  // namespace
