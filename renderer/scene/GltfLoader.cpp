@@ -24,6 +24,7 @@
 #include "renderer/scene/GltfExtensions.h"
 #include "renderer/scene/GltfPackage.h"
 #include "renderer/scene/GltfLimits.h"
+#include "renderer/scene/MikkTSpace.h"
 
 namespace radiant {
 namespace {
@@ -455,36 +456,22 @@ std::vector<glm::vec3> areaWeightedNormals(const std::vector<glm::vec3>& p,
   return n;
 }
 
-// Per-vertex tangents from the per-triangle UV derivatives (Lengyel, "Computing Tangent Space
-// Basis Vectors for an Arbitrary Mesh", 2001), made orthogonal to the normal by Gram-Schmidt.
-// glTF's v axis runs down the image while a normal map's green channel points up it, so the
-// bitangent that the file convention B = cross(N, T) * w must reproduce is -dP/dv; w is the sign
-// that makes it so (the same result MikkTSpace gives on the exporter's flipped v).
-std::vector<glm::vec4> generateTangents(const std::vector<glm::vec3>& p, const std::vector<glm::vec3>& n,
-                                        const std::vector<glm::vec2>& uv,
-                                        const std::vector<std::uint32_t>& idx) {
-  std::vector<glm::vec3> dpdu(p.size(), glm::vec3(0.f)), dpdv(p.size(), glm::vec3(0.f));
-  if (uv.size() == p.size()) {
-    for (std::size_t t = 0; t + 2 < idx.size(); t += 3) {
-      const auto a = idx[t], b = idx[t + 1], c = idx[t + 2];
-      const glm::vec3 e1 = p[b] - p[a], e2 = p[c] - p[a];
-      const glm::vec2 d1 = uv[b] - uv[a], d2 = uv[c] - uv[a];
-      const float det = d1.x * d2.y - d2.x * d1.y;
-      if (std::abs(det) < 1e-20f) continue;
-      const glm::vec3 su = (e1 * d2.y - e2 * d1.y) / det;  // dP/du
-      const glm::vec3 sv = (e2 * d1.x - e1 * d2.x) / det;  // dP/dv
-      for (auto v : {a, b, c}) { dpdu[v] += su; dpdv[v] += sv; }
+// Unit vertex normals for MikkTSpace, in the file's space: the file's own where usable, else the
+// area-weighted ones (which is also what the loader gives a file without normals, after the transform).
+std::vector<glm::vec3> unitNormals(const std::vector<glm::vec3>& nrm, const std::vector<glm::vec3>& p,
+                                   const std::vector<std::uint32_t>& idx) {
+  std::vector<glm::vec3> n = nrm, fallback;
+  if (n.size() != p.size()) n.assign(p.size(), glm::vec3(0.f));
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    const float len = glm::length(n[i]);
+    if (len > 0.f && std::isfinite(len)) {
+      n[i] /= len;
+    } else {
+      if (fallback.empty()) fallback = areaWeightedNormals(p, idx);
+      n[i] = fallback[i];
     }
   }
-  std::vector<glm::vec4> out(p.size());
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    glm::vec3 t = dpdu[i] - n[i] * glm::dot(n[i], dpdu[i]);
-    const float len = glm::length(t);
-    t = len > 1e-20f && std::isfinite(len) ? t / len : anyPerpendicular(n[i]);
-    const float w = glm::dot(glm::cross(n[i], t), -dpdv[i]) < 0.f ? -1.f : 1.f;
-    out[i] = glm::vec4(t, w);
-  }
-  return out;
+  return n;
 }
 
 glm::mat4 localMatrix(const tinygltf::Node& node) {
@@ -1059,6 +1046,26 @@ private:
       idx = std::move(list);
     }
 
+    // glTF 3.7.2.1: a normal-mapped primitive without TANGENT gets MikkTSpace tangents, computed in the
+    // file's space as an exporter computes them (then transformed below like the file's own). Without
+    // the uv set the normal map reads, any frame perpendicular to the normal will do (below).
+    // One frame per vertex serves both normal maps: the base's uv set when it has one, else the coat's.
+    const TextureRef& normalMap = mat.normalTexture.valid() ? mat.normalTexture : mat.clearcoatNormalTexture;
+    if (mat.hasNormalMap() && tan.empty() && !uv[normalMap.texCoord].empty()) {
+      nrm = unitNormals(nrm, pos, idx);  // what MikkTSpace sees, kept: split vertices keep their normal
+      const TangentSplit split =
+          splitVerticesByTangent(gltfMikkTSpaceCornerTangents(pos, nrm, uv[normalMap.texCoord], idx), idx);
+      auto copyOf = [&](auto& attribute) {
+        if (attribute.empty()) return;
+        auto old = std::move(attribute);
+        attribute.resize(split.vertexOf.size());
+        for (std::size_t v = 0; v < split.vertexOf.size(); ++v) attribute[v] = old[split.vertexOf[v]];
+      };
+      copyOf(pos), copyOf(nrm), copyOf(uv[0]), copyOf(uv[1]);
+      idx = split.indices;
+      tan = split.tangents;
+    }
+
     // A mirroring transform turns counter-clockwise into clockwise (glTF spec 3.7.4): swap two
     // corners so that every instance is counter-clockwise front facing in world space.
     const glm::mat3 linear(world);
@@ -1071,7 +1078,7 @@ private:
     const glm::mat3 normalMatrix = glm::inverseTranspose(linear);
     if (!nrm.empty()) {
       std::vector<glm::vec3> fallback;
-      for (std::size_t i = 0; i < n; ++i) {
+      for (std::size_t i = 0; i < nrm.size(); ++i) {
         const glm::vec3 v = normalMatrix * nrm[i];
         const float len = glm::length(v);
         if (len > 0.f && std::isfinite(len)) {
@@ -1087,7 +1094,7 @@ private:
     if (mat.hasNormalMap()) {
       if (!tan.empty()) {
         const float handedness = det < 0.f ? -1.f : 1.f;
-        for (std::size_t i = 0; i < n; ++i) {
+        for (std::size_t i = 0; i < tan.size(); ++i) {
           glm::vec3 t = linear * glm::vec3(tan[i]);
           t -= nrm[i] * glm::dot(nrm[i], t);
           const float len = glm::length(t);
@@ -1095,10 +1102,8 @@ private:
           tan[i] = glm::vec4(t, (tan[i].w < 0.f ? -1.f : 1.f) * handedness);
         }
       } else {
-        // Without the UV set the normal map uses, any frame perpendicular to the normal will do.
-        // One frame per vertex serves both normal maps: the base's uv set when it has one, else the coat's.
-        const TextureRef& map = mat.normalTexture.valid() ? mat.normalTexture : mat.clearcoatNormalTexture;
-        tan = generateTangents(pos, nrm, uv[map.texCoord], idx);
+        tan.resize(nrm.size());
+        for (std::size_t i = 0; i < nrm.size(); ++i) tan[i] = glm::vec4(anyPerpendicular(nrm[i]), 1.f);
       }
     }
     for (const auto& p : pos) mi.bounds.extend(p);

@@ -52,9 +52,10 @@ void invalid() {
 }
 
 void main() {
+  SurfaceUv uv = SURFACE_UV_FRAGMENT(v_uv0, v_uv1);  // before any discard (common/material.glsl)
   Material m = materials[u_material];
-  if (materialMasked(m, decodeBaseColor(m, v_uv0, v_uv1).a)) discard;
-  MaterialParams p = decodeMaterial(m, v_uv0, v_uv1);
+  if (materialMasked(m, decodeBaseColor(m, uv).a)) discard;
+  MaterialParams p = decodeMaterial(m, uv);
   Light light = lights[u_light];
 
   // This pixel's share of the light's power.

@@ -24,10 +24,11 @@ layout(location = 0) out vec4 o_radiance;  // rgb radiance toward o
 layout(location = 1) out vec4 o_geometry;  // x distance to o, yzw shading normal (facing o)
 
 void main() {
+  SurfaceUv uv = SURFACE_UV_FRAGMENT(v_uv0, v_uv1);  // before any discard (common/material.glsl)
   Material m = materials[u_material];
-  if (materialMasked(m, decodeBaseColor(m, v_uv0, v_uv1).a)) discard;
+  if (materialMasked(m, decodeBaseColor(m, uv).a)) discard;
   if (!gl_FrontFacing && !materialDoubleSided(m)) discard;  // glTF single-sided, as in the G-buffer
-  MaterialParams p = decodeMaterial(m, v_uv0, v_uv1);
+  MaterialParams p = decodeMaterial(m, uv);
 
   vec3 toO = u_origin - v_position;
   float dist = length(toO);
@@ -35,7 +36,7 @@ void main() {
   vec3 faceNormal = materialSafeNormalize(cross(dFdx(v_position), dFdy(v_position)), wo);
   if (dot(faceNormal, wo) < 0.0) faceNormal = -faceNormal;
   vec3 n = windingSideNormal(materialSafeNormalize(v_normal, faceNormal), faceNormal, gl_FrontFacing);
-  n = decodeShadingNormal(m, n, v_tangent, v_uv0, v_uv1, gl_FrontFacing);
+  n = decodeShadingNormal(m, n, v_tangent, uv, gl_FrontFacing);
   float nv = dot(n, wo);
   if (nv < 1e-3) n = normalize(n + wo * (1e-3 - nv));
 

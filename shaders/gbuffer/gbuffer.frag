@@ -21,22 +21,23 @@ layout(location = 6) out uvec4 o_layers;   // encodeLayers (common/material.glsl
 layout(location = 7) out vec4 o_specular;  // rgb specular colour, a specular weight (KHR_materials_specular)
 
 void main() {
+  SurfaceUv uv = SURFACE_UV_FRAGMENT(v_uv0, v_uv1);  // before any discard (common/material.glsl)
   Material m = materials[u_material];
-  if (materialMasked(m, decodeBaseColor(m, v_uv0, v_uv1).a)) discard;
+  if (materialMasked(m, decodeBaseColor(m, uv).a)) discard;
   // alphaMode BLEND: composited over the lit opaque frame by the transparency pass; the passes that
   // read the G-buffer light what lies behind it.
   if (materialAlphaMode(m) == 2) discard;
   // glTF: back faces of single-sided materials are not rendered.
   if (!gl_FrontFacing && !materialDoubleSided(m)) discard;
-  MaterialParams p = decodeMaterial(m, v_uv0, v_uv1);
+  MaterialParams p = decodeMaterial(m, uv);
 
   vec3 faceNormal = materialSafeNormalize(cross(dFdx(v_position), dFdy(v_position)), vec3(0, 1, 0));
   // Geometric normal on the side the viewer sees: used for shadow normal-offset bias.
   vec3 geo = dot(faceNormal, u_eye - v_position) < 0.0 ? -faceNormal : faceNormal;
   vec3 n = windingSideNormal(materialSafeNormalize(v_normal, faceNormal), geo, gl_FrontFacing);
   // KHR_materials_clearcoat: its own normal map (clearcoatNormalTexture) or none, never the base's.
-  vec3 coatNormal = decodeCoatNormal(m, n, v_tangent, v_uv0, v_uv1, gl_FrontFacing);
-  n = decodeShadingNormal(m, n, v_tangent, v_uv0, v_uv1, gl_FrontFacing);
+  vec3 coatNormal = decodeCoatNormal(m, n, v_tangent, uv, gl_FrontFacing);
+  n = decodeShadingNormal(m, n, v_tangent, uv, gl_FrontFacing);
 
   float viewDepth = max(dot(v_position - u_eye, u_viewForward), 1e-30);
   o_position = vec4(v_position, viewDepth);

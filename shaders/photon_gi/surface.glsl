@@ -1,9 +1,6 @@
 // The G-buffer surface at a pixel, for splatting and gathering.
 #ifndef RADIANT_PHOTON_GI_SURFACE
 #define RADIANT_PHOTON_GI_SURFACE
-#ifndef MATERIAL_SAMPLE
-#define MATERIAL_SAMPLE(sampler, uv) textureLod(sampler, uv, 0.0)  // compute stages have no derivatives
-#endif
 #include "common/material.glsl"  // decodeLayers (the G-buffer's layers target)
 layout(binding = 0) uniform sampler2D t_position;
 layout(binding = 1) uniform sampler2D t_normal;

@@ -26,10 +26,11 @@ float bayerThreshold(ivec2 texel) {
 }
 
 void main() {
+  SurfaceUv uv = SURFACE_UV_FRAGMENT(v_uv0, v_uv1);  // before any discard (common/material.glsl)
   Material m = materials[u_material];
   int mode = materialAlphaMode(m);
   if (mode != 0) {
-    float alpha = decodeBaseColor(m, v_uv0, v_uv1).a;
+    float alpha = decodeBaseColor(m, uv).a;
     if (materialMasked(m, alpha)) discard;
     if (mode == 2 && alpha <= bayerThreshold(ivec2(gl_FragCoord.xy))) discard;
   }

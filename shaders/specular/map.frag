@@ -25,10 +25,11 @@ layout(location = 2) out float o_distance;  // cleared to kEmptyDistance
 layout(location = 3) out vec4 o_albedo;     // rgb diffuse albedo of a non-specular, lit surface, else 0
 
 void main() {
+  SurfaceUv uv = SURFACE_UV_FRAGMENT(v_uv0, v_uv1);  // before any discard (common/material.glsl)
   if (u_faceMode == 0 && !gl_FrontFacing) discard;
   if (u_faceMode == 1 && gl_FrontFacing) discard;
   Material m = materials[u_material];
-  if (materialMasked(m, decodeBaseColor(m, v_uv0, v_uv1).a)) discard;
+  if (materialMasked(m, decodeBaseColor(m, uv).a)) discard;
 
   vec3 toP = v_position - u_reference;
   float dist = length(toP);
@@ -43,7 +44,7 @@ void main() {
   faceNormal = dot(faceNormal, faceNormal) > 1e-30 ? normalize(faceNormal) : vec3(0, 1, 0);
   vec3 n = dot(v_normal, v_normal) > 1e-30 ? normalize(v_normal) : faceNormal;
 
-  MaterialParams p = decodeMaterial(m, v_uv0, v_uv1);
+  MaterialParams p = decodeMaterial(m, uv);
   o_albedo = vec4(0.0);
   if (u_objectCode > 0) {
     o_material = specularTexel(p.baseColor.rgb, p.surface.x, p.surface.z, p.surface.w);

@@ -1,8 +1,7 @@
 // GPU half of the GPU/CPU parity test (tests/gl/materials/parity_test.cpp): evaluates the GLSL
 // material model on inputs written by the test, one invocation per case. One of PARITY_BRDF,
 // PARITY_SAMPLE, PARITY_LIGHT, PARITY_MATERIAL is defined. The results are compared with the C++ twins.
-// Compute shaders have no implicit derivatives: material textures are read at level 0.
-#define MATERIAL_SAMPLE(sampler, uv) textureLod(sampler, uv, 0.0)
+// Compute shaders have no derivatives: material textures are read at their base level (surfaceUvPoint).
 #include "common/brdf.glsl"
 #include "common/lights.glsl"
 #include "common/material.glsl"
@@ -72,8 +71,9 @@ void main() {
   uint k = uint(u_first) + i;
   vec4 c = cases[k];
   Material m = materials[u_material];
-  results[k] = decodeMaterial(m, c.xy, c.zw);
-  normals[k] = vec4(decodeShadingNormal(m, normalize(u_normal), u_tangent, c.xy, c.zw, u_front != 0), 0.0);
-  coatNormals[k] = vec4(decodeCoatNormal(m, normalize(u_normal), u_tangent, c.xy, c.zw, u_front != 0), 0.0);
+  SurfaceUv uv = surfaceUvPoint(c.xy, c.zw);
+  results[k] = decodeMaterial(m, uv);
+  normals[k] = vec4(decodeShadingNormal(m, normalize(u_normal), u_tangent, uv, u_front != 0), 0.0);
+  coatNormals[k] = vec4(decodeCoatNormal(m, normalize(u_normal), u_tangent, uv, u_front != 0), 0.0);
 }
 #endif

@@ -23,9 +23,10 @@ layout(binding = kUnitIblPrefiltered) uniform sampler2DArray t_prefiltered;
 layout(location = 0) out vec4 o_beauty;
 
 void main() {
+  SurfaceUv uv = SURFACE_UV_FRAGMENT(v_uv0, v_uv1);  // before any discard (common/material.glsl)
   Material m = materials[u_material];
   if (!gl_FrontFacing && !materialDoubleSided(m)) discard;
-  MaterialParams p = decodeMaterial(m, v_uv0, v_uv1);
+  MaterialParams p = decodeMaterial(m, uv);
   float alpha = clamp(p.baseColor.a, 0.0, 1.0);
   if (alpha <= 0.0) discard;
   if (materialUnlit(m)) {
@@ -36,8 +37,8 @@ void main() {
   vec3 wo = u_orthographic != 0 ? -u_viewForward : normalize(u_eye - v_position);
   vec3 ng = dot(faceNormal, wo) < 0.0 ? -faceNormal : faceNormal;
   vec3 n0 = windingSideNormal(materialSafeNormalize(v_normal, faceNormal), ng, gl_FrontFacing);
-  vec3 nc = decodeCoatNormal(m, n0, v_tangent, v_uv0, v_uv1, gl_FrontFacing);  // KHR_materials_clearcoat
-  vec3 n = decodeShadingNormal(m, n0, v_tangent, v_uv0, v_uv1, gl_FrontFacing);
+  vec3 nc = decodeCoatNormal(m, n0, v_tangent, uv, gl_FrontFacing);  // KHR_materials_clearcoat
+  vec3 n = decodeShadingNormal(m, n0, v_tangent, uv, gl_FrontFacing);
   float nv = dot(n, wo);
   if (nv < 1e-3) n = normalize(n + wo * (1e-3 - nv));
   float ncv = dot(nc, wo);
