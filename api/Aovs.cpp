@@ -7,9 +7,9 @@ namespace radiant::api {
 const std::vector<AovInfo>& aovTable() {
   using F = AovFormat;
   using B = AovBlend;
-  constexpr AovResolve Nearest = AovResolve::Nearest;
+  constexpr AovResolve Nearest = AovResolve::Nearest, Average = AovResolve::Average;
   // name, format, resource, first channel, channels, EXR names, blend, producer, requestable, ground truth,
-  // resolve (Average unless given).
+  // resolve (Average unless given), radiance (true unless given: false for data, which PNG shows as stored).
   // Beauty is EXR's default layer (R, G, B) so viewers show it first; the others are "<aov>.<channel>".
   static const std::vector<AovInfo> table = [] {
     std::vector<AovInfo> t = {
@@ -33,19 +33,21 @@ const std::vector<AovInfo>& aovTable() {
         // punctual lights; added to beauty.
         {0, "light_volumes", F::Rgba32F, "light_volumes", 0, 3,
          {"light_volumes.R", "light_volumes.G", "light_volumes.B"}, B::Overwrite, "light_volumes", true, ""},
-        {0, "ao", F::R32F, "ao", 0, 1, {"ao.Y"}, B::Overwrite, "ambient_occlusion", true, "ao"},
-        {0, "depth", F::Rgba32F, "gbuffer_position", 3, 1, {"depth.Z"}, B::Overwrite, "gbuffer", true, "", Nearest},
+        {0, "ao", F::R32F, "ao", 0, 1, {"ao.Y"}, B::Overwrite, "ambient_occlusion", true, "ao", Average, false},
+        {0, "depth", F::Rgba32F, "gbuffer_position", 3, 1, {"depth.Z"}, B::Overwrite, "gbuffer", true, "", Nearest, false},
         {0, "gbuffer_position", F::Rgba32F, "gbuffer_position", 0, 3,
-         {"gbuffer_position.R", "gbuffer_position.G", "gbuffer_position.B"}, B::Overwrite, "gbuffer", true, "", Nearest},
+         {"gbuffer_position.R", "gbuffer_position.G", "gbuffer_position.B"}, B::Overwrite, "gbuffer", true, "", Nearest,
+         false},
         {0, "normal", F::Rgba16F, "normal", 0, 3, {"normal.R", "normal.G", "normal.B"}, B::Overwrite, "gbuffer", true,
-         "", Nearest},
+         "", Nearest, false},
         {0, "geometric_normal", F::Rgba16F, "geometric_normal", 0, 3,
-         {"geometric_normal.R", "geometric_normal.G", "geometric_normal.B"}, B::Overwrite, "gbuffer", true, "", Nearest},
+         {"geometric_normal.R", "geometric_normal.G", "geometric_normal.B"}, B::Overwrite, "gbuffer", true, "", Nearest,
+         false},
         {0, "albedo", F::Rgba16F, "albedo", 0, 3, {"albedo.R", "albedo.G", "albedo.B"}, B::Overwrite, "gbuffer", true,
-         ""},
+         "", Average, false},
         // metallic, roughness, occlusion, transmission (KHR_materials_transmission) in R, G, B, A.
         {0, "material", F::Rgba16F, "material", 0, 4, {"material.R", "material.G", "material.B", "material.A"},
-         B::Overwrite, "gbuffer", true, "", Nearest},
+         B::Overwrite, "gbuffer", true, "", Nearest, false},
         {0, "emission", F::Rgba16F, "emission", 0, 3, {"emission.R", "emission.G", "emission.B"}, B::Overwrite,
          "gbuffer", true, ""},
         // Scored against the reference in the pass's own mode (ReferencePass::groundTruth): beauty by default.
@@ -60,9 +62,12 @@ const std::vector<AovInfo>& aovTable() {
         {0, "media", F::Rgba32F, "media", 0, 3, {"media.R", "media.G", "media.B"}, B::Overwrite,
          "spherical_billboards", true, "media"},
         {0, "media_transmittance", F::Rgba32F, "media", 3, 1, {"media_transmittance.Y"}, B::Overwrite,
-         "spherical_billboards", true, "media_transmittance"},
+         "spherical_billboards", true, "media_transmittance", Average, false},
+        // With "background": "transparent", the Renderer's coverage of the beauty (the fraction of a
+        // pixel's samples that hit a surface): the beauty's A channel in EXR and PNG; never requested.
+        {0, "alpha", F::R32F, "", 0, 1, {"A"}, B::Overwrite, "background", false, "", Average, false},
         // compare() writes it (per-pixel luminance-weighted absolute error); never requested.
-        {0, "error", F::R32F, "", 0, 1, {"error.Y"}, B::Overwrite, "compare", false, ""},
+        {0, "error", F::R32F, "", 0, 1, {"error.Y"}, B::Overwrite, "compare", false, "", Average, false},
     };
     for (std::size_t i = 0; i < t.size(); ++i) t[i].id = static_cast<int>(i);
     return t;

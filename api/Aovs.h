@@ -45,6 +45,9 @@ struct AovInfo {
   // (then compare.aov naming it is a 422, instead of silently scoring against beauty).
   std::string groundTruth;
   AovResolve resolve = AovResolve::Average;
+  // Radiance: a PNG shows it through the request's view transform (tone_map, renderer/io/ToneMap.h).
+  // false for data (reflectance, geometry, occlusion, transmittance, error), which a PNG shows as stored.
+  bool radiance = true;
 };
 
 const std::vector<AovInfo>& aovTable();

@@ -2,6 +2,24 @@
 
 namespace radiant::api {
 
+namespace {
+constexpr std::pair<ToneMap, const char*> kToneMapNames[] = {
+    {ToneMap::Standard, "standard"}, {ToneMap::Aces, "aces"},
+    {ToneMap::KhronosPbrNeutral, "khronos_pbr_neutral"}, {ToneMap::Agx, "agx"}};
+}  // namespace
+
+const char* toString(ToneMap t) {
+  for (const auto& [value, name] : kToneMapNames)
+    if (value == t) return name;
+  return "standard";
+}
+
+std::optional<ToneMap> toneMapFromString(std::string_view name) {
+  for (const auto& [value, n] : kToneMapNames)
+    if (name == n) return value;
+  return std::nullopt;
+}
+
 void to_json(nlohmann::json& j, const PassStats& s) {
   j = nlohmann::json{{"name", s.name}, {"gpu_ms", s.gpuMs}, {"cpu_ms", s.cpuMs}, {"counters", s.counters}};
 }
@@ -25,6 +43,7 @@ void to_json(nlohmann::json& j, const FrameStats& s) {
                      {"device", s.device},
                      {"metrics", s.metrics},
                      {"lighting", s.lighting},
+                     {"lighting_reason", s.lightingReason},
                      {"supersampling", s.supersampling},
                      {"camera", s.camera},
                      {"scene", s.scene},

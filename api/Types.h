@@ -8,6 +8,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -54,11 +55,32 @@ struct CameraOverride {
 
 enum class ImageFormat { Exr, Png };
 
+// The view transform of PNG output (render_request.json "tone_map"): scene-linear radiance times
+// 2^exposure to display-linear [0, 1], before the sRGB transfer (renderer/io/ToneMap.h). Standard is
+// the clamp; Aces is three.js's ACESFilmicToneMapping (model-viewer's fidelity goldens), KhronosPbrNeutral
+// the Khronos PBR Neutral tone mapper (2024), Agx three.js's AgXToneMapping (Blender's default look).
+enum class ToneMap { Standard, Aces, KhronosPbrNeutral, Agx };
+const char* toString(ToneMap t);  // the schema's names: "standard", "aces", "khronos_pbr_neutral", "agx"
+std::optional<ToneMap> toneMapFromString(std::string_view name);
+
+// What the camera sees where no surface is (render_request.json "background"): the environment (the
+// sky that lights the scene: map, ambient or studio), nothing (an alpha channel of coverage), or a
+// linear colour. Only camera rays: the environment still lights the scene. Applied after compare, so
+// stats.metrics score the frame as the reference renders it (docs/API.md, "Background").
+struct Background {
+  enum class Kind { Environment, Transparent, Colour };
+  Kind kind = Kind::Environment;
+  glm::vec3 colour{0.f};  // Kind::Colour: linear RGB radiance
+};
+
 struct OutputSpec {
   ImageFormat format = ImageFormat::Png;
   std::vector<std::string> aovs{"beauty"};  // EXR: all listed become channel groups; PNG: exactly one
   bool halfFloat = true;                    // EXR pixel type
   int pngCompression = 1;                   // PNG zlib level 0..9
+  // PNG: the request's tone_map (parseRenderRequest copies it into every output, so that an encoder
+  // needs the spec and the exposure only). The C++ default is the schema's.
+  ToneMap toneMap = ToneMap::Aces;
 };
 
 struct CompareSpec {
@@ -86,12 +108,16 @@ struct RenderRequest {
   // Techniques the request turned off ("passes": {"specular": false}); the planner skips them.
   std::set<std::string> disabledPasses;
   std::vector<OutputSpec> outputs{OutputSpec{}};
-  float exposure = 0.f;  // EV; PNG = sRGB(clamp(L * 2^exposure))
+  float exposure = 0.f;  // EV; PNG = sRGB(toneMap(L * 2^exposure))
+  ToneMap toneMap = ToneMap::Aces;  // the view transform of PNG output (also in each OutputSpec)
+  Background background;            // what camera rays that hit nothing see
   std::uint64_t seed = 0;
   glm::vec3 ambient{0.f};  // uniform sky radiance L^a (W/sr/m^2), used by ambient passes
   std::string environment;  // digest of an uploaded equirect map ("" none); replaces ambient
-  // With no lights, emission, ambient or environment, light the scene with the default studio
-  // environment (renderer/scene/StudioEnvironment.h); false renders such a scene black.
+  // A scene with no punctual lights (whatever its emission), or with directional lights only, rendered
+  // without ambient or environment, is lit by the default studio environment as well
+  // (renderer/scene/StudioEnvironment.h; docs/API.md, "Default lighting"); false keeps only the scene's
+  // own light (black without lights or emission).
   bool defaultLighting = true;
   // Samples per pixel axis of the raster passes (the schema's "supersampling"): they run at (k width) x
   // (k height) and readback resolves each AOV to width x height (api::AovResolve). The schema's default
@@ -143,9 +169,12 @@ struct FrameStats {
   int lights = 0;
   std::map<std::string, std::string> device;  // vendor, renderer, version, device, reason
   nlohmann::json metrics;  // error metrics when a compare block was given (null otherwise)
-  // What lit the frame: "scene" (its lights or emission), "ambient", "environment", "default" (the
-  // studio environment, see RenderRequest::defaultLighting) or "none".
+  // What lit the frame: "scene" (its lights or emission) and the sky, "ambient", "environment" or
+  // "default" (the studio environment, see RenderRequest::defaultLighting), joined by '+' when both
+  // ("scene+default", "scene+environment"); "none" when nothing did.
   std::string lighting;
+  // Why (docs/API.md, "Default lighting"): which rule chose `lighting`, in a sentence.
+  std::string lightingReason;
   int supersampling = 1;  // the raster's samples per pixel axis this frame used (RenderRequest::supersampling, capped)
   nlohmann::json camera;  // the camera used: position, target, up, yfov_deg, source
   nlohmann::json scene;   // name, digest, bounds {min, max}, node names

@@ -44,6 +44,16 @@ bool isIntegral(const json& v) {
   return std::isfinite(d) && std::floor(d) == d && std::fabs(d) <= 9007199254740992.0;
 }
 
+bool hasType(const std::string& type, const json& v) {
+  return type == "object"    ? v.is_object()
+         : type == "array"   ? v.is_array()
+         : type == "string"  ? v.is_string()
+         : type == "boolean" ? v.is_boolean()
+         : type == "number"  ? v.is_number()
+         : type == "integer" ? isIntegral(v)
+                             : false;
+}
+
 json checkType(const std::string& type, const json& v, const std::string& pointer) {
   if (type == "object") {
     if (!v.is_object()) typeError(pointer, "an object", v);
@@ -146,6 +156,18 @@ std::string pointerAppend(const std::string& pointer, std::size_t index) {
 }
 
 json validate(const json& schema, const json& input, const std::string& pointer) {
+  // A union of alternatives of distinct JSON types ("background": a name or a colour): the value's type
+  // picks the alternative, whose own checks then name what is wrong.
+  if (auto alternatives = schema.find("oneOf"); alternatives != schema.end()) {
+    std::string expected;
+    for (const json& alternative : *alternatives) {
+      const std::string type = alternative.value("type", "");
+      if (hasType(type, input)) return validate(alternative, input, pointer);
+      const bool vowel = type == "array" || type == "object" || type == "integer";
+      expected += (expected.empty() ? "" : " or ") + std::string(vowel ? "an " : "a ") + type;
+    }
+    typeError(pointer, expected, input);
+  }
   json value = input;
   if (auto t = schema.find("type"); t != schema.end()) value = checkType(t->get<std::string>(), value, pointer);
 
@@ -443,6 +465,12 @@ RenderRequest parseRenderRequest(const json& body, const RequestLimits& limits) 
     r.outputs.push_back(std::move(spec));
   }
   r.exposure = v["exposure"].get<float>();
+  r.toneMap = *toneMapFromString(v["tone_map"].get<std::string>());  // the schema's enum
+  for (OutputSpec& o : r.outputs) o.toneMap = r.toneMap;
+  if (const json& b = v["background"]; b.is_array())
+    r.background = Background{Background::Kind::Colour, vec3(b)};
+  else if (b == "transparent")
+    r.background.kind = Background::Kind::Transparent;
   r.seed = v["seed"].get<std::uint64_t>();
   r.ambient = vec3(v["ambient"]);
   r.environment = v["environment"].get<std::string>();

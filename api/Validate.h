@@ -4,7 +4,8 @@
 //
 // The schema language is a subset of JSON Schema: type (object, array, string, integer, number,
 // boolean), properties, additionalProperties (false only), required, minimum, maximum, enum, default,
-// description, items, minItems, maxItems, minProperties, maxProperties, pattern. Annotations ("title",
+// description, items, minItems, maxItems, minProperties, maxProperties, pattern, and oneOf whose
+// alternatives have distinct types (the value's JSON type picks the alternative). Annotations ("title",
 // "$id", "x-outputs") are ignored. Every property with a default is filled in when absent.
 //
 // Cost: an integer parameter whose value buys work or memory carries "x-cost", naming the server limit

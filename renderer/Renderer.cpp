@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <set>
 #include <stdexcept>
 
@@ -61,6 +62,35 @@ void resolveSupersampled(const std::vector<float>& rgba, int width, int height, 
           for (int c = 0; c < src.channels; ++c) p[c] += weight * row[(x * k + sx) * 4 + src.firstChannel + c];
       }
     }
+}
+
+// The beauty as the camera sees it against the request's background (api::Background): each sample
+// that hit no surface (the G-buffer's position w is 0 there: the sky, an alpha-masked cut-out) shows the
+// background colour, or 0 when it is transparent, instead of the sky; then the k x k samples are resolved
+// like the beauty, so an edge pixel mixes object and background by the fraction of its samples that hit,
+// and a transparent frame's coverage is that fraction (the premultiplied alpha of `beautySamples`).
+// `beautySamples`: the read-back beauty (GL rows, RGBA), or null when nothing drew into it (no geometry).
+void presentBackground(FrameResources& resources, const FrameView& view, int k, const api::Background& background,
+                       std::vector<float>* beautySamples, std::optional<Image>& presented, std::optional<Image>& alpha) {
+  const bool transparent = background.kind == api::Background::Kind::Transparent;
+  const glm::vec3 shown = transparent ? glm::vec3(0.f) : background.colour;
+  const std::size_t samples = static_cast<std::size_t>(view.width) * view.height;
+  // Coverage per sample in channel 3 (where the AOV table reads depth from), 1 or 0.
+  std::vector<float> position(samples * 4, 0.f);
+  if (resources.hasTexture("gbuffer_position") && resources.written("gbuffer_position"))
+    resources.texture("gbuffer_position").download(0, GL_RGBA, GL_FLOAT, position.data(), position.size() * sizeof(float));
+  for (std::size_t i = 0; i < samples; ++i) position[i * 4 + 3] = position[i * 4 + 3] > 0.f ? 1.f : 0.f;
+  std::vector<float> beauty = beautySamples ? *beautySamples : std::vector<float>(samples * 4, 0.f);
+  for (std::size_t i = 0; i < samples; ++i)
+    if (position[i * 4 + 3] == 0.f)
+      for (int c = 0; c < 3; ++c) beauty[i * 4 + c] = shown[c];
+  const int w = view.width / k, h = view.height / k;
+  presented = Image::make("beauty", w, h, 3);
+  resolveSupersampled(beauty, view.width, view.height, k, aovSource("beauty"), *presented);
+  if (transparent) {
+    alpha = Image::make("alpha", w, h, 1);
+    resolveSupersampled(position, view.width, view.height, k, AovSource{"", 3, 1}, *alpha);
+  }
 }
 
 // Replaces NaN and Inf by 0 and counts them: output is never NaN or Inf, and the stats say if a pass
@@ -422,22 +452,48 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
   stats.scene = sceneStats(scene);
   stats.warnings = scene.warnings;
 
-  // Default lighting (renderer/scene/StudioEnvironment.h): a scene that brings no light, rendered
-  // without ambient or environment, is lit by the studio map as if the request had named it.
+  // Default lighting (renderer/scene/StudioEnvironment.h; docs/API.md, "Default lighting"): rendered
+  // without ambient or environment, a scene is lit by the studio map as if the request had named it when
+  // it brings no punctual light, whatever its emission (an emissive visor or screen lights little around
+  // it; every viewer shows such a model under its environment), or directional lights only (a key light
+  // meant to sit on a viewer's environment, as GlamVelvetSofa's). Point and spot lights are a lighting
+  // set-up of their own, a room such as the Cornell boxes: they stay the frame's only light.
   api::RenderRequest effective = requestIn;
   FrameInputs inputs = inputsIn;
   const bool sceneLit = !scene.lights.empty() || scene.features.hasEmissive();
+  const bool onlyDirectionalLights = std::all_of(scene.lights.begin(), scene.lights.end(),
+                                                 [](const Light& l) { return l.type == LightType::Directional; });
   const bool ambientGiven = requestIn.ambient != glm::vec3(0.f);
-  if (sceneLit) stats.lighting = "scene";
-  else if (!requestIn.environment.empty()) stats.lighting = "environment";
-  else if (ambientGiven) stats.lighting = "ambient";
-  else if (requestIn.defaultLighting) {
-    stats.lighting = "default";
+  const std::string own = !scene.lights.empty() && scene.features.hasEmissive() ? "lights and emissive surfaces"
+                          : !scene.lights.empty()                               ? "lights"
+                          : scene.features.hasEmissive()                        ? "emissive surfaces"
+                                                                                : "";
+  std::string sky;
+  if (!requestIn.environment.empty()) {
+    sky = "environment";
+    stats.lightingReason = "the request's environment map";
+  } else if (ambientGiven) {
+    sky = "ambient";
+    stats.lightingReason = "the request's ambient";
+  } else if (requestIn.defaultLighting && onlyDirectionalLights) {
+    sky = "default";
     effective.environment = kStudioEnvironmentKey;
     inputs.environment = &studioEnvironment();
+    stats.lightingReason = scene.lights.empty() && !sceneLit ? "the scene has no lights or emissive surfaces"
+                           : scene.lights.empty() ? "the scene has no punctual lights (its emissive surfaces light "
+                                                    "little beyond themselves)"
+                                                  : "the scene's only lights are directional (a key light meant to "
+                                                    "sit on a viewer's environment)";
+    stats.lightingReason += ", and the request names no ambient or environment";
+  } else if (!requestIn.defaultLighting) {
+    stats.lightingReason = "default_lighting is false";
   } else {
-    stats.lighting = "none";
+    stats.lightingReason = "the scene has point or spot lights, a lighting set-up of its own (a room such as the "
+                           "Cornell boxes)";
   }
+  stats.lighting = sceneLit ? (sky.empty() ? "scene" : "scene+" + sky) : (sky.empty() ? "none" : sky);
+  if (!own.empty()) stats.lightingReason += (sky.empty() ? ": the scene's own " : "; with the scene's own ") + own;
+  else if (sky.empty()) stats.lightingReason += ", and the scene has no lights or emissive surfaces: nothing";
   const api::RenderRequest& request = effective;
   if (request.timeBudgetMs > 0 && im.speed.needsCalibration() && !im.calibrating) calibrateSpeed();
 
@@ -558,10 +614,15 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     std::vector<float> rgba(static_cast<std::size_t>(view.width) * view.height * 4);
     std::size_t nonFinite = 0;
     std::vector<ZeroedValues> zeroed;
+    // The background (api::Background), applied to the beauty after compare (which scores the frame with
+    // the environment behind it, as the reference renders it): the beauty as presented and its coverage.
+    const bool environmentBehind = request.background.kind == api::Background::Kind::Environment;
+    std::optional<Image> presented, alpha;
     for (const std::string& aov : aovs) {
       const AovSource src = aovSource(aov);
       Image img = Image::make(aov, outView.width, outView.height, src.channels);
-      if (im.resources.hasTexture(src.texture) && im.resources.written(aov)) {
+      const bool drawn = im.resources.hasTexture(src.texture) && im.resources.written(aov);
+      if (drawn) {
         im.resources.texture(src.texture).download(0, GL_RGBA, GL_FLOAT, rgba.data(), rgba.size() * sizeof(float));
         resolveSupersampled(rgba, view.width, view.height, k, src, img);
       } else if (aov == "beauty" || aov == "direct") {
@@ -569,6 +630,8 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
         for (int i = 0; i < outView.width * outView.height; ++i)
           for (int c = 0; c < 3; ++c) img.pixels[static_cast<std::size_t>(i) * 3 + c] = view.ambient[c];
       }
+      if (aov == "beauty" && !environmentBehind)
+        presentBackground(im.resources, view, k, request.background, drawn ? &rgba : nullptr, presented, alpha);
       if (const std::size_t bad = sanitize(img.pixels)) {
         nonFinite += bad;
         zeroed.push_back({aov, bad, writersOf(aov, plan.passes)});
@@ -594,6 +657,12 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     if (choice.active) stats.budget["speed"]["observed"] = observed;  // this frame joined the window
     if (request.compare)
       compare(im.resources, scene, outView, request, inputs.compareTarget, im.techniques, plan.passes, out);
+    if (presented) {
+      nonFinite += sanitize(presented->pixels);
+      *std::find_if(out.aovs.begin(), out.aovs.end(), [](const Image& i) { return i.aov == "beauty"; }) =
+          std::move(*presented);
+      if (alpha) out.aovs.push_back(std::move(*alpha));
+    }
     stats.renderMs = msSince(frameStart);
     report(1.0);
     if (nonFinite) stats.passes.back().counters["non_finite_pixels_zeroed"] = static_cast<double>(nonFinite);

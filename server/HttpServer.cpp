@@ -768,6 +768,7 @@ struct HttpServer::Impl {
         api::OutputSpec spec;
         spec.format = format == "exr" ? api::ImageFormat::Exr : api::ImageFormat::Png;
         spec.halfFloat = false;
+        spec.toneMap = job->request.toneMap;
         spec.aovs = {job->request.refine->aov};
         if (spec.format == api::ImageFormat::Exr)
           for (const auto& o : job->request.outputs)

@@ -1,5 +1,6 @@
 #include "server/RendererBackend.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -95,8 +96,20 @@ BackendHooks rendererHooks(const ServerConfig& config) {
   h.builtinSceneSource = [](const std::string& name) { return std::string(builtinSceneSource(name)); };
   h.encodeFrame = [](const std::vector<Image>& aovs, const api::OutputSpec& spec, std::size_t index, float exposure) {
     std::vector<Image> chosen = selectAovs(aovs, spec, index);
-    return spec.format == api::ImageFormat::Exr ? io::encodeExr(chosen, spec.halfFloat)
-                                                : io::encodePng(chosen.front(), exposure, spec.pngCompression);
+    // "background": "transparent": the Renderer adds the beauty's coverage ("alpha"), its A channel.
+    const auto alpha = std::find_if(aovs.begin(), aovs.end(), [](const Image& i) { return i.aov == "alpha"; });
+    const auto beauty = std::find_if(chosen.begin(), chosen.end(), [](const Image& i) { return i.aov == "beauty"; });
+    const bool withAlpha = alpha != aovs.end() && beauty != chosen.end();
+    if (spec.format == api::ImageFormat::Exr) {
+      if (withAlpha) chosen.insert(beauty + 1, *alpha);
+      return io::encodeExr(chosen, spec.halfFloat);
+    }
+    io::PngOptions png;
+    png.exposureEV = exposure;
+    png.toneMap = spec.toneMap;
+    png.zlibLevel = spec.pngCompression;
+    png.alpha = withAlpha ? &*alpha : nullptr;
+    return io::encodePng(chosen.front(), png);
   };
   h.techniques = Renderer::techniques();
   return h;

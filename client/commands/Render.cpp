@@ -27,6 +27,7 @@ constexpr const char* kFooter =
 
 struct RenderOptions {
   std::string sceneFile, builtin, asset, statsFile, environmentFile, requestFile, ambient, camera, size, quality;
+  std::string toneMap, background;
   std::string outDir, outFormat = "exr";
   std::vector<std::string> outs, sets, passes, disabled, aovs;
   int compareSpp = 0;
@@ -279,6 +280,15 @@ nlohmann::json buildRequest(const RenderOptions& o, const HttpClient& http, bool
     request["height"] = height;
   }
   if (o.exposureGiven->count()) request["exposure"] = o.exposure;
+  if (!o.toneMap.empty()) request["tone_map"] = o.toneMap;
+  if (o.background == "environment" || o.background == "transparent") {
+    request["background"] = o.background;
+  } else if (!o.background.empty()) {
+    const nlohmann::json colour = triple("--background (environment, transparent or R,G,B)", o.background);
+    for (const auto& v : colour)
+      if (v.get<double>() < 0) throw UsageError("--background: a colour's radiance must not be negative");
+    request["background"] = colour;
+  }
   if (o.seedGiven->count()) request["seed"] = o.seed;
   // Presets and budgets are the daemon's to validate (docs/API.md); the client passes them on.
   if (!o.quality.empty()) request["quality"] = o.quality;
@@ -431,9 +441,11 @@ int runRender(const GlobalOptions& g, const RenderOptions& o) {
   if (!o.quiet && result.contains("stats") && result["stats"].contains("warnings") && result["stats"]["warnings"].is_array())
     for (const auto& w : result["stats"]["warnings"])
       if (w.is_string()) std::cerr << "warning: " << w.get<std::string>() << "\n";
-  if (!o.quiet && result.contains("stats") && result["stats"].value("lighting", "") == "default")
-    std::cerr << "note: the scene has no lights, ambient or environment; it was lit by the default studio "
-                 "environment (see docs/API.md; --ambient, --environment or --no-default-lighting change that)\n";
+  const std::string lighting = result.contains("stats") ? result["stats"].value("lighting", "") : "";
+  if (!o.quiet && (lighting == "default" || lighting == "scene+default"))
+    std::cerr << "note: lit by the default studio environment: " << result["stats"].value("lighting_reason", "")
+              << " (docs/API.md, \"Default lighting\"; --ambient, --environment or --no-default-lighting change "
+                 "that)\n";
   if (!o.quiet) {
     const double wallMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     for (std::size_t i = 0; i < paths.size(); ++i)
@@ -478,6 +490,15 @@ void addRenderCommand(CLI::App& root, const GlobalOptions& g, Action& action) {
   repeated(c->add_option("--aov", o->aovs, "an AOV to write (repeatable; default beauty)"))->type_name("NAME");
   c->add_option("--size", o->size, "the frame size")->type_name("WxH");
   o->exposureGiven = c->add_option("--exposure", o->exposure, "exposure of the tone map")->type_name("EV");
+  c->add_option("--tone-map", o->toneMap,
+                "the view transform of PNG output (default aces: model-viewer's render-fidelity look; standard: "
+                "clamp)")
+      ->type_name(choices({"aces", "khronos_pbr_neutral", "agx", "standard"}))
+      ->check(CLI::IsMember({"aces", "khronos_pbr_neutral", "agx", "standard"}).description(""));
+  c->add_option("--background", o->background,
+                "what the camera sees where no surface is: the environment (default), transparent (PNG alpha, EXR A) "
+                "or a linear colour")
+      ->type_name("environment|transparent|R,G,B");
   o->seedGiven = c->add_option("--seed", o->seed, "the random seed")->type_name("N");
   c->add_option("--quality", o->quality, "a quality preset (validated by the daemon)")
       ->type_name(choices({"draft", "preview", "final", "reference"}));

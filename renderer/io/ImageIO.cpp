@@ -11,6 +11,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include "api/Aovs.h"
+#include "renderer/io/ToneMap.h"
 
 namespace radiant::io {
 namespace OIIO = OIIO_NAMESPACE;
@@ -97,46 +98,79 @@ std::string encodeExr(const std::vector<Image>& aovs, bool halfFloat, std::vecto
   return writeToMemory("frame.exr", spec, OIIO::TypeDesc::FLOAT, data.data());
 }
 
-std::string encodePng(const Image& image, float exposureEV, int zlibLevel) {
-  const int outChannels = image.channels == 1 ? 1 : 3;
-  OIIO::ImageSpec spec(image.width, image.height, outChannels, OIIO::TypeDesc::UINT8);
-  const float scale = std::exp2(exposureEV);
-  // 8-bit sRGB without a pow per channel. Threshold k is the linear value at which sRGB(v) * 255
-  // crosses k + 0.5, so the rounded code of v is the number of thresholds at or below it. A table over
-  // 65536 cells of [0, 1] holds the code at each cell's lower edge; codes are at least 3e-4 apart in
-  // linear units (the transfer's steepest part), wider than a cell, so one comparison with the next
-  // threshold finishes the exact rounding. Values below 0 or above 1 saturate (never wrap).
-  struct SrgbTable {
-    std::array<float, 256> threshold{};
-    std::vector<unsigned char> lowerCode = std::vector<unsigned char>(65536);
-    SrgbTable() {
-      for (int k = 0; k < 255; ++k) threshold[k] = srgbToLinear((k + 0.5f) / 255.f);
-      threshold[255] = std::numeric_limits<float>::infinity();
-      int code = 0;
-      for (int i = 0; i < 65536; ++i) {
-        while (code < 255 && threshold[code] <= i / 65535.f) ++code;
-        lowerCode[i] = static_cast<unsigned char>(code);
-      }
+namespace {
+
+// 8-bit sRGB without a pow per channel. Threshold k is the linear value at which sRGB(v) * 255 crosses
+// k + 0.5, so the rounded code of v is the number of thresholds at or below it. A table over 65536
+// cells of [0, 1] holds the code at each cell's lower edge; codes are at least 3e-4 apart in linear
+// units (the transfer's steepest part), wider than a cell, so one comparison with the next threshold
+// finishes the exact rounding. Values below 0 or above 1 saturate (never wrap).
+struct SrgbTable {
+  std::array<float, 256> threshold{};
+  std::vector<unsigned char> lowerCode = std::vector<unsigned char>(65536);
+  SrgbTable() {
+    for (int k = 0; k < 255; ++k) threshold[k] = srgbToLinear((k + 0.5f) / 255.f);
+    threshold[255] = std::numeric_limits<float>::infinity();
+    int code = 0;
+    for (int i = 0; i < 65536; ++i) {
+      while (code < 255 && threshold[code] <= i / 65535.f) ++code;
+      lowerCode[i] = static_cast<unsigned char>(code);
     }
-    unsigned char operator()(float v) const {
-      if (!(v > 0.f)) return 0;  // also NaN
-      if (v >= 1.f) return 255;
-      unsigned code = lowerCode[static_cast<std::size_t>(v * 65535.f)];
-      code += v >= threshold[code];
-      return static_cast<unsigned char>(code);
-    }
-  };
+  }
+  unsigned char operator()(float v) const {
+    if (!(v > 0.f)) return 0;  // also NaN
+    if (v >= 1.f) return 255;
+    unsigned code = lowerCode[static_cast<std::size_t>(v * 65535.f)];
+    code += v >= threshold[code];
+    return static_cast<unsigned char>(code);
+  }
+};
+
+}  // namespace
+
+std::string encodePng(const Image& image, const PngOptions& options) {
   static const SrgbTable toSrgb8;
+  const Image* alpha = options.alpha;
+  if (alpha && (alpha->width != image.width || alpha->height != image.height || alpha->channels != 1))
+    throw std::invalid_argument("encodePng: the alpha image is not one channel of the image's size");
+  const int colourChannels = image.channels == 1 ? 1 : 3;
+  const int outChannels = colourChannels + (alpha ? 1 : 0);
+  OIIO::ImageSpec spec(image.width, image.height, outChannels, OIIO::TypeDesc::UINT8);
+  // Data AOVs and scalars are shown as stored; the view transform is for radiance.
+  const api::AovInfo* info = api::findAov(image.aov);
+  const api::ToneMap op = colourChannels == 1 || (info && !info->radiance) ? api::ToneMap::Standard : options.toneMap;
+  const float scale = std::exp2(options.exposureEV);
   std::vector<unsigned char> data(static_cast<std::size_t>(image.width) * image.height * outChannels);
-  for (std::size_t p = 0; p < static_cast<std::size_t>(image.width) * image.height; ++p)
-    for (int c = 0; c < outChannels; ++c) data[p * outChannels + c] = toSrgb8(image.pixels[p * image.channels + c] * scale);
+  for (std::size_t p = 0; p < static_cast<std::size_t>(image.width) * image.height; ++p) {
+    const float* in = &image.pixels[p * image.channels];
+    unsigned char* out = &data[p * outChannels];
+    // Straight colour from the premultiplied image (alpha 0: nothing was hit, and the colour is 0).
+    const float a = alpha ? std::clamp(alpha->pixels[p], 0.f, 1.f) : 1.f;
+    const float unpremultiply = a > 0.f ? 1.f / a : 0.f;
+    if (op == api::ToneMap::Standard) {
+      for (int c = 0; c < colourChannels; ++c) out[c] = toSrgb8(in[c] * unpremultiply * scale);
+    } else {
+      const glm::vec3 display = toneMap(op, glm::vec3(in[0], in[1], in[2]) * unpremultiply, options.exposureEV);
+      for (int c = 0; c < 3; ++c) out[c] = toSrgb8(display[c]);
+    }
+    if (alpha) out[colourChannels] = static_cast<unsigned char>(std::lround(a * 255.f));
+  }
   // zlib level 1 by default: about 3x faster than zlib's default 6 for a few per cent larger files,
   // the right trade for a render service (the encode dominated the service overhead).
-  spec.attribute("png:compressionLevel", std::clamp(zlibLevel, 0, 9));
+  spec.attribute("png:compressionLevel", std::clamp(options.zlibLevel, 0, 9));
   // Stored (level 0): libpng's per-row filter search only prepares data for a compressor that does
   // not run; PNG_FILTER_NONE (8) makes the same bytes ~5x faster (0.5 ms instead of 3 at 256x256).
-  if (zlibLevel <= 0) spec.attribute("png:filter", 8);
+  if (options.zlibLevel <= 0) spec.attribute("png:filter", 8);
+  // Straight (unassociated) alpha: PNG's own convention; OIIO would otherwise unpremultiply again.
+  if (alpha) spec.attribute("oiio:UnassociatedAlpha", 1);
   return writeToMemory("frame.png", spec, OIIO::TypeDesc::UINT8, data.data());
+}
+
+std::string encodePng(const Image& image, float exposureEV, int zlibLevel) {
+  PngOptions options;
+  options.exposureEV = exposureEV;
+  options.zlibLevel = zlibLevel;
+  return encodePng(image, options);
 }
 
 void writeFile(const std::string& path, const std::string& bytes) {
@@ -169,8 +203,14 @@ Image readFrom(OIIO::ImageInput* in, const std::string& what, const std::string&
     return -1;
   };
   std::vector<int> pick;
+  // A transparent frame's coverage: the A channel beside the beauty (EXR and PNG alike).
+  if (aov == "alpha") {
+    if (find("A") < 0) throw std::runtime_error("io: " + what + " has no alpha channel (A)");
+    pick = {find("A")};
+  }
   // Unprefixed channels are the beauty (encodeExr writes it so, and PNG/HDR have nothing else).
   for (const std::string& prefix : aov == "beauty" ? std::vector<std::string>{"beauty.", ""} : std::vector<std::string>{aov + "."}) {
+    if (!pick.empty()) break;
     const int r = find(prefix + "R"), g = find(prefix + "G"), b = find(prefix + "B"), yy = find(prefix + "Y");
     if (r >= 0 && g >= 0 && b >= 0) pick = {r, g, b};
     else if (yy >= 0) pick = {yy};

@@ -1,12 +1,15 @@
-// glTF content on screen, with numbers: the default studio lighting of a lightless scene, unlit
+// glTF content on screen, with numbers: the default-lighting rule (studio environment unless the scene
+// has point or spot lights), the background (transparent, a colour), unlit
 // materials, texture transforms moving a known texel to a known pixel, and partial camera overrides.
 #include <array>
 #include <cmath>
 
+#include <glm/gtc/type_ptr.hpp>
 #include <gtest/gtest.h>
 
 #include "renderer/Renderer.h"
 #include "renderer/io/ImageIO.h"
+#include "renderer/scene/BuiltinScenes.h"
 #include "renderer/scene/Environment.h"
 #include "renderer/scene/GltfLoader.h"
 #include "renderer/scene/MaterialDecode.h"
@@ -94,6 +97,155 @@ TEST(DefaultLighting, LightlessSceneIsLitAndSaysSo) {
   const RenderOutput amb = renderer().render(scene, req);
   EXPECT_EQ(amb.stats.lighting, "ambient");
   EXPECT_NEAR(aov(amb, "beauty").at(16, 16)[1], 0.8 * 0.25, 0.05 * 0.8 * 0.25);
+}
+
+// ---- the default-lighting rule (issue 29, item 7) --------------------------------------------------
+
+// The white quad of LightlessSceneIsLitAndSaysSo seen head-on, and what the studio map gives it.
+const api::CameraOverride kQuadCamera{{0, 0, 1.5f}, {0, 0, 0}, {0, 1, 0}, 40.f};
+double studioLitWhite() {  // 0.8 E(+Z) / pi
+  return 0.8 * ibl::irradianceFromSh(ibl::irradianceSh(studioEnvironment()), {0, 0, 1}).x / glm::pi<float>();
+}
+double centreMean(const RenderOutput& out) {  // green over the centre 8x8 pixels of a 32x32 beauty
+  const Image& beauty = aov(out, "beauty");
+  double sum = 0.0;
+  for (int y = 12; y < 20; ++y)
+    for (int x = 12; x < 20; ++x) sum += beauty.at(x, y)[1];
+  return sum / 64.0;
+}
+
+// An emissive surface is no lighting set-up: DamagedHelmet's visor made its file count as lit, and it
+// rendered black. A white quad facing the camera and, behind it and facing away (it lights nothing the
+// camera sees), an emissive quad: the studio map lights the white quad exactly as when it is alone.
+TEST(DefaultLighting, EmissiveOnlySceneIsLitByTheStudioEnvironment) {
+  testing::SceneBuilder b;
+  const int white = b.material(testing::lambertian(glm::vec3(0.8f)));
+  Material glow = testing::lambertian(glm::vec3(0.f));
+  glow.emissiveFactor = glm::vec3(4.f);
+  const int emissive = b.material(glow);
+  b.quad({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, white);
+  b.quad({0, 0, -1}, {0, 0.25f, 0}, {0.25f, 0, 0}, emissive, "visor");  // normal -Z
+  const Scene scene = b.build("emissive-only");
+  ASSERT_TRUE(scene.lights.empty());
+  ASSERT_TRUE(scene.features.hasEmissive());
+  api::RenderRequest req = exrRequest(32);
+  req.camera = kQuadCamera;
+  req.disabledPasses.insert("photon_gi");  // the raster's IBL/AO terms, as LightlessSceneIsLitAndSaysSo
+  const RenderOutput out = renderer().render(scene, req);
+  EXPECT_EQ(out.stats.lighting, "scene+default");
+  EXPECT_EQ(out.stats.lightingReason,
+            "the scene has no punctual lights (its emissive surfaces light little beyond themselves), and the "
+            "request names no ambient or environment; with the scene's own emissive surfaces");
+  // 0.8 E / pi within LightlessSceneIsLitAndSaysSo's 5% (AO noise, the F0 = 0 specular); black before.
+  EXPECT_NEAR(centreMean(out), studioLitWhite(), 0.05 * studioLitWhite());
+
+  // Opting out keeps the scene's own light only: the emitter faces away, so the quad is black.
+  req.defaultLighting = false;
+  const RenderOutput own = renderer().render(scene, req);
+  EXPECT_EQ(own.stats.lighting, "scene");
+  EXPECT_EQ(own.stats.lightingReason, "default_lighting is false: the scene's own emissive surfaces");
+  EXPECT_EQ(aov(own, "beauty").at(16, 16)[1], 0.f);
+}
+
+// A file whose only light is a directional key (GlamVelvetSofa's 3 lux) is meant to sit on a viewer's
+// environment: it gets the studio map as well as its key. A 1 lux key straight onto the white quad adds
+// 0.8 * 1 / pi to the studio's 0.8 E / pi.
+TEST(DefaultLighting, KeyLightOnlySceneGetsTheStudioEnvironmentAsWell) {
+  testing::SceneBuilder b;
+  b.quad({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, b.material(testing::lambertian(glm::vec3(0.8f))));
+  b.directionalLight({0, 0, -1}, 1.f);
+  const Scene scene = b.build("key-only");
+  api::RenderRequest req = exrRequest(32);
+  req.camera = kQuadCamera;
+  req.disabledPasses.insert("photon_gi");
+  const RenderOutput out = renderer().render(scene, req);
+  EXPECT_EQ(out.stats.lighting, "scene+default");
+  EXPECT_EQ(out.stats.lightingReason,
+            "the scene's only lights are directional (a key light meant to sit on a viewer's environment), and "
+            "the request names no ambient or environment; with the scene's own lights");
+  const double key = 0.8 / glm::pi<double>();
+  EXPECT_NEAR(centreMean(out), studioLitWhite() + key, 0.05 * (studioLitWhite() + key));
+  // Without the default: the key alone.
+  req.defaultLighting = false;
+  const RenderOutput own = renderer().render(scene, req);
+  EXPECT_EQ(own.stats.lighting, "scene");
+  EXPECT_NEAR(centreMean(own), key, 0.02 * key);
+}
+
+// Point and spot lights are a lighting set-up of their own (a closed room): the built-in Cornell box is
+// rendered bit for bit as with the default lighting turned off.
+TEST(DefaultLighting, PointLightsKeepTheirOwnLightAndTheCornellBoxIsUnchanged) {
+  const Scene scene = loadBuiltinScene("cornell_box");
+  ASSERT_FALSE(scene.lights.empty());
+  api::RenderRequest req = exrRequest(32);
+  const RenderOutput lit = renderer().render(scene, req);
+  EXPECT_EQ(lit.stats.lighting, "scene");
+  EXPECT_EQ(lit.stats.lightingReason,
+            "the scene has point or spot lights, a lighting set-up of its own (a room such as the Cornell boxes): "
+            "the scene's own lights");
+  req.defaultLighting = false;
+  const RenderOutput own = renderer().render(scene, req);
+  EXPECT_EQ(own.stats.lighting, "scene");
+  EXPECT_EQ(aov(lit, "beauty").pixels, aov(own, "beauty").pixels);
+}
+
+// ---- background (issue 29, item 8) -----------------------------------------------------------------
+
+// A white quad of half-size 1/2 in a frame of half-size 1 (kFillCamera below): it covers exactly pixels
+// 8..23 of 32 in x and y, with its edges on pixel (and supersample) boundaries, so every pixel is
+// covered wholly or not at all.
+TEST(Background, TransparentIsCoverageAndAColourShowsWhereNothingIsHit) {
+  testing::SceneBuilder b;
+  b.quad({0, 0, 0}, {0.5f, 0, 0}, {0, 0.5f, 0}, b.material(testing::lambertian(glm::vec3(0.8f))));
+  const Scene scene = b.build("background-card");
+  api::RenderRequest req = exrRequest(32);
+  req.camera = api::CameraOverride{{0, 0, 2}, {0, 0, 0}, {0, 1, 0}, 2.f * 26.5650512f};
+  req.disabledPasses.insert("photon_gi");
+  const RenderOutput sky = renderer().render(scene, req);
+  EXPECT_THROW(aov(sky, "alpha"), std::runtime_error) << "no alpha unless asked for";
+  auto covered = [](int x, int y) { return x >= 8 && x < 24 && y >= 8 && y < 24; };
+
+  req.background.kind = api::Background::Kind::Transparent;
+  const RenderOutput clear = renderer().render(scene, req);
+  const Image& alpha = aov(clear, "alpha");
+  const Image& beauty = aov(clear, "beauty");
+  ASSERT_EQ(alpha.channels, 1);
+  int mismatches = 0;
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 32; ++x) {
+      const float* p = beauty.at(x, y);
+      const float* s = aov(sky, "beauty").at(x, y);
+      if (covered(x, y))  // alpha 1 and the surface's colour, as with the sky behind it
+        mismatches += alpha.at(x, y)[0] != 1.f || p[0] != s[0] || p[1] != s[1] || p[2] != s[2];
+      else  // alpha 0 and colour 0 (premultiplied), where the sky was not black
+        mismatches += alpha.at(x, y)[0] != 0.f || p[0] != 0.f || p[1] != 0.f || p[2] != 0.f || s[1] <= 0.f;
+    }
+  EXPECT_EQ(mismatches, 0);
+  // The PNG: RGBA with alpha 0 off the quad and 255 on it.
+  io::PngOptions png;
+  png.toneMap = api::ToneMap::Aces;
+  png.alpha = &alpha;
+  const std::string bytes = io::encodePng(beauty, png);
+  const Image a = io::decodeImage(bytes, "alpha");
+  ASSERT_EQ(a.width, 32);
+  EXPECT_EQ(a.at(0, 0)[0], 0.f);
+  EXPECT_EQ(a.at(7, 16)[0], 0.f);
+  EXPECT_EQ(a.at(8, 16)[0], 1.f);  // 255 / 255
+  EXPECT_EQ(a.at(23, 23)[0], 1.f);
+  EXPECT_EQ(a.at(24, 23)[0], 0.f);
+
+  // A colour: shown exactly where nothing is hit, the quad unchanged.
+  req.background = api::Background{api::Background::Kind::Colour, glm::vec3(0.25f, 0.5f, 2.f)};
+  const RenderOutput coloured = renderer().render(scene, req);
+  EXPECT_THROW(aov(coloured, "alpha"), std::runtime_error);
+  mismatches = 0;
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 32; ++x) {
+      const float* p = aov(coloured, "beauty").at(x, y);
+      const glm::vec3 shown = covered(x, y) ? glm::make_vec3(aov(sky, "beauty").at(x, y)) : glm::vec3(0.25f, 0.5f, 2.f);
+      mismatches += glm::make_vec3(p) != shown;
+    }
+  EXPECT_EQ(mismatches, 0);
 }
 
 // ---- a quad that exactly fills a 32x32 frame: pixel (x, y) sees uv ((x + .5) / 32, (y + .5) / 32) ----

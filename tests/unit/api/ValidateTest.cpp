@@ -321,3 +321,63 @@ TEST(Validate, PassesTrueAndFalseTurnTechniquesOnAndOff) {
   num["passes"] = {{"photon_gi", 0}};
   EXPECT_EQ(errorOf(num).pointer, "/passes/photon_gi");
 }
+
+// issue 29, item 8: the view transform and the background of PNG output.
+TEST(Validate, ToneMapDefaultsToAcesAndUnknownNamesAre422) {
+  json v = radiant::api::normaliseRenderRequest(minimal());
+  EXPECT_EQ(v["tone_map"], "aces");
+  EXPECT_EQ(v["background"], "environment");
+  auto r = parseRenderRequest(minimal());
+  EXPECT_EQ(r.toneMap, radiant::api::ToneMap::Aces);
+  ASSERT_EQ(r.outputs.size(), 1u);
+  EXPECT_EQ(r.outputs[0].toneMap, radiant::api::ToneMap::Aces);
+  EXPECT_EQ(r.background.kind, radiant::api::Background::Kind::Environment);
+
+  json body = minimal();
+  body["outputs"] = {{{"format", "png"}}, {{"format", "exr"}}};
+  for (const char* name : {"standard", "aces", "khronos_pbr_neutral", "agx"}) {
+    body["tone_map"] = name;
+    r = parseRenderRequest(body);
+    EXPECT_STREQ(radiant::api::toString(r.toneMap), name);
+    for (const auto& o : r.outputs) EXPECT_EQ(o.toneMap, r.toneMap) << name;  // copied into every output
+  }
+  for (const json& bad : {json("filmic"), json("ACES"), json("")}) {
+    body["tone_map"] = bad;
+    ApiError e = errorOf(body);
+    EXPECT_EQ(e.status, 422) << bad;
+    EXPECT_EQ(e.pointer, "/tone_map");
+  }
+  body["tone_map"] = 1;
+  EXPECT_EQ(errorOf(body).status, 400);  // the wrong type, as for every field
+  EXPECT_EQ(errorOf(body).pointer, "/tone_map");
+}
+
+TEST(Validate, BackgroundIsANameOrALinearColour) {
+  json body = minimal();
+  body["background"] = "transparent";
+  EXPECT_EQ(parseRenderRequest(body).background.kind, radiant::api::Background::Kind::Transparent);
+  body["background"] = {0.25, 0.5, 2};
+  auto r = parseRenderRequest(body);
+  EXPECT_EQ(r.background.kind, radiant::api::Background::Kind::Colour);
+  EXPECT_EQ(r.background.colour, glm::vec3(0.25f, 0.5f, 2.f));
+
+  body["background"] = "black";
+  ApiError e = errorOf(body);
+  EXPECT_EQ(e.status, 422);
+  EXPECT_EQ(e.pointer, "/background");
+  body["background"] = {0.1, 0.2};
+  e = errorOf(body);
+  EXPECT_EQ(e.status, 422);
+  EXPECT_EQ(e.pointer, "/background");
+  body["background"] = {0.1, -0.2, 0.3};
+  e = errorOf(body);
+  EXPECT_EQ(e.status, 422);
+  EXPECT_EQ(e.pointer, "/background/1");
+  body["background"] = {0.1, "x", 0.3};
+  EXPECT_EQ(errorOf(body).pointer, "/background/1");
+  body["background"] = 0.5;  // neither a name nor a colour
+  e = errorOf(body);
+  EXPECT_EQ(e.status, 400);
+  EXPECT_EQ(e.pointer, "/background");
+  EXPECT_NE(e.detail().find("a string or an array"), std::string::npos) << e.detail();
+}

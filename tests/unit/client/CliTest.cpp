@@ -183,5 +183,25 @@ TEST(Cli, RenderPassesAnOrbitCamera) {
     EXPECT_EQ(radiant(std::string("render --builtin cornell_box -o a.png --camera \"") + bad + "\" --dry-run").code, 2) << bad;
 }
 
+// issue 29, item 8: --tone-map and --background become the request's tone_map and background; neither is
+// sent unless given (the daemon's defaults apply), and a bad value is a usage error before any request.
+TEST(Cli, RenderPassesToneMapAndBackgroundIntoTheRequest) {
+  const json plain = json::parse(radiant("render --builtin cornell_box -o a.png --dry-run").out);
+  EXPECT_FALSE(plain.contains("tone_map"));
+  EXPECT_FALSE(plain.contains("background"));
+  const ProcessRun r =
+      radiant("render --builtin cornell_box -o a.png --tone-map khronos_pbr_neutral --background transparent --dry-run");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json req = json::parse(r.out);
+  EXPECT_EQ(req["tone_map"], "khronos_pbr_neutral");
+  EXPECT_EQ(req["background"], "transparent");
+  const json colour =
+      json::parse(radiant("render --builtin cornell_box -o a.png --background 0.25,0.5,1 --dry-run").out);
+  EXPECT_EQ(colour["background"], json::array({0.25, 0.5, 1.0}));
+  EXPECT_EQ(radiant("render --builtin cornell_box -o a.png --tone-map filmic --dry-run").code, 2);
+  EXPECT_EQ(radiant("render --builtin cornell_box -o a.png --background 0,-1,0 --dry-run").code, 2);
+  EXPECT_EQ(radiant("render --builtin cornell_box -o a.png --background black --dry-run").code, 2);
+}
+
 }  // namespace
 }  // namespace radiant
