@@ -2,12 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
 #include <nlohmann/json.hpp>
 
 namespace radiant::metrics {
@@ -115,28 +114,24 @@ ImageMetrics compareImages(const Image& test, const Image& reference, float expo
   const size_t pixels = static_cast<size_t>(test.width) * test.height;
 
   ImageMetrics m;
-  // Linear absolute and RMS error: OpenImageIO's compare over the colour channels.
-  {
-    const OIIO::ImageSpec spec(test.width, test.height, test.channels, OIIO::TypeDesc::FLOAT);
-    const OIIO::ImageBuf a(spec, const_cast<float*>(test.pixels.data()));
-    const OIIO::ImageBuf b(spec, const_cast<float*>(reference.pixels.data()));
-    const OIIO::ROI roi(0, test.width, 0, test.height, 0, 1, 0, nc);
-    const OIIO::ImageBufAlgo::CompareResults r = OIIO::ImageBufAlgo::compare(a, b, 1e30f, 1e30f, roi, 1);
-    if (r.error) throw std::runtime_error("compareImages(): OIIO::ImageBufAlgo::compare failed");
-    m.rmse = r.rms_error;
-    m.meanAbs = r.meanerror;
-    m.maxAbs = r.maxerror;
-  }
-
-  double relSum = 0.0, toneSum = 0.0;
+  // Every sum in double: a difference of two finite floats (up to 2 x FLT_MAX) and its square are
+  // finite there, so any finite input gives finite metrics (OpenImageIO's compare, used before, failed
+  // outright on frames holding values near FLT_MAX: a 500 for a request within the API's ranges).
+  double absSum = 0.0, sqSum = 0.0, relSum = 0.0, toneSum = 0.0;
   for (size_t i = 0; i < pixels; ++i)
     for (int c = 0; c < nc; ++c) {
       const double t = test.pixels[i * test.channels + c], r = reference.pixels[i * reference.channels + c];
-      relSum += (t - r) * (t - r) / (r * r + kRelMseEpsilon);
-      const double d = toneMap(t, exposureEV) - toneMap(r, exposureEV);
-      toneSum += d * d;
+      const double d = t - r;
+      absSum += std::abs(d);
+      sqSum += d * d;
+      m.maxAbs = std::max(m.maxAbs, std::abs(d));
+      relSum += d * d / (r * r + kRelMseEpsilon);
+      const double dt = toneMap(t, exposureEV) - toneMap(r, exposureEV);
+      toneSum += dt * dt;
     }
   const double n = static_cast<double>(pixels) * nc;
+  m.rmse = std::sqrt(sqSum / n);
+  m.meanAbs = absSum / n;
   m.relMse = relSum / n;
   const double toneMse = toneSum / n;
   if (toneMse > 0.0) m.psnr = 10.0 * std::log10(1.0 / toneMse);
@@ -175,12 +170,10 @@ Image errorMap(const Image& test, const Image& reference) {
     for (int x = 0; x < test.width; ++x) {
       const float* t = test.at(x, y);
       const float* r = reference.at(x, y);
-      float e;
-      if (test.channels >= 3)
-        e = 0.2126f * std::abs(t[0] - r[0]) + 0.7152f * std::abs(t[1] - r[1]) + 0.0722f * std::abs(t[2] - r[2]);
-      else
-        e = std::abs(t[0] - r[0]);
-      *out.at(x, y) = e;
+      // In double, stored clamped to the largest float: |FLT_MAX - (-FLT_MAX)| is not a float.
+      auto diff = [&](int c) { return std::abs(double(t[c]) - double(r[c])); };
+      const double e = test.channels >= 3 ? 0.2126 * diff(0) + 0.7152 * diff(1) + 0.0722 * diff(2) : diff(0);
+      *out.at(x, y) = static_cast<float>(std::min(e, double(std::numeric_limits<float>::max())));
     }
   return out;
 }

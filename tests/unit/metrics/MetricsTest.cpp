@@ -2,6 +2,7 @@
 // from the formulas in Metrics.h).
 #include <gtest/gtest.h>
 
+#include <cfloat>
 #include <cmath>
 #include <random>
 
@@ -110,7 +111,7 @@ TEST(Metrics, SsimMatchesFormulaAndFallsWithNoise) {
   EXPECT_LT(previous, 0.8);
 }
 
-TEST(Metrics, OiioErrorsAgreeWithDirectSums) {
+TEST(Metrics, ErrorsAgreeWithDirectSums) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> U(0.f, 4.f);
   Image a = Image::make("beauty", 23, 17, 4), b = Image::make("beauty", 23, 17, 4);
@@ -130,6 +131,30 @@ TEST(Metrics, OiioErrorsAgreeWithDirectSums) {
   EXPECT_NEAR(m.meanAbs, ab / n, 1e-6);
   EXPECT_NEAR(m.maxAbs, mx, 1e-6);
   EXPECT_NEAR(m.relMse, rel / n, 1e-6 * rel / n);
+}
+
+// Issue 30: a frame may hold any finite radiance (a 1e15 light, an HDR of 1.7e38). The metrics of
+// +-FLT_MAX against 0 and against -FLT_MAX are the closed forms, finite, and the error map holds FLT_MAX
+// where the difference (2 x FLT_MAX) is not a float.
+TEST(Metrics, ValuesNearFltMaxGiveFiniteMetrics) {
+  Image a = constant(2, 1, 0.f), b = constant(2, 1, 0.f);
+  std::fill(a.pixels.begin(), a.pixels.begin() + 3, FLT_MAX);  // pixel 0: FLT_MAX against 0
+  std::fill(a.pixels.begin() + 3, a.pixels.end(), FLT_MAX);    // pixel 1: FLT_MAX against -FLT_MAX
+  std::fill(b.pixels.begin() + 3, b.pixels.end(), -FLT_MAX);
+  const double f = FLT_MAX;
+  const ImageMetrics m = compareImages(a, b);
+  EXPECT_DOUBLE_EQ(m.maxAbs, 2 * f);
+  EXPECT_DOUBLE_EQ(m.meanAbs, (f + 2 * f) / 2);
+  EXPECT_DOUBLE_EQ(m.rmse, std::sqrt((f * f + 4 * f * f) / 2));
+  EXPECT_TRUE(std::isfinite(m.relMse));
+  EXPECT_NEAR(m.relMse, (f * f / kRelMseEpsilon + 4 * f * f / (f * f + kRelMseEpsilon)) / 2, 1e-12 * m.relMse);
+  // Tone-mapped, both pixels are white against black (a negative reference maps to 0): MSE 1, PSNR 0 dB.
+  ASSERT_TRUE(m.psnr.has_value());
+  EXPECT_NEAR(*m.psnr, 0.0, 1e-9);
+  const Image e = errorMap(a, b);
+  EXPECT_TRUE(std::isfinite(e.pixels[0]));
+  EXPECT_NEAR(e.pixels[0], f, 1e-6 * f);  // the weights sum to 1
+  EXPECT_EQ(e.pixels[1], FLT_MAX);
 }
 
 TEST(Metrics, RejectsMismatchedImages) {
