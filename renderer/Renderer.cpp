@@ -455,14 +455,13 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
   // Default lighting (renderer/scene/StudioEnvironment.h; docs/API.md, "Default lighting"): rendered
   // without ambient or environment, a scene is lit by the studio map as if the request had named it when
   // it brings no punctual light, whatever its emission (an emissive visor or screen lights little around
-  // it; every viewer shows such a model under its environment), or directional lights only (a key light
-  // meant to sit on a viewer's environment, as GlamVelvetSofa's). Point and spot lights are a lighting
-  // set-up of their own, a room such as the Cornell boxes: they stay the frame's only light.
+  // it; every viewer shows such a model under its environment). Punctual lights of any type are a lighting
+  // set-up of their own (a room such as the Cornell boxes, a sun over an analytic test scene, a key light
+  // as GlamVelvetSofa's, which the reference path tracer renders near-black too): they stay the frame's
+  // only light, so that the default frame and the reference see the same scene.
   api::RenderRequest effective = requestIn;
   FrameInputs inputs = inputsIn;
   const bool sceneLit = !scene.lights.empty() || scene.features.hasEmissive();
-  const bool onlyDirectionalLights = std::all_of(scene.lights.begin(), scene.lights.end(),
-                                                 [](const Light& l) { return l.type == LightType::Directional; });
   const bool ambientGiven = requestIn.ambient != glm::vec3(0.f);
   const std::string own = !scene.lights.empty() && scene.features.hasEmissive() ? "lights and emissive surfaces"
                           : !scene.lights.empty()                               ? "lights"
@@ -475,20 +474,18 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
   } else if (ambientGiven) {
     sky = "ambient";
     stats.lightingReason = "the request's ambient";
-  } else if (requestIn.defaultLighting && onlyDirectionalLights) {
+  } else if (requestIn.defaultLighting && scene.lights.empty()) {
     sky = "default";
     effective.environment = kStudioEnvironmentKey;
     inputs.environment = &studioEnvironment();
-    stats.lightingReason = scene.lights.empty() && !sceneLit ? "the scene has no lights or emissive surfaces"
-                           : scene.lights.empty() ? "the scene has no punctual lights (its emissive surfaces light "
-                                                    "little beyond themselves)"
-                                                  : "the scene's only lights are directional (a key light meant to "
-                                                    "sit on a viewer's environment)";
+    stats.lightingReason = !sceneLit ? "the scene has no lights or emissive surfaces"
+                                     : "the scene has no punctual lights (its emissive surfaces light little "
+                                       "beyond themselves)";
     stats.lightingReason += ", and the request names no ambient or environment";
   } else if (!requestIn.defaultLighting) {
     stats.lightingReason = "default_lighting is false";
   } else {
-    stats.lightingReason = "the scene has point or spot lights, a lighting set-up of its own (a room such as the "
+    stats.lightingReason = "the scene has punctual lights, a lighting set-up of its own (a room such as the "
                            "Cornell boxes)";
   }
   stats.lighting = sceneLit ? (sky.empty() ? "scene" : "scene+" + sky) : (sky.empty() ? "none" : sky);

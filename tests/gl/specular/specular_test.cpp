@@ -27,6 +27,9 @@ api::RenderRequest request(int w, int h, nlohmann::json specular = nlohmann::jso
   req.height = h;
   req.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty", "specular"}, false}};
   req.passes["specular"] = std::move(specular);
+  // The emitters and lights below are the whole of each oracle's light: no studio environment for the
+  // scenes whose only light is an emissive surface (docs/API.md, "Default lighting").
+  req.defaultLighting = false;
   return req;
 }
 
