@@ -20,25 +20,28 @@ glm::vec3 projectUnit(const glm::vec3& v, const glm::vec3& n) { return normalize
 
 bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
+// The welding maps' keys: 32-bit words (float bit patterns, indices), hashed with FNV-1a.
+struct WordsHash {
+  template <std::size_t N>
+  std::size_t operator()(const std::array<std::uint32_t, N>& k) const {
+    std::size_t h = 1469598103934665603ull;
+    for (std::uint32_t x : k) h = (h ^ x) * 1099511628211ull;
+    return h;
+  }
+};
+std::uint32_t floatBits(float f) {
+  std::uint32_t u = 0;
+  std::memcpy(&u, &f, sizeof u);
+  return u;
+}
+
 // Step 1: one id per set of vertices with bit-identical position, normal and uv (+0 and -0 compare
 // equal, as floats do); a vertex with a non-finite attribute equals nothing else.
 std::vector<std::uint32_t> weldIds(const std::vector<glm::vec3>& p, const std::vector<glm::vec3>& n,
                                    const std::vector<glm::vec2>& uv) {
   using Key = std::array<std::uint32_t, 8>;
-  struct KeyHash {
-    std::size_t operator()(const Key& k) const {
-      std::size_t h = 1469598103934665603ull;
-      for (std::uint32_t x : k) h = (h ^ x) * 1099511628211ull;
-      return h;
-    }
-  };
-  auto bits = [](float f) {
-    std::uint32_t u = 0;
-    if (f == 0.f) f = 0.f;  // -0 -> +0
-    std::memcpy(&u, &f, sizeof u);
-    return u;
-  };
-  std::unordered_map<Key, std::uint32_t, KeyHash> firstOf;
+  auto bits = [](float f) { return floatBits(f == 0.f ? 0.f : f); };  // -0 -> +0
+  std::unordered_map<Key, std::uint32_t, WordsHash> firstOf;
   firstOf.reserve(p.size());
   std::vector<std::uint32_t> id(p.size());
   for (std::size_t v = 0; v < p.size(); ++v) {
@@ -280,21 +283,10 @@ std::vector<glm::vec4> gltfMikkTSpaceCornerTangents(const std::vector<glm::vec3>
 TangentSplit splitVerticesByTangent(const std::vector<glm::vec4>& cornerTangents,
                                     const std::vector<std::uint32_t>& indices) {
   using Key = std::array<std::uint32_t, 5>;
-  struct KeyHash {
-    std::size_t operator()(const Key& k) const {
-      std::size_t h = 1469598103934665603ull;
-      for (std::uint32_t x : k) h = (h ^ x) * 1099511628211ull;
-      return h;
-    }
-  };
-  auto bits = [](float f) {
-    std::uint32_t u = 0;
-    std::memcpy(&u, &f, sizeof u);
-    return u;
-  };
+  const auto bits = floatBits;
   TangentSplit out;
   out.indices.resize(indices.size());
-  std::unordered_map<Key, std::uint32_t, KeyHash> vertexFor;
+  std::unordered_map<Key, std::uint32_t, WordsHash> vertexFor;
   vertexFor.reserve(indices.size());
   for (std::size_t c = 0; c < indices.size() && c < cornerTangents.size(); ++c) {
     const glm::vec4& t = cornerTangents[c];
