@@ -730,4 +730,11 @@ TEST(ServerConfig, HardeningFlagsParseWithinTheirBounds) {
   EXPECT_THROW(radiant::server::parseCommandLine({"--max-decode-bytes", "1000"}), std::invalid_argument);
   EXPECT_THROW(radiant::server::parseCommandLine({"--read-timeout", "-1"}), std::invalid_argument);
   EXPECT_THROW(radiant::server::parseCommandLine({"--max-connections", "2"}), std::invalid_argument);
+  // --speed-factor: auto (0, the default) or a pinned factor in [1/64, 64].
+  EXPECT_EQ(radiant::server::parseCommandLine({})->speedFactor, 0.0);
+  EXPECT_EQ(radiant::server::parseCommandLine({"--speed-factor", "auto"})->speedFactor, 0.0);
+  EXPECT_EQ(radiant::server::parseCommandLine({"--speed-factor", "2.5"})->speedFactor, 2.5);
+  EXPECT_EQ(radiant::server::parseCommandLine({"--speed-factor", "0.015625"})->speedFactor, 1.0 / 64);
+  for (const char* bad : {"0", "-1", "nan", "inf", "65", "0.01", "fast", ""})
+    EXPECT_THROW(radiant::server::parseCommandLine({"--speed-factor", bad}), std::invalid_argument) << bad;
 }
