@@ -1,11 +1,13 @@
 #include "server/ContentStore.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <fstream>
 #include <iostream>
 #include <system_error>
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <nlohmann/json.hpp>
@@ -96,7 +98,9 @@ bool ContentStore::put(const std::string& digest, std::string bytes) {
                         "the scene is " + std::to_string(bytes.size()) + " bytes, the scene store holds " +
                             std::to_string(maxBytes_));
   std::lock_guard lock(mutex_);
-  if (auto it = index_.find(digest); it != index_.end()) {
+  // Already there, unless its file (found at start-up, not yet verified) is refused: then stored anew.
+  if (auto it = index_.find(digest);
+      it != index_.end() && (it->second->bytes || it->second->verified || readVerifiedLocked(it->second))) {
     touch(it->second);
     return false;
   }
@@ -113,6 +117,7 @@ bool ContentStore::put(const std::string& digest, std::string bytes) {
   } else {
     e.bytes = std::make_shared<const std::string>(std::move(bytes));
   }
+  e.verified = true;
   lru_.push_front(std::move(e));
   index_[digest] = lru_.begin();
   total_ += lru_.front().info.bytes;
@@ -124,6 +129,9 @@ bool ContentStore::contains(const std::string& digest) {
   std::lock_guard lock(mutex_);
   auto it = index_.find(digest);
   if (it == index_.end()) return false;
+  // A file found at start-up is hashed on its first use, a HEAD too: a truncated or swapped file is a
+  // miss, so a client uploads the scene again instead of rendering a 404.
+  if (!it->second->bytes && !it->second->verified && !readVerifiedLocked(it->second)) return false;
   touch(it->second);
   return true;
 }
@@ -132,33 +140,58 @@ std::optional<std::string> ContentStore::get(const std::string& digest) {
   std::lock_guard lock(mutex_);
   auto it = index_.find(digest);
   if (it == index_.end()) return std::nullopt;
-  touch(it->second);
-  if (it->second->bytes) return *it->second->bytes;
-  // O_NOFOLLOW: a symlink put in place after startup is not followed either.
-  std::optional<std::string> bytes;
-  const std::string path = fileFor(*it->second).string();
-  if (const int fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC); fd >= 0) {
-    std::string data;
-    char buf[1 << 16];
-    ssize_t n;
-    while ((n = ::read(fd, buf, sizeof buf)) > 0) data.append(buf, std::size_t(n));
-    ::close(fd);
-    if (n == 0) bytes = std::move(data);
+  if (it->second->bytes) {
+    touch(it->second);
+    return *it->second->bytes;
   }
-  // The file must still be what its name says: anything else (edited, truncated, swapped) is
-  // forgotten and removed rather than served or decoded.
-  const bool intact = bytes && api::sceneDigest(*bytes) == digest;
-  if (!intact) {
-    std::cerr << "{\"event\":\"cache_file_refused\",\"reason\":\"" << (bytes ? "digest mismatch" : "unreadable")
-              << "\",\"digest\":\"" << digest << "\"}\n";
-    std::error_code ec;
-    if (bytes) fs::remove(path, ec);
-    total_ -= it->second->info.bytes;
-    lru_.erase(it->second);
-    index_.erase(it);
-    return std::nullopt;
-  }
+  std::optional<std::string> bytes = readVerifiedLocked(it->second);
+  if (bytes) touch(it->second);
   return bytes;
+}
+
+std::optional<std::string> ContentStore::readVerifiedLocked(std::list<Entry>::iterator it) {
+  const std::string path = fileFor(*it).string();
+  const std::string digest = it->info.digest;
+  std::optional<std::string> bytes;
+  const char* reason = "unreadable";
+  bool regular = false;
+  // O_NOFOLLOW: a symlink put in place after start-up is not followed. O_NONBLOCK: opening a FIFO
+  // returns at once (a blocking open would wait for a writer, holding the store's lock).
+  if (const int fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC); fd >= 0) {
+    struct stat st {};
+    if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+      reason = "not a regular file";
+    } else if (static_cast<std::uint64_t>(st.st_size) != it->info.bytes) {
+      regular = true;
+      reason = "size changed";
+    } else {
+      regular = true;
+      std::string data;
+      data.reserve(it->info.bytes);
+      char buf[1 << 16];
+      ssize_t n;
+      // At most the recorded size (+1 to see growth during the read).
+      while (data.size() <= it->info.bytes && (n = ::read(fd, buf, sizeof buf)) > 0) data.append(buf, std::size_t(n));
+      if (data.size() == it->info.bytes && api::sceneDigest(data) == digest) bytes = std::move(data);
+      else reason = "digest mismatch";
+    }
+    ::close(fd);
+  }
+  if (bytes) {
+    it->verified = true;
+    return bytes;
+  }
+  // Anything else (edited, truncated, grown, swapped, replaced by a FIFO) is forgotten rather than
+  // served or decoded; a regular file is removed.
+  std::cerr << "{\"event\":\"cache_file_refused\",\"reason\":\"" << reason << "\",\"digest\":\"" << digest << "\"}\n";
+  if (regular) {
+    std::error_code ec;
+    fs::remove(path, ec);
+  }
+  total_ -= it->info.bytes;
+  index_.erase(digest);
+  lru_.erase(it);
+  return std::nullopt;
 }
 
 std::vector<StoredBlobInfo> ContentStore::list() {

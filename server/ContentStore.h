@@ -4,6 +4,12 @@
 // Bounded in bytes with least-recently-used eviction. With a cache directory the bytes live in
 // <dir>/<kind>/<hex>.<format> (written atomically, mtime = last use) and survive restarts;
 // without one they live in memory. Thread-safe.
+//
+// A cache file is read only when it is still the regular file of the size the store recorded (opened
+// without following symlinks and without blocking, so a FIFO or device planted under a digest's name
+// neither blocks the store nor is read; a file grown to any size is refused before a byte is read), and
+// served only when its bytes hash to its name. A file found at start-up is verified on its first use,
+// HEAD (contains) included; a refused file is a miss: forgotten, and removed when it is a regular file.
 
 #include <cstddef>
 #include <filesystem>
@@ -41,10 +47,13 @@ private:
   struct Entry {
     StoredBlobInfo info;
     std::shared_ptr<const std::string> bytes;  // in memory (no cache dir)
+    bool verified = false;                     // its file was written or hashed by this process
   };
   std::filesystem::path fileFor(const Entry& e) const;
   void touch(std::list<Entry>::iterator it);
   void evictLocked(const std::string& keep);
+  // The entry's file, checked as above; nullopt (and the entry forgotten) when it is refused.
+  std::optional<std::string> readVerifiedLocked(std::list<Entry>::iterator it);
 
   std::filesystem::path dir_;  // "" = memory only
   std::size_t maxBytes_;

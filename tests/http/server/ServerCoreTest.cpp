@@ -1,5 +1,7 @@
 // The server core in-process, with the fake backend: routes, error model, queue, cancel, timeouts,
 // scene store, metrics, shutdown. Talks real HTTP on an ephemeral loopback port.
+#include <sys/stat.h>
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -537,6 +539,43 @@ TEST(ServerCore, ContentStoreSurvivesRestart) {
     ASSERT_EQ(r->status, 200) << r->body;
     EXPECT_EQ(body(r)["stats"]["triangles"], scene.size());
   }
+  std::filesystem::remove_all(dir);
+}
+
+// Issue 30: the cache directory reads only the regular files it wrote, checks their size before
+// reading and their digest on first use, HEAD included; anything else is a miss (404), never a hang.
+TEST(ServerCore, ContentStoreRefusesTamperedCacheFilesAsMisses) {
+  const auto dir = tempDir("tamper");
+  ServerConfig config;
+  config.cacheDir = dir.string();
+  auto sceneOf = [](int i) { return R"({"asset":{"version":"2.0"},"extras":{"i":)" + std::to_string(i) + "}}"; };
+  auto fileOf = [&](int i) { return dir / "scenes" / (radiant::api::sceneDigest(sceneOf(i)).substr(7) + ".gltf"); };
+  auto head = [&](httplib::Client& c, int i) { return c.Head(("/v1/scenes/" + radiant::api::sceneDigest(sceneOf(i))).c_str())->status; };
+  {
+    TestServer s(config);
+    auto c = s.client();
+    for (int i = 1; i <= 4; ++i) ASSERT_EQ(c.Put("/v1/scenes", sceneOf(i), "model/gltf+json")->status, 201);
+  }
+  // Before the restart: scene 1 truncated (its recorded size is then the truncated one: the digest catches it).
+  std::filesystem::resize_file(fileOf(1), 10);
+  TestServer s(config);
+  s.waitReady();
+  auto c = s.client();
+  // After the restart: scene 2 grows, scene 3 becomes a FIFO (a blocking open would hang the store).
+  { std::ofstream(fileOf(2), std::ios::app) << std::string(4096, ' '); }
+  std::filesystem::remove(fileOf(3));
+  ASSERT_EQ(::mkfifo(fileOf(3).c_str(), 0600), 0);
+  EXPECT_EQ(head(c, 1), 404) << "truncated: digest mismatch";
+  EXPECT_EQ(head(c, 2), 404) << "grown: size changed";
+  EXPECT_EQ(head(c, 3), 404) << "a FIFO: not a regular file";
+  EXPECT_EQ(head(c, 4), 200) << "intact";
+  EXPECT_FALSE(std::filesystem::exists(fileOf(1)));
+  EXPECT_FALSE(std::filesystem::exists(fileOf(2)));
+  EXPECT_TRUE(std::filesystem::is_fifo(fileOf(3))) << "not the store's file: left alone";
+  // A miss is a miss: the scene can be stored again and rendered.
+  EXPECT_EQ(c.Put("/v1/scenes", sceneOf(1), "model/gltf+json")->status, 201);
+  EXPECT_EQ(head(c, 1), 200);
+  s.stop();
   std::filesystem::remove_all(dir);
 }
 
