@@ -47,7 +47,8 @@ ContentStore::ContentStore(fs::path cacheDir, std::size_t maxBytes, const std::s
     }
     const std::string ext = f.path().extension().string();
     const std::string digest = "sha256:" + f.path().stem().string();
-    const bool known = ext == ".glb" || ext == ".gltf" || ext == ".exr" || ext == ".hdr" || ext == ".png";
+    // Each store holds its own formats: a glTF under images/ (or an image under scenes/) is not its file.
+    const bool known = kind == "images" ? ext == ".exr" || ext == ".hdr" || ext == ".png" : ext == ".glb" || ext == ".gltf";
     if (!known || !api::isSceneDigest(digest)) {
       if (f.path().filename().string().rfind(".tmp-", 0) == 0) fs::remove(f.path());  // an interrupted write
       continue;
@@ -172,8 +173,9 @@ std::optional<std::string> ContentStore::readVerifiedLocked(std::list<Entry>::it
       ssize_t n;
       // At most the recorded size (+1 to see growth during the read).
       while (data.size() <= it->info.bytes && (n = ::read(fd, buf, sizeof buf)) > 0) data.append(buf, std::size_t(n));
-      if (data.size() == it->info.bytes && api::sceneDigest(data) == digest) bytes = std::move(data);
-      else reason = "digest mismatch";
+      if (data.size() != it->info.bytes || api::sceneDigest(data) != digest) reason = "digest mismatch";
+      else if (formatOf(data) != it->info.format) reason = "format mismatch";  // e.g. JSON named <its digest>.png
+      else bytes = std::move(data);
     }
     ::close(fd);
   }

@@ -688,7 +688,8 @@ struct HttpServer::Impl {
       res.status = 200;
       if (req.method == "HEAD") return;
       static const std::map<std::string, std::string> kMime{{"exr", "image/x-exr"}, {"hdr", "image/vnd.radiance"}, {"png", "image/png"}};
-      res.set_content(*bytes, kMime.at(ContentStore::formatOf(*bytes)));
+      const auto mime = kMime.find(ContentStore::formatOf(*bytes));  // the store holds only these formats
+      res.set_content(*bytes, mime != kMime.end() ? mime->second : "application/octet-stream");
     }));
 
     http.Post("/v1/renders", wrapBody([this](const httplib::Request& req, const std::string& requestBody, httplib::Response& res) {

@@ -572,6 +572,20 @@ TEST(ServerCore, ContentStoreRefusesTamperedCacheFilesAsMisses) {
   EXPECT_FALSE(std::filesystem::exists(fileOf(1)));
   EXPECT_FALSE(std::filesystem::exists(fileOf(2)));
   EXPECT_TRUE(std::filesystem::is_fifo(fileOf(3))) << "not the store's file: left alone";
+  // A file in images/ named by its own digest but not an image, under an image's or a scene's extension.
+  const std::string json = sceneOf(5), hex = radiant::api::sceneDigest(json).substr(7);
+  for (const char* ext : {".png", ".gltf"}) {
+    std::filesystem::create_directories(dir / "images");
+    { std::ofstream(dir / "images" / (hex + ext), std::ios::binary) << json; }
+  }
+  {
+    TestServer again(config);
+    again.waitReady();
+    auto c2 = again.client();
+    const auto r = c2.Get(("/v1/images/" + radiant::api::sceneDigest(json)).c_str());
+    EXPECT_EQ(r->status, 404) << r->body;
+    again.stop();
+  }
   // A miss is a miss: the scene can be stored again and rendered.
   EXPECT_EQ(c.Put("/v1/scenes", sceneOf(1), "model/gltf+json")->status, 201);
   EXPECT_EQ(head(c, 1), 200);
