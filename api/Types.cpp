@@ -30,6 +30,7 @@ void to_json(nlohmann::json& j, const FrameStats& s) {
   nlohmann::json passes = nlohmann::json::array();
   for (const auto& p : s.passes) passes.push_back(p);
   j = nlohmann::json{{"passes", passes},
+                     {"pass_timing", s.passTiming},
                      {"skipped", s.skipped},
                      {"light_paths", s.lightPaths},
                      {"cache", cache},

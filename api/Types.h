@@ -161,6 +161,9 @@ struct ClampedValues {
 
 struct FrameStats {
   std::vector<PassStats> passes;
+  // How passes[].gpu_ms was measured: "timer_query" (GL_TIME_ELAPSED per pass, hardware devices) or
+  // "finish_bracketed" (wall time between glFinish before and after the pass, software devices).
+  std::string passTiming;
   std::map<std::string, std::string> skipped;  // pass name -> reason
   std::map<std::string, std::string> lightPaths;  // light-path class -> technique that supplies it
   std::vector<CacheEvent> cache;

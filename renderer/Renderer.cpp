@@ -338,6 +338,8 @@ struct Renderer::Impl {
 
 Renderer::Renderer(const DeviceOptions& options) : impl_(std::make_unique<Impl>()) {
   impl_->device = EglDevice::create(options);
+  // Per-pass times (GpuProfiler.h): timer queries on a hardware device, glFinish brackets on a software one.
+  impl_->profiler = GpuProfiler(impl_->device->info().software ? GpuProfiler::Method::Finish : GpuProfiler::Method::TimerQuery);
   // Reversed-Z needs the [0,1] clip-space depth range (FrameView.h).
   glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
   glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
@@ -447,6 +449,7 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
   const DeviceInfo& dev = im.device->info();
   stats.device = {{"vendor", dev.vendor}, {"renderer", dev.renderer}, {"version", dev.version},
                   {"platform", dev.platform}, {"reason", dev.reason}};
+  stats.passTiming = im.profiler.methodName();
   stats.triangles = scene.features.triangles;
   stats.lights = static_cast<int>(scene.lights.size());
   stats.scene = sceneStats(scene);
@@ -671,7 +674,7 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
   } catch (...) {
     // An environment failure may leave GL objects in any state: drop derived data so the next frame
     // rebuilds from scratch, and drain the GL error queue.
-    im.profiler = GpuProfiler{};
+    im.profiler = GpuProfiler(im.profiler.method());
     im.resources.clear();
     im.gpuScenes.clear();
     while (glGetError() != GL_NO_ERROR) {

@@ -4,16 +4,32 @@
 
 namespace radiant {
 
-GpuProfiler::Scope::Scope(GpuProfiler& p, api::PassStats& stats) : profiler_(p), stats_(stats) {
-  if (p.used_ == p.pool_.size()) p.pool_.emplace_back("pass timer " + std::to_string(p.used_));
-  slot_ = p.used_++;
-  p.pool_[slot_].begin();
+namespace {
+double msSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+}  // namespace
+
+GpuProfiler::Scope::Scope(GpuProfiler& p, api::PassStats& stats) : profiler_(p), slot_(0), stats_(stats) {
+  if (p.method_ == Method::Finish) {
+    glFinish();  // the earlier passes' work is theirs
+  } else {
+    if (p.used_ == p.pool_.size()) p.pool_.emplace_back("pass timer " + std::to_string(p.used_));
+    slot_ = p.used_++;
+    p.pool_[slot_].begin();
+  }
   start_ = std::chrono::steady_clock::now();
 }
 
 GpuProfiler::Scope::~Scope() {
+  if (profiler_.method_ == Method::Finish) {
+    stats_.cpuMs = msSince(start_);
+    glFinish();
+    stats_.gpuMs = msSince(start_);
+    return;
+  }
   profiler_.pool_[slot_].end();
-  stats_.cpuMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_).count();
+  stats_.cpuMs = msSince(start_);
   profiler_.pending_.emplace_back(slot_, &stats_);
 }
 
