@@ -122,7 +122,7 @@ double predictFrameMs(const PresetTable& table, const std::vector<std::string>& 
 // keeps one stray frame (a page-in, a burst of load) from moving the chooser; the window lets the
 // factor follow the machine's load within a few frames. The Renderer decides which frames are
 // comparable with the table (a frame compiling shaders or uploading its scene is not, nor one reusing
-// seed-keyed derived data the table's cost sweeps traced cold): see Renderer.cpp, observeSpeed.
+// seed-keyed derived data the table's cost sweeps traced cold): see Renderer.cpp, comparableWithPresetTable.
 class MachineSpeed {
 public:
   static constexpr std::size_t kWindow = 9;

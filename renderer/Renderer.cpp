@@ -350,8 +350,6 @@ Renderer::~Renderer() = default;
 
 void Renderer::setSpeedFactor(double factor) { impl_->speed.pin(factor); }
 
-nlohmann::json Renderer::speed() const { return impl_->speed.toJson(); }
-
 // The speed factor's calibration (api::MachineSpeed): the preset table's canonical frame, the built-in
 // Cornell box at the table's error size with photon_gi's cheapest front point, rendered twice with
 // fresh seeds: the first compiles the shaders and uploads the scene, the second is timed against the

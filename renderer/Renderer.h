@@ -91,8 +91,6 @@ public:
   // 0 measures it: a calibration frame before the first frame with a time budget, then the ratio of
   // measured to predicted time of recent frames comparable with the preset table. Default 0.
   void setSpeedFactor(double factor);
-  // What the chooser's speed factor is now and what it was measured from (MachineSpeed::toJson).
-  nlohmann::json speed() const;
 
 private:
   void calibrateSpeed();
