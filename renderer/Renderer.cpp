@@ -25,11 +25,25 @@
 #include "renderer/scene/BuiltinScenes.h"
 #include "renderer/scene/CostCounts.h"
 #include "renderer/scene/StudioEnvironment.h"
+#include "renderer/shading/DirectLighting.h"
+#include "renderer/shading/EnvironmentLights.h"
 #include "renderer/techniques/reference/ReferencePass.h"
 #include "renderer/techniques/Registry.h"
 
 namespace radiant {
 namespace {
+
+// The split's options from `direct`'s parameters (api/schema/techniques/direct.json): they decide
+// what `direct` lights with, and photon_gi and image-based lighting follow.
+EnvironmentLightOptions environmentLightOptions(const api::RenderRequest& request) {
+  EnvironmentLightOptions o;
+  const auto it = request.passes.find("direct");
+  if (it != request.passes.end() && it->second.is_object()) {
+    o.maxLights = it->second.value("environment_lights", o.maxLights);
+    o.threshold = it->second.value("environment_light_threshold", o.threshold);
+  }
+  return o;
+}
 
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
@@ -317,6 +331,28 @@ struct Renderer::Impl {
   } lastFrame;
   std::unique_ptr<Scene> calibrationScene;
 
+  // The raster's split of recent environment maps (renderer/shading/EnvironmentLights.h), most recent
+  // last: derived data of the map and the options only, computed once per change of either.
+  std::vector<std::pair<std::string, std::shared_ptr<const EnvironmentLights>>> environmentSplits;
+
+  std::shared_ptr<const EnvironmentLights> environmentLights(const FrameView& view, const EnvironmentLightOptions& o,
+                                                             api::FrameStats& stats) {
+    const Image& map = *view.environment;
+    const std::string key = view.environmentKey + "|" + std::to_string(map.width) + "x" + std::to_string(map.height) +
+                            "|" + o.key();
+    auto it = std::find_if(environmentSplits.begin(), environmentSplits.end(), [&](const auto& e) { return e.first == key; });
+    const bool hit = it != environmentSplits.end();
+    stats.cache.push_back({"environment_lights", hit});
+    if (hit) {
+      std::rotate(it, it + 1, environmentSplits.end());
+      return environmentSplits.back().second;
+    }
+    auto split = std::make_shared<const EnvironmentLights>(extractEnvironmentLights(map, o));
+    while (environmentSplits.size() >= 4) environmentSplits.erase(environmentSplits.begin());
+    environmentSplits.emplace_back(key, split);
+    return split;
+  }
+
   const GpuScene& gpuScene(const Scene& scene, api::FrameStats& stats) {
     const std::string key = scene.digest.empty() ? "addr:" + std::to_string(reinterpret_cast<std::uintptr_t>(&scene))
                                                  : scene.digest;
@@ -515,6 +551,18 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     supersampled.height *= k;
     FrameView supersampledView = makeFrameView(scene, supersampled, inputs.environment);
     supersampledView.supersampling = k;
+    // The environment's compact bright regions become shadowed directional lights of the raster when
+    // `direct` runs to light with them (docs/TECHNIQUES.md, "Environment lights"); the reference and
+    // the background keep the whole map.
+    const bool directPlanned =
+        std::any_of(plan.passes.begin(), plan.passes.end(), [](const Technique* t) { return t->info().name == "direct"; });
+    if (supersampledView.environment && directPlanned) {
+      const EnvironmentLightOptions o = environmentLightOptions(request);
+      supersampledView.environmentLights = im.environmentLights(supersampledView, o, stats);
+      supersampledView.environmentLightsKey = o.key();
+      const auto& taken = supersampledView.environmentLights->lights;
+      supersampledView.lights.insert(supersampledView.lights.end(), taken.begin(), taken.end());
+    }
     const FrameView& view = supersampledView;
     FrameView outView = view;
     outView.width = request.width;
@@ -533,6 +581,7 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     im.resources.setSharedResources(sharedResources(all));
     allocateDeclaredOutputs(im.resources, plan.passes);
     declareEnvironmentMap(im.resources, view);
+    declareFrameLights(im.resources, view);
     im.profiler.beginFrame();
     // PassStats must not move while the profiler holds pointers to them.
     stats.passes.resize(plan.passes.size());

@@ -38,6 +38,8 @@ FrameView makeFrameView(const Scene& scene, const api::RenderRequest& request, c
   v.exposure = request.exposure;
   v.seed = request.seed;
   v.ambient = request.ambient;
+  v.lights = scene.lights;
+  v.sceneLights = static_cast<int>(scene.lights.size());
   v.media = scene.media;
   v.media.insert(v.media.end(), request.media.begin(), request.media.end());
   if (!v.media.empty()) v.mediaKey = api::mediaDigest(v.media);

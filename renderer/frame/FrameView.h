@@ -4,12 +4,14 @@
 // depth buffer with glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE). Floating-point precision is then
 // nearly uniform in log depth, so scenes at 1e-3 m and 1e4 m scale render alike.
 #include <cstdint>
+#include <memory>
 
 #include <glm/glm.hpp>
 
 #include "api/Types.h"
 #include "renderer/Image.h"
 #include "renderer/scene/Scene.h"
+#include "renderer/shading/EnvironmentLights.h"
 
 namespace radiant {
 
@@ -27,6 +29,22 @@ struct FrameView {
   glm::vec3 ambient{0.f};              // uniform sky radiance: request.ambient, or the map's average
   const Image* environment = nullptr;  // equirect radiance map (renderer/scene/Environment.h), or null
   std::string environmentKey;          // its digest, for cache keys
+  // The raster's split of the map (renderer/shading/EnvironmentLights.h): its compact bright regions as
+  // directional lights, which `direct` shadows, and the map without them (the residual), which
+  // image-based lighting integrates and photon_gi splats at first hits. Null, or without lights, when
+  // nothing was taken. The background and the reference see `environment` itself.
+  std::shared_ptr<const EnvironmentLights> environmentLights;
+  std::string environmentLightsKey;    // its options' key (with environmentKey: the split's digest)
+  // The frame's lights: the scene's (same indices as scene.lights), then the environment's.
+  std::vector<Light> lights;
+  int sceneLights = 0;  // how many of `lights` are the scene's
+  // What image-based lighting integrates: the residual when the map was split, else the map.
+  const Image* lightingEnvironment() const {
+    return environmentLights && environmentLights->split() ? &environmentLights->residual : environment;
+  }
+  std::string lightingEnvironmentKey() const {
+    return environmentLights && environmentLights->split() ? environmentKey + "|" + environmentLightsKey : environmentKey;
+  }
   glm::vec3 target{0.f};               // the point looked at (for stats.camera)
   std::string cameraSource;            // "file", "auto", "request", or "request+file" / "request+auto" when partial
   // The frame's participating media: the scene's particle systems, then the request's (api/Media.h),

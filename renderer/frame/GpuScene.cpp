@@ -17,7 +17,7 @@ gpu::Light toGpuLight(const Light& l) {
   g.directionRange = glm::vec4(glm::normalize(l.direction), l.range);
   g.radiantIntensity = glm::vec4(l.color * l.intensity, 0.f);
   // KHR_lights_punctual: the smooth falloff runs between cos(outer) and cos(inner).
-  g.spotCone = glm::vec4(std::cos(l.outerConeAngle), std::cos(l.innerConeAngle), 0.f, 0.f);
+  g.spotCone = glm::vec4(std::cos(l.outerConeAngle), std::cos(l.innerConeAngle), l.angularRadius, 0.f);
   return g;
 }
 

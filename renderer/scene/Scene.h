@@ -172,6 +172,9 @@ struct Light {
   float outerConeAngle = 0.7853981634f;  // pi/4, glTF default
   glm::vec3 position{0.f};              // world space (point, spot)
   glm::vec3 direction{0.f, 0.f, -1.f};  // world space, the direction light travels (node's -Z)
+  // Directional lights taken from an environment map (renderer/shading/EnvironmentLights.h): the radius
+  // of the cone they subtend, in radians; 0 for glTF's punctual lights.
+  float angularRadius = 0.f;
 };
 
 enum class ProjectionType { Perspective, Orthographic };

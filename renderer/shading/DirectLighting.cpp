@@ -1,5 +1,9 @@
 #include "renderer/shading/DirectLighting.h"
 
+#include <algorithm>
+
+#include "renderer/frame/FrameView.h"
+
 namespace radiant {
 
 void declareDirectLightingResources(FrameResources& res) {
@@ -10,11 +14,21 @@ void declareDirectLightingResources(FrameResources& res) {
   if (!res.hasBuffer("shadow_info")) res.buffer("shadow_info", sizeof(gpu::ShadowInfo));
 }
 
+void declareFrameLights(FrameResources& res, const FrameView& view) {
+  std::vector<gpu::Light> lights;
+  for (const Light& l : view.lights) lights.push_back(toGpuLight(l));
+  if (lights.empty()) lights.push_back(gpu::Light{});  // a zero-size SSBO is not bindable
+  gl::Buffer& b = res.buffer("frame_lights", lights.size() * sizeof(gpu::Light));
+  b.upload(lights.data(), lights.size() * sizeof(gpu::Light));
+}
+
 void bindDirectLighting(const gl::Program& program, FrameResources& res, const GpuScene& gpu, int lightCount,
                         int pcfRadius) {
   res.texture("shadow_cube").bindUnit(gpu::kUnitShadowCube);
   res.texture("shadow_2d").bindUnit(gpu::kUnitShadow2D);
   gpu.bindSceneBuffers();
+  if (res.hasBuffer("frame_lights")) res.buffer("frame_lights").bindBase(GL_SHADER_STORAGE_BUFFER, GpuScene::kLightBinding);
+  program.set("u_sceneLightCount", std::min(lightCount, res.view().sceneLights));
   res.buffer("shadow_info").bindBase(GL_SHADER_STORAGE_BUFFER, 2);
   program.set("u_lightCount", lightCount);
   program.set("u_hasShadows", res.written("shadow_maps") ? 1 : 0);

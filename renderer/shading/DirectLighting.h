@@ -12,6 +12,11 @@ namespace radiant {
 // Declares 1x1 placeholders for the shadow resources when the shadow_maps pass did not run, so the
 // samplers are complete. Call from prepare().
 void declareDirectLightingResources(FrameResources& resources);
+// The frame's lights as the GPU reads them ("frame_lights": the scene's, then the environment's,
+// FrameView::lights); the Renderer uploads it before the passes, bindDirectLighting binds it.
+void declareFrameLights(FrameResources& resources, const FrameView& view);
+// `lightCount`: how many of the frame's lights to shade with (the scene's alone, ctx.scene.lights.size(),
+// or with the environment's, ctx.view.lights.size()).
 void bindDirectLighting(const gl::Program& program, FrameResources& resources, const GpuScene& gpu,
                         int lightCount, int pcfRadius);
 

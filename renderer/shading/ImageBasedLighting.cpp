@@ -231,8 +231,9 @@ void prepare(FrameResources& res) {
   glTextureParameteri(pre.id(), GL_TEXTURE_WRAP_S, GL_REPEAT);
   glTextureParameteri(pre.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
   if (view.environment) {
-    const Image& env = *view.environment;
-    const std::string key = view.environmentKey + "|" + std::to_string(env.width) + "x" + std::to_string(env.height);
+    // The map without the lights `direct` shades with shadows (FrameView::lightingEnvironment).
+    const Image& env = *view.lightingEnvironment();
+    const std::string key = view.lightingEnvironmentKey() + "|" + std::to_string(env.width) + "x" + std::to_string(env.height);
     // The levels live in the shared texture: prefiltered again when it holds another map's (a frame
     // with another environment since; FrameResources::holds).
     if (!res.holds("ibl_prefiltered", key)) {
@@ -257,11 +258,11 @@ void bind(FrameResources& res, const gl::Program& program, int dfgUnit, int pref
   program.set("u_iblUniform", &view.ambient[0], 3);
   std::array<glm::vec3, 9> sh{};
   if (mode == kMap) {
-    const std::string key = view.environmentKey + "|" + std::to_string(view.environment->width) + "x" +
-                            std::to_string(view.environment->height);
+    const Image& env = *view.lightingEnvironment();
+    const std::string key = view.lightingEnvironmentKey() + "|" + std::to_string(env.width) + "x" + std::to_string(env.height);
     sh = res.cached<ShCoefficients>("ibl_sh", key, [&] {
       auto s = std::make_unique<ShCoefficients>();
-      s->c = irradianceSh(*view.environment);
+      s->c = irradianceSh(env);
       return s;
     }).c;
   } else {

@@ -9,6 +9,7 @@
 layout(binding = kUnitShadowCube) uniform samplerCubeArray t_shadowCube;
 layout(binding = kUnitShadow2D) uniform sampler2DArray t_shadow2D;
 uniform int u_lightCount;
+uniform int u_sceneLightCount;  // lights[u_sceneLightCount ..] are the environment's (EnvironmentLights.h)
 uniform int u_hasShadows;
 uniform int u_pcfRadius;
 
@@ -60,18 +61,31 @@ float shadowVisibility(int li, vec3 p, vec3 ng, float lightDist) {
   return lit / count;
 }
 
-// Sum over lights of f(wi, wo) cos(theta_i) E_light V_shadow (no emission). n is the shading normal
-// (facing wo), ng the geometric normal on the same side (used for the shadow normal offset).
-// nc is the clear coat's normal (KHR_materials_clearcoat; n when there is no coat).
-vec3 directLighting(vec3 p, vec3 n, vec3 nc, vec3 ng, vec3 wo, MaterialParams material) {
+// Sum over the first `count` lights of f(wi, wo) cos(theta_i) E_light V_shadow (no emission). n is the
+// shading normal (facing wo), ng the geometric normal on the same side (used for the shadow normal
+// offset). nc is the clear coat's normal (KHR_materials_clearcoat; n when there is no coat).
+// A light with an angular radius (an environment light: a disc of the sky, not a delta) is reflected
+// by a lobe at least as wide as the disc's mirror image: GGX's D falls to half at tan(theta_h) = 0.64
+// alpha, and the disc's half-vectors reach radius / 2, so alpha >= 0.78 radius (roughness = sqrt).
+vec3 directLighting(vec3 p, vec3 n, vec3 nc, vec3 ng, vec3 wo, MaterialParams material, int count) {
   vec3 L = vec3(0.0);
-  for (int i = 0; i < u_lightCount; ++i) {
+  for (int i = 0; i < count; ++i) {
     LightSample s = sampleLight(lights[i], p);
-    vec3 f = gltfBsdfCos(n, nc, wo, s.wi, material, material.surface.w);
+    MaterialParams m = material;
+    float radius = lights[i].spotCone.z;
+    if (radius > 0.0) {
+      float floorRoughness = sqrt(0.78 * radius);
+      m.surface.y = max(m.surface.y, floorRoughness);
+      m.clearcoat.y = max(m.clearcoat.y, floorRoughness);
+    }
+    vec3 f = gltfBsdfCos(n, nc, wo, s.wi, m, m.surface.w);
     if (all(equal(f, vec3(0.0)))) continue;
     L += f * s.intensity * shadowVisibility(i, p, ng, s.dist);
   }
   return L;
+}
+vec3 directLighting(vec3 p, vec3 n, vec3 nc, vec3 ng, vec3 wo, MaterialParams material) {
+  return directLighting(p, n, nc, ng, wo, material, u_lightCount);
 }
 vec3 directLighting(vec3 p, vec3 n, vec3 ng, vec3 wo, MaterialParams material) {
   return directLighting(p, n, n, ng, wo, material);

@@ -100,7 +100,7 @@ struct Light {
   vec4 positionType;      // xyz world position, w type
   vec4 directionRange;    // xyz direction light travels (unit), w range (0 = infinite)
   vec4 radiantIntensity;  // rgb = color * intensity, w unused
-  vec4 spotCone;          // x cos(outer), y cos(inner), zw unused
+  vec4 spotCone;          // x cos(outer), y cos(inner), z angular radius (environment lights), w unused
 };
 
 // Written by the shadow_maps pass, one per light (same index as Light).

@@ -70,12 +70,13 @@ void main() {
   vec3 nc = decodeLayers(texelFetch(t_layers, px, 0), params);
   float ncv = dot(nc, wo);
   if (ncv < 1e-3) nc = normalize(nc + wo * (1e-3 - ncv));
-  vec3 L = emission + directLighting(p, n, nc, ng, wo, params);
   // The environment's specular reflection (split-sum), times the material's baked occlusion: light
   // path L(sky)GE, which this pass owns (u_iblMode is IBL_NONE otherwise). Mirror-like metals and
   // transmissive materials belong to the specular pass (Material::isSpecular(), the same per-material
-  // rule the planner and that pass use; the G-buffer carries it in ng.w).
+  // rule the planner and that pass use; the G-buffer carries it in ng.w): it sees the whole map in
+  // their reflections, the environment's lights (after the scene's) included, so they are not added here.
   bool specularOwned = ngOwned.w > 0.5;
+  vec3 L = emission + directLighting(p, n, nc, ng, wo, params, specularOwned ? u_sceneLightCount : u_lightCount);
   if (u_iblMode != IBL_NONE && !specularOwned)
     L += mat.z * iblSpecular(t_dfg, t_prefiltered, n, nc, wo, params);
   o_direct = vec4(L, 1.0);

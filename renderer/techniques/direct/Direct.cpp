@@ -60,7 +60,7 @@ void DirectPass::execute(PassContext& ctx) {
   res.texture("gbuffer_specular").bindUnit(gpu::kUnitGbufferSpecular);
   const gl::Program& prog = ctx.shaders.program({"common/fullscreen.vert", "direct/direct.frag"});
   prog.use();
-  bindDirectLighting(prog, res, ctx.gpu, static_cast<int>(ctx.scene.lights.size()), pcfRadius_);
+  bindDirectLighting(prog, res, ctx.gpu, static_cast<int>(ctx.view.lights.size()), pcfRadius_);
   res.texture(kEnvironmentMap).bindUnit(gpu::kUnitEnvironment);
   ibl::bind(res, prog, gpu::kUnitIblDfg, gpu::kUnitIblPrefiltered);
   // The environment's specular lobe (split-sum) is the light path L(sky)GE: added only when this pass
@@ -76,6 +76,11 @@ void DirectPass::execute(PassContext& ctx) {
   prog.set("u_background", &view.ambient[0], 3);
   glDrawArrays(GL_TRIANGLES, 0, 3);
   ctx.stats.counters["lights"] = static_cast<double>(ctx.scene.lights.size());
+  // The environment's compact bright regions this pass lit as shadowed lights, and their share of the
+  // map's power (renderer/shading/EnvironmentLights.h; the rest is image-based lighting's).
+  const auto& split = view.environmentLights;
+  ctx.stats.counters["environment_lights"] = split ? static_cast<double>(split->lights.size()) : 0.0;
+  ctx.stats.counters["environment_light_share"] = split ? split->fraction : 0.0;
   ctx.stats.counters["ibl_mode"] = iblSpecular ? ibl::modeFor(res) : 0;
   res.markWritten("direct");
   res.markWritten("beauty");

@@ -143,7 +143,9 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
                                    {"sky_glossy", ownsSkyGlossy}, {"leave_narrow_lobe_paths", leaveNarrowLobePaths},
                                    {"caustics", ownsCaustics},
                                    {"ppm", s.ppm}, {"alpha", s.ppmAlpha}, {"base", s.ppmBase},
-                                   {"renormalize", splat_.renormalize}};
+                                   {"renormalize", splat_.renormalize},
+                                   {"environment_lights", view.environmentLights && view.environmentLights->split()
+                                                              ? view.lightingEnvironmentKey() : ""}};
   upload_ = false;
   rebuilt_ = false;
   buildMs_ = 0.0;
@@ -185,7 +187,14 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
       if (!splatted(r) || !(h[r.mesh] > 0.f)) continue;
       const bool diffuseOnly = r.bounce == 0 && !ownsSkyGlossy &&
                                lights.emitters()[r.light].kind == rt::SceneLights::Kind::Environment;
-      out.push_back(photon_gi::photonSplat(r.position, h[r.mesh], r.normal, r.wi, r.flux * invPhotons, diffuseOnly));
+      // The sky's first hits carry only the residual's light: the environment's lights are `direct`'s,
+      // with shadow maps (renderer/shading/EnvironmentLights.h); later bounces carry the whole map.
+      const float share = r.bounce == 0 && view.environmentLights && view.environment &&
+                                  lights.emitters()[r.light].kind == rt::SceneLights::Kind::Environment
+                              ? view.environmentLights->residualShare(*view.environment, r.wi)
+                              : 1.f;
+      if (!(share > 0.f)) continue;
+      out.push_back(photon_gi::photonSplat(r.position, h[r.mesh], r.normal, r.wi, r.flux * (invPhotons * share), diffuseOnly));
     }
     c->photonSplats = out.size();
     if (splat_.renormalize)

@@ -30,14 +30,17 @@ const TechniqueInfo& ShadowMapsPass::info() const {
   return i;
 }
 
-Requirements ShadowMapsPass::requirements(const Scene& scene, const api::RenderRequest&) const {
+Requirements ShadowMapsPass::requirements(const Scene& scene, const api::RenderRequest& request) const {
   const SceneFeatures& f = scene.features;
-  if (f.lightCount() == 0) return Requirements::skip("the scene has no punctual lights");
+  // An environment map's compact bright regions are lights of the frame too (FrameView::lights).
+  if (f.lightCount() == 0 && request.environment.empty())
+    return Requirements::skip("the scene has no punctual lights and the frame no environment map");
   if (f.triangles == 0) return Requirements::skip("the scene has no triangles to cast shadows");
   return Requirements::ok();
 }
 
 void ShadowMapsPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
+  const std::vector<Light>& lights = res.view().lights;  // the scene's, then the environment's
   size_ = params.get<int>("shadow_map_size", 1024);
   const float bias = params.get<float>("shadow_bias", 1.0f);
   const float normalOffset = params.get<float>("normal_offset", 1.5f);
@@ -47,10 +50,10 @@ void ShadowMapsPass::prepare(const Scene& scene, const Params& params, FrameReso
   const float znear = radius * 1e-4f;
 
   int cubes = 0, maps2d = 0;
-  infos_.assign(std::max<std::size_t>(1, scene.lights.size()), gpu::ShadowInfo{});
+  infos_.assign(std::max<std::size_t>(1, lights.size()), gpu::ShadowInfo{});
   draws_.clear();
-  for (std::size_t li = 0; li < scene.lights.size(); ++li) {
-    const Light& l = scene.lights[li];
+  for (std::size_t li = 0; li < lights.size(); ++li) {
+    const Light& l = lights[li];
     gpu::ShadowInfo& si = infos_[li];
     const glm::vec3 dir = glm::normalize(l.direction);
     if (l.type == LightType::Point) {
@@ -77,9 +80,10 @@ void ShadowMapsPass::prepare(const Scene& scene, const Params& params, FrameReso
     }
   }
 
-  // Both arrays always exist (samplers must be complete even when unused).
-  gl::Texture& cube = res.texture("shadow_cube", GL_TEXTURE_CUBE_MAP_ARRAY, GL_R32F, size_, size_, 6 * std::max(1, cubes));
-  gl::Texture& flat = res.texture("shadow_2d", GL_TEXTURE_2D_ARRAY, GL_R32F, size_, size_, std::max(1, maps2d));
+  // Both arrays always exist (samplers must be complete even when unused); an unused one is 1 x 1.
+  const int cubeSize = cubes > 0 ? size_ : 1, flatSize = maps2d > 0 ? size_ : 1;
+  gl::Texture& cube = res.texture("shadow_cube", GL_TEXTURE_CUBE_MAP_ARRAY, GL_R32F, cubeSize, cubeSize, 6 * std::max(1, cubes));
+  gl::Texture& flat = res.texture("shadow_2d", GL_TEXTURE_2D_ARRAY, GL_R32F, flatSize, flatSize, std::max(1, maps2d));
   cube.setFilter(GL_NEAREST, GL_NEAREST);
   flat.setFilter(GL_NEAREST, GL_NEAREST);
   flat.setWrap(GL_CLAMP_TO_EDGE);
@@ -90,6 +94,7 @@ void ShadowMapsPass::prepare(const Scene& scene, const Params& params, FrameReso
   // The maps depend on geometry, lights, size and the meshes left out (Technique::shadowMapExclusions).
   excluded_ = res.shadowMapExclusions();
   std::string digest = res.sceneKey() + "|" + std::to_string(size_);
+  if (lights.size() > scene.lights.size()) digest += "|" + res.view().lightingEnvironmentKey();
   for (int m : excluded_) digest += "|-" + std::to_string(m);
   // The maps live in the shared shadow textures: valid only when they hold this digest's maps (another
   // scene may have rendered into them since; FrameResources::holds).
@@ -122,7 +127,7 @@ void ShadowMapsPass::execute(PassContext& ctx) {
   const float far[4] = {1e30f, 0.f, 0.f, 0.f};
   const float depthClear = 0.f;
   for (const Draw& d : draws_) {
-    const Light& l = ctx.scene.lights[d.light];
+    const Light& l = ctx.view.lights[d.light];
     fb.attach(GL_COLOR_ATTACHMENT0, d.cube ? cube : flat, 0, d.layer);
     fb.checkComplete("ShadowMapsPass::execute");
     fb.bind();

@@ -171,7 +171,7 @@ void SpecularPass::execute(PassContext& ctx) {
     fb.attach(GL_DEPTH_ATTACHMENT, depth);
     const gl::Program& prog = ctx.shaders.program({"specular/map.vert", "specular/map.frag"});
     prog.use();
-    bindDirectLighting(prog, res, ctx.gpu, static_cast<int>(ctx.scene.lights.size()), 1);
+    bindDirectLighting(prog, res, ctx.gpu, static_cast<int>(ctx.view.lights.size()), 1);
     peel.bindUnit(kMapTextureUnitPeel);
     glViewport(0, 0, resolution_, resolution_);
     glEnable(GL_DEPTH_TEST);

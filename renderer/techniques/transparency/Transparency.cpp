@@ -72,7 +72,7 @@ void TransparencyPass::execute(PassContext& ctx) {
 
   const gl::Program& prog = ctx.shaders.program({"gbuffer/gbuffer.vert", "transparency/transparency.frag"});
   prog.use();
-  bindDirectLighting(prog, res, gpu, static_cast<int>(ctx.scene.lights.size()), pcfRadius_);
+  bindDirectLighting(prog, res, gpu, static_cast<int>(ctx.view.lights.size()), pcfRadius_);
   ibl::bind(res, prog, gpu::kUnitIblDfg, gpu::kUnitIblPrefiltered);
   prog.set("u_diffuseIbl", 1);
   prog.setMat4("u_viewProj", &view.viewProj[0][0]);

@@ -1,10 +1,14 @@
 // The environment map: one mapping (renderer/scene/Environment.h) shared by the raster background,
 // the ambient average and the reference path tracer.
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "renderer/Renderer.h"
+#include "renderer/io/ImageIO.h"
 #include "renderer/scene/Environment.h"
 #include "tests/support/RenderTestSupport.h"
 #include "tests/support/SceneBuilder.h"
@@ -149,6 +153,91 @@ TEST(Environment, MirrorsReflectTheMapNotItsAverage) {
       EXPECT_NEAR(spec.at(x, y)[0], 1.f, 1e-3f);
       EXPECT_NEAR(spec.at(x, y)[2], 0.f, 1e-3f);
     }
+}
+
+// Issue 29, item 3: the environment casts shadows in the raster. A white sphere resting on a white
+// plane under the two shared CC0 maps, each with a small sun holding 70-79% of its power
+// (qwantani_afternoon_puresky: a clear sky; chinese_garden: a garden with sun), default frame against
+// the reference path tracer. Measured (2026-12-04, llvmpipe), raster / reference:
+//                      sunlit plane  upper sphere  lower half  sun shadow  contact (r < 0.5)
+//   environment_lights 0   (before)    -            0.94-0.99   1.56-1.64   0.73-0.80
+//   default (the split)  1.00-1.01     0.97-1.00     0.92-0.97   0.73-0.82   0.53-0.63
+// The sun's light is now right where it falls (the plane and the sphere within 3%) and its shadow is
+// sharp; what is left in the shadows is photon_gi's sky and interreflection, 20-45% dark there (more
+// photons: 0.79-0.80 and 0.73-0.76; not its gather): the issue's 10% for the shadows is not met yet
+// (docs/TECHNIQUES.md, "Environment lights"). Asserted: the sunlit parts within 3% and 5%, the lower
+// half within the issue's 10%, the sun shadow within 30% (it was 56-64% too bright), the contact
+// region darker than the sunlit plane by the reference's factor within 50%.
+TEST(Environment, SunOfAnHdrMapCastsTheReferencesShadows) {
+  const std::filesystem::path dir = RADIANT_ENVIRONMENTS_DIR;
+  if (!std::filesystem::exists(dir / "chinese_garden_1k.hdr")) GTEST_SKIP() << "no " << dir;
+  testing::SceneBuilder b;
+  const int white = b.material(testing::lambertian(glm::vec3(0.7f)));
+  b.quad({0, 0, 0}, {5, 0, 0}, {0, 0, -5}, white, "plane").sphere({0, 1, 0}, 1.f, white);
+  Scene scene = b.build("env-sun-sphere-on-plane");
+  for (const char* name : {"qwantani_afternoon_puresky_1k.hdr", "chinese_garden_1k.hdr"}) {
+    SCOPED_TRACE(name);
+    const Image env = io::readImage((dir / name).string());
+    api::RenderRequest req;
+    req.width = req.height = 64;
+    req.environment = "sha256:" + std::string(63, 'a') + (name[0] == 'q' ? "1" : "2");
+    api::CameraOverride cam;
+    cam.hasPosition = false;
+    cam.orbit = api::CameraOverride::Orbit{30.0, 60.0, 7.0};
+    cam.target = glm::vec3(0.f, 0.6f, 0.f);
+    req.camera = cam;
+    req.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty", "reference", "gbuffer_position"}, false}};
+    req.passes["reference"] = {{"spp", 256}};
+    RenderOutput out = renderer().render(scene, req, nullptr, FrameInputs{nullptr, &env});
+    ASSERT_TRUE(testing::allFinite(out));
+    const api::PassStats* direct = testing::pass(out, "direct");
+    ASSERT_NE(direct, nullptr);
+    EXPECT_EQ(direct->counters.at("environment_lights"), 1.0);
+    const Image& ref = aov(out, "reference");
+    const Image& beauty = aov(out, "beauty");
+    const Image& pos = aov(out, "gbuffer_position");
+    auto lum = [](const Image& im, int x, int y) {
+      const float* p = im.at(x, y);
+      return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+    };
+    // The plane's sunlit level: the median of the reference on the plane away from the sphere.
+    std::vector<double> lit;
+    for (int y = 0; y < 64; ++y)
+      for (int x = 0; x < 64; ++x) {
+        const float* p = pos.at(x, y);
+        if (p[3] > 0.f && std::abs(p[1]) < 1e-3f && glm::length(glm::vec2(p[0], p[2])) > 2.5f) lit.push_back(lum(ref, x, y));
+      }
+    ASSERT_GT(lit.size(), 50u);
+    std::nth_element(lit.begin(), lit.begin() + lit.size() / 2, lit.end());
+    const double sunlit = lit[lit.size() / 2];
+    struct Region { const char* what; double ref = 0, raster = 0; int n = 0; } shadow{"sun shadow"},
+        contact{"contact"}, lower{"sphere's lower half"}, sunlitPlane{"sunlit plane"}, upper{"upper half"};
+    for (int y = 0; y < 64; ++y)
+      for (int x = 0; x < 64; ++x) {
+        const float* p = pos.at(x, y);
+        if (!(p[3] > 0.f)) continue;
+        const bool plane = std::abs(p[1]) < 1e-3f;
+        const double r = glm::length(glm::vec2(p[0], p[2]));
+        Region* in = nullptr;
+        if (plane && r < 0.5) in = &contact;
+        else if (plane && lum(ref, x, y) < 0.5 * sunlit) in = &shadow;
+        else if (!plane && p[1] < 1.f) in = &lower;
+        else if (plane && r > 2.5 && lum(ref, x, y) > 0.8 * sunlit) in = &sunlitPlane;
+        else if (!plane) in = &upper;
+        if (!in) continue;
+        in->ref += lum(ref, x, y);
+        in->raster += lum(beauty, x, y);
+        ++in->n;
+      }
+    const std::pair<const Region*, double> bounds[] = {
+        {&sunlitPlane, 0.03}, {&upper, 0.05}, {&lower, 0.10}, {&shadow, 0.30}, {&contact, 0.50}};
+    for (const auto& [g, tolerance] : bounds) {
+      SCOPED_TRACE(g->what);
+      ASSERT_GT(g->n, 8);
+      EXPECT_NEAR(g->raster / g->ref, 1.0, tolerance) << g->n << " pixels, reference mean " << g->ref / g->n
+                                                        << ", sunlit plane " << sunlit;
+    }
+  }
 }
 
 }  // namespace

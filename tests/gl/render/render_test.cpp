@@ -239,7 +239,7 @@ TEST(RenderCore, StatsTimeEveryPassAndSkipWithReasons) {
   RenderOutput d = renderer().render(dark, unlitRequest);
   EXPECT_EQ(d.stats.lighting, "none");
   ASSERT_TRUE(d.stats.skipped.count("shadow_maps"));
-  EXPECT_EQ(d.stats.skipped.at("shadow_maps"), "the scene has no punctual lights");
+  EXPECT_EQ(d.stats.skipped.at("shadow_maps"), "the scene has no punctual lights and the frame no environment map");
   for (float v : aov(d, "beauty").pixels) EXPECT_EQ(v, 0.f);
 }
 

@@ -1,0 +1,52 @@
+#pragma once
+// The environment's compact bright regions (a sun, a studio key) as directional lights for the raster,
+// and the map without them. Image-based lighting (renderer/shading/ImageBasedLighting.h) has no
+// visibility: a sun in the prefiltered map and the SH irradiance casts no shadow, has no specular
+// occlusion, and its 64 x 32 GGX prefilter turns a 0.5 degree sun of radiance 1e5 into sparkle. So the
+// raster splits the map exactly in two (issue 29, item 3):
+//
+//   L(w) = R(w) + S(w),   R(w) = L(w) min(1, T / Y(w)),   S(w) = L(w) max(0, 1 - T / Y(w)),
+//
+// with Y the luminance and T = threshold x the map's solid-angle-weighted mean luminance. S is the part
+// above the threshold; its texels are grouped into connected regions (4-neighbours, u wraps), and each
+// region that is compact (solid angle <= maxSolidAngle) and carries at least minPowerFraction of the
+// map's power becomes one directional light:
+//   E = sum over its texels of S dw   (the irradiance it gives a surface facing it; the cosine is taken
+//                                      at the region's centre, exact to 1 - cos(radius)),
+//   direction: the E-weighted mean of its texel directions, angular radius: acos(1 - Omega / 2 pi).
+// The raster lights with R through image-based lighting and the lights through `direct` with shadow
+// maps; regions not taken (too broad, too weak, beyond maxLights) keep their full radiance in R. Every
+// texel's light is counted once: R + sum of the lights' S = L per texel, per channel (tested). The
+// reference path tracer and the background see L itself.
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "renderer/Image.h"
+#include "renderer/scene/Scene.h"
+
+namespace radiant {
+
+struct EnvironmentLightOptions {
+  int maxLights = 4;                // 0: no split (R = L)
+  float threshold = 10.f;           // T in multiples of the map's mean luminance
+  float maxSolidAngle = 0.1f;       // sr (a cone of about 10 degrees' radius)
+  float minPowerFraction = 0.01f;   // of the map's luminous power
+  std::string key() const;          // for cache keys
+};
+
+struct EnvironmentLights {
+  std::vector<Light> lights;  // directional: color = E (rgb irradiance), intensity 1, angularRadius set
+  Image residual;             // R, the map's size and channels (empty when no light was taken)
+  float threshold = 0.f;      // T (luminance)
+  float fraction = 0.f;       // the lights' share of the map's luminous power
+  bool split() const { return !lights.empty(); }
+  // The share of `map`'s radiance in direction `dir` (towards the sky) that the residual keeps: T / Y
+  // in the lights' texels, 1 elsewhere (photon_gi scales its first-hit sky photons by it).
+  float residualShare(const Image& map, const glm::vec3& dir) const;
+};
+
+EnvironmentLights extractEnvironmentLights(const Image& map, const EnvironmentLightOptions& options = {});
+
+}  // namespace radiant

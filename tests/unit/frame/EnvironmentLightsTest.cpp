@@ -1,0 +1,120 @@
+// The environment's split into lights and a residual (renderer/shading/EnvironmentLights.h): exact in
+// energy per texel, a sun found where it is with the irradiance it gives, nothing taken from a map
+// without a compact bright region.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "renderer/scene/Environment.h"
+#include "renderer/shading/EnvironmentLights.h"
+
+namespace radiant {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+double texelSolidAngle(const Image& m, int y) {
+  return 2.0 * kPi * kPi * std::sin(kPi * (y + 0.5) / m.height) / (double(m.width) * m.height);
+}
+
+glm::vec3 texelDir(const Image& m, int x, int y) {
+  const double u = (x + 0.5) / m.width, v = (y + 0.5) / m.height;
+  const double phi = (u - 0.5) * 2.0 * kPi, theta = v * kPi;
+  return glm::vec3(std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi));
+}
+
+// A sky of radiance (0.5, 0.6, 0.8) with a sun of radiance (5e4, 4e4, 3e4) in every texel within
+// `radius` of `sun`.
+Image sunnySky(glm::vec3 sun, float radius) {
+  Image m = Image::make("environment", 256, 128, 3);
+  for (int y = 0; y < m.height; ++y)
+    for (int x = 0; x < m.width; ++x) {
+      const bool inSun = std::acos(std::clamp(glm::dot(texelDir(m, x, y), sun), -1.f, 1.f)) < radius;
+      const glm::vec3 L = inSun ? glm::vec3(5e4f, 4e4f, 3e4f) : glm::vec3(0.5f, 0.6f, 0.8f);
+      float* p = m.at(x, y);
+      p[0] = L.x, p[1] = L.y, p[2] = L.z;
+    }
+  return m;
+}
+
+TEST(EnvironmentLights, ASunBecomesOneLightWithItsIrradianceAndTheSplitIsExact) {
+  const glm::vec3 sun = glm::normalize(glm::vec3(0.4f, 0.7f, -0.3f));
+  const Image map = sunnySky(sun, 0.05f);
+  const EnvironmentLights split = extractEnvironmentLights(map);
+  ASSERT_EQ(split.lights.size(), 1u);
+  const Light& l = split.lights[0];
+  EXPECT_EQ(l.type, LightType::Directional);
+  // Light travels from the sun: its direction is -sun, within a texel's angle (1.4 degrees).
+  EXPECT_GT(glm::dot(-l.direction, sun), std::cos(0.025f));
+  // The light and the residual add up to the map, texel by texel and channel by channel: the sun's
+  // texels keep exactly the threshold's luminance, the sky's all of theirs.
+  glm::dvec3 sunIrradiance(0.0), residualInSun(0.0);
+  double sunSolidAngle = 0.0;
+  for (int y = 0; y < map.height; ++y)
+    for (int x = 0; x < map.width; ++x) {
+      const float* p = map.at(x, y);
+      const float* r = split.residual.at(x, y);
+      const double dw = texelSolidAngle(map, y);
+      if (p[0] > 1.f) {
+        sunIrradiance += glm::dvec3(p[0], p[1], p[2]) * dw;
+        residualInSun += glm::dvec3(r[0], r[1], r[2]) * dw;
+        sunSolidAngle += dw;
+        EXPECT_NEAR(0.2126 * r[0] + 0.7152 * r[1] + 0.0722 * r[2], split.threshold, 1e-3 * split.threshold);
+        EXPECT_NEAR(r[0] / r[2], p[0] / p[2], 1e-4);  // the colour is kept
+      } else {
+        for (int c = 0; c < 3; ++c) EXPECT_EQ(r[c], p[c]);
+      }
+    }
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(l.color[c] * l.intensity, sunIrradiance[c] - residualInSun[c], 1e-4 * sunIrradiance[c]);
+  // The cone of the sun's solid angle: its radius (0.05 rad up to texel quantisation).
+  EXPECT_NEAR(l.angularRadius, std::acos(1.0 - sunSolidAngle / (2.0 * kPi)), 1e-5);
+  EXPECT_NEAR(l.angularRadius, 0.05, 0.01);
+  // The sun holds nearly all the power: (5e4 x 0.0079 sr) against 0.59 x 4 pi.
+  EXPECT_GT(split.fraction, 0.95f);
+  EXPECT_NEAR(split.residualShare(map, sun), split.threshold / (0.2126 * 5e4 + 0.7152 * 4e4 + 0.0722 * 3e4), 1e-6);
+  EXPECT_EQ(split.residualShare(map, -sun), 1.f);
+}
+
+TEST(EnvironmentLights, NothingIsTakenFromAMapWithoutACompactBrightRegion) {
+  // A uniform sky, and a broad bright half: no texel or only a wide region above 10x the mean.
+  Image uniform = Image::make("environment", 64, 32, 3);
+  for (float& v : uniform.pixels) v = 1.f;
+  EXPECT_FALSE(extractEnvironmentLights(uniform).split());
+  Image half = uniform;
+  for (int y = 0; y < half.height / 2; ++y)
+    for (int x = 0; x < half.width; ++x) half.at(x, y)[0] = half.at(x, y)[1] = half.at(x, y)[2] = 1000.f;
+  EnvironmentLightOptions o;
+  o.threshold = 1.5f;  // the upper half is 2x the mean: above it, but 2 pi sr wide
+  EXPECT_FALSE(extractEnvironmentLights(half, o).split());
+  // maxLights 0 turns the split off; two suns with maxLights 1 keep the weaker one in the residual.
+  const Image sunny = sunnySky(glm::vec3(0, 1, 0), 0.05f);
+  o = {};
+  o.maxLights = 0;
+  EXPECT_FALSE(extractEnvironmentLights(sunny, o).split());
+  Image two = sunnySky(glm::normalize(glm::vec3(1, 1, 0)), 0.06f);
+  const Image other = sunnySky(glm::normalize(glm::vec3(-1, 1, 0)), 0.04f);
+  for (std::size_t i = 0; i < two.pixels.size(); ++i) two.pixels[i] = std::max(two.pixels[i], other.pixels[i]);
+  o = {};
+  o.maxLights = 1;
+  const EnvironmentLights one = extractEnvironmentLights(two, o);
+  ASSERT_EQ(one.lights.size(), 1u);
+  EXPECT_GT(glm::dot(-one.lights[0].direction, glm::normalize(glm::vec3(1, 1, 0))), 0.999f);  // the larger
+  EXPECT_EQ(one.residualShare(two, glm::normalize(glm::vec3(-1, 1, 0))), 1.f);
+  EXPECT_EQ(extractEnvironmentLights(two).lights.size(), 2u);
+}
+
+TEST(EnvironmentLights, NonFiniteAndEmptyMapsAreLeftAlone) {
+  Image m = Image::make("environment", 32, 16, 3);
+  EXPECT_FALSE(extractEnvironmentLights(m).split());  // black: no power
+  for (float& v : m.pixels) v = 1.f;
+  m.at(3, 3)[0] = std::numeric_limits<float>::infinity();
+  m.at(4, 3)[1] = std::numeric_limits<float>::quiet_NaN();
+  const EnvironmentLights s = extractEnvironmentLights(m);
+  for (const Light& l : s.lights) EXPECT_TRUE(std::isfinite(l.color.x + l.color.y + l.color.z));
+  EXPECT_FALSE(extractEnvironmentLights(Image{}).split());
+}
+
+}  // namespace
+}  // namespace radiant
