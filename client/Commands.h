@@ -31,6 +31,21 @@ void addInfoCommands(CLI::App& root, const GlobalOptions& g, Action& action);   
 void addSweepCommands(CLI::App& root, const GlobalOptions& g, Action& action);  // sweep, report, bench
 void addCompareCommand(CLI::App& root, const GlobalOptions& g, Action& action); // no server needed
 
+// radiant bench --fidelity (commands/Fidelity.cpp): every model under `models` x every map under
+// `environments`, the default frame scored against the reference path tracer (docs/PERFORMANCE.md).
+struct FidelityOptions {
+  std::string dir = "bench-out";                            // writes DIR/fidelity.md, .json, DIR/fidelity/
+  std::string models = "../shared/testdata/gltf-samples";   // one folder per model (Khronos layout)
+  std::string environments = "../shared/testdata/environments";
+  std::vector<std::string> onlyModels, onlyEnvironments;    // empty = all (folder names, map file stems)
+  int size = 128, spp = 1024;
+  double thetaDeg = 30, phiDeg = 75;                        // camera.orbit; radius: the automatic framing's
+  bool convergence = false;                                 // also a seed-1 reference, scored against seed 0
+  bool quiet = false;
+  std::vector<std::string> servers;                         // the first is used (default the global one)
+};
+int fidelityBench(const GlobalOptions& g, const FidelityOptions& o);
+
 // Helpers shared by commands.
 std::string readFile(const std::string& path);            // throws UsageError
 void writeFile(const std::string& path, const std::string& bytes);  // throws UsageError
@@ -41,5 +56,8 @@ std::string sceneFileBytes(const std::string& path, std::string* note = nullptr)
 // Uploads `bytes` unless the server already has its digest; returns the digest.
 std::string ensureSceneUploaded(const HttpClient& http, const std::string& bytes, const std::string& fileName,
                                 bool verbose);
+// Uploads an image (an environment map, Radiance HDR, or an EXR) to /v1/images unless the server has
+// it; returns its digest.
+std::string ensureImageUploaded(const HttpClient& http, const std::string& path, bool verbose);
 
 }  // namespace radiant::client

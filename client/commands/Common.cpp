@@ -51,4 +51,17 @@ std::string ensureSceneUploaded(const HttpClient& http, const std::string& bytes
   return digest;
 }
 
+std::string ensureImageUploaded(const HttpClient& http, const std::string& path, bool verbose) {
+  const std::string bytes = readFile(path);
+  const std::string digest = api::sceneDigest(bytes);
+  const HttpResponse head = http.head("/v1/images/" + digest);
+  if (head.status == 200) return digest;
+  if (head.status != 404) HttpClient::expectOk(head);
+  const bool exr = bytes.size() >= 4 && bytes.compare(0, 4, "\x76\x2f\x31\x01") == 0;
+  const HttpResponse r = http.put("/v1/images", bytes, exr ? "image/x-exr" : "image/vnd.radiance");
+  HttpClient::expectOk(r);
+  if (verbose) std::cerr << "uploaded " << path << " as " << digest << " (" << bytes.size() << " bytes)\n";
+  return digest;
+}
+
 }  // namespace radiant::client

@@ -88,20 +88,6 @@ nlohmann::json cameraOption(const std::string& text) {
   return cam;
 }
 
-// Uploads an environment map unless the server has it; returns its digest.
-std::string ensureImageUploaded(const HttpClient& http, const std::string& path, bool verbose) {
-  const std::string bytes = readFile(path);
-  const std::string digest = api::sceneDigest(bytes);
-  const HttpResponse head = http.head("/v1/images/" + digest);
-  if (head.status == 200) return digest;
-  if (head.status != 404) HttpClient::expectOk(head);
-  const bool exr = bytes.size() >= 4 && bytes.compare(0, 4, "\x76\x2f\x31\x01") == 0;
-  const HttpResponse r = http.put("/v1/images", bytes, exr ? "image/x-exr" : "image/vnd.radiance");
-  HttpClient::expectOk(r);
-  if (verbose) std::cerr << "uploaded " << path << " as " << digest << " (" << bytes.size() << " bytes)\n";
-  return digest;
-}
-
 std::string extensionOf(const std::string& path) {
   auto dot = path.rfind('.');
   if (dot == std::string::npos) return "";

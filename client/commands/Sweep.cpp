@@ -103,6 +103,9 @@ struct BenchOptions {
   CLI::Option* sceneGiven = nullptr;
   std::vector<std::string> techniques;  // the suite: only these (empty = every implemented one)
   sweep::RunOptions run;
+  bool fidelity = false;
+  CLI::Option* sizeGiven = nullptr;
+  FidelityOptions fid;
 };
 
 int runSweep(const GlobalOptions& g, SweepOptions so) {
@@ -327,6 +330,15 @@ int runBench(const GlobalOptions& g, BenchOptions bo) {
   const int requests = bo.requests, size = bo.size, throughputN = bo.throughputN, pngCompression = bo.pngCompression;
   const std::string& scene = bo.scene;
   sweep::RunOptions& o = bo.run;
+  if (bo.fidelity) {
+    if (service) throw UsageError("bench: --fidelity and --service are separate benchmarks");
+    FidelityOptions& f = bo.fid;
+    f.dir = bo.dir;
+    if (bo.sizeGiven && bo.sizeGiven->count()) f.size = size;
+    f.servers = o.servers;
+    f.quiet = o.quiet;
+    return fidelityBench(g, f);
+  }
   if (service) return serviceBench(g, dir, requests, size, scene, throughputN, pngCompression);
   if (o.servers.empty()) o.servers.push_back(g.server);
   // The suite follows what the (first) server implements and ships.
@@ -438,8 +450,13 @@ void addSweepCommands(CLI::App& root, const GlobalOptions& g, Action& action) {
       "DIR/report.html and DIR/report.md. Re-running resumes. Each technique is scored on its first output\n"
       "AOV that has a ground truth in the server's /v1/info (ground_truths).\n"
       "--service: the service's overhead (end-to-end latency against the renderer's frame time) and the\n"
-      "throughput of back-to-back small requests; writes DIR/service.json and prints a Markdown table.");
-  b->add_option("-o,--output", bo->dir, "the output directory (default bench-out)")->type_name("DIR");
+      "throughput of back-to-back small requests; writes DIR/service.json and prints a Markdown table.\n"
+      "--fidelity: every model under --models x every map under --environments at one orbit camera, the\n"
+      "default frame (background transparent, tone_map aces) scored against the reference path tracer at\n"
+      "--spp with model-viewer's render-fidelity metric (dB, lower is better), relMSE and SSIM; writes\n"
+      "DIR/fidelity.md (also printed), DIR/fidelity.json and per scene a contact sheet default | reference |\n"
+      "error in DIR/fidelity/; references are cached in DIR/fidelity/reference/ (docs/PERFORMANCE.md).");
+  b->add_option("-o,--output,--out", bo->dir, "the output directory (default bench-out)")->type_name("DIR");
   b->add_flag("--quick", bo->quick, "three scenes, smaller frames, fewer repeats");
   b->add_flag("--service", bo->service, "measure the service's overhead and throughput instead");
   b->add_flag("--no-report", bo->noReport, "write the results only");
@@ -449,7 +466,23 @@ void addSweepCommands(CLI::App& root, const GlobalOptions& g, Action& action) {
       ->type_name("URL");
   b->add_option("--inflight", bo->run.inflight, "requests in flight per server")->type_name("N")->check(CLI::Range(1, 64));
   b->add_option("--requests", bo->requests, "--service: sequential requests (default 20)")->type_name("N")->check(CLI::Range(1, 10000));
-  b->add_option("--size", bo->size, "--service: frame size in pixels (default 256)")->type_name("PX")->check(CLI::Range(1, 4096));
+  bo->sizeGiven = b->add_option("--size", bo->size, "--service: frame size in pixels (default 256); --fidelity: (default 128)")
+                      ->type_name("PX")
+                      ->check(CLI::Range(1, 4096));
+  b->add_flag("--fidelity", bo->fidelity, "the render-fidelity benchmark of the default frame against the reference");
+  b->add_option("--spp", bo->fid.spp, "--fidelity: the reference's samples per pixel (default 1024)")
+      ->type_name("N")
+      ->check(CLI::Range(1, 65536));
+  b->add_option("--models", bo->fid.models, "--fidelity: the model folders (default ../shared/testdata/gltf-samples)")
+      ->type_name("DIR");
+  b->add_option("--environments", bo->fid.environments,
+                "--fidelity: the .hdr/.exr maps (default ../shared/testdata/environments)")
+      ->type_name("DIR");
+  repeated(b->add_option("--model", bo->fid.onlyModels, "--fidelity: only this model folder (repeatable)"))->type_name("NAME");
+  repeated(b->add_option("--environment", bo->fid.onlyEnvironments, "--fidelity: only this map, by file stem (repeatable)"))
+      ->type_name("NAME");
+  b->add_flag("--convergence", bo->fid.convergence,
+              "--fidelity: also render a second reference seed and score it against the first");
   bo->sceneGiven = b->add_option("--scene", bo->scene,
                                  "the suite: only this built-in scene; --service: the built-in scene (default cornell_box)")
                        ->type_name("NAME");

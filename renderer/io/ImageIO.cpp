@@ -252,6 +252,45 @@ Image readImage(const std::string& path, const std::string& aov) {
   return readFrom(in.get(), path, aov);
 }
 
+ImageRgba8 decodePngRgba8(std::string_view bytes) {
+  if (bytes.substr(0, 4) != "\x89PNG") throw std::runtime_error("io: not a PNG image");
+  OIIO::Filesystem::IOMemReader reader(const_cast<char*>(bytes.data()), bytes.size());
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);  // the codes as stored, not premultiplied
+  // create + set_ioproxy + open: ImageInput::open(name, &config, proxy) ignores the proxy here.
+  auto in = OIIO::ImageInput::create("png");
+  OIIO::ImageSpec spec;
+  if (!in || !in->set_ioproxy(&reader) || !in->open("image.png", spec, config))
+    throw std::runtime_error("io: cannot read the PNG: " + (in ? in->geterror() : OIIO::geterror()));
+  const int n = spec.nchannels;
+  if (spec.width <= 0 || spec.height <= 0 || n < 1 || n > 4 || spec.format != OIIO::TypeDesc::UINT8)
+    throw std::runtime_error("io: the PNG is not 8-bit with 1 to 4 channels");
+  std::vector<unsigned char> all(static_cast<std::size_t>(spec.width) * spec.height * n);
+  if (!in->read_image(0, 0, 0, n, OIIO::TypeDesc::UINT8, all.data()))
+    throw std::runtime_error("io: read the PNG: " + in->geterror());
+  ImageRgba8 img = ImageRgba8::make(spec.width, spec.height);
+  const bool hasAlpha = n == 2 || n == 4;
+  const int colours = hasAlpha ? n - 1 : n;
+  for (std::size_t p = 0; p < static_cast<std::size_t>(spec.width) * spec.height; ++p) {
+    for (int c = 0; c < 3; ++c) img.pixels[p * 4 + c] = all[p * n + std::min(c, colours - 1)];
+    img.pixels[p * 4 + 3] = hasAlpha ? all[p * n + n - 1] : 255;
+  }
+  return img;
+}
+
+std::string encodePngRgba8(const ImageRgba8& image, bool alpha, int zlibLevel) {
+  if (image.width <= 0 || image.height <= 0 || image.pixels.size() != static_cast<std::size_t>(image.width) * image.height * 4)
+    throw std::runtime_error("io: encodePngRgba8(): empty or malformed image");
+  OIIO::ImageSpec spec(image.width, image.height, alpha ? 4 : 3, OIIO::TypeDesc::UINT8);
+  spec.attribute("png:compressionLevel", std::clamp(zlibLevel, 0, 9));
+  if (alpha) spec.attribute("oiio:UnassociatedAlpha", 1);
+  if (alpha) return writeToMemory("image.png", spec, OIIO::TypeDesc::UINT8, image.pixels.data());
+  std::vector<unsigned char> rgb(static_cast<std::size_t>(image.width) * image.height * 3);
+  for (std::size_t p = 0; p < static_cast<std::size_t>(image.width) * image.height; ++p)
+    for (int c = 0; c < 3; ++c) rgb[p * 3 + c] = image.pixels[p * 4 + c];
+  return writeToMemory("image.png", spec, OIIO::TypeDesc::UINT8, rgb.data());
+}
+
 Image decodeImage(std::string_view bytes, const std::string& aov, std::size_t maxDecodedBytes) {
   auto starts = [&](std::string_view magic) { return bytes.substr(0, magic.size()) == magic; };
   const char* name = starts(std::string_view("\x76\x2f\x31\x01", 4)) ? "image.exr"

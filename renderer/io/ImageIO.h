@@ -52,6 +52,13 @@ struct DecodeLimitExceeded : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// A PNG's 8-bit codes as they are stored (no transfer decoded, straight alpha kept: OpenImageIO would
+// otherwise premultiply), RGBA; an RGB or grey file gets alpha 255. What the render-fidelity metric
+// scores. Throws std::runtime_error for anything but an 8-bit PNG of 1 to 4 channels.
+ImageRgba8 decodePngRgba8(std::string_view bytes);
+// An 8-bit PNG of the codes as they are (straight alpha; alpha = false writes RGB and drops it).
+std::string encodePngRgba8(const ImageRgba8& image, bool alpha = true, int zlibLevel = 6);
+
 // sRGB transfer of one linear value in [0,1] (IEC 61966-2-1).
 float linearToSrgb(float linear);
 float srgbToLinear(float encoded);

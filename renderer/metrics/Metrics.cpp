@@ -163,6 +163,69 @@ Image falseColour(const Image& error, double maxError, double* usedMax) {
   return out;
 }
 
+namespace {
+
+void checkCompatible(const ImageRgba8& candidate, const ImageRgba8& golden, const char* who) {
+  auto ok = [](const ImageRgba8& i) {
+    return i.width > 0 && i.height > 0 && i.pixels.size() == static_cast<size_t>(i.width) * i.height * 4;
+  };
+  if (!ok(candidate) || !ok(golden))
+    throw std::invalid_argument(std::string(who) + ": an image is empty or malformed");
+  if (candidate.width != golden.width || candidate.height != golden.height)
+    throw std::invalid_argument(std::string(who) + ": candidate is " + std::to_string(candidate.width) + "x" +
+                                std::to_string(candidate.height) + " but golden is " + std::to_string(golden.width) +
+                                "x" + std::to_string(golden.height));
+}
+
+// pixelmatch's blend: the colour over a white backdrop by its straight alpha in [0, 1].
+double blendWithWhite(double c, double a) { return 255.0 + (c - 255.0) * a; }
+
+// NTSC YIQ of an sRGB-coded colour, pixelmatch's coefficients (rgb2y, rgb2i, rgb2q).
+void rgbToYiq(double r, double g, double b, double yiq[3]) {
+  yiq[0] = 0.29889531 * r + 0.58662247 * g + 0.11448223 * b;
+  yiq[1] = 0.59597799 * r - 0.27417610 * g - 0.32180189 * b;
+  yiq[2] = 0.21147017 * r - 0.52261711 * g + 0.31114694 * b;
+}
+
+}  // namespace
+
+double yiqColourDelta(const std::uint8_t* candidate, const std::uint8_t* golden) {
+  double a[3], b[3];
+  const double ac = candidate[3] / 255.0, ag = golden[3] / 255.0;
+  rgbToYiq(blendWithWhite(candidate[0], ac), blendWithWhite(candidate[1], ac), blendWithWhite(candidate[2], ac), a);
+  rgbToYiq(blendWithWhite(golden[0], ag), blendWithWhite(golden[1], ag), blendWithWhite(golden[2], ag), b);
+  const double dy = a[0] - b[0], di = a[1] - b[1], dq = a[2] - b[2];
+  // Kotsarenko and Ramos eq. 4: a weighted squared distance in YIQ.
+  return 0.5053 * dy * dy + 0.299 * di * di + 0.1957 * dq * dq;
+}
+
+FidelityScore renderFidelity(const ImageRgba8& candidate, const ImageRgba8& golden) {
+  checkCompatible(candidate, golden, "renderFidelity()");
+  FidelityScore s;
+  double sum = 0.0;
+  for (size_t p = 0; p < static_cast<size_t>(candidate.width) * candidate.height; ++p) {
+    if (candidate.pixels[p * 4 + 3] == 0) continue;  // not the model: model-viewer skips it
+    const double delta = yiqColourDelta(&candidate.pixels[p * 4], &golden.pixels[p * 4]);
+    sum += delta * delta;
+    ++s.covered;
+  }
+  if (s.covered == 0) return s;
+  s.rms = std::sqrt(sum / static_cast<double>(s.covered)) / kFidelityMaxColourDistance;
+  s.floored = s.rms < kFidelityFloorRms;
+  s.decibels = 10.0 * std::log10(std::max(s.rms, kFidelityFloorRms));
+  return s;
+}
+
+Image fidelityDeltaMap(const ImageRgba8& candidate, const ImageRgba8& golden) {
+  checkCompatible(candidate, golden, "fidelityDeltaMap()");
+  Image out = Image::make("fidelity_delta", candidate.width, candidate.height, 1);
+  for (size_t p = 0; p < static_cast<size_t>(candidate.width) * candidate.height; ++p)
+    if (candidate.pixels[p * 4 + 3] != 0)
+      out.pixels[p] = static_cast<float>(yiqColourDelta(&candidate.pixels[p * 4], &golden.pixels[p * 4]) /
+                                         kFidelityMaxColourDistance);
+  return out;
+}
+
 Image errorMap(const Image& test, const Image& reference) {
   checkCompatible(test, reference, "errorMap()");
   Image out = Image::make("error", test.width, test.height, 1);

@@ -17,6 +17,10 @@
 //   C1 = (K1 L)^2, C2 = (K2 L)^2, K1 = 0.01, K2 = 0.03, L = 1. The SSIM map is evaluated where the
 //   window fits inside the image ("valid" region, as in the authors' reference code) and averaged.
 //   Images smaller than 11 pixels in a dimension use the window clipped at the border and renormalised.
+// - renderFidelity: the score of the glTF render-fidelity comparisons (google/model-viewer,
+//   packages/render-fidelity-tools: common.ts ImageComparator::analyze and pixelmatch's colorDelta), on
+//   the 8-bit display images, not on linear values; see there.
+#include <cstddef>
 #include <optional>
 
 #include <nlohmann/json_fwd.hpp>
@@ -55,6 +59,41 @@ Image errorMap(const Image& test, const Image& reference);
 // display-referred sRGB in [0, 1] (decode them before writing a linear image). maxError <= 0 or
 // non-finite picks the image's largest finite error (all black-purple when that is 0).
 Image falseColour(const Image& error, double maxError = 0.0, double* usedMax = nullptr);
+
+// model-viewer's render-fidelity score of a candidate against a golden image, both 8-bit RGBA of the
+// same size (PNG codes, straight alpha):
+//  1. each channel is blended with white by its own image's alpha: c' = 255 + (c - 255) a / 255;
+//  2. both are taken to YIQ with pixelmatch's coefficients (yiqColourDelta below), and the pixel's
+//     delta = 0.5053 dY^2 + 0.299 dI^2 + 0.1957 dQ^2 (Kotsarenko and Ramos 2010, "Measuring perceived
+//     colour difference using YIQ NTSC transmission colour space in mobile applications", eq. 4: already
+//     a squared distance, at most kFidelityMaxColourDistance: red against cyan);
+//  3. only pixels where the CANDIDATE's alpha is not 0 count (the model's pixels);
+//  4. rms = sqrt(sum delta^2 / covered) / kFidelityMaxColourDistance (the delta is squared once more,
+//     as model-viewer does), and the score is 10 log10(rms) dB: lower is better, model-viewer's
+//     regression threshold is kFidelityThresholdDb.
+// Two cases model-viewer leaves undefined (it divides by zero or takes log10(0)):
+//  - identical images (rms 0, -inf dB): rms is clamped to kFidelityFloorRms, so the score is
+//    kFidelityFloorDb = -100 dB and `floored` is set;
+//  - no covered pixel: nothing to score; decibels is nullopt (and rms 0).
+// Throws std::invalid_argument when the sizes differ or an image is empty or malformed.
+inline constexpr double kFidelityMaxColourDistance = 35215.0;
+inline constexpr double kFidelityFloorRms = 1e-10;
+inline constexpr double kFidelityFloorDb = -100.0;
+inline constexpr double kFidelityThresholdDb = -22.0;
+
+struct FidelityScore {
+  std::optional<double> decibels;  // 10 log10(max(rms, kFidelityFloorRms)); nullopt when covered == 0
+  double rms = 0.0;                // sqrt(sum delta^2 / covered) / kFidelityMaxColourDistance
+  std::size_t covered = 0;         // pixels with candidate alpha != 0
+  bool floored = false;            // rms was below kFidelityFloorRms (identical on the covered pixels)
+};
+
+// pixelmatch's colorDelta of two 8-bit RGBA pixels (steps 1 and 2 above): in [0, 35215].
+double yiqColourDelta(const std::uint8_t* candidate, const std::uint8_t* golden);
+FidelityScore renderFidelity(const ImageRgba8& candidate, const ImageRgba8& golden);
+// The per-pixel delta / kFidelityMaxColourDistance as a one-channel image (aov "fidelity_delta"); 0
+// where the candidate's alpha is 0 (not scored). Same argument checks as renderFidelity.
+Image fidelityDeltaMap(const ImageRgba8& candidate, const ImageRgba8& golden);
 
 // The tone map used by psnr and ssim: sRGB transfer (IEC 61966-2-1) of clamp(v * 2^exposureEV, 0, 1).
 double toneMap(double linear, float exposureEV);

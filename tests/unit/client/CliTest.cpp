@@ -120,6 +120,12 @@ TEST(Cli, BadCommandLinesAreUsageErrors) {
   EXPECT_NE(r.err.find("--time-budget-ms"), std::string::npos) << r.err;
   EXPECT_EQ(radiant("sweep s.json --inflight 0").code, 2);
   EXPECT_EQ(radiant("completion fish").code, 2);
+  // bench --fidelity: not with --service; a missing model folder is named before any server is asked.
+  EXPECT_EQ(radiant("bench --fidelity --service").code, 2);
+  const ProcessRun f = radiant("bench --fidelity --models /nonexistent/models");
+  EXPECT_EQ(f.code, 2);
+  EXPECT_NE(f.err.find("/nonexistent/models"), std::string::npos) << f.err;
+  EXPECT_EQ(radiant("bench --fidelity --spp 0").code, 2);
 }
 
 TEST(Cli, BashCompletionListsEveryCommandAndEachCommandsFlags) {

@@ -59,5 +59,24 @@ TEST(ImageIO, HalfExrWithinRangeIsUnchangedAndCountsNothing) {
   EXPECT_EQ(io::decodeImage(exr, "beauty").pixels, beauty.pixels);  // each exactly representable
 }
 
+// The render-fidelity metric scores a PNG's codes as stored: straight alpha, no transfer decoded.
+TEST(ImageIO, Rgba8PngRoundTripKeepsStraightCodesAndAnRgbFileReadsOpaque) {
+  ImageRgba8 img = ImageRgba8::make(3, 1);
+  img.pixels = {255, 0, 0, 255, 200, 100, 50, 128, 7, 8, 9, 0};
+  const ImageRgba8 back = io::decodePngRgba8(io::encodePngRgba8(img));
+  EXPECT_EQ(back.width, 3);
+  EXPECT_EQ(back.pixels, img.pixels);  // 200, 100, 50 at alpha 128 is not premultiplied on reading
+  const ImageRgba8 rgb = io::decodePngRgba8(io::encodePngRgba8(img, false));
+  EXPECT_EQ(rgb.pixels, (std::vector<std::uint8_t>{255, 0, 0, 255, 200, 100, 50, 255, 7, 8, 9, 255}));
+  // A transparent frame's PNG (encodePng with coverage): colour = sRGB(beauty / alpha), alpha = coverage.
+  Image beauty = row("beauty", 3, {0.5f, 0.5f, 0.5f});  // premultiplied by coverage 0.5: linear 1 = code 255
+  const Image alpha = row("alpha", 1, {0.5f});
+  io::PngOptions o;
+  o.alpha = &alpha;
+  const ImageRgba8 frame = io::decodePngRgba8(io::encodePng(beauty, o));
+  EXPECT_EQ(frame.pixels, (std::vector<std::uint8_t>{255, 255, 255, 128}));
+  EXPECT_THROW(io::decodePngRgba8("not a png"), std::runtime_error);
+}
+
 }  // namespace
 }  // namespace radiant

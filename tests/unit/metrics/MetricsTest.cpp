@@ -163,5 +163,89 @@ TEST(Metrics, RejectsMismatchedImages) {
   EXPECT_THROW(errorMap(Image{}, Image{}), std::invalid_argument);
 }
 
+// --- render fidelity (model-viewer's score; numbers evaluated by hand from the formulas in Metrics.h) ---
+
+ImageRgba8 rgba(int w, int h, std::uint8_t r, std::uint8_t g, std::uint8_t b, std::uint8_t a) {
+  ImageRgba8 i = ImageRgba8::make(w, h);
+  for (int p = 0; p < w * h; ++p) {
+    i.pixels[p * 4 + 0] = r, i.pixels[p * 4 + 1] = g, i.pixels[p * 4 + 2] = b, i.pixels[p * 4 + 3] = a;
+  }
+  return i;
+}
+
+TEST(RenderFidelity, PureRedAgainstBlackByHand) {
+  // Red (255, 0, 0) against black: dY = 255 x 0.29889531 = 76.21830405, dI = 255 x 0.59597799 =
+  // 151.97438745, dQ = 255 x 0.21147017 = 53.92489335; delta = 0.5053 dY^2 + 0.299 dI^2 + 0.1957 dQ^2
+  // = 2935.399 + 6905.770 + 569.078 = 10410.247. One pixel: rms = delta / 35215 = 0.295620, -5.2927 dB.
+  const ImageRgba8 red = rgba(1, 1, 255, 0, 0, 255), black = rgba(1, 1, 0, 0, 0, 255);
+  EXPECT_NEAR(yiqColourDelta(red.at(0, 0), black.at(0, 0)), 10410.2469, 1e-3);
+  const FidelityScore s = renderFidelity(red, black);
+  EXPECT_EQ(s.covered, 1u);
+  EXPECT_FALSE(s.floored);
+  EXPECT_NEAR(s.rms, 0.2956197, 1e-6);
+  ASSERT_TRUE(s.decibels.has_value());
+  EXPECT_NEAR(*s.decibels, -5.29267, 1e-4);
+  // The delta is symmetric, and red against cyan is the largest there is (model-viewer's 35215).
+  EXPECT_NEAR(yiqColourDelta(black.at(0, 0), red.at(0, 0)), 10410.2469, 1e-3);
+  const ImageRgba8 cyan = rgba(1, 1, 0, 255, 255, 255);
+  EXPECT_NEAR(yiqColourDelta(red.at(0, 0), cyan.at(0, 0)), 35214.749, 1e-2);
+  EXPECT_LE(yiqColourDelta(red.at(0, 0), cyan.at(0, 0)), kFidelityMaxColourDistance);
+}
+
+TEST(RenderFidelity, WhiteAgainstBlackHasOnlyLuma) {
+  // The Y weights sum to 1.00000001 and the I and Q weights to 0: grey differences are pure luma,
+  // delta = 0.5053 x (255 x 1.00000001)^2 = 32857.133.
+  const ImageRgba8 white = rgba(1, 1, 255, 255, 255, 255), black = rgba(1, 1, 0, 0, 0, 255);
+  EXPECT_NEAR(yiqColourDelta(white.at(0, 0), black.at(0, 0)), 32857.1332, 1e-3);
+}
+
+TEST(RenderFidelity, AlphaBlendsWithWhite) {
+  // Black at alpha 128: 255 + (0 - 255) x 128 / 255 = 127 per channel, so against opaque white
+  // dY = 128 x 1.00000001 and delta = 0.5053 x 128^2 = 8278.835.
+  const ImageRgba8 halfBlack = rgba(1, 1, 0, 0, 0, 128), white = rgba(1, 1, 255, 255, 255, 255);
+  EXPECT_NEAR(yiqColourDelta(halfBlack.at(0, 0), white.at(0, 0)), 8278.8354, 1e-3);
+  // Opaque grey 127 is the same colour as black at alpha 128 over white: delta 0, the floor.
+  const FidelityScore s = renderFidelity(halfBlack, rgba(1, 1, 127, 127, 127, 255));
+  EXPECT_TRUE(s.floored);
+  EXPECT_EQ(*s.decibels, kFidelityFloorDb);
+  // The golden is blended by its own alpha: a fully transparent golden is white whatever its colour.
+  EXPECT_EQ(yiqColourDelta(white.at(0, 0), rgba(1, 1, 0, 0, 0, 0).at(0, 0)), 0.0);
+}
+
+TEST(RenderFidelity, OnlyTheCandidatesCoveredPixelsCount) {
+  // Pixel 0: red against black (delta 10410.247); pixel 1: identical; pixel 2: candidate alpha 0 (not
+  // the model) against a golden that differs as much as it can: ignored. rms = sqrt(delta^2 / 2) /
+  // 35215 = 0.2090347, -6.79782 dB.
+  ImageRgba8 candidate = rgba(3, 1, 0, 0, 0, 255), golden = rgba(3, 1, 0, 0, 0, 255);
+  candidate.at(0, 0)[0] = 255;
+  candidate.at(2, 0)[3] = 0;
+  golden.at(2, 0)[0] = 255, golden.at(2, 0)[1] = 255, golden.at(2, 0)[2] = 255;
+  const FidelityScore s = renderFidelity(candidate, golden);
+  EXPECT_EQ(s.covered, 2u);
+  EXPECT_NEAR(s.rms, 0.2090347, 1e-6);
+  EXPECT_NEAR(*s.decibels, -6.79782, 1e-4);
+  const Image map = fidelityDeltaMap(candidate, golden);
+  EXPECT_NEAR(map.pixels[0], 10410.2469 / 35215.0, 1e-6);
+  EXPECT_EQ(map.pixels[1], 0.f);
+  EXPECT_EQ(map.pixels[2], 0.f);  // not scored
+}
+
+TEST(RenderFidelity, IdenticalImagesScoreTheFloorAndNoCoverageScoresNothing) {
+  const ImageRgba8 a = rgba(4, 4, 10, 200, 30, 255);
+  const FidelityScore same = renderFidelity(a, a);
+  EXPECT_EQ(same.rms, 0.0);
+  EXPECT_TRUE(same.floored);
+  EXPECT_EQ(*same.decibels, -100.0);  // 10 log10(kFidelityFloorRms = 1e-10)
+  const FidelityScore none = renderFidelity(rgba(4, 4, 10, 200, 30, 0), a);
+  EXPECT_EQ(none.covered, 0u);
+  EXPECT_FALSE(none.decibels.has_value());
+}
+
+TEST(RenderFidelity, RejectsMismatchedOrEmptyImages) {
+  EXPECT_THROW(renderFidelity(rgba(2, 2, 0, 0, 0, 255), rgba(2, 3, 0, 0, 0, 255)), std::invalid_argument);
+  EXPECT_THROW(renderFidelity(ImageRgba8{}, ImageRgba8{}), std::invalid_argument);
+  EXPECT_THROW(fidelityDeltaMap(rgba(1, 1, 0, 0, 0, 255), ImageRgba8{}), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace radiant::metrics
