@@ -1,8 +1,7 @@
 #pragma once
 // Long GPU work in stretches with a cancel check between them (renderer/raytracing/Cancel.h): a
 // cancelled, timed-out or shut-down request stops after the stretch in flight, not after the draw.
-// No glFinish between stretches: the driver queues only a few of them ahead, and a pass that waited for
-// each would leave the GPU idle between them.
+// A stretch is waited for (a fence) only when the next but one is issued, so the GPU is never idle.
 #include <string_view>
 
 #include "renderer/gl/Gl.h"
