@@ -472,6 +472,23 @@ nlohmann::json sceneStats(const Scene& scene) {
           {"materials", scene.materials.size()},
           {"textures", scene.textures.size()}};
 }
+// The GL state passes change and expect at its default on entry (blending, depth test and mask, colour
+// mask, the bound program and framebuffer), set back as a fresh context has it after a pass stopped
+// mid-way for a cancelled request: the renderer's next frame must not inherit a half-finished pass's state.
+void resetPipelineState() {
+  glDisable(GL_BLEND);
+  glBlendEquation(GL_FUNC_ADD);
+  glBlendFunc(GL_ONE, GL_ZERO);
+  glDisable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDepthMask(GL_TRUE);
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glBindVertexArray(0);
+  glUseProgram(0);
+  while (glGetError() != GL_NO_ERROR) {
+  }
+}
 }  // namespace
 
 RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requestIn, const std::atomic<bool>* cancel,
@@ -574,6 +591,8 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     stats.lightPaths = plan.lightPaths;
 
     im.resources.beginFrame(gpu, view, &stats.cache);
+    const rt::Cancel cancelToken(cancel);
+    im.resources.setCancel(cancelToken);  // prepare() and the derived-data builders (photons, beams, BVH)
     im.resources.setLightPathOwners(plan.lightPaths);
     // Declared resources (renderer/frame/FrameAllocation.h): the Renderer allocates the planned passes'
     // AOV outputs, beauty and the environment map; each pass then touches the shared resources only as
@@ -610,6 +629,7 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     im.resources.setShadowMapExclusions(std::move(shadowMapExclusions));
     for (std::size_t i = 0; i < plan.passes.size(); ++i) {
       Technique* t = plan.passes[i];
+      cancelToken.check("the frame's set-up, before preparing " + t->info().name);
       im.resources.beginPass(t->info().name, declaredAccess(t->info()), FrameResources::Phase::Prepare);
       t->prepare(scene, params[i], im.resources);
       im.resources.endPass();
@@ -629,14 +649,14 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     };
     for (std::size_t i = 0; i < plan.passes.size(); ++i) {
       report(0.95 * static_cast<double>(i) / passCount);
-      if (cancel && cancel->load())
+      if (cancelToken.requested())
         throw api::ApiError(409, "canceled", "Render canceled", "the render was cancelled before pass " +
                                                                   plan.passes[i]->info().name);
       Technique* t = plan.passes[i];
       gl::DebugGroup group(t->info().name);
       PassContext ctx{scene, gpu, view, params[i], im.resources, im.shaders, stats.passes[i]};
       ctx.progress = [&, i](double f) { report(0.95 * (static_cast<double>(i) + std::clamp(f, 0.0, 1.0)) / passCount); };
-      ctx.cancelled = [cancel] { return cancel && cancel->load(); };
+      ctx.cancel = cancelToken;
       im.resources.beginPass(t->info().name, declaredAccess(t->info()), FrameResources::Phase::Execute);
       {
         GpuProfiler::Scope scope(im.profiler, stats.passes[i]);
@@ -714,11 +734,23 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     report(1.0);
     if (nonFinite) stats.passes.back().counters["non_finite_pixels_zeroed"] = static_cast<double>(nonFinite);
     reportOutputRange(out, zeroed, request);  // after compare: its error and reference AOVs are outputs too
+    im.resources.setCancel({});  // the flag belongs to this request's job, which may go away after it
     return out;
-  } catch (const api::ApiError&) {
+  } catch (const rt::Cancelled& c) {
+    // A pass or builder saw the cancel flag mid-loop (renderer/raytracing/Cancel.h): what it built is not
+    // stored, and the GL pipeline state it changed goes back to the defaults a fresh context has.
+    im.resources.setCancel({});
+    im.resources.forgetHeld();
     im.profiler.beginFrame();
+    resetPipelineState();
+    throw api::ApiError(409, "canceled", "Render canceled", c.what());
+  } catch (const api::ApiError& e) {
+    im.resources.setCancel({});
+    im.profiler.beginFrame();
+    if (e.status == 409) resetPipelineState();
     throw;
   } catch (...) {
+    im.resources.setCancel({});
     // An environment failure may leave GL objects in any state: drop derived data so the next frame
     // rebuilds from scratch, and drain the GL error queue.
     im.profiler = GpuProfiler(im.profiler.method());

@@ -62,6 +62,7 @@ void FrameResources::beginFrame(const GpuScene& gpu, const FrameView& view, std:
   gpu_ = &gpu;
   view_ = &view;
   cacheLog_ = cacheLog;
+  cancel_ = {};
   endPass();  // a pass that threw last frame left its scope open
   written_.clear();
   declaredThisFrame_.clear();

@@ -23,6 +23,7 @@
 #include "api/Types.h"
 #include "renderer/gl/Gl.h"
 #include "renderer/gl/ShaderLibrary.h"
+#include "renderer/raytracing/Cancel.h"
 
 namespace radiant {
 
@@ -46,6 +47,10 @@ public:
   // Called by the Renderer at the start of each frame.
   void beginFrame(const GpuScene& gpu, const FrameView& view, std::vector<api::CacheEvent>* cacheLog);
   const GpuScene& gpuScene() const { return *gpu_; }
+  // The frame's cancel token (renderer/raytracing/Cancel.h), for prepare() and the derived-data builders
+  // (photon tracing, the BVH, beams), which see no PassContext. Set by the Renderer after beginFrame().
+  void setCancel(rt::Cancel cancel) { cancel_ = cancel; }
+  const rt::Cancel& cancel() const { return cancel_; }
   // The frame's scene identity for cache keys of derived data (GpuScene::sceneKey).
   const std::string& sceneKey() const;
   const FrameView& view() const { return *view_; }
@@ -73,6 +78,9 @@ public:
   // clear(), forget what it held.
   bool holds(const std::string& resource, const std::string& digest, const std::string& logKey = "");
   void setHolds(const std::string& resource, std::string digest) { holds_[resource] = std::move(digest); }
+  // Forgets what every resource holds: after a pass stopped mid-write (a cancelled request), any shared
+  // resource may be half rewritten, so each is redrawn when next asked for.
+  void forgetHeld() { holds_.clear(); }
   // What `resource` holds (the digest of its last setHolds), "" when nothing: data derived from it (the
   // caustic cubes from the specular maps) keys its own cache on it.
   std::string heldDigest(const std::string& resource) const {
@@ -144,6 +152,7 @@ public:
   void clear();
 
 private:
+  rt::Cancel cancel_;
   struct TextureSpec {
     GLenum target, format;
     int width, height, depth, levels;

@@ -7,6 +7,7 @@
 #include "renderer/frame/GpuScene.h"
 #include "renderer/frame/Technique.h"
 #include "renderer/gl/ShaderLibrary.h"
+#include "renderer/raytracing/Cancel.h"
 
 namespace radiant {
 
@@ -21,9 +22,11 @@ struct PassContext {
   api::PassStats& stats;
   // The pass's own progress in [0, 1] (optional to call; thread-safe; the Renderer maps it onto the frame).
   std::function<void(double)> progress = [](double) {};
-  // Whether the request has been cancelled or has timed out (the Renderer polls it between passes; a
-  // long pass may poll it inside and stop early, e.g. illumination_network between iteration batches).
-  std::function<bool()> cancelled = [] { return false; };
+  // The request's cancel flag (renderer/raytracing/Cancel.h): the Renderer polls it between passes, and
+  // every loop of a pass that can run longer than a few milliseconds polls it too (per tile, row, block
+  // of photons, stretch of GPU work) and throws rt::Cancelled, so that a cancelled, timed-out or
+  // shut-down render stops within one second whatever pass it is in.
+  rt::Cancel cancel;
 };
 
 }  // namespace radiant

@@ -13,6 +13,7 @@ namespace radiant::rt {
 namespace {
 
 constexpr std::uint64_t kBlock = 1024;  // photons per work item; records are concatenated in block order
+constexpr std::uint64_t kCancelPollPhotons = 64;  // a millisecond or less of tracing
 
 bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
@@ -93,7 +94,10 @@ void tracePhotons(const RayScene& rays, const SceneLights& lights, const PhotonO
         const std::uint64_t lo = begin + b * kBlock, hi = std::min(count, lo + kBlock);
         auto& out = perBlock[b];
         out.reserve((hi - lo) * 2);
-        for (std::uint64_t i = lo; i < hi; ++i) tracePhoton(rays, lights, options, i, out, counter);
+        for (std::uint64_t i = lo; i < hi; ++i) {
+          if ((i - lo) % kCancelPollPhotons == 0) options.cancel.check("photon tracing");
+          tracePhoton(rays, lights, options, i, out, counter);
+        }
       }
       rayCount += counter.rays;
     });

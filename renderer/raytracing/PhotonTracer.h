@@ -20,6 +20,7 @@
 
 #include <glm/glm.hpp>
 
+#include "renderer/raytracing/Cancel.h"
 #include "renderer/raytracing/Lights.h"
 #include "renderer/raytracing/RayScene.h"
 
@@ -52,6 +53,9 @@ struct PhotonOptions {
   bool russianRoulette = true;
   std::uint64_t seed = 0;
   int threads = 0;  // 0 = TBB default
+  // Polled every kCancelPollPhotons photons: tracePhotons() then throws Cancelled and leaves `set` as it
+  // was (the new records are appended only once every photon is traced), so a cached set stays whole.
+  Cancel cancel;
 };
 
 struct PhotonSet {

@@ -23,6 +23,7 @@ using namespace radiant::rt;
 
 constexpr std::uint64_t kMinPathsPerBlock = 4096;
 constexpr std::uint64_t kBlocksPerWave = 8;  // images in flight; summed in block order
+constexpr std::uint64_t kCancelPollPaths = 256;  // light paths between two polls of the cancel flag: well under a ms
 constexpr int kRussianRouletteStart = 3;
 
 bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
@@ -129,7 +130,10 @@ Image LightTracer::render(const Camera& camera, int width, int height, const Lig
           std::vector<float>& image = wave[b];
           image.assign(pixels * 3, 0.f);
           const std::uint64_t lo = (first + b) * pathsPerBlock, hi = std::min(paths, lo + pathsPerBlock);
-          for (std::uint64_t i = lo; i < hi; ++i) tracer.trace(i, image, counter);
+          for (std::uint64_t i = lo; i < hi; ++i) {
+            if ((i - lo) % kCancelPollPaths == 0) options.cancel.check("the reference light tracer's paths");
+            tracer.trace(i, image, counter);
+          }
         }
         rayCount += counter.rays;
       });

@@ -30,6 +30,7 @@
 #include <glm/glm.hpp>
 
 #include "renderer/Image.h"
+#include "renderer/raytracing/Cancel.h"
 #include "renderer/scene/Scene.h"
 
 namespace radiant::rt { class RayScene; }
@@ -47,6 +48,7 @@ struct LightTracerOptions {
   const Image* environment = nullptr;
   int threads = 0;  // 0 = TBB default
   std::function<void(double)> progress;  // fraction of paths traced, after each wave of blocks
+  rt::Cancel cancel;  // polled every kCancelPollPaths paths of a block; render() then throws rt::Cancelled
 };
 
 class LightTracer {

@@ -24,6 +24,8 @@ namespace {
 using namespace radiant::rt;
 
 constexpr int kTileSize = 16;
+// Samples of one pixel between two polls of the cancel flag: tens of microseconds of work each.
+constexpr int kCancelPollSamples = 16;
 constexpr int kRussianRouletteStart = 3;
 
 }  // namespace
@@ -287,6 +289,7 @@ Image PathTracer::render(const Camera& camera, int width, int height, const Refe
             const std::uint64_t pixel = static_cast<std::uint64_t>(y) * width + x;
             glm::dvec3 sum(0.0);
             for (int s = 0; s < options.spp; ++s) {
+              if (s % kCancelPollSamples == 0) options.cancel.check("the reference path tracer's tiles");
               Sampler sampler(pixel, static_cast<std::uint64_t>(s), options.seed);
               const glm::vec2 jitter = sampler.next2();
               const Ray ray = cameraRays.ray(x + jitter.x, y + jitter.y);

@@ -63,6 +63,7 @@
 #include <glm/glm.hpp>
 
 #include "renderer/Image.h"
+#include "renderer/raytracing/Cancel.h"
 #include "renderer/scene/Scene.h"
 
 namespace radiant::rt {
@@ -87,6 +88,9 @@ struct ReferenceOptions {
   int threads = 0;                     // 0 = TBB default
   // Called with the fraction of tiles done, from worker threads (keep it cheap and thread-safe).
   std::function<void(double)> progress;
+  // Polled every kCancelPollSamples samples of a pixel (a few ms of work however high spp is): render()
+  // then throws rt::Cancelled once every worker has stopped.
+  rt::Cancel cancel;
   // Drop exactly the caustic paths L S+ D E (the camera's first vertex scatters through a non-delta
   // lobe, every later vertex through a Dirac delta, then an emitter or the sky), which the light tracer
   // renders (renderer/reference/LightTracer.h): path tracer with this + light tracer's caustics = the

@@ -234,6 +234,8 @@ Image VolumeTracer::render(const Camera& camera, int width, int height, const Vo
         for (int x = 0; x < width; ++x) {
           glm::dvec4 sum(0.0);
           for (int s = 0; s < o.spp; ++s) {
+            // Full mode's paths scatter up to maxScattering times among many particles: poll often.
+            if (s % 4 == 0) o.cancel.check("the volumetric reference's rows");
             Sampler sampler(static_cast<std::uint64_t>(y) * width + x, static_cast<std::uint64_t>(s), o.seed);
             const glm::vec2 jitter = o.spp == 1 ? glm::vec2(0.5f) : sampler.next2();
             Ray ray = cameraRays.ray(x + jitter.x, y + jitter.y);

@@ -28,6 +28,7 @@
 #include <glm/glm.hpp>
 
 #include "renderer/Image.h"
+#include "renderer/raytracing/Cancel.h"
 #include "renderer/scene/Scene.h"
 
 namespace radiant::rt {
@@ -50,6 +51,7 @@ struct VolumeOptions {
   std::uint64_t seed = 0;
   glm::vec3 sky{0.f};
   int threads = 0;  // 0 = TBB default
+  rt::Cancel cancel;  // polled every few samples of a pixel; render() then throws rt::Cancelled
 };
 
 class VolumeTracer {

@@ -10,11 +10,12 @@ uniform mat4 u_view;
 uniform mat4 u_proj;
 uniform float u_znear;
 uniform int u_orthographic;
+uniform int u_firstInstance;  // drawn in stretches (renderer/shading/Stretches.h)
 
 flat out int v_block;
 
 void main() {
-  v_block = order[gl_InstanceID];
+  v_block = order[u_firstInstance + gl_InstanceID];
   const vec4 cr = blocks[v_block].centerRadius;
   gl_Position = sphereQuadVertex(cr.xyz, cr.w, gl_VertexID, u_view, u_proj, u_znear, u_orthographic == 1);
 }

@@ -3,10 +3,11 @@
 #include "photon_gi/photon.glsl"
 
 uniform mat4 u_viewProj;
+uniform int u_firstInstance;  // drawn in stretches (renderer/shading/Stretches.h)
 flat out int v_photon;
 
 void main() {
-  int photon = gl_InstanceID;
+  int photon = u_firstInstance + gl_InstanceID;
   vec2 c = vec2((gl_VertexID & 1) != 0 ? 1.0 : -1.0, (gl_VertexID & 2) != 0 ? 1.0 : -1.0);
   GpuPhoton p = photons[photon];
   vec3 n = p.normal.xyz;

@@ -10,11 +10,12 @@ uniform mat4 u_view;  // world -> view (the camera looks down -z)
 uniform mat4 u_proj;
 uniform float u_znear;
 uniform int u_orthographic;
+uniform int u_firstInstance;  // drawn in stretches (renderer/shading/Stretches.h)
 
 flat out int v_particle;
 
 void main() {
-  const int i = gl_InstanceID;
+  const int i = u_firstInstance + gl_InstanceID;
   v_particle = i;
   const vec4 cr = particles[i].centerRadius;
   gl_Position = sphereQuadVertex(cr.xyz, cr.w, gl_VertexID, u_view, u_proj, u_znear, u_orthographic == 1);

@@ -51,6 +51,7 @@ bool boundsMayBeVisible(const Bounds& b, const glm::mat4& viewProj) {
 }
 
 constexpr int kGroup = 8;
+constexpr int kRowsPerStretch = 32;  // photon grid rows drawn between two cancel checks
 // The secondary lookup's tree drops branches below this path weight (the specular pass's bound).
 constexpr float kMinBranchWeight = 1e-3f;
 constexpr float kMaxLightTan = 11.4f;  // tan(85 degrees)  // work-group side of area.comp and energy.comp
@@ -282,7 +283,11 @@ void CausticsPass::execute(PassContext& ctx) {
     const gl::Program& drawProg = method_ == Method::Triangles
                                       ? ctx.shaders.program({"caustics/grid.vert", "caustics/triangles.geom", "caustics/deposit.frag"})
                                       : ctx.shaders.program({"caustics/grid.vert", "caustics/splat.geom", "caustics/deposit.frag"});
+    int pairsDrawn = 0;
     for (const Pair& pair : pairs_) {
+      ctx.cancel.check("caustics' photon pass, pair " + std::to_string(pairsDrawn + 1) + " of " +
+                       std::to_string(pairs_.size()));
+      ctx.progress(0.9 * pairsDrawn++ / double(pairs_.size()));
       // (1) Photon tracing pass: the generator seen from the light, negative power where it is not.
       photonFb.bind();
       glViewport(0, 0, P, P);
@@ -349,12 +354,15 @@ void CausticsPass::execute(PassContext& ctx) {
       drawProg.set("u_causticResolution", static_cast<float>(C));
       drawProg.set("u_splatRadius", splatRadius_);
       glProgramUniformMatrix4fv(drawProg.id(), drawProg.uniformLocation("u_faceViewProj"), 6, GL_FALSE, &faces[0][0][0]);
-      if (method_ == Method::Triangles) {
-        drawProg.set("u_gridMode", 0);
-        glDrawArrays(GL_TRIANGLES, 0, 6 * (P - 1) * (P - 1));
-      } else {
-        drawProg.set("u_gridMode", 1);
-        glDrawArrays(GL_POINTS, 0, P * P);
+      // In stretches of kRowsPerStretch grid rows (gl_VertexID counts from `first`, so the stretches
+      // draw exactly the one draw's primitives), with a cancel check between them.
+      drawProg.set("u_gridMode", method_ == Method::Triangles ? 0 : 1);
+      const int rows = method_ == Method::Triangles ? P - 1 : P;
+      const int perRow = method_ == Method::Triangles ? 6 * (P - 1) : P;
+      for (int row = 0; row < rows; row += kRowsPerStretch) {
+        if (row > 0) ctx.cancel.check("caustics' drawing");
+        glDrawArrays(method_ == Method::Triangles ? GL_TRIANGLES : GL_POINTS, row * perRow,
+                     std::min(kRowsPerStretch, rows - row) * perRow);
       }
       glDisable(GL_BLEND);
       glMemoryBarrier(GL_ALL_BARRIER_BITS);

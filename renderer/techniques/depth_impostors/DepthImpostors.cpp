@@ -7,8 +7,12 @@
 #include "renderer/frame/FrameView.h"
 #include "renderer/frame/PassContext.h"
 #include "renderer/shading/MediaLayer.h"
+#include "renderer/shading/Stretches.h"
 
 namespace radiant {
+namespace {
+constexpr int kBlocksPerStretch = 256;  // block impostors drawn between two cancel checks (each gathers its slices: heavier than a billboard)
+}  // namespace
 
 const TechniqueInfo& DepthImpostorsPass::info() const {
   static const TechniqueInfo i{"depth_impostors",
@@ -156,7 +160,7 @@ void DepthImpostorsPass::execute(PassContext& ctx) {
   for (int k = 1; k <= set.fourierTerms(); ++k)
     prog.set(("u_fourierDamping[" + std::to_string(k - 1) + "]").c_str(),
              static_cast<float>(impostors::fourierDamping(k, set.fourierTerms())));
-  if (blocks > 0) glDrawArraysInstanced(GL_TRIANGLES, 0, 6, blocks);
+  drawInstancedInStretches(prog, GL_TRIANGLES, 6, blocks, kBlocksPerStretch, ctx.cancel, "depth_impostors' gather");
   glDisable(GL_BLEND);
   res.markWritten("media");
   res.markWritten("media_transmittance");

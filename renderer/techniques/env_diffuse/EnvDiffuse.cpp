@@ -189,6 +189,8 @@ void EnvDiffusePass::buildCubeMaps(PassContext& ctx, const ReceiverState& st) {
     glDisable(GL_CULL_FACE);  // single-sided back faces are discarded in the shader (glTF semantics)
     glDisable(GL_BLEND);
     for (int face = 0; face < 6; ++face) {
+      // A face (its meshes gathering the previous bounce's 6 M^2 quads) is one stretch of GPU work.
+      ctx.cancel.check("env_diffuse's cube maps, bounce " + std::to_string(bounce) + " face " + std::to_string(face));
       fb.attach(GL_COLOR_ATTACHMENT0, radianceHi, 0, face);
       fb.attach(GL_COLOR_ATTACHMENT1, geometryHi, 0, face);
       fb.checkComplete("EnvDiffusePass::buildCubeMaps");
@@ -259,6 +261,7 @@ void EnvDiffusePass::execute(PassContext& ctx) {
   prog.set("u_horizonClip", horizonClip_ ? 1 : 0);
   prog.set("u_quadCount", 6 * downsample_ * downsample_);
   for (const ReceiverState& r : receivers_) {
+    ctx.cancel.check("env_diffuse's final gathering");
     res.buffer(r.prefix + "quads").bindBase(GL_SHADER_STORAGE_BUFFER, kQuadBinding);
     res.texture(r.prefix + "irradiance").bindUnit(5);
     const std::set<int> own(r.receiver.meshes.begin(), r.receiver.meshes.end());

@@ -250,7 +250,8 @@ void IlluminationNetworkPass::execute(PassContext& ctx) {
   net_->residuals.resize(std::size_t(resumedFrom_));
   net_->stateKey = stateKey_;
   const std::vector<double> run =
-      gpu.iterate(ctx.shaders, iterations_ - resumedFrom_, view.ambient, linearSource_, ctx.cancelled);
+      gpu.iterate(ctx.shaders, iterations_ - resumedFrom_, view.ambient, linearSource_,
+                  [&ctx] { return ctx.cancel.requested(); });
   iterationsRun_ = static_cast<int>(run.size());
   // A cancelled request still leaves a valid state: its first resumedFrom_ + run.size() iterations.
   net_->residuals.insert(net_->residuals.end(), run.begin(), run.end());
@@ -300,7 +301,7 @@ void IlluminationNetworkPass::execute(PassContext& ctx) {
       if (drawn > 0) {
         glFinish();
         ctx.progress(0.5 + 0.5 * drawn / stretches);
-        if (ctx.cancelled()) {
+        if (ctx.cancel.requested()) {
           glDisable(GL_BLEND);
           throw api::ApiError(409, "canceled", "Render canceled",
                               "the render was cancelled during illumination_network's march after stretch " +

@@ -74,7 +74,8 @@ int build(std::vector<Primitive>& prims, int begin, int end, int depth, BeamBvh&
 
 }  // namespace
 
-BeamBvh buildBeamBvh(const std::vector<Beam>& beams, const std::vector<BeamCone>& cones, const Bounds& boundsIn) {
+BeamBvh buildBeamBvh(const std::vector<Beam>& beams, const std::vector<BeamCone>& cones, const Bounds& boundsIn,
+                     const rt::Cancel& cancel) {
   BeamBvh out;
   Bounds bounds = boundsIn;
   const glm::vec3 pad(1e-3f * std::max(bounds.radius(), 1e-6f));
@@ -88,6 +89,7 @@ BeamBvh buildBeamBvh(const std::vector<Beam>& beams, const std::vector<BeamCone>
   const int count = static_cast<int>(cones.size());
   for (int g0 = 0; g0 < count; g0 += kBeamsPerGroup) {
     const int g1 = std::min(count, g0 + kBeamsPerGroup);
+    cancel.check("light_volumes' beam BVH");
     std::vector<Primitive> prims;
     for (int i = g0; i < g1; ++i) {
       const BeamCone& c = cones[i];

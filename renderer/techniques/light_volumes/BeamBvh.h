@@ -30,6 +30,8 @@ struct BeamBvh {
 
 // The BVH of the beams (with their cones) inside `bounds` (the receivers' world bounds: nothing outside
 // receives).
-BeamBvh buildBeamBvh(const std::vector<Beam>& beams, const std::vector<BeamCone>& cones, const Bounds& bounds);
+// Polls `cancel` per group of beams (throws rt::Cancelled).
+BeamBvh buildBeamBvh(const std::vector<Beam>& beams, const std::vector<BeamCone>& cones, const Bounds& bounds,
+                     const rt::Cancel& cancel = {});
 
 }  // namespace radiant::light_volumes

@@ -440,6 +440,7 @@ void appendScattererBeams(const Light& light, const std::vector<TriangleInput>& 
   const std::size_t first = out.beams.size();
   std::vector<GlossySource> glossy;
   for (std::size_t ti = 0; ti < triangles.size(); ++ti) {
+    if (ti % 256 == 0) o.cancel.check("light_volumes' beam set-up");
     TriangleInput in = triangles[ti];
     for (const bool refract : {false, true}) {
       if (refract && !in.material.isTransmissive()) break;
@@ -456,6 +457,7 @@ void appendScattererBeams(const Light& light, const std::vector<TriangleInput>& 
   std::size_t checked = 0, failed = 0;
   float worst = 0.f;
   for (GlossySource& g : glossy) {
+    if (checked % 64 == 0) o.cancel.check("light_volumes' tessellation check");
     g.ratio = tessellationRatio(out.beams[g.beam], receiverDistance);
     if (!(g.ratio >= 0.f)) continue;
     ++checked;
@@ -487,6 +489,7 @@ void appendScattererBeams(const Light& light, const std::vector<TriangleInput>& 
     bool fits = true;
     for (const GlossySource& g : glossy) {
       if (!(g.ratio > o.maxTriangleSigma)) continue;
+      o.cancel.check("light_volumes' beam subdivision");
       TriangleInput in = triangles[g.triangle];
       in.refract = g.refract;
       const std::size_t begin = children.size();

@@ -9,6 +9,7 @@
 
 #include <glm/glm.hpp>
 
+#include "renderer/raytracing/Cancel.h"
 #include "renderer/scene/Scene.h"
 
 namespace radiant::light_volumes {
@@ -58,6 +59,9 @@ struct BeamOptions {
   // minus the beams they replace). A scatterer whose subdivision would exceed what is left of it is not
   // subdivided and falls back (specularFallback) as before. 0: never subdivide.
   std::size_t maxSubdivisionBeams = 65536;
+  // Polled per batch of triangles and of tessellation checks (which trace rays) and per subdivided
+  // triangle: buildBeams() then throws rt::Cancelled.
+  rt::Cancel cancel;
   // > 0: every scattered beam gets this sigma (a Gaussian-lobe debug BSDF, notes A6: it separates the
   // algorithm's error from the GGX fit's). Tests only; not a request knob.
   float sigmaOverride = 0.f;

@@ -83,6 +83,7 @@ void LightVolumesPass::prepare(const Scene& scene, const Params& params, FrameRe
   o.specularFallback = params.get<std::string>("tessellation_fallback", "specular") == "specular";
   o.cullSigmas = params.get<float>("cull_sigmas", 4.f);
   o.maxSubdivisionBeams = static_cast<std::size_t>(std::max(0, params.get<int>("max_subdivision_beams", 65536)));
+  o.cancel = res.cancel();
   split_ = params.get<std::string>("split", "2d") == "paper" ? light_volumes::Split::Paper : light_volumes::Split::TwoD;
   bvh_ = params.get<std::string>("traversal", "bvh") == "bvh";
   // Every light path is counted once: without LS+DE and LG+DE (another technique owns them) the pass
@@ -111,7 +112,7 @@ void LightVolumesPass::prepare(const Scene& scene, const Params& params, FrameRe
     c->beams = light_volumes::buildBeams(scene, o, receiverDistance);
     c->setupMs = msSince(t0);
     t0 = Clock::now();
-    c->bvh = light_volumes::buildBeamBvh(c->beams.beams, c->beams.cones, scene.features.bounds);
+    c->bvh = light_volumes::buildBeamBvh(c->beams.beams, c->beams.cones, scene.features.bounds, res.cancel());
     c->bvhMs = msSince(t0);
     return c;
   });
@@ -175,6 +176,8 @@ void LightVolumesPass::execute(PassContext& ctx) {
   }
   if (work.empty()) work.push_back(bvh_ ? std::pair{-1, 0} : std::pair{0, 0});
   for (std::size_t k = 0; k < work.size(); ++k) {
+    // One slice or BVH group per stretch of GPU work, a cancel check between them.
+    if (k > 0) ctx.cancel.check("light_volumes' gather, stretch " + std::to_string(k) + " of " + std::to_string(work.size()));
     if (bvh_) prog.set("u_root", work[k].first);
     else {
       prog.set("u_begin", work[k].first);

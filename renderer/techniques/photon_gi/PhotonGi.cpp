@@ -118,6 +118,7 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
     rt::PhotonOptions o;
     o.maxBounces = s.maxBounces;
     o.seed = view.seed;
+    o.cancel = res.cancel();  // a cancelled trace throws and leaves cache.set as it was (PhotonTracer.h)
     traced_ = s.photons - cache.set.emitted;
     rt::tracePhotons(rays, lights, o, s.photons, cache.set);
     traceMs_ = msSince(t0);

@@ -9,6 +9,7 @@
 #include "renderer/frame/GpuTypes.h"
 #include "renderer/raytracing/Bsdf.h"
 #include "renderer/shading/PhotonGrid.h"
+#include "renderer/shading/Stretches.h"
 
 namespace radiant::photon_gi {
 namespace {
@@ -19,6 +20,7 @@ constexpr GLuint kSplatBinding = kPhotonSplatBinding, kCellBinding = kPhotonCell
 // gather.comp and fixup_list.comp: the fix-up list (binding 4 is free in photon_gi's shaders).
 constexpr GLuint kFixupListBinding = 4;
 constexpr int kMaxCellsPerAxis = 128;
+constexpr int kSplatsPerStretch = 65536;  // splat quads drawn between two cancel checks
 constexpr std::uint32_t kGatherSlice = kPhotonGatherSlice;
 constexpr float kPlaneTolerance = kPhotonPlaneTolerance;
 constexpr float kNormalCosine = kPhotonNormalCosine;
@@ -191,7 +193,7 @@ void splatAndResolve(FrameResources& res, gl::ShaderLibrary& shaders, const Fram
     const gl::Program& prog = shaders.program({"photon_gi/splat.vert", "photon_gi/splat.frag"});
     common(prog);
     prog.setMat4("u_viewProj", glm::value_ptr(view.viewProj));
-    if (count > 0) glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, count);
+    drawInstancedInStretches(prog, GL_TRIANGLE_STRIP, 4, count, kSplatsPerStretch, res.cancel(), "photon_gi's splatting");
     glDisable(GL_BLEND);
   } else {
     const gl::Program& prog = shaders.program({"photon_gi/gather.comp"});
@@ -235,6 +237,7 @@ void splatAndResolve(FrameResources& res, gl::ShaderLibrary& shaders, const Fram
       prog.set("u_list", fixup ? 1 : 0);
       target.bindImage(0, GL_READ_WRITE);
       for (std::uint32_t k = 0; k < slices; ++k) {
+        if (k > 0) res.cancel().check("photon_gi's gather");
         glUniform1ui(glGetUniformLocation(prog.id(), "u_sliceBegin"), k * kGatherSlice);
         glUniform1ui(glGetUniformLocation(prog.id(), "u_sliceLength"), kGatherSlice);
         prog.set("u_accumulate", k > 0 ? 1 : 0);

@@ -25,6 +25,7 @@ const Image& mediaReferenceImage(FrameResources& res, const Scene& scene, const 
   o.maxScattering = std::max(1, r.maxBounces);
   o.seed = view.seed;
   o.sky = view.ambient;
+  o.cancel = res.cancel();
   const glm::mat4& w = view.camera.world;
   const nlohmann::json key = {{"scene", res.sceneKey()}, {"media", view.mediaKey},
                               {"camera", std::vector<float>(&w[0][0], &w[0][0] + 16)},
@@ -70,6 +71,7 @@ const Image& referenceImage(FrameResources& res, const Scene& scene, const Frame
   o.skyRadiance = view.ambient;
   o.environment = view.environment;  // when set, it replaces skyRadiance
   o.environmentDistribution = environmentDistribution(res, view);
+  o.cancel = res.cancel();
   if (r.aov == "direct") {
     o.minPathBounce = 0, o.maxPathBounce = 1;  // what the raster `direct` AOV holds: emission, sky, direct
   } else if (r.aov == "indirect" || r.aov == "indirect_diffuse") {
@@ -98,6 +100,7 @@ const Image& referenceImage(FrameResources& res, const Scene& scene, const Frame
     lo.maxPathBounce = o.maxPathBounce;
     lo.skyRadiance = o.skyRadiance;
     lo.environment = o.environment;
+    lo.cancel = res.cancel();
     if (progress) lo.progress = [&progress, ptShare](double f) { progress(ptShare + (1.0 - ptShare) * f); };
   }
   const glm::mat4& w = view.camera.world;

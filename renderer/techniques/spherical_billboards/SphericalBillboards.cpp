@@ -7,8 +7,12 @@
 #include "renderer/frame/PassContext.h"
 #include "renderer/raytracing/Media.h"
 #include "renderer/shading/MediaLayer.h"
+#include "renderer/shading/Stretches.h"
 
 namespace radiant {
+namespace {
+constexpr int kParticlesPerStretch = 4096;  // billboards drawn between two cancel checks
+}  // namespace
 
 const TechniqueInfo& SphericalBillboardsPass::info() const {
   static const TechniqueInfo i{"spherical_billboards",
@@ -94,7 +98,8 @@ void SphericalBillboardsPass::execute(PassContext& ctx) {
   prog.set("u_chord", chord_);
   prog.set("u_softScale", softScale_);
   prog.set("u_lightCount", static_cast<int>(ctx.scene.lights.size()));
-  if (!particles_.empty()) glDrawArraysInstanced(GL_TRIANGLES, 0, 6, static_cast<GLsizei>(particles_.size()));
+  drawInstancedInStretches(prog, GL_TRIANGLES, 6, static_cast<int>(particles_.size()), kParticlesPerStretch,
+                           ctx.cancel, "spherical_billboards' particles");
   glDisable(GL_BLEND);
 
   // 2. The layer to full resolution.

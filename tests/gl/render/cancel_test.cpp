@@ -1,0 +1,210 @@
+// Cancellation that reaches every loop (issue 30; docs/API.md, "Jobs, queue, timeouts"): a render
+// cancelled mid-pass throws 409 "canceled" within a second of its flag, whatever pass it is in, and
+// leaves the Renderer and its caches usable: a small render after it equals the same render of an
+// identical scene under another digest (fresh caches, never touched by the cancelled frame).
+//
+// Each case's big frame would take several seconds or more on llvmpipe; the flag is raised 200 ms in.
+// What is asserted is the condition (the frame was cancelled, not finished, and the next frame is
+// right); time only bounds the wait, by the one second the API promises.
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "api/Validate.h"
+#include "renderer/Renderer.h"
+#include "renderer/scene/BuiltinScenes.h"
+#include "tests/support/ImageDifference.h"
+#include "tests/support/RenderTestSupport.h"
+
+namespace radiant {
+namespace {
+
+using nlohmann::json;
+using Clock = std::chrono::steady_clock;
+using testing::aov;
+using testing::renderer;
+
+double msBetween(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+// photon_gi (on by default) traces its photons in prepare(): off unless it is the pass under test, so
+// that the flag lands in the pass under test.
+json body(json passes, json aovs, int size, json media = json::array()) {
+  if (!passes.contains("photon_gi")) passes["photon_gi"] = false;
+  json b = {{"scene", {{"builtin", "unused"}}},
+            {"width", size},
+            {"height", size},
+            {"supersampling", 1},
+            {"outputs", json::array({{{"format", "exr"}, {"aovs", aovs}}})},
+            {"passes", passes}};
+  if (!media.empty()) b["media"] = media, b["ambient"] = {0.3, 0.35, 0.45};
+  return b;
+}
+
+// A cloud of n particles on a jittered lattice in the unit cube around the origin.
+json cloud(int n) {
+  json particles = json::array();
+  const int side = static_cast<int>(std::ceil(std::cbrt(double(n))));
+  for (int i = 0; i < n; ++i) {
+    const int x = i % side, y = (i / side) % side, z = i / (side * side);
+    particles.push_back({{"p", {-1.0 + 2.0 * (x + 0.5) / side, -1.0 + 2.0 * (y + 0.5) / side,
+                                -1.0 + 2.0 * (z + 0.5) / side}},
+                         {"r", 2.5 / side}});
+  }
+  return json::array({{{"kind", "cloud"}, {"tau", 2.0}, {"albedo", {0.9, 0.9, 0.9}}, {"particles", particles}}});
+}
+
+struct Case {
+  const char* name;
+  const char* scene;  // builtin
+  json big, small;    // request bodies
+  const char* aov;    // compared after the cancel
+  const char* where;  // in the 409's detail: the loop that saw the flag
+  // The pass whose execute() the flag should land in: it is raised 200 ms after that pass starts (the
+  // frame's progress reaches its share), or 200 ms after the frame starts when "" (work in prepare()).
+  const char* pass = "";
+};
+
+Scene sceneUnder(const char* builtin, const std::string& digest) {
+  Scene s = loadBuiltinScene(builtin);
+  s.digest = digest;
+  return s;
+}
+
+// Renders `c.big` with the flag raised after 200 ms; then `c.small` on the same renderer and on the
+// same scene under another digest.
+void cancelMidPass(const Case& c) {
+  Renderer& r = renderer();
+  const Scene fresh = sceneUnder(c.scene, std::string("sha256:cancel-fresh-") + c.name);
+  const Scene used = sceneUnder(c.scene, std::string("sha256:cancel-used-") + c.name);
+  const RenderOutput expected = r.render(fresh, api::parseRenderRequest(c.small));
+
+  // Pass i of n starts at progress 0.95 i / n (Renderer::render); the small frame plans the same passes.
+  double passStart = 0.0;
+  if (*c.pass) {
+    std::size_t i = 0;
+    while (i < expected.stats.passes.size() && expected.stats.passes[i].name != c.pass) ++i;
+    ASSERT_LT(i, expected.stats.passes.size()) << c.pass << " is not planned";
+    passStart = 0.95 * double(i) / double(expected.stats.passes.size());
+  }
+  std::atomic<bool> cancel{false}, started{!*c.pass};
+  FrameInputs inputs;
+  inputs.progress = [&](double v) {
+    if (v >= passStart - 1e-9) started = true;
+  };
+  Clock::time_point raised{};
+  std::atomic<bool> done{false};
+  std::thread canceller([&] {
+    while (!started.load() && !done.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    const auto until = Clock::now() + std::chrono::milliseconds(200);
+    while (Clock::now() < until && !done.load()) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    if (done.load()) return;
+    raised = Clock::now();
+    cancel.store(true);
+  });
+  const auto start = Clock::now();
+  std::string detail;
+  int status = 0;
+  try {
+    r.render(used, api::parseRenderRequest(c.big), &cancel, inputs);
+  } catch (const api::ApiError& e) {
+    status = e.status;
+    detail = e.detail();
+    EXPECT_EQ(e.type, "canceled");
+  }
+  const auto end = Clock::now();
+  done = true;
+  canceller.join();
+  ASSERT_TRUE(cancel.load()) << c.name << ": the big frame finished in " << msBetween(start, end)
+                             << " ms, before the flag: make it bigger";
+  EXPECT_EQ(status, 409) << c.name;
+  const double latency = msBetween(raised, end);
+  std::printf("%s: stopped %.0f ms after the flag (%.0f ms in): %s\n", c.name, latency, msBetween(start, end),
+              detail.c_str());
+  EXPECT_LT(latency, 1000.0) << c.name << ": " << detail;
+  EXPECT_NE(detail.find(c.where), std::string::npos) << c.name << ": cancelled elsewhere: " << detail;
+
+  const RenderOutput after = r.render(used, api::parseRenderRequest(c.small));
+  EXPECT_TRUE(testing::allFinite(after));
+  EXPECT_LT(testing::maxAbsDifference(aov(expected, c.aov), aov(after, c.aov)), 1e-5)
+      << c.name << ": the frame after the cancelled one differs from the same frame on fresh caches";
+}
+
+TEST(Cancel, ReferencePathTracer) {
+  cancelMidPass({"reference", "cornell_box", body({{"reference", {{"spp", 65536}}}}, {"reference"}, 64),
+                 body({{"reference", {{"spp", 4}}}}, {"reference"}, 16), "reference", "reference path tracer"});
+}
+
+TEST(Cancel, ReferenceLightTracer) {
+  // cornell_glass has delta lobes: the reference adds the light tracer's caustics after the path tracer.
+  cancelMidPass({"reference_light_tracer", "cornell_glass",
+                 body({{"reference", {{"spp", 1}, {"light_paths_per_pixel", 65536}}}}, {"reference"}, 64),
+                 body({{"reference", {{"spp", 2}, {"light_paths_per_pixel", 2}}}}, {"reference"}, 16), "reference", "light tracer", "reference"});
+}
+
+TEST(Cancel, PhotonGiTracing) {
+  cancelMidPass({"photon_gi", "cornell_box", body({{"photon_gi", {{"photons", 4000000}}}}, {"beauty"}, 32),
+                 body({{"photon_gi", {{"photons", 20000}}}}, {"beauty"}, 32), "beauty", "photon tracing"});
+}
+
+TEST(Cancel, Caustics) {
+  cancelMidPass({"caustics", "cornell_glass",
+                 body({{"caustics", {{"photon_resolution", 256}, {"cube_resolution", 1024}}}}, {"beauty", "caustics"}, 256),
+                 body({{"caustics", {{"photon_resolution", 32}, {"cube_resolution", 64}}}}, {"beauty", "caustics"}, 32),
+                 "caustics", "caustics", "caustics"});
+}
+
+TEST(Cancel, LightVolumes) {
+  cancelMidPass({"light_volumes", "cornell_glossy",
+                 body({{"light_volumes", {{"max_subdivision_beams", 1048576}, {"max_triangle_sigma", 0.01},
+                                          {"traversal", "linear"}}}},
+                      {"beauty"}, 256),
+                 body({{"light_volumes", {{"max_subdivision_beams", 0}}}}, {"beauty"}, 32), "beauty", "light_volumes"});
+}
+
+TEST(Cancel, EnvDiffuse) {
+  cancelMidPass({"env_diffuse", "cornell_box",
+                 body({{"env_diffuse", {{"cube_resolution", 512}, {"downsample", 16}, {"bounces", 4}}}},
+                      {"beauty", "indirect_diffuse"}, 256),
+                 body({{"env_diffuse", {{"cube_resolution", 32}, {"downsample", 4}}}}, {"beauty", "indirect_diffuse"}, 32),
+                 "indirect_diffuse", "env_diffuse", "env_diffuse"});
+}
+
+TEST(Cancel, SphericalBillboards) {
+  cancelMidPass({"spherical_billboards", "cornell_box",
+                 body({{"spherical_billboards", json::object()}}, {"beauty", "media"}, 512, cloud(60000)),
+                 body({{"spherical_billboards", json::object()}}, {"beauty", "media"}, 32, cloud(64)), "media", "spherical_billboards", "spherical_billboards"});
+}
+
+TEST(Cancel, DepthImpostors) {
+  cancelMidPass({"depth_impostors", "cornell_box",
+                 body({{"spherical_billboards", false}, {"depth_impostors", {{"particles_per_block", 1}}}},
+                      {"beauty", "media"}, 512, cloud(20000)),
+                 body({{"spherical_billboards", false}, {"depth_impostors", json::object()}}, {"beauty", "media"}, 32,
+                      cloud(64)),
+                 "media", "depth_impostors", "depth_impostors"});
+}
+
+// Known gap (issue 30, open): at 8192 nodes x 128 directions the network's visibility build
+// (NetworkGpu::buildVisibility, one dispatch over N x D) runs about 1.5 s on llvmpipe before the
+// iterations' first poll, so this frame stops 1.5 s after the flag. Enable once it is split.
+TEST(Cancel, DISABLED_IlluminationNetworkIterations) {
+  cancelMidPass({"illumination_network", "cornell_box",
+                 body({{"spherical_billboards", false},
+                       {"illumination_network", {{"nodes", 8192}, {"directions", 128}, {"iterations", 1024}, {"warm_start", false}}}},
+                      {"beauty", "media"}, 64, cloud(512)),
+                 body({{"spherical_billboards", false},
+                       {"illumination_network", {{"nodes", 64}, {"directions", 8}, {"iterations", 2}, {"warm_start", false}}}},
+                      {"beauty", "media"}, 32, cloud(64)),
+                 "media", "illumination_network", "illumination_network"});
+}
+
+}  // namespace
+}  // namespace radiant
