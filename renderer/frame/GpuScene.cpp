@@ -163,8 +163,12 @@ GpuScene::GpuScene(const Scene& scene) : sceneKey(nextSceneKey(scene)) {
 }
 
 void GpuScene::bindSceneBuffers() const {
-  materials.bindBase(GL_SHADER_STORAGE_BUFFER, kMaterialBinding);
+  bindMaterialBuffers();
   lights.bindBase(GL_SHADER_STORAGE_BUFFER, kLightBinding);
+}
+
+void GpuScene::bindMaterialBuffers() const {
+  materials.bindBase(GL_SHADER_STORAGE_BUFFER, kMaterialBinding);
   sheenAlbedo.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingSheenAlbedo);
 }
 
@@ -180,7 +184,9 @@ void GpuScene::draw(const gl::Program& program, bool withTextures) const {
 
 void GpuScene::drawMeshes(const gl::Program& program, bool withTextures,
                           const std::function<bool(std::size_t meshIndex)>& select) const {
-  bindSceneBuffers();
+  // Not the lights: a pass may have bound the frame's (the scene's and the environment's,
+  // bindDirectLighting) for the program it draws with.
+  bindMaterialBuffers();
   const GLint materialLoc = program.uniformLocation("u_material");
   for (std::size_t i = 0; i < meshes.size(); ++i) {
     if (!select(i)) continue;

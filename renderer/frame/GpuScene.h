@@ -55,6 +55,8 @@ public:
 
   // Binds the materials, lights and sheen-albedo buffers at their shared.h bindings.
   void bindSceneBuffers() const;
+  // The materials and sheen-albedo buffers alone (what draw() and drawMeshes() bind).
+  void bindMaterialBuffers() const;
   // Binds mesh `meshIndex`'s material textures to units gpu::materialTextureUnit(slot) (what draw() does per mesh).
   void bindMaterialTextures(std::size_t meshIndex) const;
 

@@ -240,5 +240,56 @@ TEST(Environment, SunOfAnHdrMapCastsTheReferencesShadows) {
   }
 }
 
+// The environment's lights reach the diffuse ends of the specular pass's chains (E S D L): a mirror
+// sphere on a white plane under the clear-sky map shows the sunlit plane in its lower half as the
+// reference does. The specular pass draws its layered distance maps with drawMeshes, which must not
+// rebind the scene's light buffer over the frame's (the plane in the mirror came out unlit by the sun,
+// 0.5 of the reference, when it did).
+TEST(Environment, AMirrorShowsThePlaneLitByTheMapsSun) {
+  const std::filesystem::path dir = RADIANT_ENVIRONMENTS_DIR;
+  if (!std::filesystem::exists(dir / "qwantani_afternoon_puresky_1k.hdr")) GTEST_SKIP() << "no " << dir;
+  testing::SceneBuilder b;
+  const int white = b.material(testing::lambertian(glm::vec3(0.7f)));
+  Material mirror = testing::lambertian(glm::vec3(0.9f));
+  mirror.metallicFactor = 1.f;
+  mirror.roughnessFactor = 0.f;
+  const int chrome = b.material(mirror);
+  b.quad({0, 0, 0}, {5, 0, 0}, {0, 0, -5}, white, "plane").sphere({0, 1, 0}, 1.f, chrome);
+  Scene scene = b.build("env-sun-mirror-on-plane");
+  const Image env = io::readImage((dir / "qwantani_afternoon_puresky_1k.hdr").string());
+  api::RenderRequest req;
+  req.width = req.height = 48;
+  req.environment = "sha256:" + std::string(63, 'a') + "1";
+  api::CameraOverride cam;
+  cam.hasPosition = false;
+  cam.orbit = api::CameraOverride::Orbit{30.0, 75.0, 6.0};
+  cam.target = glm::vec3(0.f, 0.8f, 0.f);
+  req.camera = cam;
+  req.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty", "reference", "gbuffer_position"}, false}};
+  req.passes["reference"] = {{"spp", 128}};
+  RenderOutput out = renderer().render(scene, req, nullptr, FrameInputs{nullptr, &env});
+  ASSERT_TRUE(testing::allFinite(out));
+  ASSERT_NE(testing::pass(out, "specular"), nullptr);
+  const Image& ref = aov(out, "reference");
+  const Image& beauty = aov(out, "beauty");
+  const Image& pos = aov(out, "gbuffer_position");
+  double r = 0, raster = 0;
+  int n = 0;
+  for (int y = 0; y < 48; ++y)
+    for (int x = 0; x < 48; ++x) {
+      const float* p = pos.at(x, y);
+      // The sphere's lower half, which reflects the plane (its rim reflects the sky: left out).
+      if (!(p[3] > 0.f) || p[1] < 1e-3f || p[1] > 0.8f) continue;
+      if (glm::length(glm::vec3(p[0], p[1] - 1.f, p[2])) > 1.01f) continue;
+      const float* a = ref.at(x, y);
+      const float* c = beauty.at(x, y);
+      r += 0.2126 * a[0] + 0.7152 * a[1] + 0.0722 * a[2];
+      raster += 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+      ++n;
+    }
+  ASSERT_GT(n, 20);
+  EXPECT_NEAR(raster / r, 1.0, 0.15) << n << " pixels, reference mean " << r / n;
+}
+
 }  // namespace
 }  // namespace radiant
