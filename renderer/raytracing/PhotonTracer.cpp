@@ -23,6 +23,7 @@ void tracePhoton(const RayScene& rays, const SceneLights& lights, const PhotonOp
   Emission e;
   if (!lights.sampleLe(sampler, e)) return;
   glm::vec3 flux = e.flux;
+  const bool deltaStartsCaustic = lights.emitters()[e.light].kind == SceneLights::Kind::Punctual;
   Ray ray = e.ray;
   const int lastBounce = o.maxBounces - 1;
   bool narrowLobePath = true;  // every scattering so far off a metal or glass by a non-diffuse lobe
@@ -59,10 +60,13 @@ void tracePhoton(const RayScene& rays, const SceneLights& lights, const PhotonOp
     const glm::vec2 uDir = sampler.next2();
     GltfBsdf::Sample s;
     if (!sh.bsdf.sample(woL, uLobe, uFresnel, uDir, s)) return;
-    // A delta scattering ends only a path that has had no other: L S+ D is the caustics' class. After a
-    // diffuse or glossy vertex the photon crosses glass and mirrors (L D S+ D: a lit ceiling seen through
-    // a glass sphere by the floor), as the reference path tracer's paths do.
-    if (s.delta && !scatteredNonDelta) return;
+    // A delta scattering ends only a path that has had no other and that left a punctual light: L S+ D
+    // from point, spot and directional lights is the caustics pass's class. After a diffuse or glossy
+    // vertex the photon crosses glass and mirrors (L D S+ D: a lit ceiling seen through a glass sphere by
+    // the floor), as the reference path tracer's paths do; so does light from the sky and from emissive
+    // triangles, which the caustics pass has no photons for (the sky through a thin glass wall onto
+    // what it encloses: TransmissionTest's striped spheres, issue 29 item 5).
+    if (s.delta && !scatteredNonDelta && deltaStartsCaustic) return;
     scatteredNonDelta = scatteredNonDelta || !s.delta;
     narrowLobePath = narrowLobePath && (s.flags & (kLobeGlossy | kLobeSpecular)) != 0 &&
                      rays.materialOf(hit.mesh).scattersNarrowLobe();

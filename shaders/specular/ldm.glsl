@@ -34,6 +34,17 @@ vec4 specularTexel(vec3 baseColor, float metallic, float transmission, float ior
   return vec4(mix(vec3(r * r), baseColor, metallic), -1.0);
 }
 
+// Whether a texel of a specular object is stored in its layered distance maps as specular (a
+// refractor or a mirror, specularTexel) or as a lit diffuse surface. A specular object is one by its
+// material's factors (Material::isSpecular); its textures can make parts of it diffuse: the stripes of
+// a transmissionTexture, a metallicRoughnessTexture's dielectric regions. Such a texel is stored as
+// what most of its light does: transmission or metalness of at least one half makes it specular.
+// Below that it is a dielectric whose diffuse lobe carries the most, stored lit (emission + direct +
+// photon_gi's gather) and its 4% Fresnel reflection dropped; before, it was a 4% mirror, black where
+// a ray through the object's transmissive parts met it (issue 29, item 5: TransmissionTest's
+// striped spheres rendered solid).
+bool specularInMaps(float metallic, float transmission) { return transmission >= 0.5 || metallic >= 0.5; }
+
 const float kEmptyDistance = 3.0e38;
 
 #ifdef LDM_TRACING

@@ -46,7 +46,7 @@ void main() {
 
   MaterialParams p = decodeMaterial(m, uv);
   o_albedo = vec4(0.0);
-  if (u_objectCode > 0) {
+  if (u_objectCode > 0 && specularInMaps(p.surface.x, p.surface.z)) {
     o_material = specularTexel(p.baseColor.rgb, p.surface.x, p.surface.z, p.surface.w);
   } else {
     // The Lambertian part of the glTF BRDF (what the caustics pass lights at the maps' texels).

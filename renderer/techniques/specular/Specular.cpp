@@ -82,6 +82,9 @@ void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResour
     // KHR_materials_volume: the object's medium, which the traced rays inside it cross (trace.glsl).
     const glm::vec3 sigmaT = scene.material(m.material).attenuationCoefficient();
     o.gpu.extent = glm::vec4(extent * 1.01f + 1e-6f, sigmaT);
+    const Material& mat = scene.material(m.material);
+    o.partlyDiffuse = !(mat.transmissionFactor >= 0.5f || mat.metallicFactor >= 0.5f) ||
+                      (mat.isTransmissive() && mat.transmissionTexture.valid()) || mat.metallicRoughnessTexture.valid();
     objectOfMesh_[i] = static_cast<int>(objects_.size());
     objects_.push_back(o);
   }
@@ -226,7 +229,8 @@ void SpecularPass::execute(PassContext& ctx) {
     }
     if (photons && photons->count > 0) {
       // L D+ D S+ E: photon_gi's estimate at every diffuse texel of the environment layers (layer >= 2;
-      // layers 0 and 1 hold the object itself), one face at a time, in slices (llvmpipe's loop limit).
+      // layers 0 and 1 hold the object itself, gathered too where some of its texels are diffuse:
+      // Object::partlyDiffuse), one face at a time, in slices (llvmpipe's loop limit).
       glMemoryBarrier(GL_ALL_BARRIER_BITS);
       const gl::Program& gather = ctx.shaders.program({"specular/map_indirect.comp"});
       gather.use();
@@ -257,7 +261,7 @@ void SpecularPass::execute(PassContext& ctx) {
       for (int k = 0; k < objectCount; ++k) {
         const glm::vec3 ref(objects_[k].gpu.referenceRadius);
         gather.set("u_reference", &ref[0], 3);
-        for (int l = 2; l < layers_; ++l)
+        for (int l = objects_[k].partlyDiffuse ? 0 : 2; l < layers_; ++l)
           for (int f = 0; f < 6; ++f) {
             gather.set("u_layerFace", (k * layers_ + l) * 6 + f);
             gather.set("u_face", f);

@@ -45,6 +45,10 @@ private:
   struct Object {
     std::size_t mesh;
     GpuObject gpu;
+    // Some of its texels may be stored as lit diffuse surfaces in its own maps (layers 0 and 1):
+    // specular/ldm.glsl specularInMaps() can fail for its material (a transmission or
+    // metallic-roughness texture, or factors below one half), so photon_gi's gather runs there too.
+    bool partlyDiffuse = false;
   };
   std::vector<Object> objects_;
   std::vector<int> objectOfMesh_;  // specular object index per mesh, -1 for diffuse meshes
