@@ -8,7 +8,7 @@ layout(std430, binding = 2) buffer BinCount { uint binCount[]; };
 layout(std430, binding = 6) writeonly buffer NodeBin { int nodeBin[]; };
 
 void main() {
-  const int p = int(gl_GlobalInvocationID.x), i = int(gl_GlobalInvocationID.y);
+  const int p = int(gl_GlobalInvocationID.x), i = u_directionFirst + int(gl_GlobalInvocationID.y);
   if (p >= u_nodes || i >= u_directions) return;
   const int b = networkBin(dirs[i], nodes[p].positionTau.xyz);
   nodeBin[i * u_nodes + p] = b;

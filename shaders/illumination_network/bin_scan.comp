@@ -7,7 +7,7 @@ layout(std430, binding = 3) writeonly buffer BinStart { uint binStart[]; };
 layout(std430, binding = 4) writeonly buffer BinFill { uint binFill[]; };
 
 void main() {
-  const int i = int(gl_GlobalInvocationID.x);
+  const int i = u_directionFirst + int(gl_GlobalInvocationID.x);
   if (i >= u_directions) return;
   const int bins = u_window * u_window;
   uint sum = 0u;

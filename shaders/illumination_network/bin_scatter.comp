@@ -7,7 +7,7 @@ layout(std430, binding = 5) writeonly buffer BinItems { int binItems[]; };
 layout(std430, binding = 6) readonly buffer NodeBin { int nodeBin[]; };
 
 void main() {
-  const int p = int(gl_GlobalInvocationID.x), i = int(gl_GlobalInvocationID.y);
+  const int p = int(gl_GlobalInvocationID.x), i = u_directionFirst + int(gl_GlobalInvocationID.y);
   if (p >= u_nodes || i >= u_directions) return;
   const int at = i * u_window * u_window + nodeBin[i * u_nodes + p];
   const uint slot = binStart[at] + atomicAdd(binFill[at], 1u);

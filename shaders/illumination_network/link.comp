@@ -14,7 +14,7 @@ layout(std430, binding = 7) writeonly buffer Upstream { int upstream[]; };
 layout(std430, binding = 8) writeonly buffer Alpha { float alpha[]; };
 
 void main() {
-  const int p = int(gl_GlobalInvocationID.x), i = int(gl_GlobalInvocationID.y);
+  const int p = int(gl_GlobalInvocationID.x), i = u_directionFirst + int(gl_GlobalInvocationID.y);
   if (p >= u_nodes || i >= u_directions) return;
   const vec3 w = dirs[i].w.xyz;
   const vec4 np = nodes[p].positionTau;

@@ -9,6 +9,7 @@
 uniform int u_nodes;       // N
 uniform int u_directions;  // D (the light pass bins one direction at a time)
 uniform int u_window;      // M: the window's M x M bins
+uniform int u_directionFirst;  // the visibility build's first direction of this stretch (0 when unset)
 uniform vec3 u_center;     // bounding sphere of the medium
 uniform float u_radius;
 

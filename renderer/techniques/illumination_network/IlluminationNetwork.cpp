@@ -222,7 +222,7 @@ void IlluminationNetworkPass::execute(PassContext& ctx) {
   network::NetworkGpu& gpu = *net_->gpu;
   const bool build = !gpu.visibilityBuilt();
   if (build) {
-    gpu.buildVisibility(ctx.shaders);
+    gpu.buildVisibility(ctx.shaders, ctx.cancel);
     // Link statistics, once per network.
     network::Visibility V = gpu.downloadVisibility();
     if (exactLinks_) {

@@ -12,6 +12,7 @@
 
 #include "renderer/gl/Gl.h"
 #include "renderer/gl/ShaderLibrary.h"
+#include "renderer/raytracing/Cancel.h"
 #include "renderer/techniques/illumination_network/Network.h"
 
 namespace radiant::network {
@@ -27,7 +28,9 @@ public:
   int window() const { return M_; }
 
   // Builds V on the GPU (GL issued here).
-  void buildVisibility(gl::ShaderLibrary& shaders);
+  // In stretches of directions with `cancel` checked between them (throws rt::Cancelled, leaving the
+  // visibility unbuilt).
+  void buildVisibility(gl::ShaderLibrary& shaders, const rt::Cancel& cancel = {});
   bool visibilityBuilt() const { return built_; }
   Visibility downloadVisibility() const;
   // Replaces the link opacities (exactLinkOpacity).
