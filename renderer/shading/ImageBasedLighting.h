@@ -20,6 +20,7 @@
 #include <glm/glm.hpp>
 
 #include "renderer/Image.h"
+#include "renderer/raytracing/Cancel.h"
 
 namespace radiant::ibl {
 
@@ -35,11 +36,11 @@ glm::vec3 dfgAt(float mu, float roughness, int samples = 4096);
 
 // kPrefilterLevels equirect images of kPrefilterWidth x kPrefilterHeight, RGBA, level k for roughness
 // k / (kPrefilterLevels - 1), laid out level after level (a 2D array texture).
-std::vector<float> prefilterEnvironment(const Image& map);
+std::vector<float> prefilterEnvironment(const Image& map, const rt::Cancel& cancel = {});
 
 // The 9 SH coefficients of the irradiance E(n) = sum c_i Y_i(n), already multiplied by A_l
 // (evaluate with irradianceFromSh).
-std::array<glm::vec3, 9> irradianceSh(const Image& map);
+std::array<glm::vec3, 9> irradianceSh(const Image& map, const rt::Cancel& cancel = {});
 glm::vec3 irradianceFromSh(const std::array<glm::vec3, 9>& sh, const glm::vec3& n);
 
 }  // namespace radiant::ibl

@@ -30,4 +30,23 @@ void drawInstancedInStretches(const gl::Program& prog, GLenum mode, int vertices
   prog.set("u_firstInstance", 0);
 }
 
+StretchGate::~StretchGate() {
+  if (previous_) glDeleteSync(previous_);
+}
+
+void StretchGate::check(std::string_view where) {
+  if (previous_) {
+    glClientWaitSync(previous_, GL_SYNC_FLUSH_COMMANDS_BIT, GLuint64(60) * 1000000000);
+    glDeleteSync(previous_);
+    previous_ = nullptr;
+  }
+  cancel_.check(where);
+}
+
+void StretchGate::issued() {
+  if (!cancel_.flag()) return;  // nothing can cancel this request: never wait
+  if (previous_) glDeleteSync(previous_);
+  previous_ = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+}
+
 }  // namespace radiant

@@ -16,4 +16,22 @@ namespace radiant {
 void drawInstancedInStretches(const gl::Program& prog, GLenum mode, int vertices, int instances, int perStretch,
                               const rt::Cancel& cancel, std::string_view where);
 
+// The same for a loop of GPU work that is not one instanced draw (a cube map's faces, a face's
+// dispatches): call check() before issuing each stretch and issued() after it. check() waits for the
+// stretch issued last (a fence, only while the request can be cancelled) and throws rt::Cancelled
+// naming `where` when the flag is up.
+class StretchGate {
+public:
+  explicit StretchGate(const rt::Cancel& cancel) : cancel_(cancel) {}
+  StretchGate(const StretchGate&) = delete;
+  StretchGate& operator=(const StretchGate&) = delete;
+  ~StretchGate();
+  void check(std::string_view where);
+  void issued();
+
+private:
+  const rt::Cancel& cancel_;
+  GLsync previous_ = nullptr;
+};
+
 }  // namespace radiant

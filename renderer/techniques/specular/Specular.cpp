@@ -13,6 +13,7 @@
 #include "renderer/shading/DirectLighting.h"
 #include "renderer/shading/PhotonGrid.h"
 #include "renderer/shading/SpecularObjects.h"
+#include "renderer/shading/Stretches.h"
 
 namespace radiant {
 namespace {
@@ -188,6 +189,9 @@ void SpecularPass::execute(PassContext& ctx) {
     const float sceneRadius = std::max(ctx.scene.features.bounds.radius(), 1e-6f);
     const GLint codeLoc = prog.uniformLocation("u_objectCode");
     int draws = 0;
+    // One face of one layer of one object's maps is a stretch of GPU work (TransmissionTest's maps ran
+    // minutes, deaf to the cancel flag).
+    StretchGate gate(ctx.cancel);
     for (int k = 0; k < objectCount; ++k) {
       const Object& o = objects_[k];
       const glm::vec3 ref(o.gpu.referenceRadius);
@@ -196,6 +200,7 @@ void SpecularPass::execute(PassContext& ctx) {
       for (int l = 0; l < layers_; ++l)
         for (int f = 0; f < 6; ++f) {
           const int layerFace = (k * layers_ + l) * 6 + f;
+          gate.check("specular's distance maps, object " + std::to_string(k) + " layer " + std::to_string(l));
           if (l >= 3) {
             // Depth peeling reads the previous layer of this face; copy it out first, since sampling a
             // texture that is also attached is a feedback loop.
@@ -224,6 +229,7 @@ void SpecularPass::execute(PassContext& ctx) {
             glProgramUniform1i(prog.id(), codeLoc, objectOfMesh_[mesh] + 1);
             return true;
           });
+          gate.issued();
           ++draws;
         }
     }
@@ -263,6 +269,7 @@ void SpecularPass::execute(PassContext& ctx) {
         gather.set("u_reference", &ref[0], 3);
         for (int l = objects_[k].partlyDiffuse ? 0 : 2; l < layers_; ++l)
           for (int f = 0; f < 6; ++f) {
+            gate.check("specular's indirect light in the maps, object " + std::to_string(k));
             gather.set("u_layerFace", (k * layers_ + l) * 6 + f);
             gather.set("u_face", f);
             // mode 1 (blocks > 1): the block samples; 2: spread them, mark the texels none fits; 0: gather
@@ -288,6 +295,7 @@ void SpecularPass::execute(PassContext& ctx) {
             } else {
               gatherSlices(0, 0, resolution_);
             }
+            gate.issued();
           }
       }
       ctx.stats.counters["maps_indirect_dispatches"] = dispatches;

@@ -2,6 +2,7 @@
 // has punctual lights), the background (transparent, a colour), unlit
 // materials, texture transforms moving a known texel to a known pixel, and partial camera overrides.
 #include <array>
+#include <atomic>
 #include <cmath>
 
 #include <glm/gtc/type_ptr.hpp>
@@ -606,6 +607,28 @@ TEST(ImageBasedLighting, TablesMatchTheirClosedForms) {
   EXPECT_NEAR(ibl::irradianceFromSh(s2, {0, 1, 0}).x, glm::pi<float>(), 0.1f * glm::pi<float>());
   EXPECT_NEAR(ibl::irradianceFromSh(s2, {0, -1, 0}).x, 0.f, 0.1f * glm::pi<float>());
   EXPECT_NEAR(ibl::irradianceFromSh(s2, {1, 0, 0}).x, 0.5f * glm::pi<float>(), 0.05f * glm::pi<float>());
+}
+
+// A map one texel wide (issue 30: a 1 x 6000 EXR held the render thread 90 s, deaf to the deadline):
+// the irradiance integral samples each axis to its own density, so the map's SH equal those of the same
+// map 64 texels wide (each row repeated) within the midpoint rule's error; a raised cancel flag stops
+// both the SH and the prefilter (rt::Cancelled).
+TEST(ImageBasedLighting, AOneTexelWideMapIntegratesAsItsWideningAndStopsWhenCancelled) {
+  constexpr int kHeight = 6000;
+  Image thin = Image::make("thin", 1, kHeight, 3), wide = Image::make("wide", 64, kHeight, 3);
+  for (int y = 0; y < kHeight; ++y) {
+    const float v = 1.f + float(y % 7) + (y < kHeight / 3 ? 4.f : 0.f);  // brighter above: l = 1 terms
+    for (int c = 0; c < 3; ++c) thin.at(0, y)[c] = v * (1.f + 0.5f * c);
+    for (int x = 0; x < 64; ++x)
+      for (int c = 0; c < 3; ++c) wide.at(x, y)[c] = thin.at(0, y)[c];
+  }
+  const auto a = ibl::irradianceSh(thin), b = ibl::irradianceSh(wide);
+  for (int i = 0; i < 9; ++i)
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[i][c], b[i][c], 1e-4 * std::abs(b[0][c])) << i << " " << c;
+  EXPECT_GT(ibl::irradianceFromSh(a, {0, 1, 0}).x, ibl::irradianceFromSh(a, {0, -1, 0}).x);  // not a constant
+  const std::atomic<bool> raised{true};
+  EXPECT_THROW(ibl::irradianceSh(thin, rt::Cancel(&raised)), rt::Cancelled);
+  EXPECT_THROW(ibl::prefilterEnvironment(thin, rt::Cancel(&raised)), rt::Cancelled);
 }
 
 // glTF's default material (a mesh with no material) is metallic 1, roughness 1, white (spec 3.9.6):

@@ -198,6 +198,15 @@ TEST(Cancel, DepthImpostors) {
                  "media", "depth_impostors", "depth_impostors"});
 }
 
+TEST(Cancel, SpecularDistanceMaps) {
+  // The maps are drawn one object-layer-face at a time with a check between faces: at 1024 texels per
+  // side and 6 layers the maps of cornell_glass's objects take seconds.
+  cancelMidPass({"specular", "cornell_glass",
+                 body({{"caustics", false}, {"specular", {{"cube_resolution", 1024}, {"layers", 6}}}}, {"beauty"}, 32),
+                 body({{"caustics", false}, {"specular", {{"cube_resolution", 32}, {"layers", 3}}}}, {"beauty"}, 16),
+                 "beauty", "specular's", "specular"});
+}
+
 // At 8192 nodes x 128 directions the network's visibility build (NetworkGpu::buildVisibility) runs about
 // 1.5 s on llvmpipe; it is split into stretches of directions with a check between them, so the flag
 // lands in the build or in the iterations, both the pass's own loops.
