@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "renderer/Renderer.h"
@@ -14,6 +15,11 @@
 namespace radiant::server {
 
 namespace {
+
+// The largest pixel value an uploaded image may hold (docs/API.md, PUT /v1/images): 1e18 leaves 1e20 of
+// float headroom (FLT_MAX 3.4e38) for the products and sums a radiance enters (solid angles, BRDF / pdf
+// ratios, texel counts), while the brightest real maps hold an unclipped sun at 1e5 to 1e9.
+constexpr float kMaxImageRadiance = 1e18f;
 
 class RendererBackend final : public RenderBackend {
 public:
@@ -78,17 +84,22 @@ BackendHooks rendererHooks(const ServerConfig& config) {
     } catch (const std::exception& e) {
       throw api::ApiError(422, "invalid-image", "Invalid image", e.what());
     }
-    // Radiance is finite and non-negative: a NaN would poison the reference's importance-sampling
-    // distribution and every metric, so such an image is refused, naming the first bad pixel.
+    // Radiance is finite, non-negative and at most kMaxImageRadiance: a NaN would poison the
+    // reference's importance-sampling distribution and every metric, and a value near FLT_MAX overflows
+    // the float sums that weigh it (an environment's prefilter and distribution, a metric's squares), so
+    // such an image is refused, naming the first bad pixel.
     for (int y = 0; y < image.height; ++y)
       for (int x = 0; x < image.width; ++x)
         for (int c = 0; c < image.channels; ++c) {
           const float v = image.at(x, y)[c];
-          if (!std::isfinite(v) || v < 0.f)
+          if (!std::isfinite(v) || v < 0.f || v > kMaxImageRadiance) {
+            char value[32];
+            std::snprintf(value, sizeof value, "%g", double(v));
             throw api::ApiError(422, "invalid-image", "Invalid image",
                                 "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ") channel " +
-                                    std::to_string(c) + " is " + std::to_string(v) +
-                                    ": radiance must be finite and non-negative");
+                                    std::to_string(c) + " is " + value +
+                                    ": radiance must be finite, non-negative and at most 1e18");
+          }
         }
     return image;
   };

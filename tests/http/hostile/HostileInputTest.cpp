@@ -15,6 +15,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <future>
 #include <thread>
 
@@ -299,6 +300,26 @@ TEST_F(Hostile, AnUploadedComparisonImageIsCheckedFromItsHeader) {
   expectProblem(r, 422, "limit-exceeded", "", "16384x16384");
   EXPECT_NE(r->body.find("--max-decode-bytes"), std::string::npos);
   EXPECT_LT(peakRssMiB(daemon_->pid()), 1024.0);
+}
+
+TEST_F(Hostile, UploadedImagesHoldFiniteNonNegativeRadianceUpTo1e18) {
+  // An environment map or comparison image near FLT_MAX overflowed the float sums it enters (issue 30:
+  // compare's 500s, 1e38 accepted): NaN, infinite, negative and above-1e18 pixels are refused, naming
+  // the pixel; an unclipped sun of 1e9 is accepted.
+  auto exrWith = [](float v) {
+    radiant::Image img = radiant::Image::make("beauty", 4, 2, 3);
+    for (float& p : img.pixels) p = 0.5f;
+    img.at(3, 1)[2] = v;
+    return radiant::io::encodeExr({img}, false);
+  };
+  for (float bad : {std::nanf(""), -1.f, 1e38f, 2e18f, std::numeric_limits<float>::infinity()}) {
+    auto r = daemon_->client().Put("/v1/images", exrWith(bad), "image/x-exr");
+    expectProblem(r, 422, "invalid-image", "", "pixel (3, 1) channel 2");
+  }
+  auto ok = daemon_->client().Put("/v1/images", exrWith(1e9f), "image/x-exr");
+  ASSERT_TRUE(ok);
+  EXPECT_EQ(ok->status, 201) << ok->body.substr(0, 300);
+  EXPECT_EQ(daemon_->client().Get("/v1/ready")->status, 200);
 }
 
 TEST_F(Hostile, AccessorsWithoutBufferViewAreChargedBeforeExpansion) {
