@@ -158,42 +158,50 @@ std::size_t sceneBytes(const Scene& s) {
   return bytes;
 }
 
-// Decoded scenes by digest, least recently used dropped first, bounded in entries and in bytes
-// (--scene-cache, --scene-cache-bytes). A scene larger than the whole budget is used, not kept.
-class DecodedScenes {
+std::size_t imageBytes(const Image& i) { return i.pixels.size() * sizeof(float); }
+
+// Decoded scenes (or images) by digest, least recently used dropped first, bounded in entries and in
+// bytes (--scene-cache, --scene-cache-bytes). One larger than the whole budget is used, not kept.
+template <class T, std::size_t (*SizeOf)(const T&)>
+class DecodedCache {
 public:
-  DecodedScenes(std::size_t capacity, std::size_t maxBytes) : capacity_(capacity), maxBytes_(maxBytes) {}
+  DecodedCache(std::size_t capacity, std::size_t maxBytes) : capacity_(capacity), maxBytes_(maxBytes) {}
   std::size_t totalBytes() {
     std::lock_guard lock(mutex_);
     return bytes_;
   }
-  std::shared_ptr<const Scene> get(const std::string& digest) {
+  std::shared_ptr<const T> get(const std::string& digest) {
     std::lock_guard lock(mutex_);
     auto it = index_.find(digest);
     if (it == index_.end()) return nullptr;
     lru_.splice(lru_.begin(), lru_, it->second);
     return it->second->second;
   }
-  void put(const std::string& digest, std::shared_ptr<const Scene> scene) {
-    const std::size_t size = sceneBytes(*scene);
+  void put(const std::string& digest, std::shared_ptr<const T> value) {
+    const std::size_t size = SizeOf(*value);
     std::lock_guard lock(mutex_);
     if (index_.count(digest) || size > maxBytes_) return;
-    lru_.emplace_front(digest, std::move(scene));
+    lru_.emplace_front(digest, std::move(value));
     index_[digest] = lru_.begin();
     bytes_ += size;
     while (lru_.size() > capacity_ || bytes_ > maxBytes_) {
-      bytes_ -= sceneBytes(*lru_.back().second);
+      bytes_ -= SizeOf(*lru_.back().second);
       index_.erase(lru_.back().first);
       lru_.pop_back();
     }
   }
 
 private:
+  using Entry = std::pair<std::string, std::shared_ptr<const T>>;
   std::mutex mutex_;
   std::size_t capacity_, maxBytes_, bytes_ = 0;
-  std::list<std::pair<std::string, std::shared_ptr<const Scene>>> lru_;
-  std::map<std::string, std::list<std::pair<std::string, std::shared_ptr<const Scene>>>::iterator> index_;
+  std::list<Entry> lru_;
+  std::map<std::string, typename std::list<Entry>::iterator> index_;
 };
+using DecodedScenes = DecodedCache<Scene, sceneBytes>;
+// Environment maps and comparison images, decoded once per digest (a 4k map took a decode per
+// request): the last 4 at most, within half of --scene-cache-bytes.
+using DecodedImages = DecodedCache<Image, imageBytes>;
 
 }  // namespace
 
@@ -205,6 +213,7 @@ struct HttpServer::Impl {
   ContentStore scenes;
   ContentStore images;  // comparison targets (compare.against = their digest)
   DecodedScenes decoded;
+  DecodedImages decodedImages;
   RenderService service;
   BoundedServer http;
   std::atomic<bool> shuttingDown{false};
@@ -225,6 +234,7 @@ struct HttpServer::Impl {
         scenes(config.cacheDir, config.maxSceneBytes, "scenes"),
         images(config.cacheDir, config.maxSceneBytes, "images"),
         decoded(config.sceneCacheEntries, config.sceneCacheBytes),
+        decodedImages(std::min<std::size_t>(4, config.sceneCacheEntries), config.sceneCacheBytes / 2),
         service(config, hooks, frames, metrics) {
     routes();
   }
@@ -344,8 +354,12 @@ struct HttpServer::Impl {
     if (!bytes)
       throw api::ApiError(404, "unknown-image", "Unknown image",
                           pointer + ": no image " + digest + " (upload it to /v1/images first)", pointer);
+    if (auto image = decodedImages.get(digest)) return image;
     if (!hooks.decodeImage) throw std::logic_error("no image decoder configured");
-    return std::make_shared<const Image>(hooks.decodeImage(*bytes));
+    auto image = std::make_shared<const Image>(hooks.decodeImage(*bytes));
+    metrics.countImageDecode();
+    decodedImages.put(digest, image);
+    return image;
   }
 
   // ---- helpers --------------------------------------------------------------------------------
@@ -594,6 +608,7 @@ struct HttpServer::Impl {
           {"radiant_scene_store_bytes", {"Bytes of uploaded scenes stored.", double(scenes.totalBytes())}},
           {"radiant_scene_cache_bytes", {"Bytes of decoded scenes kept in memory (--scene-cache-bytes).", double(decoded.totalBytes())}},
           {"radiant_image_store_bytes", {"Bytes of uploaded comparison images stored.", double(images.totalBytes())}},
+          {"radiant_image_cache_bytes", {"Bytes of decoded images kept in memory (half of --scene-cache-bytes).", double(decodedImages.totalBytes())}},
           {"radiant_frame_store_bytes", {"Bytes of encoded frames stored.", double(frames.totalBytes())}}};
       res.status = 200;
       res.set_content(metrics.text(gauges), "text/plain; version=0.0.4; charset=utf-8");

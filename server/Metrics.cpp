@@ -64,6 +64,11 @@ void Metrics::observePass(const std::string& pass, const std::string& clock, dou
   passes_[{pass, clock}].observe(s);
 }
 
+void Metrics::countImageDecode() {
+  std::lock_guard lock(mutex_);
+  ++imageDecodes_;
+}
+
 std::string Metrics::text(const std::map<std::string, std::pair<std::string, double>>& gauges) const {
   std::lock_guard lock(mutex_);
   std::string out;
@@ -74,6 +79,9 @@ std::string Metrics::text(const std::map<std::string, std::pair<std::string, dou
   out += "# HELP radiant_renders_total Render jobs by outcome.\n# TYPE radiant_renders_total counter\n";
   for (const auto& [result, n] : renders_)
     out += "radiant_renders_total{result=\"" + escapeLabel(result) + "\"} " + std::to_string(n) + "\n";
+  out += "# HELP radiant_image_decodes_total Uploaded images (environment maps, comparison images) decoded for a\n"
+         "# request because no decoded copy was in memory.\n";
+  out += "# TYPE radiant_image_decodes_total counter\nradiant_image_decodes_total " + std::to_string(imageDecodes_) + "\n";
   out += "# HELP radiant_render_seconds_total Wall-clock seconds the render thread spent rendering.\n";
   out += "# TYPE radiant_render_seconds_total counter\nradiant_render_seconds_total " + num(renderSecondsTotal_) + "\n";
   out += "# HELP radiant_queue_wait_seconds Time jobs waited in the queue.\n# TYPE radiant_queue_wait_seconds histogram\n";

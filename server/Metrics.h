@@ -32,6 +32,7 @@ public:
   void observeRender(double seconds);
   void observeEncode(double seconds);
   void observePass(const std::string& pass, const std::string& clock, double seconds);
+  void countImageDecode();  // an uploaded image decoded for a request (not found decoded in memory)
   // Gauges are sampled when the text is written.
   std::string text(const std::map<std::string, std::pair<std::string, double>>& gauges) const;
 
@@ -41,6 +42,7 @@ private:
   std::map<std::string, std::uint64_t> renders_;
   Histogram queue_, render_, encode_;
   double renderSecondsTotal_ = 0;
+  std::uint64_t imageDecodes_ = 0;
   std::map<std::pair<std::string, std::string>, Histogram> passes_;
 };
 

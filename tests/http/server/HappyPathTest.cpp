@@ -127,10 +127,21 @@ TEST(RealDaemon, ComparesAgainstAnUploadedImage) {
   EXPECT_EQ(c.Post("/v1/renders", body.dump(), "application/json")->status, 200);
 
   // The same upload serves as an environment map; an unknown one is 404 at /environment, and the
-  // sky given twice (ambient and environment) is 422 there.
+  // sky given twice (ambient and environment) is 422 there. It is decoded once: the compare above
+  // decoded it, the environment renders find it decoded in memory (radiant_image_decodes_total).
+  auto metric = [&](const std::string& name) {
+    const std::string text = c.Get("/metrics")->body;
+    const auto at = text.find("\n" + name + " ");
+    return at == std::string::npos ? -1.0 : std::stod(text.substr(at + name.size() + 2));
+  };
+  const double decodes = metric("radiant_image_decodes_total");
+  EXPECT_GE(decodes, 1.0);
+  EXPECT_GT(metric("radiant_image_cache_bytes"), 0.0);
   body["environment"] = digest;
   r = c.Post("/v1/renders", body.dump(), "application/json");
   EXPECT_EQ(r->status, 200) << r->body;
+  EXPECT_EQ(c.Post("/v1/renders", body.dump(), "application/json")->status, 200);
+  EXPECT_EQ(metric("radiant_image_decodes_total"), decodes);
   body["environment"] = "sha256:" + std::string(64, 'b');
   r = c.Post("/v1/renders", body.dump(), "application/json");
   EXPECT_EQ(r->status, 404);
