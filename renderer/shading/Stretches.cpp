@@ -7,26 +7,21 @@ namespace radiant {
 void drawInstancedInStretches(const gl::Program& prog, GLenum mode, int vertices, int instances, int perStretch,
                               const rt::Cancel& cancel, std::string_view where) {
   perStretch = std::max(1, perStretch);
-  // One stretch in flight while the next is issued: before issuing stretch k + 1 the pass waits for
-  // stretch k - 1 (a fence), so the check sees the GPU's progress. Without it a driver that defers
-  // fragment work (llvmpipe) takes every stretch's draw call at once and the checks all pass before the
-  // flag: a spherical_billboards frame ran 5 s past it.
-  GLsync previous = nullptr;
-  for (int first = 0; first < instances; first += perStretch) {
-    if (previous) {
-      glClientWaitSync(previous, GL_SYNC_FLUSH_COMMANDS_BIT, GLuint64(60) * 1000000000);
-      glDeleteSync(previous);
-      previous = nullptr;
+  // One stretch in flight while the next is issued (StretchGate): without the wait a driver that
+  // defers fragment work (llvmpipe) takes every stretch's draw call at once and the checks all pass
+  // before the flag: a spherical_billboards frame ran 5 s past it.
+  StretchGate gate(cancel);
+  try {
+    for (int first = 0; first < instances; first += perStretch) {
+      if (first > 0) gate.check(where);
+      prog.set("u_firstInstance", first);
+      glDrawArraysInstanced(mode, 0, vertices, std::min(perStretch, instances - first));
+      if (first + perStretch < instances) gate.issued();
     }
-    if (first > 0 && cancel.requested()) {
-      prog.set("u_firstInstance", 0);
-      cancel.check(where);
-    }
-    prog.set("u_firstInstance", first);
-    glDrawArraysInstanced(mode, 0, vertices, std::min(perStretch, instances - first));
-    if (cancel.flag() && first + perStretch < instances) previous = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+  } catch (const rt::Cancelled&) {
+    prog.set("u_firstInstance", 0);
+    throw;
   }
-  if (previous) glDeleteSync(previous);
   prog.set("u_firstInstance", 0);
 }
 

@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "renderer/frame/GpuTypes.h"
+#include "renderer/shading/Stretches.h"
 
 namespace radiant::network {
 
@@ -101,27 +102,17 @@ void NetworkGpu::buildVisibility(gl::ShaderLibrary& shaders, const rt::Cancel& c
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
   // Every step reads and writes one direction's data only, so the build runs in stretches of
   // directions, about kVisibilityInvocationsPerStretch node-direction pairs each, with a cancel check
-  // between them (one dispatch over N x D ran 1.5 s on llvmpipe at 8192 x 128, deaf to the flag). As
-  // renderer/shading/Stretches.cpp: before issuing stretch k + 1 the build waits for stretch k - 1.
+  // between them (renderer/shading/Stretches.h; one dispatch over N x D ran 1.5 s on llvmpipe at
+  // 8192 x 128, deaf to the flag). Only these four programs read u_directionFirst, and every stretch
+  // sets it.
   const gl::Program* steps[4] = {&shaders.program({"illumination_network/bin_count.comp"}),
                                  &shaders.program({"illumination_network/bin_scan.comp"}),
                                  &shaders.program({"illumination_network/bin_scatter.comp"}),
                                  &shaders.program({"illumination_network/link.comp"})};
   const int perStretch = std::clamp(kVisibilityInvocationsPerStretch / std::max(N_, 1), 1, std::max(D_, 1));
-  GLsync previous = nullptr;
-  auto resetFirst = [&] {
-    for (const gl::Program* step : steps) step->set("u_directionFirst", 0);
-  };
+  StretchGate gate(cancel);
   for (int first = 0; first < D_; first += perStretch) {
-    if (previous) {
-      glClientWaitSync(previous, GL_SYNC_FLUSH_COMMANDS_BIT, GLuint64(60) * 1000000000);
-      glDeleteSync(previous);
-      previous = nullptr;
-    }
-    if (first > 0 && cancel.requested()) {
-      resetFirst();
-      cancel.check("illumination_network's visibility build");
-    }
+    if (first > 0) gate.check("illumination_network's visibility build");
     const GLuint count = static_cast<GLuint>(std::min(perStretch, D_ - first));
     for (int k = 0; k < 4; ++k) {
       bindCommon(*steps[k]);
@@ -130,10 +121,8 @@ void NetworkGpu::buildVisibility(gl::ShaderLibrary& shaders, const rt::Cancel& c
       else glDispatchCompute(groups(N_), count, 1);
       glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     }
-    if (cancel.flag() && first + perStretch < D_) previous = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+    if (first + perStretch < D_) gate.issued();
   }
-  if (previous) glDeleteSync(previous);
-  resetFirst();
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
   gl::checkError("NetworkGpu::buildVisibility()");
   built_ = true;
