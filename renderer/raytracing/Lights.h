@@ -65,12 +65,16 @@ inline int findInterval(const float* cdf, int n, float value) {
 // sphere. O(texels) to build, so it is derived data of the environment: FrameResources caches it per
 // environment digest and size ("environment_distribution", renderer/frame/RayScenes.h), and every
 // render with the same map reuses it.
+// With `weight` (an image of the map's size) the texels are drawn by weight's luminance instead, while
+// `integral` stays the map's: photon_gi draws fewer photons from the environment's lights, whose first
+// hits are `direct`'s (renderer/techniques/photon_gi/PhotonGi.cpp). The weight must be positive
+// wherever the map is, or the estimate loses that light.
 struct EnvironmentDistribution {
   int width = 0, height = 0;
   std::vector<float> conditional, marginal;  // h rows of (w + 1) CDF entries; h + 1 row sums
   float total = 0.f;
   glm::vec3 integral{0.f};  // \int L(w) dw, per channel
-  static std::shared_ptr<const EnvironmentDistribution> build(const Image& map);
+  static std::shared_ptr<const EnvironmentDistribution> build(const Image& map, const Image* weight = nullptr);
 };
 
 // The environment: uniform sky or an equirectangular map importance sampled by its
@@ -153,9 +157,12 @@ private:
   bool active_ = false;
 };
 
-inline std::shared_ptr<const EnvironmentDistribution> EnvironmentDistribution::build(const Image& map) {
+inline std::shared_ptr<const EnvironmentDistribution> EnvironmentDistribution::build(const Image& map,
+                                                                                     const Image* weight) {
   auto d = std::make_shared<EnvironmentDistribution>();
   const int w = map.width, h = map.height;
+  if (weight && (weight->width != w || weight->height != h || weight->channels < 1))
+    throw std::invalid_argument("EnvironmentDistribution: the weight is not of the map's size");
   d->width = w;
   d->height = h;
   d->conditional.assign(static_cast<size_t>(h) * (w + 1), 0.f);
@@ -168,7 +175,10 @@ inline std::shared_ptr<const EnvironmentDistribution> EnvironmentDistribution::b
     for (int x = 0; x < w; ++x) {
       const float* p = map.at(x, y);
       const glm::vec3 L = map.channels >= 3 ? glm::vec3(p[0], p[1], p[2]) : glm::vec3(p[0]);
-      cdf[x + 1] = cdf[x] + std::max(0.f, luminance(L)) * sinTheta;
+      const float* q = weight ? weight->at(x, y) : p;
+      const int channels = weight ? weight->channels : map.channels;
+      const glm::vec3 W = channels >= 3 ? glm::vec3(q[0], q[1], q[2]) : glm::vec3(q[0]);
+      cdf[x + 1] = cdf[x] + std::max(0.f, luminance(W)) * sinTheta;
       sum += dOmega * glm::dvec3(L);
     }
     d->marginal[y + 1] = d->marginal[y] + cdf[w];

@@ -5,6 +5,7 @@
 // direction).
 #define LDM_TRACING
 #include "common/brdf.glsl"
+#include "common/gbuffer_geometry.glsl"
 #include "specular/ldm.glsl"
 #include "caustics/cube.glsl"
 #include "caustics/lookup.glsl"
@@ -30,7 +31,7 @@ void main() {
   vec4 P = texelFetch(t_position, px, 0);
   vec4 N = texelFetch(t_normal, px, 0);
   if (P.w <= 0.0 || N.w == 0.0) return;               // background, or unlit
-  if (texelFetch(t_geoNormal, px, 0).w > 0.5) return;  // a specular surface: the specular pass's
+  if (gbufferSpecularOwned(texelFetch(t_geoNormal, px, 0))) return;  // a specular surface: the specular pass's
   vec3 x = P.xyz;
   vec3 n = normalize(N.xyz);
   vec3 wo = u_orthographic != 0 ? -u_viewForward : normalize(u_eye - x);

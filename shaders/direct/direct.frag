@@ -4,6 +4,7 @@
 #include "common/environment.glsl"
 #include "common/ibl.glsl"
 #include "common/material.glsl"
+#include "common/gbuffer_geometry.glsl"
 
 in vec2 v_uv;
 
@@ -75,7 +76,7 @@ void main() {
   // transmissive materials belong to the specular pass (Material::isSpecular(), the same per-material
   // rule the planner and that pass use; the G-buffer carries it in ng.w): it sees the whole map in
   // their reflections, the environment's lights (after the scene's) included, so they are not added here.
-  bool specularOwned = ngOwned.w > 0.5;
+  bool specularOwned = gbufferSpecularOwned(ngOwned);
   vec3 L = emission + directLighting(p, n, nc, ng, wo, params, specularOwned ? u_sceneLightCount : u_lightCount);
   if (u_iblMode != IBL_NONE && !specularOwned)
     L += mat.z * iblSpecular(t_dfg, t_prefiltered, n, nc, wo, params);

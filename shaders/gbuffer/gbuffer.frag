@@ -1,4 +1,5 @@
 #include "common/material.glsl"
+#include "common/gbuffer_geometry.glsl"
 
 in vec3 v_position;
 in vec3 v_normal;
@@ -15,8 +16,8 @@ layout(location = 1) out vec4 o_normal;    // xyz shading normal, w = 1 (0: unli
 layout(location = 2) out vec4 o_albedo;    // rgb base colour
 layout(location = 3) out vec4 o_material;  // metallic, roughness, occlusion, transmission
 layout(location = 4) out vec4 o_emission;  // rgb emitted radiance, a = ior (KHR_materials_ior)
-layout(location = 5) out vec4 o_geoNormal; // xyz geometric normal facing the viewer side, w = 1 when the
-                                           // specular pass owns the surface's reflections (isSpecular())
+layout(location = 5) out vec4 o_geoNormal; // xyz geometric normal facing the viewer side, w flags:
+                                           // common/material.glsl gbufferGeoFlags
 layout(location = 6) out uvec4 o_layers;   // encodeLayers (common/material.glsl): clear coat, coat normal, sheen
 layout(location = 7) out vec4 o_specular;  // rgb specular colour, a specular weight (KHR_materials_specular)
 
@@ -45,7 +46,7 @@ void main() {
   o_albedo = p.baseColor;
   o_material = vec4(p.surface.x, p.surface.y, p.emission.a, p.surface.z);
   o_emission = vec4(p.emission.rgb, p.surface.w);
-  o_geoNormal = vec4(geo, materialSpecularOwned(m) ? 1.0 : 0.0);
+  o_geoNormal = vec4(geo, gbufferGeoFlags(materialSpecularOwned(m), gl_FrontFacing));
   o_layers = encodeLayers(p, coatNormal);
   o_specular = p.specular;
   if (materialUnlit(m)) {

@@ -38,6 +38,7 @@ struct SplatSurface {
   vec3 x;      // world position
   vec3 n;      // shading normal
   vec3 ng;     // geometric normal facing the viewer
+  vec3 nw;     // geometric normal on the front of the triangle's winding (coverage points' side)
   vec3 wo;     // towards the eye
   vec3 nc;     // the clear coat's normal (KHR_materials_clearcoat)
   MaterialParams p;  // the G-buffer's material with its layers (clear coat, sheen, specular)
@@ -77,17 +78,22 @@ vec3 photonContribution(GpuPhoton p, SplatSurface s) {
   return p.power.rgb * f * k;
 }
 
-// A coverage point (uniform by area over its surface, weight A / n): w k / h^2 at s, where s passes the
-// same surface test regardless of which side the surface is seen from. Summed over a surface's points
-// this estimates the kernel mass that lies on the surface around s (1 in the interior).
-float coverageKernel(GpuPhoton p, vec3 x, vec3 ng) {
+// A coverage point (uniform by area over its surface, weight A / n, its normal the front of its
+// triangle's winding): w k / h^2 at a point x whose winding front is nw. Summed over a surface's points
+// this estimates the kernel mass that lies on the surface around x (1 in the interior), whichever side
+// x is seen from: a photon on the side the viewer sees passes the photon test exactly where a coverage
+// point of the same winding passes this one. The test compares winding fronts, not |cos|: a surface
+// facing x's across a gap (the underside of a sphere resting on a plane) receives no photons on its
+// hidden side, and counting its points there darkened the plane around the contact by half (0.53 of
+// the reference; docs/TECHNIQUES.md, photon_gi, "Edge renormalisation").
+float coverageKernel(GpuPhoton p, vec3 x, vec3 nw) {
   float h = p.positionRadius.w;
   vec3 d = x - p.positionRadius.xyz;
   float planeDistance = dot(d, p.normal.xyz);
   if (abs(planeDistance) > u_planeTolerance * h) return 0.0;
-  if (abs(dot(ng, p.normal.xyz)) < u_normalCosine) return 0.0;
+  if (dot(nw, p.normal.xyz) < u_normalCosine) return 0.0;
   vec3 inPlane = d - planeDistance * p.normal.xyz;
   return p.power.a * kernel2d(dot(inPlane, inPlane) / (h * h)) / (h * h);
 }
-float coverageContribution(GpuPhoton p, SplatSurface s) { return coverageKernel(p, s.x, s.ng); }
+float coverageContribution(GpuPhoton p, SplatSurface s) { return coverageKernel(p, s.x, s.nw); }
 #endif

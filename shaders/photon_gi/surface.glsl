@@ -2,6 +2,7 @@
 #ifndef RADIANT_PHOTON_GI_SURFACE
 #define RADIANT_PHOTON_GI_SURFACE
 #include "common/material.glsl"  // decodeLayers (the G-buffer's layers target)
+#include "common/gbuffer_geometry.glsl"
 layout(binding = 0) uniform sampler2D t_position;
 layout(binding = 1) uniform sampler2D t_normal;
 layout(binding = 2) uniform sampler2D t_albedo;
@@ -22,7 +23,9 @@ bool loadSurface(ivec2 px, out SplatSurface s) {
   vec4 N = texelFetch(t_normal, px, 0);
   if (N.w == 0.0) return false;  // KHR_materials_unlit: nothing lights it (gbuffer.frag)
   s.n = normalize(N.xyz);
-  s.ng = normalize(texelFetch(t_geoNormal, px, 0).xyz);
+  vec4 geo = texelFetch(t_geoNormal, px, 0);
+  s.ng = normalize(geo.xyz);
+  s.nw = normalize(gbufferWindingNormal(geo));
   s.wo = u_orthographic != 0 ? -u_viewForward : normalize(u_eye - P.xyz);
   vec4 m = texelFetch(t_material, px, 0);
   s.p = materialParams(texelFetch(t_albedo, px, 0).rgb, m.x, m.y, m.w, texelFetch(t_emission, px, 0).a);

@@ -60,6 +60,8 @@ vec4 gatherAt(ivec2 px, vec4 acc) {
   vec4 g = imageLoad(i_geometry, ivec3(px, u_layerFace));
   vec3 x = texelPoint(px, g);
   vec3 n = texelNormal(g, x);
+  // The coverage points' side (photon_gi/photon.glsl coverageKernel): the stored vertex normal, unflipped.
+  vec3 nw = normalize(octDecode(g.xy));
   ivec3 c = photonCellOf(x);
   for (int k = 0; k < 27; ++k) {
     uint begin, end;
@@ -67,7 +69,7 @@ vec4 gatherAt(ivec2 px, vec4 acc) {
     for (uint i = begin; i < end; ++i) {
       GpuPhoton p = photons[i];
       if (p.power.a > 0.0) {
-        acc.a += coverageKernel(p, x, n);
+        acc.a += coverageKernel(p, x, nw);
       } else if (dot(n, p.wi.xyz) > 0.0) {
         acc.rgb += p.power.rgb * photonKernel(p, x, n);
       }

@@ -21,6 +21,8 @@ double msSince(Clock::time_point t) { return std::chrono::duration<double, std::
 // they estimate is within about 1% at this density.
 constexpr double kCoveragePerKernel = 64.0;
 constexpr std::size_t kMaxCoveragePerSurface = 1u << 18;
+// The environment lights' weight in the emission of sky photons (photonEnvironmentDistribution).
+constexpr float kDefaultEnvironmentLightPhotons = 0.5f;
 
 struct PhotonCache {
   rt::PhotonSet set;
@@ -33,6 +35,48 @@ struct SplatCache {
 
 [[noreturn]] void badParam(const std::string& key, const std::string& detail) {
   throw api::ApiError(422, "invalid-value", "Invalid photon_gi parameter", detail, "/passes/photon_gi/" + key);
+}
+
+// Which environment photons are drawn (docs/TECHNIQUES.md, photon_gi, "Emission"). When the frame split
+// the map into lights S and a residual R (renderer/shading/EnvironmentLights.h), the lights' first hits
+// are `direct`'s: photons drawn by L spend 70-79% of the sky's photons on a sun whose first hits are
+// not splatted, and the residual's direct light is estimated from the rest. Texels are then drawn by
+// the luminance of R + weight S; every photon still carries L / pdf, so every bounce stays unbiased
+// (R > 0 wherever L > 0), and the suns' photons, fewer and heavier, carry their light's later bounces.
+// Null (draw by L) when the map is not split or weight is 1. Derived data of the map, the split and
+// the weight: cached per their key.
+struct PhotonEnvironmentDistribution {
+  std::shared_ptr<const rt::EnvironmentDistribution> distribution;
+};
+std::shared_ptr<const rt::EnvironmentDistribution> photonEnvironmentDistribution(FrameResources& res,
+                                                                                 const FrameView& view, float weight,
+                                                                                 std::string& key) {
+  key = view.environmentKey;
+  if (!view.environment || !view.environmentLights || !view.environmentLights->split() || weight >= 1.f)
+    return environmentDistribution(res, view);
+  const Image& map = *view.environment;
+  const Image& residual = view.environmentLights->residual;
+  if (residual.width != map.width || residual.height != map.height) return environmentDistribution(res, view);
+  key = view.lightingEnvironmentKey() + "|light_photons=" + std::to_string(weight);
+  return res
+      .cached<PhotonEnvironmentDistribution>(
+          "photon_gi_environment_distribution", key,
+          [&] {
+            Image w = Image::make("photon_weight", map.width, map.height, 1);
+            for (int y = 0; y < map.height; ++y)
+              for (int x = 0; x < map.width; ++x) {
+                const float* l = map.at(x, y);
+                const float* r = residual.at(x, y);
+                auto lum = [](const float* p, int c) {
+                  return c >= 3 ? rt::luminance(glm::vec3(p[0], p[1], p[2])) : p[0];
+                };
+                const float yl = std::max(0.f, lum(l, map.channels)), yr = std::max(0.f, lum(r, residual.channels));
+                w.at(x, y)[0] = yr + weight * std::max(0.f, yl - yr);
+              }
+            return std::make_unique<PhotonEnvironmentDistribution>(
+                PhotonEnvironmentDistribution{rt::EnvironmentDistribution::build(map, &w)});
+          })
+      .distribution;
 }
 
 }  // namespace
@@ -88,6 +132,9 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   s.ppmAlpha = params.get<double>("ppm_alpha", 2.0 / 3.0);
   s.ppmBase = params.get<double>("ppm_base_photons", 250000.0);
   s.maxBounces = params.get<int>("max_bounces", 8);
+  s.environmentLightPhotons = params.get<float>("environment_light_photons", kDefaultEnvironmentLightPhotons);
+  if (!(s.environmentLightPhotons >= 0.01f) || s.environmentLightPhotons > 1.f)
+    badParam("environment_light_photons", "environment_light_photons must be in [0.01, 1]");
   if (!(s.C > 0.f) || !std::isfinite(s.C)) badParam("C", "C must be a positive number");
   settings_ = s;
   splat_.method = params.get<std::string>("method", "gather") == "gather" ? photon_gi::Method::Gather
@@ -103,14 +150,17 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   splat_.gatherStep = params.get<int>("gather_step", 2) * std::max(1, view.supersampling);
   // --- Photon records: derived data of the scene, its lights and environment, never of the camera.
   const rt::RayScene& rays = sharedRayScene(res, scene);
+  std::string emissionKey;
+  const auto emission = photonEnvironmentDistribution(res, view, s.environmentLightPhotons, emissionKey);
+  lightPhotonWeight_ = emissionKey == view.environmentKey ? 1.f : s.environmentLightPhotons;
   const nlohmann::json photonKey = {{"scene", res.sceneKey()},
                                     {"ambient", {view.ambient.x, view.ambient.y, view.ambient.z}},
-                                    {"environment", view.environmentKey},
+                                    {"environment", emissionKey},
                                     {"seed", view.seed},
                                     {"max_bounces", s.maxBounces}};
   PhotonCache& cache = res.cached<PhotonCache>("photon_gi_photons", photonKey.dump(),
                                                [] { return std::make_unique<PhotonCache>(); });
-  const rt::SceneLights lights(rays, view.environment, view.ambient, environmentDistribution(res, view));
+  const rt::SceneLights lights(rays, view.environment, view.ambient, emission);
   traced_ = 0;
   traceMs_ = 0.0;
   if (cache.set.emitted < s.photons) {
@@ -273,6 +323,7 @@ void PhotonGiPass::execute(PassContext& ctx) {
   c["h_min"] = hMin_;
   c["h_max"] = hMax_;
   c["C"] = settings_.C;
+  c["environment_light_photons"] = lightPhotonWeight_;  // 1: sky photons drawn by the map itself
   c["gather"] = splat_.method == photon_gi::Method::Gather ? 1.0 : 0.0;
   c["gather_step"] = splat_.method == photon_gi::Method::Gather ? splat_.gatherStep : 1;
   upload_ = false;

@@ -40,6 +40,7 @@ private:
     bool ppm = false;
     double ppmAlpha = 2.0 / 3.0, ppmBase = 250000;
     int maxBounces = 8;
+    float environmentLightPhotons = 0.5f;
   } settings_;
   photon_gi::SplatSettings splat_;
   photon_gi::SplatGrid* grid_ = nullptr;  // in the cache, valid for this frame
@@ -48,7 +49,8 @@ private:
   // (FrameResources::holds), so a cached set of another scene or setting is uploaded again (and rebuilt:
   // the CPU copy is released after upload).
   std::string splatDigest_;
-  bool rebuilt_ = false;  // this frame rebuilt a cached set that was not resident
+  bool rebuilt_ = false;
+  float lightPhotonWeight_ = 1.f;  // the environment lights' weight in the sky photons' emission  // this frame rebuilt a cached set that was not resident
   std::size_t records_ = 0, photonSplats_ = 0, coveragePoints_ = 0;
   std::uint64_t traced_ = 0;  // photons traced by this frame (0 when the set was cached)
   double traceMs_ = 0.0, buildMs_ = 0.0;

@@ -158,16 +158,20 @@ TEST(Environment, MirrorsReflectTheMapNotItsAverage) {
 // Issue 29, item 3: the environment casts shadows in the raster. A white sphere resting on a white
 // plane under the two shared CC0 maps, each with a small sun holding 70-79% of its power
 // (qwantani_afternoon_puresky: a clear sky; chinese_garden: a garden with sun), default frame against
-// the reference path tracer. Measured (2026-12-04, llvmpipe), raster / reference:
-//                      sunlit plane  upper sphere  lower half  sun shadow  contact (r < 0.5)
-//   environment_lights 0   (before)    -            0.94-0.99   1.56-1.64   0.73-0.80
-//   default (the split)  1.00-1.01     0.97-1.00     0.92-0.97   0.73-0.82   0.53-0.63
-// The sun's light is now right where it falls (the plane and the sphere within 3%) and its shadow is
-// sharp; what is left in the shadows is photon_gi's sky and interreflection, 20-45% dark there (more
-// photons: 0.79-0.80 and 0.73-0.76; not its gather): the issue's 10% for the shadows is not met yet
-// (docs/TECHNIQUES.md, "Environment lights"). Asserted: the sunlit parts within 3% and 5%, the lower
-// half within the issue's 10%, the sun shadow within 30% (it was 56-64% too bright), the contact
-// region darker than the sunlit plane by the reference's factor within 50%.
+// the reference path tracer, 128 px. Regions are compared on the pixels whose 8 neighbours lie in the
+// same region: a pixel across a silhouette or the sun shadow's edge is the reference's area integral
+// (jittered rays) against the raster's one sample, aliasing whatever the lighting, and counting only
+// the edge pixels on one side of a threshold biased the shadow's ratio to 0.76 (2026-12-04).
+// Measured (2026-12-04, llvmpipe), raster / reference, qwantani / chinese_garden, seed 0:
+//                          sunlit plane  upper sphere  lower half   sun shadow   contact (r < 0.5)
+//   two-sided coverage     1.00 / 1.01   0.98 / 1.00   0.95 / 1.00  0.86 / 1.05  0.52 / 0.55
+//   default                1.01 / 1.01   0.98 / 0.99   0.94 / 1.03  0.87 / 1.06  1.16 / 1.21
+// The contact was photon_gi's edge renormalisation counting the sphere's coverage points on the plane
+// (photon_gi/photon.glsl coverageKernel). What is left in the shadows is photon_gi's: the sky photons'
+// noise (a single seed's shadow ranges 0.86-1.08) and, at the contact, the kernel's blur (h = 0.35-0.45,
+// the contact region's own size; over 4 seeds the contact is 1.12 / 1.16 of the reference): the
+// issue's 10% for the contact needs visibility finer than a kernel (docs/TECHNIQUES.md, direct,
+// "Environment lights").
 TEST(Environment, SunOfAnHdrMapCastsTheReferencesShadows) {
   const std::filesystem::path dir = RADIANT_ENVIRONMENTS_DIR;
   if (!std::filesystem::exists(dir / "chinese_garden_1k.hdr")) GTEST_SKIP() << "no " << dir;
@@ -175,11 +179,12 @@ TEST(Environment, SunOfAnHdrMapCastsTheReferencesShadows) {
   const int white = b.material(testing::lambertian(glm::vec3(0.7f)));
   b.quad({0, 0, 0}, {5, 0, 0}, {0, 0, -5}, white, "plane").sphere({0, 1, 0}, 1.f, white);
   Scene scene = b.build("env-sun-sphere-on-plane");
+  constexpr int kSize = 128;
   for (const char* name : {"qwantani_afternoon_puresky_1k.hdr", "chinese_garden_1k.hdr"}) {
     SCOPED_TRACE(name);
     const Image env = io::readImage((dir / name).string());
     api::RenderRequest req;
-    req.width = req.height = 64;
+    req.width = req.height = kSize;
     req.environment = "sha256:" + std::string(63, 'a') + (name[0] == 'q' ? "1" : "2");
     api::CameraOverride cam;
     cam.hasPosition = false;
@@ -202,35 +207,45 @@ TEST(Environment, SunOfAnHdrMapCastsTheReferencesShadows) {
     };
     // The plane's sunlit level: the median of the reference on the plane away from the sphere.
     std::vector<double> lit;
-    for (int y = 0; y < 64; ++y)
-      for (int x = 0; x < 64; ++x) {
+    for (int y = 0; y < kSize; ++y)
+      for (int x = 0; x < kSize; ++x) {
         const float* p = pos.at(x, y);
         if (p[3] > 0.f && std::abs(p[1]) < 1e-3f && glm::length(glm::vec2(p[0], p[2])) > 2.5f) lit.push_back(lum(ref, x, y));
       }
-    ASSERT_GT(lit.size(), 50u);
+    ASSERT_GT(lit.size(), 200u);
     std::nth_element(lit.begin(), lit.begin() + lit.size() / 2, lit.end());
     const double sunlit = lit[lit.size() / 2];
     struct Region { const char* what; double ref = 0, raster = 0; int n = 0; } shadow{"sun shadow"},
         contact{"contact"}, lower{"sphere's lower half"}, sunlitPlane{"sunlit plane"}, upper{"upper half"};
-    for (int y = 0; y < 64; ++y)
-      for (int x = 0; x < 64; ++x) {
+    // 0 none, 1 plane in the sun, 2 plane in the shadow, 3 sphere's lower half, 4 its upper half.
+    auto classOf = [&](int x, int y) {
+      if (x < 0 || y < 0 || x >= kSize || y >= kSize) return 0;
+      const float* p = pos.at(x, y);
+      if (!(p[3] > 0.f)) return 0;
+      if (std::abs(p[1]) < 1e-3f) return lum(ref, x, y) < 0.5 * sunlit ? 2 : 1;
+      return p[1] < 1.f ? 3 : 4;
+    };
+    for (int y = 0; y < kSize; ++y)
+      for (int x = 0; x < kSize; ++x) {
+        const int c = classOf(x, y);
+        bool interior = c != 0;
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) interior = interior && classOf(x + dx, y + dy) == c;
+        if (!interior) continue;
         const float* p = pos.at(x, y);
-        if (!(p[3] > 0.f)) continue;
-        const bool plane = std::abs(p[1]) < 1e-3f;
         const double r = glm::length(glm::vec2(p[0], p[2]));
         Region* in = nullptr;
-        if (plane && r < 0.5) in = &contact;
-        else if (plane && lum(ref, x, y) < 0.5 * sunlit) in = &shadow;
-        else if (!plane && p[1] < 1.f) in = &lower;
-        else if (plane && r > 2.5 && lum(ref, x, y) > 0.8 * sunlit) in = &sunlitPlane;
-        else if (!plane) in = &upper;
+        if (c == 2) in = r < 0.5 ? &contact : &shadow;
+        else if (c == 1 && r > 2.5 && lum(ref, x, y) > 0.8 * sunlit) in = &sunlitPlane;
+        else if (c == 3) in = &lower;
+        else if (c == 4) in = &upper;
         if (!in) continue;
         in->ref += lum(ref, x, y);
         in->raster += lum(beauty, x, y);
         ++in->n;
       }
     const std::pair<const Region*, double> bounds[] = {
-        {&sunlitPlane, 0.03}, {&upper, 0.05}, {&lower, 0.10}, {&shadow, 0.30}, {&contact, 0.50}};
+        {&sunlitPlane, 0.03}, {&upper, 0.05}, {&lower, 0.10}, {&shadow, 0.15}, {&contact, 0.25}};
     for (const auto& [g, tolerance] : bounds) {
       SCOPED_TRACE(g->what);
       ASSERT_GT(g->n, 8);

@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include "renderer/raytracing/Lights.h"
+#include "renderer/raytracing/Sampler.h"
 #include "renderer/scene/Environment.h"
 #include "renderer/shading/EnvironmentLights.h"
 
@@ -75,6 +77,60 @@ TEST(EnvironmentLights, ASunBecomesOneLightWithItsIrradianceAndTheSplitIsExact) 
   EXPECT_GT(split.fraction, 0.95f);
   EXPECT_NEAR(split.residualShare(map, sun), split.threshold / (0.2126 * 5e4 + 0.7152 * 4e4 + 0.0722 * 3e4), 1e-6);
   EXPECT_EQ(split.residualShare(map, -sun), 1.f);
+}
+
+// photon_gi draws sky photons by R + w S when the map is split (renderer/techniques/photon_gi/PhotonGi.cpp,
+// photonEnvironmentDistribution): the weighted distribution keeps the map's integral, its samples land
+// on the sun as often as the weights say, and the estimate L / pdf stays the map's integral (unbiased).
+TEST(EnvironmentLights, PhotonsDrawnByTheResidualPlusAWeightedSunEstimateTheWholeMap) {
+  const glm::vec3 sun = glm::normalize(glm::vec3(0.4f, 0.7f, -0.3f));
+  const Image map = sunnySky(sun, 0.05f);
+  const EnvironmentLights split = extractEnvironmentLights(map);
+  ASSERT_TRUE(split.split());
+  constexpr float kWeight = 0.5f;
+  Image weight = Image::make("weight", map.width, map.height, 1);
+  double sunShareOfWeight = 0.0, totalWeight = 0.0, sunShareOfMap = 0.0, totalMap = 0.0;
+  for (int y = 0; y < map.height; ++y)
+    for (int x = 0; x < map.width; ++x) {
+      const float* l = map.at(x, y);
+      const float* r = split.residual.at(x, y);
+      const float yl = 0.2126f * l[0] + 0.7152f * l[1] + 0.0722f * l[2];
+      const float yr = 0.2126f * r[0] + 0.7152f * r[1] + 0.0722f * r[2];
+      weight.at(x, y)[0] = yr + kWeight * (yl - yr);
+      const double wdw = weight.at(x, y)[0] * texelSolidAngle(map, y);
+      totalWeight += wdw;
+      totalMap += yl * texelSolidAngle(map, y);
+      if (l[0] > 1.f) sunShareOfWeight += wdw, sunShareOfMap += yl * texelSolidAngle(map, y);
+    }
+  sunShareOfWeight /= totalWeight;
+  sunShareOfMap /= totalMap;
+  const auto plain = rt::EnvironmentDistribution::build(map);
+  const auto weighted = rt::EnvironmentDistribution::build(map, &weight);
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(weighted->integral[c], plain->integral[c]);
+  const Image small = Image::make("weight", 8, 4, 1);
+  EXPECT_THROW(rt::EnvironmentDistribution::build(map, &small), std::invalid_argument) << "a weight of another size";
+  const rt::EnvironmentLight light(&map, glm::vec3(0.f), weighted);
+  constexpr int kSamples = 200000;
+  glm::dvec3 estimate(0.0);
+  int onSun = 0, pdfMismatch = 0;
+  for (int i = 0; i < kSamples; ++i) {
+    rt::Sampler sampler(static_cast<std::uint64_t>(i), 0, 7);
+    float pdf = 0.f;
+    const glm::vec3 dir = light.sample(sampler.next2(), pdf);
+    ASSERT_GT(pdf, 0.f);
+    if (std::abs(light.pdf(dir) - pdf) > 1e-3f * pdf) ++pdfMismatch;
+    estimate += glm::dvec3(light.radiance(dir)) / double(pdf) / double(kSamples);
+    if (light.radiance(dir).x > 1.f) ++onSun;
+  }
+  // pdf(dir) is the sample's density but for directions that float rounding maps to a neighbouring
+  // texel (acos near the poles loses about 3e-4 rad, a polar row being 0.025 rad high).
+  EXPECT_LT(pdfMismatch, kSamples / 1000) << pdfMismatch;
+  // Drawn by L, 98% of the samples land on the sun; drawn by R + S / 2 nearly twice as many land on the
+  // sky: (R + S) / (R + S / 2) with S >> R.
+  EXPECT_GT((1.0 - sunShareOfWeight) / (1.0 - sunShareOfMap), 1.9);
+  EXPECT_NEAR(double(onSun) / kSamples, sunShareOfWeight, 0.01);
+  // L / pdf is at most 2 (sun) or 1 (sky) times the weight's mean: 200k samples, well under 1%.
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(estimate[c], plain->integral[c], 0.01 * plain->integral[c]);
 }
 
 TEST(EnvironmentLights, NothingIsTakenFromAMapWithoutACompactBrightRegion) {
