@@ -336,7 +336,7 @@ struct Renderer::Impl {
   std::vector<std::pair<std::string, std::shared_ptr<const EnvironmentLights>>> environmentSplits;
 
   std::shared_ptr<const EnvironmentLights> environmentLights(const FrameView& view, const EnvironmentLightOptions& o,
-                                                             api::FrameStats& stats) {
+                                                             api::FrameStats& stats, const rt::Cancel& cancel) {
     const Image& map = *view.environment;
     const std::string key = view.environmentKey + "|" + std::to_string(map.width) + "x" + std::to_string(map.height) +
                             "|" + o.key();
@@ -347,13 +347,13 @@ struct Renderer::Impl {
       std::rotate(it, it + 1, environmentSplits.end());
       return environmentSplits.back().second;
     }
-    auto split = std::make_shared<const EnvironmentLights>(extractEnvironmentLights(map, o));
+    auto split = std::make_shared<const EnvironmentLights>(extractEnvironmentLights(map, o, cancel));
     while (environmentSplits.size() >= 4) environmentSplits.erase(environmentSplits.begin());
     environmentSplits.emplace_back(key, split);
     return split;
   }
 
-  const GpuScene& gpuScene(const Scene& scene, api::FrameStats& stats) {
+  const GpuScene& gpuScene(const Scene& scene, api::FrameStats& stats, const rt::Cancel& cancel) {
     const std::string key = scene.digest.empty() ? "addr:" + std::to_string(reinterpret_cast<std::uintptr_t>(&scene))
                                                  : scene.digest;
     auto it = std::find_if(gpuScenes.begin(), gpuScenes.end(), [&](const auto& e) { return e.first == key; });
@@ -364,7 +364,7 @@ struct Renderer::Impl {
       return *gpuScenes.back().second;
     }
     const auto t0 = Clock::now();
-    auto g = std::make_unique<GpuScene>(scene);
+    auto g = std::make_unique<GpuScene>(scene, cancel);
     stats.uploadMs = msSince(t0);
     while (gpuScenes.size() >= gpuSceneCapacity) gpuScenes.erase(gpuScenes.begin());
     gpuScenes.emplace_back(key, std::move(g));
@@ -571,11 +571,12 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     // The environment's compact bright regions become shadowed directional lights of the raster when
     // `direct` runs to light with them (docs/TECHNIQUES.md, "Environment lights"); the reference and
     // the background keep the whole map.
+    const rt::Cancel cancelToken(cancel);
     const bool directPlanned =
         std::any_of(plan.passes.begin(), plan.passes.end(), [](const Technique* t) { return t->info().name == "direct"; });
     if (supersampledView.environment && directPlanned) {
       const EnvironmentLightOptions o = environmentLightOptions(request);
-      supersampledView.environmentLights = im.environmentLights(supersampledView, o, stats);
+      supersampledView.environmentLights = im.environmentLights(supersampledView, o, stats, cancelToken);
       supersampledView.environmentLightsKey = o.key();
       const auto& taken = supersampledView.environmentLights->lights;
       supersampledView.lights.insert(supersampledView.lights.end(), taken.begin(), taken.end());
@@ -586,12 +587,11 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     outView.height = request.height;
     outView.supersampling = 1;
     stats.camera = cameraStats(view);
-    const GpuScene& gpu = im.gpuScene(scene, stats);
+    const GpuScene& gpu = im.gpuScene(scene, stats, cancelToken);
     stats.skipped = plan.skipped;
     stats.lightPaths = plan.lightPaths;
 
     im.resources.beginFrame(gpu, view, &stats.cache);
-    const rt::Cancel cancelToken(cancel);
     im.resources.setCancel(cancelToken);  // prepare() and the derived-data builders (photons, beams, BVH)
     im.resources.setLightPathOwners(plan.lightPaths);
     // Declared resources (renderer/frame/FrameAllocation.h): the Renderer allocates the planned passes'

@@ -87,7 +87,7 @@ std::string nextSceneKey(const Scene& scene) {
 }
 }  // namespace
 
-GpuScene::GpuScene(const Scene& scene) : sceneKey(nextSceneKey(scene)) {
+GpuScene::GpuScene(const Scene& scene, const rt::Cancel& cancel) : sceneKey(nextSceneKey(scene)) {
   // Textures: colour textures are sampled through sRGB formats so the hardware linearises them.
   std::map<std::pair<int, bool>, int> textureIndex;
   auto gpuTexture = [&](const TextureRef& ref, bool srgb) -> int {
@@ -121,6 +121,7 @@ GpuScene::GpuScene(const Scene& scene) : sceneKey(nextSceneKey(scene)) {
   materials = makeBuffer("materials", mats);
 
   for (const MeshInstance& mi : scene.meshes) {
+    cancel.check("the scene's upload (gpu_scene)");
     GpuMesh g;
     const std::size_t n = mi.positions.size();
     const std::string label = "mesh " + mi.name;

@@ -9,6 +9,7 @@
 
 #include "renderer/frame/GpuTypes.h"
 #include "renderer/gl/Gl.h"
+#include "renderer/raytracing/Cancel.h"
 #include "renderer/scene/Scene.h"
 
 namespace radiant {
@@ -37,7 +38,9 @@ bool materialSlotIsSrgb(int slot);
 
 class GpuScene {
 public:
-  explicit GpuScene(const Scene& scene);
+  // `cancel` is polled between meshes (each uploads its buffers and first-used textures): a cancelled
+  // upload throws rt::Cancelled and the half-built object is destroyed, never cached.
+  explicit GpuScene(const Scene& scene, const rt::Cancel& cancel = {});
   // Identity of what was uploaded, for keys of derived data: "<digest>#<upload generation>". The
   // generation is unique per upload, so a key never outlives the scene it was built from (an address
   // could be reused by the next scene).

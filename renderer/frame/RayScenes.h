@@ -35,7 +35,7 @@ inline std::shared_ptr<const rt::EnvironmentDistribution> environmentDistributio
                           "x" + std::to_string(env.channels);
   return res.cached<SharedEnvironmentDistribution>("environment_distribution", key, [&] {
               return std::make_unique<SharedEnvironmentDistribution>(
-                  SharedEnvironmentDistribution{rt::EnvironmentDistribution::build(env)});
+                  SharedEnvironmentDistribution{rt::EnvironmentDistribution::build(env, nullptr, res.cancel())});
             })
       .distribution;
 }

@@ -15,6 +15,7 @@
 #include <glm/glm.hpp>
 
 #include "renderer/Image.h"
+#include "renderer/raytracing/Cancel.h"
 #include "renderer/raytracing/RayScene.h"
 #include "renderer/scene/Environment.h"
 
@@ -74,7 +75,9 @@ struct EnvironmentDistribution {
   std::vector<float> conditional, marginal;  // h rows of (w + 1) CDF entries; h + 1 row sums
   float total = 0.f;
   glm::vec3 integral{0.f};  // \int L(w) dw, per channel
-  static std::shared_ptr<const EnvironmentDistribution> build(const Image& map, const Image* weight = nullptr);
+  // O(texels); `cancel` is polled every 64 rows.
+  static std::shared_ptr<const EnvironmentDistribution> build(const Image& map, const Image* weight = nullptr,
+                                                              const Cancel& cancel = {});
 };
 
 // The environment: uniform sky or an equirectangular map importance sampled by its
@@ -158,7 +161,8 @@ private:
 };
 
 inline std::shared_ptr<const EnvironmentDistribution> EnvironmentDistribution::build(const Image& map,
-                                                                                     const Image* weight) {
+                                                                                     const Image* weight,
+                                                                                     const Cancel& cancel) {
   auto d = std::make_shared<EnvironmentDistribution>();
   const int w = map.width, h = map.height;
   if (weight && (weight->width != w || weight->height != h || weight->channels < 1))
@@ -169,6 +173,7 @@ inline std::shared_ptr<const EnvironmentDistribution> EnvironmentDistribution::b
   d->marginal.assign(h + 1, 0.f);
   glm::dvec3 sum(0.0);
   for (int y = 0; y < h; ++y) {
+    if ((y & 63) == 0) cancel.check("the environment's sampling distribution (environment_distribution)");
     const float sinTheta = std::sin(kPi * (y + 0.5f) / h);
     const double dOmega = 2.0 * kPi * kPi * std::sin(kPi * (y + 0.5) / h) / (double(w) * h);
     float* cdf = &d->conditional[static_cast<size_t>(y) * (w + 1)];

@@ -40,7 +40,8 @@ std::string EnvironmentLightOptions::key() const {
   return s.str();
 }
 
-EnvironmentLights extractEnvironmentLights(const Image& map, const EnvironmentLightOptions& o) {
+EnvironmentLights extractEnvironmentLights(const Image& map, const EnvironmentLightOptions& o, const rt::Cancel& cancel) {
+  constexpr const char* kWhere = "the environment's light split (environment_lights)";
   EnvironmentLights out;
   const int w = map.width, h = map.height, c = map.channels;
   if (o.maxLights <= 0 || w <= 0 || h <= 0 || c <= 0 || !(o.threshold > 0.f) ||
@@ -50,6 +51,7 @@ EnvironmentLights extractEnvironmentLights(const Image& map, const EnvironmentLi
   std::vector<double> dOmega(h);
   double power = 0.0, sphere = 0.0;
   for (int y = 0; y < h; ++y) {
+    if ((y & 63) == 0) cancel.check(kWhere);
     dOmega[y] = 2.0 * kPi * kPi * std::sin(kPi * (y + 0.5) / h) / (double(w) * h);
     for (int x = 0; x < w; ++x) {
       const double Y = luminanceOf(map.at(x, y), c);
@@ -64,14 +66,17 @@ EnvironmentLights extractEnvironmentLights(const Image& map, const EnvironmentLi
   // Connected regions of texels above T (4-neighbours; u wraps around, v does not).
   const std::size_t n = static_cast<std::size_t>(w) * h;
   std::vector<std::uint8_t> above(n, 0), seen(n, 0);
-  for (int y = 0; y < h; ++y)
+  for (int y = 0; y < h; ++y) {
+    if ((y & 63) == 0) cancel.check(kWhere);
     for (int x = 0; x < w; ++x) {
       const double Y = luminanceOf(map.at(x, y), c);
       above[static_cast<std::size_t>(y) * w + x] = std::isfinite(Y) && Y > T;
     }
+  }
   std::vector<Region> regions;
   std::vector<std::int32_t> stack;
   for (std::size_t start = 0; start < n; ++start) {
+    if ((start & 65535) == 0) cancel.check(kWhere);
     if (!above[start] || seen[start]) continue;
     Region r;
     stack.assign(1, static_cast<std::int32_t>(start));
@@ -80,6 +85,7 @@ EnvironmentLights extractEnvironmentLights(const Image& map, const EnvironmentLi
       const std::int32_t i = stack.back();
       stack.pop_back();
       r.texels.push_back(i);
+      if ((r.texels.size() & 65535) == 0) cancel.check(kWhere);
       const int x = i % w, y = i / w;
       const float* p = map.at(x, y);
       const double Y = luminanceOf(p, c);

@@ -24,6 +24,7 @@
 #include <glm/glm.hpp>
 
 #include "renderer/Image.h"
+#include "renderer/raytracing/Cancel.h"
 #include "renderer/scene/Scene.h"
 
 namespace radiant {
@@ -47,6 +48,8 @@ struct EnvironmentLights {
   float residualShare(const Image& map, const glm::vec3& dir) const;
 };
 
-EnvironmentLights extractEnvironmentLights(const Image& map, const EnvironmentLightOptions& options = {});
+// Linear in the map's texels; `cancel` is polled every 64 rows and every 65,536 texels of a region.
+EnvironmentLights extractEnvironmentLights(const Image& map, const EnvironmentLightOptions& options = {},
+                                           const rt::Cancel& cancel = {});
 
 }  // namespace radiant

@@ -63,7 +63,8 @@ std::shared_ptr<const rt::EnvironmentDistribution> photonEnvironmentDistribution
           "photon_gi_environment_distribution", key,
           [&] {
             Image w = Image::make("photon_weight", map.width, map.height, 1);
-            for (int y = 0; y < map.height; ++y)
+            for (int y = 0; y < map.height; ++y) {
+              if ((y & 63) == 0) res.cancel().check("photon_gi's environment distribution");
               for (int x = 0; x < map.width; ++x) {
                 const float* l = map.at(x, y);
                 const float* r = residual.at(x, y);
@@ -73,8 +74,9 @@ std::shared_ptr<const rt::EnvironmentDistribution> photonEnvironmentDistribution
                 const float yl = std::max(0.f, lum(l, map.channels)), yr = std::max(0.f, lum(r, residual.channels));
                 w.at(x, y)[0] = yr + weight * std::max(0.f, yl - yr);
               }
+            }
             return std::make_unique<PhotonEnvironmentDistribution>(
-                PhotonEnvironmentDistribution{rt::EnvironmentDistribution::build(map, &w)});
+                PhotonEnvironmentDistribution{rt::EnvironmentDistribution::build(map, &w, res.cancel())});
           })
       .distribution;
 }

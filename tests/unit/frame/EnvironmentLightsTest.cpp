@@ -2,6 +2,7 @@
 // energy per texel, a sun found where it is with the irradiance it gives, nothing taken from a map
 // without a compact bright region.
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 
@@ -131,6 +132,22 @@ TEST(EnvironmentLights, PhotonsDrawnByTheResidualPlusAWeightedSunEstimateTheWhol
   EXPECT_NEAR(double(onSun) / kSamples, sunShareOfWeight, 0.01);
   // L / pdf is at most 2 (sun) or 1 (sky) times the weight's mean: 200k samples, well under 1%.
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(estimate[c], plain->integral[c], 0.01 * plain->integral[c]);
+}
+
+// Issue 30: both builds are linear in the map's texels (a 1 x 22-million map is within the decode
+// budget) and poll the request's cancel flag; a raised flag stops them, an unraised one changes nothing.
+TEST(EnvironmentLights, TheSplitAndTheSamplingDistributionStopWhenCancelled) {
+  const Image map = sunnySky(glm::normalize(glm::vec3(0.4f, 0.7f, -0.3f)), 0.05f);
+  std::atomic<bool> flag{true};
+  const rt::Cancel raised(&flag);
+  EXPECT_THROW(extractEnvironmentLights(map, {}, raised), rt::Cancelled);
+  EXPECT_THROW(rt::EnvironmentDistribution::build(map, nullptr, raised), rt::Cancelled);
+  flag = false;
+  const EnvironmentLights split = extractEnvironmentLights(map, {}, raised);
+  ASSERT_EQ(split.lights.size(), 1u);
+  EXPECT_EQ(split.residual.pixels, extractEnvironmentLights(map).residual.pixels);
+  EXPECT_EQ(rt::EnvironmentDistribution::build(map, nullptr, raised)->marginal,
+            rt::EnvironmentDistribution::build(map)->marginal);
 }
 
 TEST(EnvironmentLights, NothingIsTakenFromAMapWithoutACompactBrightRegion) {
