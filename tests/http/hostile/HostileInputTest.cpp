@@ -564,6 +564,58 @@ TEST(HostileService, SigtermKeepsServingFramesForTheGracePeriod) {
   fs::remove_all(dir);
 }
 
+// Issue 30: a render past its deadline, or DELETEd while it runs, gives the render thread back. The
+// heavy frame (the reference at 65,536 spp, 256 x 256: billions of paths) would run for minutes on
+// any machine, so the light frame after it can only finish inside its own deadline if the heavy one
+// stopped: asserted are outcomes (504, then 200; canceled, not timed out), not durations.
+TEST(HostileService, ATimedOutOrDeletedRenderGivesTheRenderThreadBack) {
+  const auto dir = radiant::testing::scratch("cancel-http");
+  Daemon d(RADIANTD_PATH, {"--port", "0", "--request-timeout", "6"}, {}, dir / "stderr.log");
+  ASSERT_TRUE(d.waitReady(std::chrono::seconds(60)));
+  auto c = d.client();
+  c.set_read_timeout(60, 0);
+  const std::string heavy =
+      R"({"scene":{"builtin":"cornell_box"},"width":256,"height":256,"passes":{"reference":{"spp":65536}}})";
+  const std::string light =
+      R"({"scene":{"builtin":"cornell_box"},"width":16,"height":16,"supersampling":1,"passes":{"photon_gi":false}})";
+  // A synchronous render past its deadline: 504; the next one renders.
+  auto timedOut = c.Post("/v1/renders", heavy, "application/json");
+  ASSERT_TRUE(timedOut);
+  EXPECT_EQ(timedOut->status, 504) << timedOut->body;
+  auto next = c.Post("/v1/renders", light, "application/json");
+  ASSERT_TRUE(next);
+  EXPECT_EQ(next->status, 200) << "the timed-out render kept the render thread: " << next->body.substr(0, 300);
+  // An asynchronous render DELETEd while running ends canceled (not failed at its deadline), and the
+  // next one renders.
+  auto accepted = c.Post("/v1/renders", heavy.substr(0, heavy.size() - 1) + R"(,"async":true})", "application/json");
+  ASSERT_TRUE(accepted);
+  ASSERT_EQ(accepted->status, 202) << accepted->body;
+  const std::string id = json::parse(accepted->body)["id"];
+  const std::string jobUrl = "/v1/renders/" + id;
+  json job = json::object();
+  for (int i = 0; i < 600 && job.value("state", "") != "running"; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    auto j = c.Get(jobUrl.c_str());
+    ASSERT_TRUE(j);
+    job = json::parse(j->body);
+  }
+  ASSERT_EQ(job["state"], "running") << job.dump();
+  auto deleted = c.Delete(jobUrl.c_str());
+  ASSERT_TRUE(deleted);
+  EXPECT_EQ(deleted->status, 202) << deleted->body;
+  for (int i = 0; i < 1200 && (job["state"] == "running" || job["state"] == "queued"); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    auto j = c.Get(jobUrl.c_str());
+    ASSERT_TRUE(j);
+    job = json::parse(j->body);
+  }
+  EXPECT_EQ(job["state"], "canceled") << job.dump();
+  next = c.Post("/v1/renders", light, "application/json");
+  ASSERT_TRUE(next);
+  EXPECT_EQ(next->status, 200) << "the canceled render kept the render thread: " << next->body.substr(0, 300);
+  fs::remove_all(dir);
+}
+
 TEST(HostileService, CacheDirRefusesSymlinksAndFilesThatDoNotMatchTheirDigest) {
   const auto dir = radiant::testing::scratch("cachedir");
   const std::string good = triangle().gltf();
