@@ -45,6 +45,9 @@ std::string usage() {
   --max-json-depth N        deepest nesting of a request or a glTF document (default 64)
   --max-decode-bytes N      memory one scene or image may decode into: pixels of every image,
                             expanded accessors of every mesh instance (default 536870912)
+  --decode-memory-bytes N   memory all decodes in flight may use together: at most
+                            max(1, N / max-decode-bytes) scenes or images decode at once, a
+                            further one waits up to 1 s, then gets 503 decode-busy (default 1073741824)
   --scene-cache-bytes N     decoded scenes kept in memory, in bytes (default 1073741824)
   --gpu-scenes N            scenes kept uploaded to the GPU with their derived data (BVH, shadow maps,
                             photon maps), least recently used evicted (default 4, at most 256)
@@ -129,6 +132,7 @@ void apply(ServerConfig& c, const std::string& name, const std::string& v, std::
   else if (name == "gl-debug") c.glDebug = v != "false" && v != "0";
   else if (name == "max-json-depth") c.limits.maxJsonDepth = static_cast<std::size_t>(toInt(flag, v, 8, 1000));
   else if (name == "max-decode-bytes") c.maxDecodeBytes = static_cast<std::size_t>(toInt(flag, v, 1 << 20, 1ll << 40));
+  else if (name == "decode-memory-bytes") c.decodeMemoryBytes = static_cast<std::size_t>(toInt(flag, v, 1 << 20, 1ll << 40));
   else if (name == "gpu-scenes") c.gpuScenes = static_cast<int>(toInt(flag, v, 1, 256));
   else if (name == "speed-factor") {
     c.speedFactor = v == "auto" ? 0.0 : toDouble(flag, v);

@@ -1,8 +1,10 @@
 #include "server/HttpServer.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
 #include <iostream>
 #include <list>
@@ -203,6 +205,53 @@ using DecodedScenes = DecodedCache<Scene, sceneBytes>;
 // request): the last 4 at most, within half of --scene-cache-bytes.
 using DecodedImages = DecodedCache<Image, imageBytes>;
 
+// Memory admission for decoding (issue 30): each decode of an uploaded or named scene or image may use
+// up to --max-decode-bytes, so at most max(1, --decode-memory-bytes / --max-decode-bytes) run at once.
+// A decode that finds no slot waits up to a second for one, then is refused with 503 decode-busy and
+// Retry-After: concurrent uploads cannot add up to more than the budget (3 meshopt uploads decoding
+// 256 MiB each took the daemon to 1.8 GB).
+class DecodeGate {
+public:
+  explicit DecodeGate(int slots) : free_(std::max(1, slots)), slots_(std::max(1, slots)) {}
+  int slots() const { return slots_; }
+  class Slot {
+  public:
+    explicit Slot(DecodeGate& g) : g_(&g) {}
+    Slot(const Slot&) = delete;
+    Slot& operator=(const Slot&) = delete;
+    ~Slot() {
+      {
+        std::lock_guard lock(g_->mutex_);
+        ++g_->free_;
+      }
+      g_->cv_.notify_one();
+    }
+
+  private:
+    DecodeGate* g_;
+  };
+  // Throws ApiError 503 decode-busy when no slot frees within `wait`.
+  Slot acquire(std::chrono::milliseconds wait = std::chrono::seconds(1)) {
+    std::unique_lock lock(mutex_);
+    if (!cv_.wait_for(lock, wait, [&] { return free_ > 0; })) {
+      ++refused_;
+      throw api::ApiError(503, "decode-busy", "Busy decoding",
+                          std::to_string(slots_) +
+                              " scenes or images are being decoded, the most this server decodes at once "
+                              "(--decode-memory-bytes / --max-decode-bytes): retry after the Retry-After seconds");
+    }
+    --free_;
+    return Slot(*this);
+  }
+  std::uint64_t refused() const { return refused_.load(); }
+
+private:
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  int free_, slots_;
+  std::atomic<std::uint64_t> refused_{0};
+};
+
 }  // namespace
 
 struct HttpServer::Impl {
@@ -214,6 +263,7 @@ struct HttpServer::Impl {
   ContentStore images;  // comparison targets (compare.against = their digest)
   DecodedScenes decoded;
   DecodedImages decodedImages;
+  DecodeGate decodeGate;
   RenderService service;
   BoundedServer http;
   std::atomic<bool> shuttingDown{false};
@@ -235,6 +285,7 @@ struct HttpServer::Impl {
         images(config.cacheDir, config.maxSceneBytes, "images"),
         decoded(config.sceneCacheEntries, config.sceneCacheBytes),
         decodedImages(std::min<std::size_t>(4, config.sceneCacheEntries), config.sceneCacheBytes / 2),
+        decodeGate(static_cast<int>(std::min<std::size_t>(1024, config.decodeMemoryBytes / std::max<std::size_t>(1, config.maxDecodeBytes)))),
         service(config, hooks, frames, metrics) {
     routes();
   }
@@ -271,6 +322,7 @@ struct HttpServer::Impl {
     if (!hooks.decodeScene) throw std::logic_error("no scene decoder configured");
     std::shared_ptr<Scene> scene;
     try {
+      const auto slot = decodeGate.acquire();
       scene = std::make_shared<Scene>(hooks.decodeScene(bytes));
     } catch (const api::ApiError& e) {
       // A render request points at its own field (/scene/inline_glb); an upload, whose body is the
@@ -356,6 +408,7 @@ struct HttpServer::Impl {
                           pointer + ": no image " + digest + " (upload it to /v1/images first)", pointer);
     if (auto image = decodedImages.get(digest)) return image;
     if (!hooks.decodeImage) throw std::logic_error("no image decoder configured");
+    const auto slot = decodeGate.acquire();
     auto image = std::make_shared<const Image>(hooks.decodeImage(*bytes));
     metrics.countImageDecode();
     decodedImages.put(digest, image);
@@ -401,6 +454,7 @@ struct HttpServer::Impl {
         const std::string body = readBody(req, res, reader);
         f(req, body, res);
       } catch (const api::ApiError& e) {
+        if (e.type == "decode-busy") res.set_header("Retry-After", "1");
         sendProblem(res, e, tRequest.renderId);
       } catch (const std::exception& e) {
         sendProblem(res, 500, "internal-error", "Internal error", e.what(), "", tRequest.renderId);
@@ -414,6 +468,7 @@ struct HttpServer::Impl {
       try {
         f(req, res);
       } catch (const api::ApiError& e) {
+        if (e.type == "decode-busy") res.set_header("Retry-After", "1");
         sendProblem(res, e, tRequest.renderId);
       } catch (const std::exception& e) {
         sendProblem(res, 500, "internal-error", "Internal error", e.what(), "", tRequest.renderId);
@@ -436,6 +491,8 @@ struct HttpServer::Impl {
                 {"frame_ttl_s", config.frameTtlS},
                 {"max_json_depth", config.limits.maxJsonDepth},
                 {"max_decode_bytes", config.maxDecodeBytes},
+                {"decode_memory_bytes", config.decodeMemoryBytes},
+                {"concurrent_decodes", decodeGate.slots()},
                 {"max_frame_bytes", config.maxFrameBytes},
                 {"scene_cache_bytes", config.sceneCacheBytes},
                 {"gpu_scenes", config.gpuScenes},
@@ -609,7 +666,8 @@ struct HttpServer::Impl {
           {"radiant_scene_cache_bytes", {"Bytes of decoded scenes kept in memory (--scene-cache-bytes).", double(decoded.totalBytes())}},
           {"radiant_image_store_bytes", {"Bytes of uploaded comparison images stored.", double(images.totalBytes())}},
           {"radiant_image_cache_bytes", {"Bytes of decoded images kept in memory (half of --scene-cache-bytes).", double(decodedImages.totalBytes())}},
-          {"radiant_frame_store_bytes", {"Bytes of encoded frames stored.", double(frames.totalBytes())}}};
+          {"radiant_frame_store_bytes", {"Bytes of encoded frames stored.", double(frames.totalBytes())}},
+          {"radiant_decodes_refused", {"Decodes refused with 503 decode-busy since start (--decode-memory-bytes).", double(decodeGate.refused())}}};
       res.status = 200;
       res.set_content(metrics.text(gauges), "text/plain; version=0.0.4; charset=utf-8");
     }));
@@ -684,6 +742,7 @@ struct HttpServer::Impl {
       bool created = false;
       if (!images.get(digest)) {
         if (!hooks.decodeImage) throw std::logic_error("no image decoder configured");
+        const auto slot = decodeGate.acquire();
         const Image decoded = hooks.decodeImage(body);  // refuse what cannot be read before storing it
         created = images.put(digest, body);
       }

@@ -27,6 +27,9 @@ struct FakeControl {
   std::atomic<int> creates{0}, started{0}, finished{0};
   std::atomic<bool> failNext{false}, apiErrorNext{false}, failCreate{false};
   std::atomic<int> delayMs{0};
+  // Scene decodes of a document holding "hold-decode" wait while holdDecode is set (decoding counts them).
+  std::atomic<bool> holdDecode{false};
+  std::atomic<int> decoding{0};
 
   void close() { std::lock_guard l(m); gateOpen = false; }
   void open() { { std::lock_guard l(m); gateOpen = true; } cv.notify_all(); }
@@ -98,7 +101,12 @@ inline server::BackendHooks fakeHooks(FakeControl& c) {
     if (c.failCreate) throw std::runtime_error("eglInitialize failed: EGL_NOT_INITIALIZED (fake)");
     return std::make_unique<FakeBackend>(c);
   };
-  h.decodeScene = [](std::string_view bytes) {
+  h.decodeScene = [&c](std::string_view bytes) {
+    if (bytes.find("hold-decode") != std::string_view::npos) {
+      ++c.decoding;
+      while (c.holdDecode) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+      --c.decoding;
+    }
     Scene s;
     const bool glb = bytes.size() >= 4 && bytes.substr(0, 4) == "glTF";
     if (!glb) {

@@ -654,6 +654,42 @@ TEST(ServerCore, TimeoutFreesTheQueueSlot) {
   s.control.open();
 }
 
+// Issue 30, memory admission: with --decode-memory-bytes equal to --max-decode-bytes one decode runs at a
+// time; an upload that finds the slot taken waits up to a second, then gets 503 decode-busy with
+// Retry-After, and succeeds once the slot is free.
+TEST(ServerCore, DecodesBeyondTheDecodeMemoryAreRefusedWithRetryAfter) {
+  ServerConfig config;
+  config.maxDecodeBytes = 64u << 20;
+  config.decodeMemoryBytes = 64u << 20;
+  TestServer s(config);
+  s.waitReady();
+  auto info = body(s.client().Get("/v1/info"));
+  EXPECT_EQ(info["limits"]["concurrent_decodes"], 1);
+  s.control.holdDecode = true;
+  const std::string held = R"({"asset":{"version":"2.0"},"extras":{"hold-decode":1}})";
+  std::thread first([&] {
+    auto c = s.client();
+    auto r = c.Put("/v1/scenes", held, "model/gltf+json");
+    ASSERT_TRUE(r);
+    EXPECT_EQ(r->status, 201) << r->body;
+  });
+  for (int i = 0; i < 2000 && s.control.decoding.load() == 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  ASSERT_EQ(s.control.decoding.load(), 1);
+  auto c = s.client();
+  const std::string other = R"({"asset":{"version":"2.0"},"extras":{"n":7}})";
+  auto busy = c.Put("/v1/scenes", other, "model/gltf+json");
+  expectProblem(busy, 503, "decode-busy", "");
+  EXPECT_EQ(busy->get_header_value("Retry-After"), "1");
+  auto metrics = c.Get("/metrics");
+  ASSERT_TRUE(metrics);
+  EXPECT_NE(metrics->body.find("radiant_decodes_refused 1\n"), std::string::npos) << metrics->body;
+  s.control.holdDecode = false;
+  first.join();
+  auto ok = c.Put("/v1/scenes", other, "model/gltf+json");
+  ASSERT_TRUE(ok);
+  EXPECT_EQ(ok->status, 201) << ok->body;
+}
+
 TEST(ServerCore, MetricsCountRequestsPassesAndQueue) {
   TestServer s;
   s.waitReady();
