@@ -412,6 +412,8 @@ void Renderer::calibrateSpeed() {
   im.speed.calibrate(im.lastFrame.measuredMs, im.lastFrame.predictedMs);
 }
 
+void Renderer::setDerivedCacheBytes(std::size_t bytes) { impl_->resources.setDerivedBytes(bytes); }
+
 void Renderer::setGpuSceneCapacity(std::size_t scenes) {
   impl_->gpuSceneCapacity = std::max<std::size_t>(1, scenes);
   impl_->resources.setDerivedCapacity(impl_->gpuSceneCapacity);

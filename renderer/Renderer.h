@@ -87,6 +87,10 @@ public:
   // resources (shadow and cube maps) hold the last scene rendered (FrameResources::holds).
   // Default 4; radiantd --gpu-scenes.
   void setGpuSceneCapacity(std::size_t scenes);
+  // Bytes the sized derived data (photon sets, splat grids) may hold together, least recently used
+  // dropped first (FrameResources::setDerivedBytes). Default 1 TiB (unbounded); radiantd
+  // --derived-cache-bytes.
+  void setDerivedCacheBytes(std::size_t bytes);
   // The budget chooser's speed factor (api::MachineSpeed): > 0 pins it (radiantd --speed-factor),
   // 0 measures it: a calibration frame before the first frame with a time budget, then the ratio of
   // measured to predicted time of recent frames comparable with the preset table. Default 0.

@@ -38,6 +38,7 @@ struct ServerConfig {
   std::size_t sceneCacheBytes = std::size_t(1024) << 20;   // decoded scenes kept in memory, in bytes
   double speedFactor = 0.0;            // time budgets' speed factor: 0 measures it, > 0 pins it (--speed-factor)
   int gpuScenes = 4;                   // scenes kept uploaded to the GPU (with their derived data), LRU
+  std::size_t derivedCacheBytes = std::size_t(1024) << 20;  // photon sets and splat grids kept, LRU (--derived-cache-bytes)
   double readTimeoutS = 30;            // receiving one request (headers and body), in total
   double keepAliveTimeoutS = 2;        // an idle keep-alive connection is closed after this
   // After SIGTERM, frame and job GETs are served this long (ending early once every frame was

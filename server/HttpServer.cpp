@@ -496,6 +496,7 @@ struct HttpServer::Impl {
                 {"max_frame_bytes", config.maxFrameBytes},
                 {"scene_cache_bytes", config.sceneCacheBytes},
                 {"gpu_scenes", config.gpuScenes},
+                {"derived_cache_bytes", config.derivedCacheBytes},
                 {"speed_factor", config.speedFactor > 0 ? json(config.speedFactor) : json("auto")},
                 {"read_timeout_s", config.readTimeoutS},
                 {"keep_alive_timeout_s", config.keepAliveTimeoutS},

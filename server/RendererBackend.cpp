@@ -23,8 +23,10 @@ constexpr float kMaxImageRadiance = 1e18f;
 
 class RendererBackend final : public RenderBackend {
 public:
-  RendererBackend(const DeviceOptions& options, int gpuScenes, double speedFactor) : renderer_(options) {
+  RendererBackend(const DeviceOptions& options, int gpuScenes, double speedFactor, std::size_t derivedBytes)
+      : renderer_(options) {
     renderer_.setGpuSceneCapacity(static_cast<std::size_t>(gpuScenes));
+    renderer_.setDerivedCacheBytes(derivedBytes);
     renderer_.setSpeedFactor(speedFactor);
   }
   DeviceInfo device() const override { return renderer_.device(); }
@@ -49,8 +51,9 @@ BackendHooks rendererHooks(const ServerConfig& config) {
   BackendHooks h;
   const int gpuScenes = config.gpuScenes;
   const double speedFactor = config.speedFactor;
-  h.createBackend = [device, gpuScenes, speedFactor] {
-    return std::make_unique<RendererBackend>(device, gpuScenes, speedFactor);
+  const std::size_t derivedBytes = config.derivedCacheBytes;
+  h.createBackend = [device, gpuScenes, speedFactor, derivedBytes] {
+    return std::make_unique<RendererBackend>(device, gpuScenes, speedFactor, derivedBytes);
   };
   const std::size_t maxBytes = config.maxBodyBytes;
   const std::size_t maxDecoded = config.maxDecodeBytes;

@@ -62,6 +62,7 @@ void FrameResources::beginFrame(const GpuScene& gpu, const FrameView& view, std:
   gpu_ = &gpu;
   view_ = &view;
   cacheLog_ = cacheLog;
+  ++frame_;
   cancel_ = {};
   endPass();  // a pass that threw last frame left its scope open
   written_.clear();
@@ -69,6 +70,32 @@ void FrameResources::beginFrame(const GpuScene& gpu, const FrameView& view, std:
 }
 
 const std::string& FrameResources::sceneKey() const { return gpu_->sceneKey; }
+
+std::size_t FrameResources::derivedBytes() const {
+  std::size_t total = 0;
+  for (const auto& [key, entries] : cache_)
+    for (const Entry& e : entries)
+      if (e.bytes) total += e.bytes();
+  return total;
+}
+
+void FrameResources::keepWithinDerivedBytes() {
+  std::size_t total = derivedBytes();
+  while (total > derivedBytes_) {
+    // The least recently used sized entry of an earlier frame: the oldest frame, then the back of its list.
+    std::list<Entry>* from = nullptr;
+    std::list<Entry>::iterator victim;
+    for (auto& [key, entries] : cache_)
+      for (auto it = entries.begin(); it != entries.end(); ++it)
+        if (it->bytes && it->frame != frame_ && (!from || it->frame <= victim->frame)) {
+          from = &entries;
+          victim = it;
+        }
+    if (!from) return;  // only this frame's entries are left
+    total -= victim->bytes();
+    from->erase(victim);
+  }
+}
 
 gl::Texture& FrameResources::texture(const std::string& name, GLenum target, GLenum internalFormat, int width,
                                      int height, int depth, int levels) {

@@ -12,6 +12,12 @@
 // digests (renders alternating between scenes or parameter sets reuse them; radiantd --gpu-scenes sets
 // it with the scene cache). Derived data that lives in a shared frame resource (shadow maps, cube maps,
 // uploaded buffers) is valid only while the resource holds it: holds() / setHolds() below.
+// Derived data whose type reports its size (`std::size_t bytes() const`: photon sets, splat grids) is
+// also kept within a byte budget over every key together (radiantd --derived-cache-bytes): when an entry
+// is added, the least recently used entries go first, never one this frame has looked up (a pass may
+// hold a reference to it).
+#include <concepts>
+#include <cstdint>
 #include <functional>
 #include <list>
 #include <map>
@@ -137,11 +143,25 @@ public:
       entries.splice(entries.begin(), entries, it);
     } else {
       auto value = build();
-      entries.push_front({inputsDigest, std::shared_ptr<void>(value.release(), [](void* p) { delete static_cast<T*>(p); })});
+      T* raw = value.release();
+      std::function<std::size_t()> bytes;
+      if constexpr (requires(const T& v) { { v.bytes() } -> std::convertible_to<std::size_t>; })
+        bytes = [raw] { return static_cast<std::size_t>(raw->bytes()); };
+      entries.push_front({inputsDigest, std::shared_ptr<void>(raw, [](void* p) { delete static_cast<T*>(p); }),
+                          std::move(bytes), frame_});
       while (entries.size() > derivedCapacity_) entries.pop_back();
+      keepWithinDerivedBytes();  // on insertion only: a budget below one set still reuses the set in use
     }
+    entries.front().frame = frame_;
     return *static_cast<T*>(entries.front().value.get());
   }
+  // Bytes the sized derived data may hold together (at least one entry is always kept: the one in use).
+  void setDerivedBytes(std::size_t bytes) {
+    derivedBytes_ = bytes;
+    keepWithinDerivedBytes();
+  }
+  // The sized derived data's bytes now (photon sets grow as requests refine them).
+  std::size_t derivedBytes() const;
   // Digests kept per cache key (at least 1; default 4).
   void setDerivedCapacity(std::size_t n) {
     derivedCapacity_ = n < 1 ? 1 : n;
@@ -161,7 +181,13 @@ private:
   struct Entry {
     std::string digest;
     std::shared_ptr<void> value;
+    std::function<std::size_t()> bytes;  // empty: the type does not report its size
+    std::uint64_t frame = 0;             // the last frame that looked it up
   };
+  // Drops the least recently used sized entries of earlier frames until derivedBytes() <= derivedBytes_.
+  void keepWithinDerivedBytes();
+  std::uint64_t frame_ = 0;  // beginFrame() counts
+  std::size_t derivedBytes_ = std::size_t(1) << 40;
   gl::ShaderLibrary& shaders_;
   const GpuScene* gpu_ = nullptr;
   const FrameView* view_ = nullptr;

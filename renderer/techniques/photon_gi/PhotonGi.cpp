@@ -26,11 +26,15 @@ constexpr float kDefaultEnvironmentLightPhotons = 0.5f;
 
 struct PhotonCache {
   rt::PhotonSet set;
+  std::size_t bytes() const { return set.records.capacity() * sizeof(rt::PhotonRecord); }  // FrameResources' budget
 };
 struct SplatCache {
   photon_gi::SplatGrid grid;
   std::size_t photonSplats = 0, coveragePoints = 0;
   float hMin = 0.f, hMax = 0.f;
+  std::size_t bytes() const {
+    return grid.splats.capacity() * sizeof(photon_gi::GpuSplat) + grid.cellStart.capacity() * sizeof(grid.cellStart[0]);
+  }
 };
 
 [[noreturn]] void badParam(const std::string& key, const std::string& detail) {

@@ -299,6 +299,34 @@ TEST(RenderCore, GpuSceneCacheKeepsTheMostRecentlyUsedScenes) {
   r.setGpuSceneCapacity(4);
 }
 
+// Issue 30: photon sets and splat grids are kept within a byte budget (radiantd --derived-cache-bytes;
+// 4M photons took 2.4 GB at rest when only the scene count bounded them). Under a budget of one byte
+// only the frame in use keeps its own: alternating scenes re-trace their photons; under a large one
+// both sets stay and the third frame traces nothing.
+TEST(RenderCore, PhotonSetsAreKeptWithinTheDerivedCacheBytes) {
+  auto traced = [](const RenderOutput& o) {
+    for (const auto& p : o.stats.passes)
+      if (p.name == "photon_gi") return p.counters.at("photons_traced");
+    ADD_FAILURE() << "no photon_gi pass";
+    return -1.0;
+  };
+  Renderer& r = renderer();
+  r.setGpuSceneCapacity(4);
+  api::RenderRequest req = request(8);
+  req.passes["photon_gi"] = {{"photons", 20000}};
+  const Scene a = umbraScene(1.f, "derived-bytes-a"), b = umbraScene(1.f, "derived-bytes-b");
+  r.setDerivedCacheBytes(std::size_t(1) << 30);
+  EXPECT_EQ(traced(r.render(a, req)), 20000.0);
+  EXPECT_EQ(traced(r.render(b, req)), 20000.0);
+  EXPECT_EQ(traced(r.render(a, req)), 0.0) << "both photon sets fit in 1 GiB";
+  r.setDerivedCacheBytes(1);  // drops every set of an earlier frame at once
+  EXPECT_EQ(traced(r.render(b, req)), 20000.0);
+  EXPECT_EQ(traced(r.render(b, req)), 0.0) << "the set of the frame before is kept while it is the only one";
+  EXPECT_EQ(traced(r.render(a, req)), 20000.0);
+  EXPECT_EQ(traced(r.render(b, req)), 20000.0) << "a's set pushed b's out";
+  r.setDerivedCacheBytes(std::size_t(1) << 40);
+}
+
 TEST(RenderCore, SharedDerivedResourcesHoldTheSceneRenderedLast) {
   // Two scenes whose shadows differ (the occluder left or right of the light), rendered A, B, A with
   // both kept uploaded: the third frame must equal the first. The shadow maps live in one texture that
