@@ -308,6 +308,20 @@ void decodeDraco(tinygltf::Model& model, std::size_t maxBytes) {
         tinygltf::Accessor& acc = model.accessors[std::size_t(accIndex)];
         const int comps = tinygltf::GetNumComponentsInType(std::uint32_t(acc.type));
         if (comps <= 0 || comps > 4) throw SceneError(ptr + "/attributes/" + name, "unsupported accessor type");
+        // Validated before any value is read (issue 30): the stream's type must be one of glTF's component
+        // types (a DT_BOOL attribute with bytes other than 0 and 1 is undefined behaviour inside Draco's
+        // conversion, found by tests/fuzz/draco_fuzzer.cpp) and its component count the accessor's.
+        switch (a->data_type()) {
+          case draco::DT_INT8: case draco::DT_UINT8: case draco::DT_INT16: case draco::DT_UINT16:
+          case draco::DT_UINT32: case draco::DT_FLOAT32: break;
+          default:
+            throw SceneError(ptr + "/attributes/" + name, "the Draco attribute's data type (" +
+                                                             std::to_string(int(a->data_type())) +
+                                                             ") is not a glTF component type");
+        }
+        if (a->num_components() != comps)
+          throw SceneError(ptr + "/attributes/" + name, "the Draco attribute has " + std::to_string(int(a->num_components())) +
+                                                           " components, its accessor " + std::to_string(comps));
         std::vector<float> values(points * std::size_t(comps), 0.f);
         for (std::size_t i = 0; i < points; ++i)
           if (!a->ConvertValue<float>(a->mapped_index(draco::PointIndex(std::uint32_t(i))), std::int8_t(comps),

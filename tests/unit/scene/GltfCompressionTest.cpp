@@ -7,6 +7,8 @@
 #include <cstring>
 #include <limits>
 
+#include <tuple>
+
 #include <gtest/gtest.h>
 
 #include <draco/compression/encode.h>
@@ -103,6 +105,58 @@ TEST(GltfCompression, DracoPrimitiveDecodesToTheEncodedMesh) {
       for (int k = 0; k < 3; ++k) EXPECT_LT(glm::length(mi.normals[mi.indices[t + k]] - glm::normalize(glm::round(c * 2.f))), 1e-6f);
     }
     EXPECT_TRUE(s.warnings.empty());
+  }
+}
+
+// Issue 30, validate before decoding: a Draco attribute is checked against its accessor before any value
+// is read: its data type must be a glTF component type (a DT_BOOL attribute holding other bytes than 0
+// and 1 was undefined behaviour inside Draco's conversion, tests/fuzz/draco_fuzzer.cpp) and its
+// component count the accessor's. Both are 422 invalid-scene at the attribute's pointer.
+TEST(GltfCompression, DracoAttributesOfAnotherTypeOrComponentCountAreRefused) {
+  const Cube cube;
+  auto file = [&](draco::DataType normalType, int normalComponents) {
+    draco::TriangleSoupMeshBuilder builder;
+    builder.Start(int(cube.idx.size() / 3));
+    const int pos = builder.AddAttribute(draco::GeometryAttribute::POSITION, 3, draco::DT_FLOAT32);
+    const int nrm = builder.AddAttribute(draco::GeometryAttribute::NORMAL, std::int8_t(normalComponents), normalType);
+    const std::int32_t ints[3] = {1, 2, 3};
+    const float floats[3] = {0.f, 0.f, 1.f};
+    const void* n = normalType == draco::DT_INT32 ? static_cast<const void*>(ints) : static_cast<const void*>(floats);
+    for (std::size_t f = 0; f < cube.idx.size() / 3; ++f) {
+      const auto* i = &cube.idx[f * 3];
+      builder.SetAttributeValuesForFace(pos, draco::FaceIndex(std::uint32_t(f)), &cube.p[i[0]], &cube.p[i[1]], &cube.p[i[2]]);
+      builder.SetAttributeValuesForFace(nrm, draco::FaceIndex(std::uint32_t(f)), n, n, n);
+    }
+    std::unique_ptr<draco::Mesh> mesh = builder.Finalize();
+    draco::Encoder encoder;
+    draco::EncoderBuffer encoded;
+    EXPECT_TRUE(encoder.EncodeMeshToBuffer(*mesh, &encoded).ok());
+    GltfBuilder b;
+    const int view = b.view(encoded.data(), encoded.size());
+    const int posAcc = b.push("accessors", {{"componentType", 5126}, {"count", mesh->num_points()}, {"type", "VEC3"},
+                                            {"min", {-0.5, -0.5, -0.5}}, {"max", {0.5, 0.5, 0.5}}});
+    const int nrmAcc = b.push("accessors", {{"componentType", 5126}, {"count", mesh->num_points()}, {"type", "VEC3"}});
+    const json draco = {{"bufferView", view},
+                        {"attributes", {{"POSITION", mesh->GetNamedAttribute(draco::GeometryAttribute::POSITION)->unique_id()},
+                                        {"NORMAL", mesh->GetNamedAttribute(draco::GeometryAttribute::NORMAL)->unique_id()}}}};
+    const int m = b.mesh(json::array({{{"attributes", {{"POSITION", posAcc}, {"NORMAL", nrmAcc}}},
+                                       {"extensions", {{"KHR_draco_mesh_compression", draco}}}}}));
+    b.scene({b.node({{"mesh", m}})});
+    b.doc["extensionsUsed"] = {"KHR_draco_mesh_compression"};
+    b.doc["extensionsRequired"] = {"KHR_draco_mesh_compression"};
+    return b.glb();
+  };
+  const std::string pointer = "/meshes/0/primitives/0/extensions/KHR_draco_mesh_compression/attributes/NORMAL";
+  EXPECT_NO_THROW(loadSceneFromMemory(file(draco::DT_FLOAT32, 3)));
+  for (const auto& [type, comps, says] : {std::tuple{draco::DT_INT32, 3, "not a glTF component type"},
+                                          std::tuple{draco::DT_FLOAT32, 2, "has 2 components, its accessor 3"}}) {
+    try {
+      loadSceneFromMemory(file(type, comps));
+      ADD_FAILURE() << "accepted " << says;
+    } catch (const SceneError& e) {
+      EXPECT_EQ(e.pointer, pointer);
+      EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+    }
   }
 }
 
