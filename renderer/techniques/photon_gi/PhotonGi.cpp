@@ -41,8 +41,8 @@ struct SplatCache {
   throw api::ApiError(422, "invalid-value", "Invalid photon_gi parameter", detail, "/passes/photon_gi/" + key);
 }
 
-// Which environment photons are drawn (docs/TECHNIQUES.md, photon_gi, "Emission"). When the frame split
-// the map into lights S and a residual R (renderer/shading/EnvironmentLights.h), the lights' first hits
+// Which environment photons are drawn (docs/TECHNIQUES.md, photon_gi, "Sky photons under a split
+// map"). When the frame split the map into lights S and a residual R (renderer/shading/EnvironmentLights.h), the lights' first hits
 // are `direct`'s: photons drawn by L spend 70-79% of the sky's photons on a sun whose first hits are
 // not splatted, and the residual's direct light is estimated from the rest. Texels are then drawn by
 // the luminance of R + weight S; every photon still carries L / pdf, so every bounce stays unbiased
