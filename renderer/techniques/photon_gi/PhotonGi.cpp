@@ -42,13 +42,13 @@ struct SplatCache {
 }
 
 // Which environment photons are drawn (docs/TECHNIQUES.md, photon_gi, "Sky photons under a split
-// map"). When the frame split the map into lights S and a residual R (renderer/shading/EnvironmentLights.h), the lights' first hits
-// are `direct`'s: photons drawn by L spend 70-79% of the sky's photons on a sun whose first hits are
-// not splatted, and the residual's direct light is estimated from the rest. Texels are then drawn by
-// the luminance of R + weight S; every photon still carries L / pdf, so every bounce stays unbiased
-// (R > 0 wherever L > 0), and the suns' photons, fewer and heavier, carry their light's later bounces.
-// Null (draw by L) when the map is not split or weight is 1. Derived data of the map, the split and
-// the weight: cached per their key.
+// map"). When the frame split the map into lights S and a residual R (EnvironmentLights.h), the
+// lights' first hits are `direct`'s: photons drawn by L spend 70-79% of the sky's photons on a sun
+// whose first hits are not splatted, and the residual's direct light is estimated from the rest.
+// Texels are then drawn by the luminance of R + weight S; every photon still carries L / pdf, so every
+// bounce stays unbiased (R > 0 wherever L > 0), and the suns' photons, fewer and heavier, carry their
+// light's later bounces. Null (draw by L) when the map is not split or weight is 1. Derived data of
+// the map, the split and the weight: cached per their key.
 struct PhotonEnvironmentDistribution {
   std::shared_ptr<const rt::EnvironmentDistribution> distribution;
 };
