@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <limits>
 #include <stdexcept>
@@ -291,6 +292,48 @@ std::string encodePngRgba8(const ImageRgba8& image, bool alpha, int zlibLevel) {
   return writeToMemory("image.png", spec, OIIO::TypeDesc::UINT8, rgb.data());
 }
 
+namespace {
+
+// An OpenEXR header's attributes (name\0 type\0 int32 size, value), checked before OpenEXR reads them:
+// OpenEXR allocates an attribute's declared size first, so a 508-byte upload declaring a 1.6 GB string
+// took the daemon to 2 GB (found by tests/fuzz/image_fuzzer.cpp, 2026-12-04). Every header (several in
+// a multi-part file) must end inside the bytes, names and types must be terminated within 256 bytes,
+// and no value may be larger than what is left of the file.
+void checkExrHeaders(std::string_view b) {
+  auto bad = [](const std::string& why) { throw std::runtime_error("io: the uploaded exr image is invalid: " + why); };
+  if (b.size() < 8) bad("shorter than its magic number and version");
+  const std::uint32_t flags = std::uint8_t(b[5]) | std::uint32_t(std::uint8_t(b[6])) << 8 | std::uint32_t(std::uint8_t(b[7])) << 16;
+  const bool multipart = (flags & 0x10) != 0;  // bit 12 of the version field
+  std::size_t i = 8;
+  for (int header = 0;; ++header) {
+    int attributes = 0;
+    for (;; ++attributes) {
+      if (i >= b.size()) bad("a header does not end inside the file");
+      if (b[i] == '\0') {  // the header's end
+        ++i;
+        break;
+      }
+      for (int field = 0; field < 2; ++field) {  // name, then type
+        const std::size_t end = b.find('\0', i);
+        if (end == std::string_view::npos || end - i > 255) bad("an attribute name or type is not terminated");
+        i = end + 1;
+      }
+      if (b.size() - i < 4) bad("an attribute has no size");
+      const std::int32_t size = std::int32_t(std::uint32_t(std::uint8_t(b[i])) | std::uint32_t(std::uint8_t(b[i + 1])) << 8 |
+                                             std::uint32_t(std::uint8_t(b[i + 2])) << 16 |
+                                             std::uint32_t(std::uint8_t(b[i + 3])) << 24);
+      i += 4;
+      if (size < 0 || std::size_t(size) > b.size() - i)
+        bad("attribute " + std::to_string(attributes) + " declares " + std::to_string(size) + " bytes, more than the file holds");
+      i += std::size_t(size);
+    }
+    // A multi-part file lists its headers one after the other and ends the list with an empty one.
+    if (!multipart || attributes == 0 || header > 1024) break;
+  }
+}
+
+}  // namespace
+
 Image decodeImage(std::string_view bytes, const std::string& aov, std::size_t maxDecodedBytes) {
   auto starts = [&](std::string_view magic) { return bytes.substr(0, magic.size()) == magic; };
   const char* name = starts(std::string_view("\x76\x2f\x31\x01", 4)) ? "image.exr"
@@ -298,6 +341,7 @@ Image decodeImage(std::string_view bytes, const std::string& aov, std::size_t ma
                      : starts("\x89PNG")                        ? "image.png"
                                                                  : nullptr;
   if (!name) throw std::runtime_error("io: not an EXR, Radiance HDR or PNG image");
+  if (name == std::string_view("image.exr")) checkExrHeaders(bytes);
   OIIO::Filesystem::IOMemReader reader(const_cast<char*>(bytes.data()), bytes.size());
   auto in = OIIO::ImageInput::open(name, nullptr, &reader);
   return readFrom(in.get(), std::string("the uploaded ") + (name + 6) + " image", aov, maxDecodedBytes);

@@ -80,3 +80,35 @@ TEST(ImageIO, Rgba8PngRoundTripKeepsStraightCodesAndAnRgbFileReadsOpaque) {
 
 }  // namespace
 }  // namespace radiant
+
+namespace radiant {
+namespace {
+
+// Issue 30: an uploaded EXR whose header declares an attribute larger than the file is refused before
+// OpenEXR allocates it (a 508-byte upload declaring a 1.6 GB "Software" string took 2 GB,
+// tests/fuzz/image_fuzzer.cpp); a header that does not end inside the file likewise. Our own EXRs pass.
+TEST(ImageIO, ExrHeadersDeclaringMoreThanTheFileHoldsAreRefusedBeforeTheyAreRead) {
+  Image beauty = Image::make("beauty", 4, 2, 3);
+  for (std::size_t i = 0; i < beauty.pixels.size(); ++i) beauty.pixels[i] = float(i);
+  const std::string exr = io::encodeExr({beauty}, false);
+  EXPECT_EQ(io::decodeImage(exr, "beauty").pixels, beauty.pixels);
+  // The first attribute's size field follows its name and type.
+  const std::size_t name = exr.find('\0', 8), type = exr.find('\0', name + 1);
+  std::string huge = exr;
+  huge[type + 1] = '\x53', huge[type + 2] = '\x00', huge[type + 3] = '\x00', huge[type + 4] = '\x63';  // 1.66e9
+  try {
+    io::decodeImage(huge, "beauty");
+    ADD_FAILURE() << "accepted an attribute of 1.66e9 bytes";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("more than the file holds"), std::string::npos) << e.what();
+  }
+  try {
+    io::decodeImage(exr.substr(0, type + 3), "beauty");
+    ADD_FAILURE() << "accepted a truncated header";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("invalid"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace radiant
