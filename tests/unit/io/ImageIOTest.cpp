@@ -112,3 +112,26 @@ TEST(ImageIO, ExrHeadersDeclaringMoreThanTheFileHoldsAreRefusedBeforeTheyAreRead
 
 }  // namespace
 }  // namespace radiant
+
+namespace radiant {
+namespace {
+
+// The same for a PNG chunk declaring more than the file holds (a 304-byte tEXt of 1.7 GB took 2 GB,
+// tests/data/crashers/images/png_8x4_takes_2gb.png).
+TEST(ImageIO, PngChunksDeclaringMoreThanTheFileHoldsAreRefusedBeforeTheyAreRead) {
+  Image beauty = Image::make("beauty", 4, 2, 3);
+  for (std::size_t i = 0; i < beauty.pixels.size(); ++i) beauty.pixels[i] = 0.125f * float(i % 8);
+  const std::string png = io::encodePng(beauty, 0.f);
+  EXPECT_EQ(io::decodeImage(png, "beauty").width, 4);
+  std::string huge = png;
+  huge[8] = '\x67', huge[9] = '\x00', huge[10] = '\x00', huge[11] = '\x0d';  // IHDR's length: 1.7e9
+  try {
+    io::decodeImage(huge, "beauty");
+    ADD_FAILURE() << "accepted a chunk of 1.7e9 bytes";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("more than the file holds"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace radiant
