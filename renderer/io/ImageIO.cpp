@@ -12,6 +12,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include "api/Aovs.h"
+#include "renderer/io/MemoryReader.h"
 #include "renderer/io/ToneMap.h"
 
 namespace radiant::io {
@@ -255,7 +256,7 @@ Image readImage(const std::string& path, const std::string& aov) {
 
 ImageRgba8 decodePngRgba8(std::string_view bytes) {
   if (bytes.substr(0, 4) != "\x89PNG") throw std::runtime_error("io: not a PNG image");
-  OIIO::Filesystem::IOMemReader reader(const_cast<char*>(bytes.data()), bytes.size());
+  MemoryReader reader(bytes);
   OIIO::ImageSpec config;
   config.attribute("oiio:UnassociatedAlpha", 1);  // the codes as stored, not premultiplied
   // create + set_ioproxy + open: ImageInput::open(name, &config, proxy) ignores the proxy here.
@@ -360,7 +361,7 @@ Image decodeImage(std::string_view bytes, const std::string& aov, std::size_t ma
   if (!name) throw std::runtime_error("io: not an EXR, Radiance HDR or PNG image");
   if (name == std::string_view("image.exr")) checkExrHeaders(bytes);
   if (name == std::string_view("image.png")) checkPngChunks(bytes);
-  OIIO::Filesystem::IOMemReader reader(const_cast<char*>(bytes.data()), bytes.size());
+  MemoryReader reader(bytes);
   auto in = OIIO::ImageInput::open(name, nullptr, &reader);
   return readFrom(in.get(), std::string("the uploaded ") + (name + 6) + " image", aov, maxDecodedBytes);
 }

@@ -3,11 +3,14 @@
 // it (ambient 1e6, a 1e15 light: issue 30), so encodeExr writes the largest finite half and counts.
 #include <cfloat>
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <limits>
 
 #include <gtest/gtest.h>
 
 #include "renderer/io/ImageIO.h"
+#include "renderer/io/MemoryReader.h"
 
 namespace radiant {
 namespace {
@@ -131,6 +134,39 @@ TEST(ImageIO, PngChunksDeclaringMoreThanTheFileHoldsAreRefusedBeforeTheyAreRead)
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("more than the file holds"), std::string::npos) << e.what();
   }
+}
+
+}  // namespace
+}  // namespace radiant
+
+namespace radiant {
+namespace {
+
+// Uploaded images are read through io::MemoryReader, whose reads never leave the bytes: OpenImageIO
+// 2.4's IOMemReader copied from any offset, and an EXR whose line offset table pointed before the
+// file made OpenEXR read before the upload's buffer (tests/data/crashers/images/exr_offset_before_the_file.exr,
+// found by the image fuzzer; its ASan run keeps it as a regression test).
+TEST(ImageIO, MemoryReadsNeverLeaveTheBytes) {
+  const std::string bytes = "0123456789";
+  io::MemoryReader r(bytes);
+  char buf[16] = {};
+  EXPECT_EQ(r.pread(buf, 4, -1), 0u);
+  EXPECT_EQ(r.pread(buf, 4, 10), 0u);
+  EXPECT_EQ(r.pread(buf, 4, int64_t(1) << 62), 0u);
+  EXPECT_EQ(r.pread(buf, 16, 7), 3u);
+  EXPECT_EQ(std::string(buf, 3), "789");
+  EXPECT_FALSE(r.seek(-1));
+  EXPECT_TRUE(r.seek(8));
+  EXPECT_EQ(r.read(buf, 16), 2u);
+  EXPECT_EQ(std::string(buf, 2), "89");
+  EXPECT_EQ(r.read(buf, 16), 0u);
+  EXPECT_EQ(r.size(), 10u);
+  // The fuzzer's file is refused (its offset table points outside it), not read around.
+  std::ifstream in(std::string(RADIANT_SOURCE_DIR) + "/tests/data/crashers/images/exr_offset_before_the_file.exr",
+                   std::ios::binary);
+  const std::string exr((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GT(exr.size(), 100u);
+  EXPECT_THROW(io::decodeImage(exr, "beauty"), std::runtime_error);
 }
 
 }  // namespace
