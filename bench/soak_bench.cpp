@@ -1,6 +1,9 @@
-// Soak benchmark (issue 13; not a test, not in CI): starts radiantd and sends N mixed requests on
-// one keep-alive client: synchronous renders with each pass, scene uploads (a new digest each
-// time), inline scenes, async renders cancelled at once, and bad requests of every hardening class.
+// Soak benchmark (issues 13 and 30; not a test, not in CI): starts radiantd and sends N mixed requests
+// on one keep-alive client, per 25: synchronous renders with each pass, scene uploads (a new digest each
+// time), inline scenes, async renders cancelled at once, bad requests of every hardening class, and
+// (issue 30) an uploaded environment map (a new digest each time) lighting the default passes, a
+// participating-medium frame, a refining job of 2 batches, and one hostile upload from
+// tests/data/crashers/{images,gltf} in turn (any status below 500).
 // The daemon's RSS is sampled every 500 requests. Goal: RSS flat within 5% after warm-up, no 5xx,
 // every accepted job's frames downloadable.
 //   build/bench/soak_bench [--requests N] [--warmup N]
@@ -16,6 +19,7 @@
 #include <httplib.h>
 #include <nlohmann/json.hpp>
 
+#include "renderer/io/ImageIO.h"
 #include "tests/support/DaemonProcess.h"
 #include "tests/unit/scene/GltfTestBuilder.h"
 
@@ -38,6 +42,25 @@ std::string uniqueScene(int i) {
   const int m = b.mesh(json::array({radiant::test::trianglePrimitive<std::uint8_t>(b, p, {0, 1, 2})}));
   b.scene({b.node({{"mesh", m}})});
   return b.glb();
+}
+
+// A 16x8 environment map, a new digest every time: a sky with a sun-like texel (the environment's
+// light split and photon_gi's sky photons run for it).
+std::string uniqueEnvironment(int i) {
+  radiant::Image sky = radiant::Image::make("beauty", 16, 8, 3);
+  for (std::size_t p = 0; p < sky.pixels.size(); ++p) sky.pixels[p] = 0.5f + 1e-4f * float(i % 1000) + 0.01f * float(p % 3);
+  for (int c = 0; c < 3; ++c) sky.pixels[(2 * 16 + 5) * 3 + std::size_t(c)] = 400.f;
+  return radiant::io::encodeExr({sky}, false);
+}
+
+std::vector<std::string> hostileFiles(const std::string& folder) {
+  std::vector<std::string> files;
+  for (const auto& e : std::filesystem::directory_iterator(std::string(RADIANT_SOURCE_DIR) + "/tests/data/crashers/" + folder)) {
+    if (!e.is_regular_file() || e.path().extension() == ".py") continue;
+    std::ifstream in(e.path(), std::ios::binary);
+    files.emplace_back((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  }
+  return files;
 }
 
 }  // namespace
@@ -75,6 +98,8 @@ int main(int argc, char** argv) {
       {"{\"scene\":{\"builtin\":\"cornell\xff\"}}", "utf8"},
       {R"({"scene":{"builtin":"cornell_box"},"outputs":[{"format":"exr","aovs":["beauty","beauty"]}]})", "duplicate"}};
 
+  const std::vector<std::string> hostileImages = hostileFiles("images"), hostileScenes = hostileFiles("gltf");
+
   std::map<std::string, int> counts;
   int fiveHundreds = 0, otherFailures = 0, framesMissing = 0, framesFetched = 0;
   std::vector<std::pair<int, double>> samples;
@@ -86,45 +111,85 @@ int main(int argc, char** argv) {
       else ++framesMissing;
     }
   };
-  auto note = [&](const httplib::Result& r, const std::string& what, bool expect2xx) {
+  // expect: 1 = 2xx, 0 = 4xx, -1 = anything below 500 (hostile uploads: a few are valid files).
+  auto note = [&](const httplib::Result& r, const std::string& what, int expect) {
     ++counts[what];
     if (!r) { ++otherFailures; return json(); }
     if (r->status >= 500) {
       ++fiveHundreds;
       std::fprintf(stderr, "soak: %s -> %d %s\n", what.c_str(), r->status, r->body.substr(0, 300).c_str());
-    } else if (expect2xx != (r->status < 300)) {
+    } else if (expect >= 0 && (expect == 1) != (r->status < 300)) {
       ++otherFailures;
       std::fprintf(stderr, "soak: %s -> %d %s\n", what.c_str(), r->status, r->body.substr(0, 300).c_str());
     }
     return json::parse(r->body, nullptr, false);
   };
 
+  std::map<int, double> kindSeconds;  // per kind of the cycle, for the summary
   for (int i = 0; i < requests; ++i) {
-    const int kind = i % 20;
-    if (kind < 12) {  // renders: each pass in turn, on each built-in scene
-      const auto& [pass, params] = passes[std::size_t(i / 20 + kind) % passes.size()];
+    const int kind = i % 25;
+    const auto started = std::chrono::steady_clock::now();
+    if (kind == 20) {  // a new environment map, then the default passes under it
+      const json up = note(c.Put("/v1/images", uniqueEnvironment(i), "image/x-exr"), "upload environment", 1);
+      if (up.is_object()) {
+        const json body = {{"scene", {{"inline_glb", radiant::test::base64(uniqueScene(i))}}}, {"environment", up["digest"]},
+                           {"width", 16}, {"height", 16}, {"seed", i}};
+        const json job = note(c.Post("/v1/renders", body.dump(), "application/json"), "render environment", 1);
+        if (job.is_object()) fetchFrames(job);
+      }
+    } else if (kind == 21) {  // a participating medium (the planner's media passes)
+      const json body = {{"scene", {{"builtin", "explosion"}}}, {"width", 16}, {"height", 16}, {"seed", i}};
+      const json job = note(c.Post("/v1/renders", body.dump(), "application/json"), "render media", 1);
+      if (job.is_object()) fetchFrames(job);
+    } else if (kind == 22) {  // a refining job of 2 batches, waited for
+      const json accepted = note(c.Post("/v1/renders", json{{"scene", {{"builtin", "cornell_box"}}}, {"width", 16}, {"height", 16},
+                                                          {"async", true}, {"refine", {{"max_batches", 2}}}}.dump(),
+                                        "application/json"),
+                                 "refine", 1);
+      if (!accepted.is_object()) continue;
+      const std::string url = "/v1/renders/" + accepted["id"].get<std::string>();
+      for (int k = 0; k < 2000; ++k) {
+        auto r = c.Get(url.c_str());
+        const json job = r ? json::parse(r->body, nullptr, false) : json();
+        const std::string state = job.is_object() ? job.value("state", "") : "";
+        if (state == "done") { fetchFrames(job); break; }
+        if (state != "queued" && state != "running") {
+          ++otherFailures;
+          std::fprintf(stderr, "soak: refine -> %s\n", r ? r->body.substr(0, 300).c_str() : "no answer");
+          break;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      }
+    } else if (kind == 23) {  // a hostile image upload
+      note(c.Put("/v1/images", hostileImages[std::size_t(i / 25) % hostileImages.size()], "application/octet-stream"),
+           "hostile image", -1);
+    } else if (kind == 24) {  // a hostile glTF upload
+      note(c.Put("/v1/scenes", hostileScenes[std::size_t(i / 25) % hostileScenes.size()], "application/octet-stream"),
+           "hostile scene", -1);
+    } else if (kind < 12) {  // renders: each pass in turn, on each built-in scene
+      const auto& [pass, params] = passes[std::size_t(i / 25 + kind) % passes.size()];
       json body = {{"scene", {{"builtin", scenes[std::size_t(i) % scenes.size()]}}}, {"width", 16}, {"height", 16},
                    {"seed", i}, {"passes", {{pass, params}}}};
       if (pass == "gbuffer") body["outputs"] = {{{"format", "exr"}, {"aovs", {"beauty", "normal", "depth"}}}};
-      const json job = note(c.Post("/v1/renders", body.dump(), "application/json"), "render " + pass, true);
+      const json job = note(c.Post("/v1/renders", body.dump(), "application/json"), "render " + pass, 1);
       if (job.is_object()) fetchFrames(job);
     } else if (kind < 14) {  // uploads, then a render of the upload by digest
-      const json up = note(c.Put("/v1/scenes", uniqueScene(i), "model/gltf-binary"), "upload", true);
+      const json up = note(c.Put("/v1/scenes", uniqueScene(i), "model/gltf-binary"), "upload", 1);
       if (up.is_object()) {
         const json job = note(c.Post("/v1/renders", json{{"scene", {{"digest", up["digest"]}}}, {"width", 16}, {"height", 16}}.dump(),
                                      "application/json"),
-                              "render uploaded", true);
+                              "render uploaded", 1);
         if (job.is_object()) fetchFrames(job);
       }
     } else if (kind == 14) {  // inline GLB
       const json body = {{"scene", {{"inline_glb", radiant::test::base64(uniqueScene(-i))}}}, {"width", 16}, {"height", 16}};
-      const json job = note(c.Post("/v1/renders", body.dump(), "application/json"), "render inline", true);
+      const json job = note(c.Post("/v1/renders", body.dump(), "application/json"), "render inline", 1);
       if (job.is_object()) fetchFrames(job);
     } else if (kind < 17) {  // async, cancelled at once; if it finished first, its frames must be there
       const json accepted = note(c.Post("/v1/renders", json{{"scene", {{"builtin", "cornell_box"}}}, {"width", 32}, {"height", 32},
                                                           {"async", true}, {"passes", {{"reference", {{"spp", 4}}}}}}.dump(),
                                         "application/json"),
-                                 "async", true);
+                                 "async", 1);
       if (!accepted.is_object()) continue;
       const std::string url = "/v1/renders/" + accepted["id"].get<std::string>();
       c.Delete(url.c_str());
@@ -139,8 +204,9 @@ int main(int argc, char** argv) {
       }
     } else {  // bad requests: 4xx, never 5xx
       const auto& [text, what] = bad[std::size_t(i) % bad.size()];
-      note(c.Post("/v1/renders", text, "application/json"), "bad " + what, false);
+      note(c.Post("/v1/renders", text, "application/json"), "bad " + what, 0);
     }
+    kindSeconds[kind] += std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     if (rssMiB(d.pid(), "VmRSS:") < 0) {
       std::printf("soak: the daemon is gone after %d requests\n", i + 1);
       ++otherFailures;
@@ -162,6 +228,10 @@ int main(int argc, char** argv) {
   std::printf("soak: RSS after %d requests: min %.1f MiB, max %.1f MiB (spread %.1f%%); peak (VmHWM) %.1f MiB\n", warmup,
               lo, hi, hi > 0 ? 100.0 * (hi - lo) / lo : 0.0, rssMiB(d.pid(), "VmHWM:"));
   for (const auto& [what, n] : counts) std::printf("soak:   %-24s %d\n", what.c_str(), n);
+  std::printf("soak: seconds per kind of the cycle (0-11 renders, 12-13 uploads, 14 inline, 15-16 async, 17-19 bad,\n"
+              "soak: 20 environment, 21 media, 22 refine, 23-24 hostile):");
+  for (const auto& [kind, t] : kindSeconds) std::printf(" %d:%.0f", kind, t);
+  std::printf("\n");
   const bool flat = hi <= lo * 1.05;
   const bool ok = fiveHundreds == 0 && framesMissing == 0 && otherFailures == 0 && flat;
   if (ok) std::filesystem::remove_all(dir);
