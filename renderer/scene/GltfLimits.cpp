@@ -294,8 +294,24 @@ std::optional<ImageHeader> readImageHeader(const unsigned char* bytes, std::size
   return h;
 }
 
+bool isGltfImageFormat(const unsigned char* bytes, std::size_t size) {
+  const bool png = size >= 8 && std::memcmp(bytes, "\x89PNG\r\n\x1a\n", 8) == 0;
+  const bool jpeg = size >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF;
+  return png || jpeg || isWebp(bytes, size);
+}
+
 bool DecodeBudget::chargeImage(const unsigned char* bytes, std::size_t size, int imageIndex, std::string* err) {
   const std::string ptr = "/images/" + std::to_string(imageIndex);
+  // glTF 2.0 images are PNG or JPEG (WebP with EXT_texture_webp). stb_image, behind tinygltf, reads
+  // more (BMP, TGA, GIF, PSD, HDR, PIC, PNM), and its readers of those are not hardened: a 680-byte GLB
+  // holding an 8-pixel Radiance HDR image with a zero RLE run kept its decoder looping for good (found by
+  // tests/fuzz/image_fuzzer.cpp, 2026-12-04; tests/data/crashers/gltf/hdr_image_whose_rle_hangs_stb.glb).
+  if (!isGltfImageFormat(bytes, size)) {
+    imageError_.emplace(ptr, ptr + ": not a PNG, JPEG or WebP image (glTF 2.0 images are PNG or JPEG, WebP with "
+                                   "EXT_texture_webp; convert other formats to PNG)", "");
+    if (err) *err += imageError_->what() + std::string("\n");
+    return false;
+  }
   const auto header = readImageHeader(bytes, size);
   if (!header) {
     // stb refuses, while reading the header, a PNG whose pixels would exceed 2^30 bytes; its
@@ -310,7 +326,7 @@ bool DecodeBudget::chargeImage(const unsigned char* bytes, std::size_t size, int
                               std::to_string(limit_) + " bytes (radiantd " + kDecodeFlag + ")",
                           kDecodeFlag);
     else
-      imageError_.emplace(ptr, ptr + ": not an image this loader decodes (PNG, JPEG, WebP (still), BMP, TGA, GIF, PSD, HDR, PIC, PNM)", "");
+      imageError_.emplace(ptr, ptr + ": not an image this loader decodes (PNG, JPEG, still WebP)", "");
     if (err) *err += imageError_->what() + std::string("\n");
     return false;
   }

@@ -68,6 +68,9 @@ std::optional<ImageHeader> readImageHeader(const unsigned char* bytes, std::size
 // A WebP file (RIFF container, "WEBP" form type: EXT_texture_webp). stb_image does not decode WebP;
 // libwebp does (GltfLoader.cpp), 8-bit RGBA.
 bool isWebp(const unsigned char* bytes, std::size_t size);
+// PNG, JPEG or WebP by its magic bytes: the image formats a glTF may hold (DecodeBudget::chargeImage
+// refuses the others before a decoder sees them).
+bool isGltfImageFormat(const unsigned char* bytes, std::size_t size);
 
 void checkGltfText(std::string_view jsonText, const LoadOptions& options);
 // Returns the budget left for images once accessor expansion is charged.
