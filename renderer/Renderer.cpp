@@ -625,7 +625,9 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     for (std::size_t i = 0; i < plan.passes.size(); ++i) {
       Technique* t = plan.passes[i];
       stats.passes[i].name = t->info().name;
-      params[i] = Params(choice.params.at(t->info().name));
+      const auto given = request.explicitParams.find(t->info().name);
+      params[i] = Params(choice.params.at(t->info().name),
+                         given == request.explicitParams.end() ? std::set<std::string>{} : given->second);
       for (int m : t->shadowMapExclusions(scene, params[i])) shadowMapExclusions.insert(m);
     }
     im.resources.setShadowMapExclusions(std::move(shadowMapExclusions));

@@ -3,6 +3,7 @@
 // Adding a technique never touches another: it registers itself in renderer/techniques/Registry.cpp,
 // declares its parameters in api/schema/techniques/<name>.json and its method in docs/TECHNIQUES.md.
 
+#include <set>
 #include <string>
 #include <vector>
 
@@ -48,11 +49,16 @@ struct Requirements {
 };
 
 // A technique's parameters, validated against its schema with every default filled in
-// (api::techniqueParams), whether or not the request named the technique.
+// (api::techniqueParams), whether or not the request named the technique; given() tells the keys the
+// request set itself (RenderRequest::explicitParams) from defaults and preset or budget choices, for a
+// pass whose default adapts to the frame but must run an explicit value as asked (specular's
+// cube_resolution).
 class Params {
 public:
   Params() : json_(nlohmann::json::object()) {}
-  explicit Params(nlohmann::json j) : json_(j.is_object() ? std::move(j) : nlohmann::json::object()) {}
+  explicit Params(nlohmann::json j, std::set<std::string> given = {})
+      : json_(j.is_object() ? std::move(j) : nlohmann::json::object()), given_(std::move(given)) {}
+  bool given(const char* key) const { return given_.count(key) != 0; }
   template <class T>
   T get(const char* key, T fallback) const {
     auto it = json_.find(key);
@@ -68,6 +74,7 @@ public:
   }
 private:
   nlohmann::json json_;
+  std::set<std::string> given_;
 };
 
 // What scores one of a technique's AOVs (ARCHITECTURE.md, "A technique owns its knowledge"): the

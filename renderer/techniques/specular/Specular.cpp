@@ -26,14 +26,33 @@ constexpr float kMinBranchWeight = 1e-3f;
 
 constexpr int kMapTextureUnitPeel = gpu::kUnitPeel;
 // Indirect light in the maps (shaders/specular/map_indirect.comp): one photon gather per block of
-// texels, kMapIndirectSamples x kMapIndirectSamples blocks per face, spread over the block's texels on
-// the same surface (the rest gather themselves). photon_gi's estimate is smooth over its kernel radius;
-// a gather at every texel of a 256 x 256 face cost 13 s per photon set on llvmpipe (docs/PERFORMANCE.md).
-constexpr int kMapIndirectSamples = 64;
-int mapIndirectBlock(int resolution) { return std::max(1, resolution / kMapIndirectSamples); }
+// `map_indirect_block` texels per side (at least 8 blocks per face side), spread over the block's
+// texels on the same surface (the rest gather themselves). photon_gi's estimate is smooth over its
+// kernel radius; a gather at every texel of a 256 x 256 face cost 13 s per photon set on llvmpipe
+// (docs/PERFORMANCE.md), and with 36 glass spheres the gathers at 4 x 4 blocks were 14 of the specular
+// pass's 22 s at 256 x 256 (issue 31).
+int mapIndirectBlock(int resolution, int block) { return std::clamp(block, 1, std::max(1, resolution / 8)); }
 constexpr float kEmptyDistance = 3.0e38f;  // shaders/specular/ldm.glsl
 
 }  // namespace
+
+double projectedDiameterPixels(const FrameView& view, const Bounds& bounds) {
+  if (bounds.empty()) return 0.0;
+  const double r = bounds.radius();
+  const glm::vec4 clip = view.viewProj * glm::vec4(bounds.center(), 1.f);
+  const double scale = double(view.proj[1][1]) * view.height;  // pixels per unit of r / w
+  if (view.proj[3][3] != 0.f) return r * scale;                 // orthographic: w = 1
+  if (clip.w <= -r) return 0.0;                                 // wholly behind the camera
+  if (clip.w <= r) return std::numeric_limits<double>::infinity();  // around the camera
+  return r * scale / clip.w;
+}
+
+int mapResolution(double objectPixels, double texelsPerPixel, int maxResolution) {
+  const double wanted = std::min(objectPixels * texelsPerPixel, double(maxResolution));
+  int r = 16;
+  while (r < wanted && r < maxResolution) r *= 2;
+  return std::min(r, maxResolution);
+}
 
 const TechniqueInfo& SpecularPass::info() const {
   static const TechniqueInfo i{
@@ -62,8 +81,12 @@ void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResour
   maxDepth_ = std::clamp(params.get<int>("max_depth", 4), 1, 8);
   linearSteps_ = std::clamp(params.get<int>("linear_steps", 32), 1, 256);
   secantSteps_ = std::clamp(params.get<int>("secant_steps", 4), 0, 32);
-  resolution_ = std::clamp(params.get<int>("cube_resolution", 256), 16, 2048);
+  const int maxResolution = std::clamp(params.get<int>("cube_resolution", 256), 16, 2048);
+  // A cube_resolution the request gives is run as asked, unless it gives map_texels_per_pixel too.
+  const bool adaptive = !params.given("cube_resolution") || params.given("map_texels_per_pixel");
+  const double texelsPerPixel = adaptive ? std::clamp(params.get<double>("map_texels_per_pixel", 1.0), 0.0, 64.0) : 0.0;
   layers_ = std::clamp(params.get<int>("layers", 3), 3, 6);
+  indirectBlock_ = std::clamp(params.get<int>("map_indirect_block", 8), 1, 64);
   minmax_ = params.get<bool>("minmax", true);
 
   const Bounds& sb = scene.features.bounds;
@@ -90,6 +113,23 @@ void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResour
     objects_.push_back(o);
   }
 
+  // The maps' resolution follows what the camera sees of the specular objects (issue 31): a map's face
+  // needs about as many texels across as the largest object covers pixels (mapResolution), not a fixed
+  // 256 whatever its size on screen; at most cube_resolution.
+  resolution_ = maxResolution;
+  largestObjectPixels_ = 0.0;
+  causticsKeepMaps_ = false;
+  if (texelsPerPixel > 0.0) {
+    for (const Object& o : objects_)
+      largestObjectPixels_ = std::max(largestObjectPixels_, projectedDiameterPixels(res.view(), scene.meshes[o.mesh].bounds));
+    // The caustics pass traces its photons from the lights through these maps: what they need does
+    // not depend on the camera (a generator a few pixels wide on screen can focus a caustic across the
+    // floor; at 128 texels a glass slab lost 4% of its caustic photons at its edges against 256), so
+    // with caustics in the frame the maps stay at cube_resolution.
+    causticsKeepMaps_ = res.lightPathOwner("LS+DE") == "caustics";
+    if (!causticsKeepMaps_) resolution_ = mapResolution(largestObjectPixels_, texelsPerPixel, maxResolution);
+  }
+
   const int w = res.view().width, h = res.view().height;
   const int cubes = std::max<int>(1, static_cast<int>(objects_.size()) * layers_);
   gl::Texture& material = res.texture("specular_ldm_material", GL_TEXTURE_CUBE_MAP_ARRAY, GL_RGBA16F, resolution_,
@@ -113,7 +153,7 @@ void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResour
   // One face's photon sums over the gather's slices (shaders/specular/map_indirect.comp).
   res.texture("specular_ldm_indirect", GL_TEXTURE_2D, GL_RGBA32F, resolution_, resolution_)
       .setFilter(GL_NEAREST, GL_NEAREST);
-  const int blocks = (resolution_ + mapIndirectBlock(resolution_) - 1) / mapIndirectBlock(resolution_);
+  const int blocks = (resolution_ + mapIndirectBlock(resolution_, indirectBlock_) - 1) / mapIndirectBlock(resolution_, indirectBlock_);
   res.texture("specular_ldm_indirect_blocks", GL_TEXTURE_2D, GL_RGBA32F, blocks, blocks)
       .setFilter(GL_NEAREST, GL_NEAREST);
   res.texture("specular_ldm_indirect_fixup", GL_TEXTURE_2D, GL_R32F, resolution_, resolution_)
@@ -139,7 +179,7 @@ void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResour
   // in its prepare, after this one). Not on the tracing knobs (steps, depth, minmax): a sweep over
   // those reuses them.
   digest_ = res.sceneKey() + "|res=" + std::to_string(resolution_) + "|layers=" + std::to_string(layers_) +
-            "|objects=" + std::to_string(objects_.size());
+            "|objects=" + std::to_string(objects_.size()) + "|indirect_block=" + std::to_string(indirectBlock_);
 }
 
 void SpecularPass::execute(PassContext& ctx) {
@@ -247,7 +287,7 @@ void SpecularPass::execute(PassContext& ctx) {
       res.texture("specular_ldm_indirect").bindImage(3, GL_READ_WRITE);
       res.texture("specular_ldm_indirect_blocks").bindImage(4, GL_READ_WRITE);
       res.texture("specular_ldm_indirect_fixup").bindImage(5, GL_READ_WRITE);
-      const int block = mapIndirectBlock(resolution_);
+      const int block = mapIndirectBlock(resolution_, indirectBlock_);
       const int blocks = (resolution_ + block - 1) / block;
       gather.set("u_block", block);
       gather.set("u_kernel", photons->kernel);
@@ -325,6 +365,8 @@ void SpecularPass::execute(PassContext& ctx) {
   }
   res.markWritten("specular_maps");
   ctx.stats.counters["cube_resolution"] = resolution_;
+  ctx.stats.counters["largest_object_pixels"] = std::isfinite(largestObjectPixels_) ? largestObjectPixels_ : -1.0;
+  ctx.stats.counters["maps_kept_for_caustics"] = causticsKeepMaps_ ? 1 : 0;
   ctx.stats.counters["layers"] = layers_;
 
   // Trace from the rasterised first hits of the specular objects.

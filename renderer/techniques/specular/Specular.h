@@ -20,6 +20,16 @@
 
 namespace radiant {
 
+struct FrameView;
+struct Bounds;
+
+// The diameter in raster pixels of the sphere bounding `bounds` as the frame's camera sees it (0 when
+// it lies behind the camera, infinite when the camera is inside it).
+double projectedDiameterPixels(const FrameView& view, const Bounds& bounds);
+// The layered distance maps' face resolution for the largest specular object's projected diameter:
+// texelsPerPixel times it, rounded up to a power of two, within [16, maxResolution].
+int mapResolution(double objectPixels, double texelsPerPixel, int maxResolution);
+
 class SpecularPass final : public Technique {
 public:
   const TechniqueInfo& info() const override;
@@ -53,6 +63,9 @@ private:
   std::vector<Object> objects_;
   std::vector<int> objectOfMesh_;  // specular object index per mesh, -1 for diffuse meshes
   int maxDepth_ = 4, linearSteps_ = 32, secantSteps_ = 4, resolution_ = 256, layers_ = 3;
+  double largestObjectPixels_ = 0.0;  // the largest specular object's projected diameter (raster pixels)
+  bool causticsKeepMaps_ = false;
+  int indirectBlock_ = 8;             // map_indirect_block     // caustics traces its photons through the maps: cube_resolution
   bool minmax_ = true;
   bool mapsValid_ = false;
   std::string digest_;  // the maps' key without the photon set (execute() appends it; FrameResources::holds)

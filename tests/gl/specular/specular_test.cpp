@@ -9,6 +9,7 @@
 
 #include "renderer/metrics/Metrics.h"
 #include "renderer/reference/PathTracer.h"
+#include "renderer/techniques/specular/Specular.h"
 #include "tests/gl/specular/SpecularTestSupport.h"
 
 namespace radiant {
@@ -26,6 +27,7 @@ api::RenderRequest request(int w, int h, nlohmann::json specular = nlohmann::jso
   req.width = w;
   req.height = h;
   req.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty", "specular"}, false}};
+  for (const auto& [key, value] : specular.items()) req.explicitParams["specular"].insert(key);  // as the parser does
   req.passes["specular"] = std::move(specular);
   // The emitters and lights below are the whole of each oracle's light: no studio environment for the
   // scenes whose only light is an emissive surface (docs/API.md, "Default lighting").
@@ -735,6 +737,66 @@ TEST(Specular, MapsAreCachedAcrossTracingKnobs) {
   // No specular material: the planner skips the pass with the reason.
   RenderOutput c = renderer().render(loadBuiltinScene("cornell_box"), request(16, 16));
   EXPECT_EQ(c.stats.skipped.count("specular"), 1u);
+}
+
+// The maps' resolution follows what the camera sees (issue 31): texels per face side = the largest
+// specular object's projected diameter in raster pixels (map_texels_per_pixel 1), as a power of two in
+// [16, cube_resolution]; a cube_resolution the request gives runs as given; with caustics in the frame
+// (they trace the lights' photons through the maps, whatever the camera) the maps stay at
+// cube_resolution. Oracle of the size: the glass sphere of cornell_glass (radius 0.17 at (0.19, 0.17,
+// 0.13), its bounding box's circumscribed sphere r = 0.17 sqrt 3) seen by the built-in camera (39.3
+// degrees, at z = 1.94 looking down -z): D = r cot(19.65 deg) H / (1.94 - 0.13).
+TEST(Specular, MapsFollowTheObjectsSizeOnScreen) {
+  const Scene painted = testing::radiancePaintedCornell("cornell_glass");
+  const double r = 0.17 * std::sqrt(3.0), w = 1.94 - 0.13, cot = 1.0 / std::tan(0.5 * 39.3 * 3.14159265358979 / 180.0);
+  auto specularCounter = [](const RenderOutput& o, const char* key) { return passStats(o, "specular")->counters.at(key); };
+  for (int n : {32, 64, 128}) {
+    SCOPED_TRACE(n);
+    RenderOutput out = renderer().render(painted, request(n, n));
+    const double d = r * cot * n / w;
+    EXPECT_NEAR(specularCounter(out, "largest_object_pixels"), d, 0.02 * d);
+    EXPECT_EQ(specularCounter(out, "cube_resolution"), mapResolution(d, 1.0, 256));
+    EXPECT_EQ(specularCounter(out, "maps_kept_for_caustics"), 0.0);
+  }
+  EXPECT_EQ(mapResolution(14.6, 1.0, 256), 16);
+  EXPECT_EQ(mapResolution(58.4, 1.0, 256), 64);
+  EXPECT_EQ(mapResolution(500.0, 1.0, 256), 256);
+  EXPECT_EQ(mapResolution(500.0, 1.0, 100), 100);
+  EXPECT_EQ(mapResolution(1.0, 1.0, 256), 16);
+  EXPECT_EQ(mapResolution(40.0, 2.0, 256), 128);
+
+  // The error it costs, on the LDM tracing alone (the radiance-painted box: every path is camera ->
+  // glass^k -> emitter): the specular AOV at 64 px (the sphere's bound 29 px across), maps at 32 texels
+  // against maps at 256, relative L1 over the pixels the sphere covers (measured 0.0245, llvmpipe).
+  const int n = 64;
+  RenderOutput adaptive = renderer().render(painted, request(n, n));
+  RenderOutput full = renderer().render(painted, request(n, n, {{"map_texels_per_pixel", 0}}));
+  EXPECT_EQ(specularCounter(adaptive, "cube_resolution"), 32.0);
+  EXPECT_EQ(specularCounter(full, "cube_resolution"), 256.0);
+  const Image& a = findAov(adaptive, "specular");
+  const Image& f = findAov(full, "specular");
+  double diff = 0, sum = 0;
+  int pixels = 0;
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      const float* fv = f.at(x, y);
+      if (fv[0] + fv[1] + fv[2] <= 0.f) continue;
+      ++pixels;
+      for (int c = 0; c < 3; ++c) diff += std::abs(a.at(x, y)[c] - fv[c]), sum += fv[c];
+    }
+  std::printf("maps at 32 against 256 texels: relative L1 %.4f over %d sphere pixels\n", diff / sum, pixels);
+  EXPECT_GT(pixels, 150);
+  EXPECT_LT(diff / sum, 0.05);
+
+  // A cube_resolution the request gives runs as given.
+  RenderOutput asked = renderer().render(painted, request(n, n, {{"cube_resolution", 128}}));
+  EXPECT_EQ(specularCounter(asked, "cube_resolution"), 128.0);
+  RenderOutput both = renderer().render(painted, request(n, n, {{"cube_resolution", 128}, {"map_texels_per_pixel", 0.5}}));
+  EXPECT_EQ(specularCounter(both, "cube_resolution"), 16.0);  // 0.5 x 29 px
+  // With the point light the caustics pass runs and the maps stay at cube_resolution.
+  RenderOutput lit = renderer().render(loadBuiltinScene("cornell_glass"), request(n, n));
+  EXPECT_EQ(specularCounter(lit, "maps_kept_for_caustics"), 1.0);
+  EXPECT_EQ(specularCounter(lit, "cube_resolution"), 256.0);
 }
 
 }  // namespace
