@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <stdexcept>
 
@@ -300,6 +301,37 @@ namespace {
 // took the daemon to 2 GB (found by tests/fuzz/image_fuzzer.cpp, 2026-12-04). Every header (several in
 // a multi-part file) must end inside the bytes, names and types must be terminated within 256 bytes,
 // and no value may be larger than what is left of the file.
+// An attribute of type chlist: channels (name\0, int32 pixel type 0-2, uint8 pLinear, 3 reserved bytes,
+// int32 x and y sampling >= 1) ended by an empty name, all inside the attribute's declared size.
+// OpenEXR reads the list until its terminator whatever the size: an 884-byte upload whose last channel
+// name ran one byte past its attribute made it read the next attributes as channels, and opening it
+// took 1.5 GB and 8 s (image fuzzer, 2026-12-04).
+void checkExrChannelList(std::string_view v, const std::function<void(const std::string&)>& bad) {
+  std::size_t i = 0;
+  int channels = 0;
+  auto le32 = [&](std::size_t at) {
+    return std::int32_t(std::uint32_t(std::uint8_t(v[at])) | std::uint32_t(std::uint8_t(v[at + 1])) << 8 |
+                        std::uint32_t(std::uint8_t(v[at + 2])) << 16 | std::uint32_t(std::uint8_t(v[at + 3])) << 24);
+  };
+  for (;; ++channels) {
+    if (i >= v.size()) bad("the channel list does not end inside its attribute");
+    if (v[i] == '\0') {
+      if (i + 1 != v.size()) bad("the channel list ends before its attribute does");
+      break;
+    }
+    const std::size_t end = v.find('\0', i);
+    if (end == std::string_view::npos || end - i > 255) bad("a channel name is not terminated inside the channel list");
+    i = end + 1;
+    if (v.size() - i < 16) bad("channel " + std::to_string(channels) + " is cut short");
+    const std::int32_t type = le32(i), xs = le32(i + 8), ys = le32(i + 12);
+    if (type < 0 || type > 2) bad("channel " + std::to_string(channels) + " has pixel type " + std::to_string(type));
+    if (xs < 1 || ys < 1 || xs > 65536 || ys > 65536) bad("channel " + std::to_string(channels) + " has sampling out of range");
+    i += 16;
+    if (channels > 1024) bad("more than 1024 channels");
+  }
+  if (channels == 0) bad("the channel list is empty");
+}
+
 void checkExrHeaders(std::string_view b) {
   auto bad = [](const std::string& why) { throw std::runtime_error("io: the uploaded exr image is invalid: " + why); };
   if (b.size() < 8) bad("shorter than its magic number and version");
@@ -308,15 +340,18 @@ void checkExrHeaders(std::string_view b) {
   std::size_t i = 8;
   for (int header = 0;; ++header) {
     int attributes = 0;
+    bool hasChannels = false, hasDataWindow = false;
     for (;; ++attributes) {
       if (i >= b.size()) bad("a header does not end inside the file");
       if (b[i] == '\0') {  // the header's end
         ++i;
         break;
       }
+      std::string_view fields[2];
       for (int field = 0; field < 2; ++field) {  // name, then type
         const std::size_t end = b.find('\0', i);
         if (end == std::string_view::npos || end - i > 255) bad("an attribute name or type is not terminated");
+        fields[field] = b.substr(i, end - i);
         i = end + 1;
       }
       if (b.size() - i < 4) bad("an attribute has no size");
@@ -326,8 +361,17 @@ void checkExrHeaders(std::string_view b) {
       i += 4;
       if (size < 0 || std::size_t(size) > b.size() - i)
         bad("attribute " + std::to_string(attributes) + " declares " + std::to_string(size) + " bytes, more than the file holds");
+      const std::string_view value = b.substr(i, std::size_t(size));
+      if (fields[1] == "chlist") checkExrChannelList(value, bad);
+      if (fields[0] == "channels") hasChannels = fields[1] == "chlist";
+      if (fields[0] == "dataWindow") {
+        if (fields[1] != "box2i" || value.size() != 16) bad("dataWindow is not a box2i");
+        hasDataWindow = true;
+      }
       i += std::size_t(size);
     }
+    // Every part of an image names its channels and its data window (OpenEXR's required attributes).
+    if (attributes > 0 && (!hasChannels || !hasDataWindow)) bad("a header has no channels or no dataWindow");
     // A multi-part file lists its headers one after the other and ends the list with an empty one.
     if (!multipart || attributes == 0 || header > 1024) break;
   }

@@ -169,5 +169,38 @@ TEST(ImageIO, MemoryReadsNeverLeaveTheBytes) {
   EXPECT_THROW(io::decodeImage(exr, "beauty"), std::runtime_error);
 }
 
+// An EXR channel list is read by OpenEXR until its terminator, whatever its attribute's size: an
+// 884-byte upload whose last channel name ran one byte past the attribute took 1.5 GB and 8 s to open
+// (image fuzzer). The list must end exactly at its attribute's end, with valid pixel types and
+// sampling, and a header must name its channels and data window.
+TEST(ImageIO, ExrChannelListsMustEndInsideTheirAttribute) {
+  std::ifstream in(std::string(RADIANT_SOURCE_DIR) +
+                       "/tests/data/crashers/images/exr_channel_list_past_its_attribute_takes_1_5gb.exr",
+                   std::ios::binary);
+  const std::string bad((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GT(bad.size(), 800u);
+  try {
+    io::decodeImage(bad, "beauty");
+    ADD_FAILURE() << "accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("channel list"), std::string::npos) << e.what();
+  }
+  // A valid file passes, and a pixel type out of range is refused.
+  Image beauty = Image::make("beauty", 4, 2, 3);
+  const std::string exr = io::encodeExr({beauty}, false);
+  EXPECT_NO_THROW(io::decodeImage(exr, "beauty"));
+  const std::size_t list = exr.find("chlist");
+  ASSERT_NE(list, std::string::npos);
+  std::string typed = exr;
+  const std::size_t firstType = typed.find('\0', list + 7 + 4) + 1;  // after the first channel's name
+  typed[firstType] = '\x07';
+  try {
+    io::decodeImage(typed, "beauty");
+    ADD_FAILURE() << "accepted pixel type 7";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("pixel type 7"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace radiant
