@@ -6,6 +6,8 @@
 #include <random>
 
 #include <gtest/gtest.h>
+
+#include "renderer/shading/CubeFaces.h"
 #include <glm/gtc/constants.hpp>
 
 #include "renderer/techniques/env_diffuse/FormFactor.h"
@@ -235,6 +237,41 @@ TEST(CubeMap, TexelSolidAnglesSumToTheSphere) {
   // One face is a sixth of the sphere; a centre texel of a fine face is ~ (2/M)^2.
   EXPECT_NEAR(cubeTexelSolidAngle(-1, -1, 1, 1), 4 * M_PI / 6, 1e-5);
   EXPECT_NEAR(cubeTexelSolidAngle(0, 0, 0.01f, 0.01f), 1e-4, 1e-7);
+}
+
+// sphereInCubeFace against the face cameras themselves: a sphere is in a face exactly when some point
+// of it projects inside the face's NDC square in front of the camera; sampled spheres must never be
+// culled from a face that sees them (the specular maps skip the meshes a face cannot see).
+TEST(CubeFaces, SpheresAreCulledOnlyFromFacesThatCannotSeeThem) {
+  const glm::vec3 o(0.3f, -1.f, 2.f);
+  std::uint32_t state = 12345u;
+  auto uniform = [&] { state = state * 1664525u + 1013904223u; return float(state >> 8) / float(1u << 24); };
+  int culled = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const glm::vec3 c = o + 4.f * glm::vec3(uniform() - 0.5f, uniform() - 0.5f, uniform() - 0.5f);
+    const float r = 0.3f * uniform();
+    for (int f = 0; f < 6; ++f) {
+      if (sphereInCubeFace(o, f, c, r)) continue;
+      ++culled;
+      const glm::mat4 vp = ShadowMapsPass::cubeFaceViewProj(o, f, 0.01f);
+      for (int k = 0; k < 64; ++k) {  // points of the sphere's surface and centre
+        glm::vec3 d(uniform() - 0.5f, uniform() - 0.5f, uniform() - 0.5f);
+        d = k == 0 ? glm::vec3(0.f) : r * glm::normalize(d + glm::vec3(1e-6f));
+        const glm::vec4 p = vp * glm::vec4(c + d, 1.f);
+        const bool inside = p.w > 0.f && std::abs(p.x) <= p.w && std::abs(p.y) <= p.w;
+        EXPECT_FALSE(inside) << "face " << f << " culls a sphere it sees, point " << k;
+      }
+    }
+  }
+  EXPECT_GT(culled, 2000 * 3);  // most spheres are in one or two of the six faces
+  // On an axis a small sphere is in that face alone; on a face diagonal in both faces.
+  for (int f = 0; f < 6; ++f) {
+    glm::vec3 a(0.f);
+    a[f / 2] = f % 2 == 0 ? 1.f : -1.f;
+    for (int g = 0; g < 6; ++g) EXPECT_EQ(sphereInCubeFace(o, g, o + 2.f * a, 0.1f), g == f) << f << " " << g;
+  }
+  EXPECT_TRUE(sphereInCubeFace(o, 0, o + glm::vec3(1, 1, 0), 0.01f));
+  EXPECT_TRUE(sphereInCubeFace(o, 2, o + glm::vec3(1, 1, 0), 0.01f));
 }
 
 }  // namespace
