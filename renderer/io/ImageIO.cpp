@@ -189,9 +189,13 @@ Image readFrom(OIIO::ImageInput* in, const std::string& what, const std::string&
   if (!in) throw std::runtime_error("io: cannot read " + what + ": " + OIIO::geterror());
   const OIIO::ImageSpec& spec = in->spec();
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0) throw std::runtime_error("io: " + what + " is empty");
-  // From the header, before allocating: the float copy of every channel plus the RGB image kept.
+  // From the header, before allocating: the float copy of every channel plus the RGB image kept, and
+  // OpenImageIO's own buffer while reading, which holds up to 256 scanlines whatever the image's height:
+  // a 95-byte Radiance HDR declaring one row of 2,222,222 pixels had it allocate 6.8 GB (image fuzzer,
+  // 2026-12-04; tests/data/crashers/images/hdr_one_wide_row_takes_6_8gb.hdr).
   const std::uint64_t pixels = std::uint64_t(spec.width) * std::uint64_t(spec.height);
-  const std::uint64_t need = pixels * std::uint64_t(spec.nchannels) * 4 + pixels * 3 * 4;
+  const std::uint64_t readBuffer = std::uint64_t(spec.width) * 256u * std::uint64_t(spec.nchannels) * 4;
+  const std::uint64_t need = pixels * std::uint64_t(spec.nchannels) * 4 + pixels * 3 * 4 + readBuffer;
   if (maxDecodedBytes > 0 && need > maxDecodedBytes)
     throw DecodeLimitExceeded("io: " + what + " is " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
                               " with " + std::to_string(spec.nchannels) + " channels: decoding needs " +

@@ -204,3 +204,32 @@ TEST(ImageIO, ExrChannelListsMustEndInsideTheirAttribute) {
 
 }  // namespace
 }  // namespace radiant
+
+namespace radiant {
+namespace {
+
+// OpenImageIO reads up to 256 scanlines into its own buffer whatever the image's height: a 95-byte
+// Radiance HDR declaring one row of 2,222,222 pixels made it allocate 6.8 GB (image fuzzer). The decode
+// budget charges that buffer from the header, so the upload is refused before the read.
+TEST(ImageIO, OneVeryWideRowIsChargedForTheReadersBuffer) {
+  std::ifstream in(std::string(RADIANT_SOURCE_DIR) + "/tests/data/crashers/images/hdr_one_wide_row_takes_6_8gb.hdr",
+                   std::ios::binary);
+  const std::string wide((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_EQ(wide.size(), 95u);
+  try {
+    io::decodeImage(wide, "beauty", 512u << 20);
+    ADD_FAILURE() << "accepted";
+  } catch (const io::DecodeLimitExceeded& e) {
+    EXPECT_NE(std::string(e.what()).find("--max-decode-bytes"), std::string::npos) << e.what();
+  } catch (const std::runtime_error& e) {
+    ADD_FAILURE() << "refused, but not by the decode budget: " << e.what();
+  }
+  // A 64 x 1 row is charged 64 x 256 x 3 x 4 bytes for the buffer, and decodes within a budget of that.
+  Image row = Image::make("beauty", 64, 1, 3);
+  const std::string exr = io::encodeExr({row}, false);
+  EXPECT_NO_THROW(io::decodeImage(exr, "beauty", 64 * 256 * 3 * 4 + 64 * 6 * 4 + 64 * 3 * 4));
+  EXPECT_THROW(io::decodeImage(exr, "beauty", 64 * 256 * 3 * 4), io::DecodeLimitExceeded);
+}
+
+}  // namespace
+}  // namespace radiant
