@@ -374,13 +374,17 @@ struct HttpServer::Impl {
           const std::filesystem::path file = resolveRelativeUri(ref.value, "/scene/asset", root, root);
           packed = packGltfFile(file, root, std::max<std::size_t>(config.maxBodyBytes, std::size_t(256) << 20));
         } catch (const PackError& e) {
-          const bool missing = e.pointer.empty();
+          // 404 only for a file that is not there; a directory, FIFO or device is 422, a file over the
+          // size limit 422 limit-exceeded (both were 404 unknown-scene: issue 30's 4xx wording).
+          const bool missing = e.kind == PackError::Kind::Missing;
           const bool path = e.pointer == "/scene/asset";
+          const std::string detail =
+              "/scene/asset: " + (path ? std::string() : ref.value + (e.pointer.empty() ? "" : " at " + e.pointer) + ": ") + e.what();
+          if (e.kind == PackError::Kind::TooLarge)
+            throw api::ApiError(422, "limit-exceeded", "Limit exceeded", detail + " (radiantd --max-body-bytes, at least 256 MiB for assets)",
+                                "/scene/asset");
           throw api::ApiError(missing ? 404 : 422, missing ? "unknown-scene" : "invalid-scene",
-                              missing ? "Unknown scene" : "Invalid scene",
-                              "/scene/asset: " + (path ? std::string() : ref.value + (missing ? "" : " at " + e.pointer) + ": ") +
-                                  e.what(),
-                              "/scene/asset");
+                              missing ? "Unknown scene" : "Invalid scene", detail, "/scene/asset");
         }
         const std::string digest = api::sceneDigest(packed.bytes);
         return decode(digest, packed.bytes, "/scene/asset");

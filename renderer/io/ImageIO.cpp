@@ -185,22 +185,28 @@ void writeFile(const std::string& path, const std::string& bytes) {
 
 namespace {
 
+// What decoding an image of this size costs, from its header, before allocating: the float copy of
+// every channel plus the RGB image kept, and OpenImageIO's own buffer while reading, which holds up to
+// 256 scanlines whatever the image's height: a 95-byte Radiance HDR declaring one row of 2,222,222
+// pixels had it allocate 6.8 GB (image fuzzer, 2026-12-04; tests/data/crashers/images/hdr_one_wide_row_takes_6_8gb.hdr).
+// Over `maxDecodedBytes` (0: no limit) it is refused, naming the flag.
+void chargeDecode(const std::string& what, std::int64_t width, std::int64_t height, std::int64_t channels,
+                  std::size_t maxDecodedBytes) {
+  const std::uint64_t pixels = std::uint64_t(width) * std::uint64_t(height);
+  const std::uint64_t readBuffer = std::uint64_t(width) * 256u * std::uint64_t(channels) * 4;
+  const std::uint64_t need = pixels * std::uint64_t(channels) * 4 + pixels * 3 * 4 + readBuffer;
+  if (maxDecodedBytes > 0 && need > maxDecodedBytes)
+    throw DecodeLimitExceeded("io: " + what + " is " + std::to_string(width) + "x" + std::to_string(height) + " with " +
+                              std::to_string(channels) + " channels: decoding needs " + std::to_string(need) +
+                              " bytes, above this server's decode budget of " + std::to_string(maxDecodedBytes) +
+                              " bytes (radiantd --max-decode-bytes)");
+}
+
 Image readFrom(OIIO::ImageInput* in, const std::string& what, const std::string& aov, std::size_t maxDecodedBytes = 0) {
   if (!in) throw std::runtime_error("io: cannot read " + what + ": " + OIIO::geterror());
   const OIIO::ImageSpec& spec = in->spec();
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0) throw std::runtime_error("io: " + what + " is empty");
-  // From the header, before allocating: the float copy of every channel plus the RGB image kept, and
-  // OpenImageIO's own buffer while reading, which holds up to 256 scanlines whatever the image's height:
-  // a 95-byte Radiance HDR declaring one row of 2,222,222 pixels had it allocate 6.8 GB (image fuzzer,
-  // 2026-12-04; tests/data/crashers/images/hdr_one_wide_row_takes_6_8gb.hdr).
-  const std::uint64_t pixels = std::uint64_t(spec.width) * std::uint64_t(spec.height);
-  const std::uint64_t readBuffer = std::uint64_t(spec.width) * 256u * std::uint64_t(spec.nchannels) * 4;
-  const std::uint64_t need = pixels * std::uint64_t(spec.nchannels) * 4 + pixels * 3 * 4 + readBuffer;
-  if (maxDecodedBytes > 0 && need > maxDecodedBytes)
-    throw DecodeLimitExceeded("io: " + what + " is " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
-                              " with " + std::to_string(spec.nchannels) + " channels: decoding needs " +
-                              std::to_string(need) + " bytes, above this server's decode budget of " +
-                              std::to_string(maxDecodedBytes) + " bytes (radiantd --max-decode-bytes)");
+  chargeDecode(what, spec.width, spec.height, spec.nchannels, maxDecodedBytes);
   // Which channels: the layer `aov` by name (aov.R/G/B, or aov.Y); for "beauty" also unprefixed R/G/B
   // (or Y), a file's only layer, and at last the first three channels or the first one. EXR stores channels
   // in alphabetical order (B before G before R), so names, not positions, decide.
@@ -310,7 +316,7 @@ namespace {
 // OpenEXR reads the list until its terminator whatever the size: an 884-byte upload whose last channel
 // name ran one byte past its attribute made it read the next attributes as channels, and opening it
 // took 1.5 GB and 8 s (image fuzzer, 2026-12-04).
-void checkExrChannelList(std::string_view v, const std::function<void(const std::string&)>& bad) {
+int checkExrChannelList(std::string_view v, const std::function<void(const std::string&)>& bad) {
   std::size_t i = 0;
   int channels = 0;
   auto le32 = [&](std::size_t at) {
@@ -334,9 +340,10 @@ void checkExrChannelList(std::string_view v, const std::function<void(const std:
     if (channels > 1024) bad("more than 1024 channels");
   }
   if (channels == 0) bad("the channel list is empty");
+  return channels;
 }
 
-void checkExrHeaders(std::string_view b) {
+void checkExrHeaders(std::string_view b, std::size_t maxDecodedBytes) {
   auto bad = [](const std::string& why) { throw std::runtime_error("io: the uploaded exr image is invalid: " + why); };
   if (b.size() < 8) bad("shorter than its magic number and version");
   const std::uint32_t flags = std::uint8_t(b[5]) | std::uint32_t(std::uint8_t(b[6])) << 8 | std::uint32_t(std::uint8_t(b[7])) << 16;
@@ -345,6 +352,8 @@ void checkExrHeaders(std::string_view b) {
   for (int header = 0;; ++header) {
     int attributes = 0;
     bool hasChannels = false, hasDataWindow = false;
+    int channels = 0;
+    std::int64_t width = 0, height = 0;
     for (;; ++attributes) {
       if (i >= b.size()) bad("a header does not end inside the file");
       if (b[i] == '\0') {  // the header's end
@@ -366,16 +375,26 @@ void checkExrHeaders(std::string_view b) {
       if (size < 0 || std::size_t(size) > b.size() - i)
         bad("attribute " + std::to_string(attributes) + " declares " + std::to_string(size) + " bytes, more than the file holds");
       const std::string_view value = b.substr(i, std::size_t(size));
-      if (fields[1] == "chlist") checkExrChannelList(value, bad);
-      if (fields[0] == "channels") hasChannels = fields[1] == "chlist";
+      const int listed = fields[1] == "chlist" ? checkExrChannelList(value, bad) : 0;
+      if (fields[0] == "channels") hasChannels = fields[1] == "chlist", channels = listed;
       if (fields[0] == "dataWindow") {
         if (fields[1] != "box2i" || value.size() != 16) bad("dataWindow is not a box2i");
+        auto le32 = [&](std::size_t at) {
+          return std::int64_t(std::int32_t(std::uint32_t(std::uint8_t(value[at])) | std::uint32_t(std::uint8_t(value[at + 1])) << 8 |
+                                           std::uint32_t(std::uint8_t(value[at + 2])) << 16 |
+                                           std::uint32_t(std::uint8_t(value[at + 3])) << 24));
+        };
+        width = le32(8) - le32(0) + 1, height = le32(12) - le32(4) + 1;
+        if (width <= 0 || height <= 0) bad("the dataWindow is empty");
         hasDataWindow = true;
       }
       i += std::size_t(size);
     }
     // Every part of an image names its channels and its data window (OpenEXR's required attributes).
     if (attributes > 0 && (!hasChannels || !hasDataWindow)) bad("a header has no channels or no dataWindow");
+    // Its size against the decode budget, as readFrom charges it, before OpenEXR allocates anything
+    // (a 100000 x 100000 header was "Unexpected end of file" where HDR and PNG were limit-exceeded).
+    if (attributes > 0) chargeDecode("the uploaded exr image", width, height, channels, maxDecodedBytes);
     // A multi-part file lists its headers one after the other and ends the list with an empty one.
     if (!multipart || attributes == 0 || header > 1024) break;
   }
@@ -407,7 +426,7 @@ Image decodeImage(std::string_view bytes, const std::string& aov, std::size_t ma
                      : starts("\x89PNG")                        ? "image.png"
                                                                  : nullptr;
   if (!name) throw std::runtime_error("io: not an EXR, Radiance HDR or PNG image");
-  if (name == std::string_view("image.exr")) checkExrHeaders(bytes);
+  if (name == std::string_view("image.exr")) checkExrHeaders(bytes, maxDecodedBytes);
   if (name == std::string_view("image.png")) checkPngChunks(bytes);
   MemoryReader reader(bytes);
   auto in = OIIO::ImageInput::open(name, nullptr, &reader);

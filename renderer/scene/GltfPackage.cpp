@@ -130,7 +130,8 @@ fs::path resolveRelativeUri(const std::string& uri, const std::string& ptr, cons
                              uri.substr(0, colon) + ":\")");
   const std::string path = percentDecode(uri);
   if (path.find('\0') != std::string::npos) throw PackError(ptr, "URI \"" + uri + "\" refused: it contains a NUL byte");
-  if (path.empty() || path[0] == '/' || path[0] == '\\' || fs::path(path).is_absolute())
+  if (path.empty()) throw PackError(ptr, "URI \"\" refused: the path is empty");
+  if (path[0] == '/' || path[0] == '\\' || fs::path(path).is_absolute())
     throw PackError(ptr, "URI \"" + uri + "\" refused: absolute paths are not allowed (use a path relative to the .gltf)");
   std::size_t start = 0;
   while (start <= path.size()) {
@@ -272,14 +273,18 @@ PackResult packGltf(std::string_view bytes, const fs::path& baseDir, const fs::p
 PackResult packGltfFile(const fs::path& file, const fs::path& rootIn, std::size_t maxBytes) {
   std::error_code ec;
   const fs::path canon = fs::weakly_canonical(fs::absolute(file, ec), ec);
-  if (ec || !fs::is_regular_file(canon))
-    throw PackError("", file.string() + " does not exist or is not a regular file");
+  if (ec || !fs::exists(canon)) throw PackError("", file.string() + " does not exist", PackError::Kind::Missing);
+  if (!fs::is_regular_file(canon))
+    throw PackError("", file.string() + " is not a regular file (a directory, FIFO or device)", PackError::Kind::NotRegular);
   fs::path root = rootIn.empty() ? canon.parent_path() : fs::canonical(rootIn, ec);
-  if (ec) throw PackError("", "the root " + rootIn.string() + " does not exist");
-  if (!pathIsInside(root, canon)) throw PackError("", file.string() + " is outside " + root.string());
+  if (ec) throw PackError("", "the root " + rootIn.string() + " does not exist", PackError::Kind::Missing);
+  if (!pathIsInside(root, canon)) throw PackError("", file.string() + " is outside " + root.string(), PackError::Kind::Missing);
   const auto size = fs::file_size(canon, ec);
-  if (ec || size > maxBytes)
-    throw PackError("", file.string() + (ec ? ": " + ec.message() : " is over the size limit of " + std::to_string(maxBytes) + " bytes"));
+  if (ec) throw PackError("", file.string() + ": " + ec.message(), PackError::Kind::Missing);
+  if (size > maxBytes)
+    throw PackError("", file.string() + " is " + std::to_string(size) + " bytes, over the size limit of " +
+                            std::to_string(maxBytes) + " bytes",
+                    PackError::Kind::TooLarge);
   std::ifstream in(canon, std::ios::binary);
   std::string bytes(size, '\0');
   if (!in.read(bytes.data(), std::streamsize(size))) throw PackError("", "cannot read " + file.string());

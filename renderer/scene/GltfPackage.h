@@ -25,9 +25,13 @@ namespace radiant {
 
 // A file that cannot be packed: `pointer` is the JSON pointer of the offending field ("" = the file).
 struct PackError : std::runtime_error {
-  PackError(std::string pointer_, const std::string& message)
-      : std::runtime_error(message), pointer(std::move(pointer_)) {}
+  // What went wrong with the file named (pointer empty): it is not there, it is there but not a regular
+  // file (a directory, FIFO or device), or it is over the size limit; Invalid: its contents or a URI in it.
+  enum class Kind { Invalid, Missing, NotRegular, TooLarge };
+  PackError(std::string pointer_, const std::string& message, Kind kind_ = Kind::Invalid)
+      : std::runtime_error(message), pointer(std::move(pointer_)), kind(kind_) {}
   std::string pointer;
+  Kind kind;
 };
 
 struct PackResult {

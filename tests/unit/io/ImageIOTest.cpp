@@ -222,3 +222,32 @@ TEST(ImageIO, OneVeryWideRowIsChargedForTheReadersBuffer) {
 
 }  // namespace
 }  // namespace radiant
+
+namespace radiant {
+namespace {
+
+// An EXR's declared size is charged from its header before OpenEXR reads it, as HDR and PNG are: a
+// 100000 x 100000 header was refused as "Unexpected end of file" (issue 30's 4xx wording).
+TEST(ImageIO, ExrDeclaredSizeIsChargedFromTheHeader) {
+  Image beauty = Image::make("beauty", 4, 2, 3);
+  std::string exr = io::encodeExr({beauty}, false);
+  const std::size_t at = exr.find(std::string("dataWindow\0box2i\0", 17));
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t box = at + 17 + 4;  // xMin, yMin, xMax, yMax
+  for (std::size_t k : {box + 8, box + 12}) {
+    const std::uint32_t v = 99999;
+    for (int i = 0; i < 4; ++i) exr[k + i] = char((v >> (8 * i)) & 255);
+  }
+  try {
+    io::decodeImage(exr, "beauty", 512u << 20);
+    ADD_FAILURE() << "accepted";
+  } catch (const io::DecodeLimitExceeded& e) {
+    EXPECT_NE(std::string(e.what()).find("100000x100000"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("--max-decode-bytes"), std::string::npos) << e.what();
+  } catch (const std::runtime_error& e) {
+    ADD_FAILURE() << "refused, but not by the decode budget: " << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace radiant

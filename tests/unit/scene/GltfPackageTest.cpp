@@ -2,6 +2,8 @@
 // without any file access, giving the same scene; bad URIs are refused with the field and the reason.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
 #include "renderer/scene/GltfLoader.h"
 #include "renderer/scene/GltfPackage.h"
 #include "tests/unit/scene/GltfTestBuilder.h"
@@ -138,6 +140,40 @@ TEST(GltfPackage, MissingFileIsNamed) {
   } catch (const PackError& e) {
     EXPECT_EQ(e.pointer, "/buffers/0/uri");
     EXPECT_NE(std::string(e.what()).find("nothere.bin"), std::string::npos) << e.what();
+  }
+}
+
+// The file a scene.asset names: what is wrong with it decides the server's answer (404 only when it
+// is not there; a directory or FIFO 422; over the size limit 422 limit-exceeded), and an empty path says
+// so (it was refused as "absolute").
+TEST(GltfPackage, TheNamedFileSaysWhetherItIsMissingNotRegularOrTooLarge) {
+  test::TempDir dir("pack_kinds");
+  TexturedQuad q;
+  test::writeFile(dir.path / "quad.gltf", q.gltf("data:application/octet-stream;base64,", "tex.png"));
+  std::filesystem::create_directories(dir.path / "folder.gltf");
+  ASSERT_EQ(::mkfifo((dir.path / "pipe.gltf").c_str(), 0600), 0);
+  auto kindOf = [&](const std::string& name, std::size_t maxBytes) {
+    try {
+      packGltfFile(dir.path / name, dir.path, maxBytes);
+    } catch (const PackError& e) {
+      EXPECT_EQ(e.pointer, "") << name;
+      return std::pair{e.kind, std::string(e.what())};
+    }
+    return std::pair{PackError::Kind::Invalid, std::string("packed")};
+  };
+  EXPECT_EQ(kindOf("nothere.gltf", 1u << 20).first, PackError::Kind::Missing);
+  EXPECT_EQ(kindOf("folder.gltf", 1u << 20).first, PackError::Kind::NotRegular);
+  const auto fifo = kindOf("pipe.gltf", 1u << 20);  // refused without opening it (no reader: it would block)
+  EXPECT_EQ(fifo.first, PackError::Kind::NotRegular);
+  EXPECT_NE(fifo.second.find("not a regular file"), std::string::npos) << fifo.second;
+  const auto large = kindOf("quad.gltf", 16);
+  EXPECT_EQ(large.first, PackError::Kind::TooLarge);
+  EXPECT_NE(large.second.find("over the size limit of 16 bytes"), std::string::npos) << large.second;
+  try {
+    resolveRelativeUri("", "/scene/asset", dir.path, dir.path);
+    ADD_FAILURE() << "an empty path was resolved";
+  } catch (const PackError& e) {
+    EXPECT_NE(std::string(e.what()).find("the path is empty"), std::string::npos) << e.what();
   }
 }
 
