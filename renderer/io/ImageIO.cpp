@@ -306,11 +306,6 @@ std::string encodePngRgba8(const ImageRgba8& image, bool alpha, int zlibLevel) {
 
 namespace {
 
-// An OpenEXR header's attributes (name\0 type\0 int32 size, value), checked before OpenEXR reads them:
-// OpenEXR allocates an attribute's declared size first, so a 508-byte upload declaring a 1.6 GB string
-// took the daemon to 2 GB (found by tests/fuzz/image_fuzzer.cpp, 2026-12-04). Every header (several in
-// a multi-part file) must end inside the bytes, names and types must be terminated within 256 bytes,
-// and no value may be larger than what is left of the file.
 // An attribute of type chlist: channels (name\0, int32 pixel type 0-2, uint8 pLinear, 3 reserved bytes,
 // int32 x and y sampling >= 1) ended by an empty name, all inside the attribute's declared size.
 // OpenEXR reads the list until its terminator whatever the size: an 884-byte upload whose last channel
@@ -343,6 +338,13 @@ int checkExrChannelList(std::string_view v, const std::function<void(const std::
   return channels;
 }
 
+// An OpenEXR header's attributes (name\0 type\0 int32 size, value), checked before OpenEXR reads them:
+// OpenEXR allocates an attribute's declared size first, so a 508-byte upload declaring a 1.6 GB string
+// took the daemon to 2 GB (found by tests/fuzz/image_fuzzer.cpp, 2026-12-04). Every header (several in
+// a multi-part file) must end inside the bytes, names and types must be terminated within 256 bytes,
+// and no value may be larger than what is left of the file. A chlist must pass checkExrChannelList, each
+// header must name its channels and a box2i dataWindow, and the data window is charged to the decode
+// budget (chargeDecode) before OpenEXR allocates for it.
 void checkExrHeaders(std::string_view b, std::size_t maxDecodedBytes) {
   auto bad = [](const std::string& why) { throw std::runtime_error("io: the uploaded exr image is invalid: " + why); };
   if (b.size() < 8) bad("shorter than its magic number and version");
