@@ -204,7 +204,10 @@ void EnvDiffusePass::buildCubeMaps(PassContext& ctx, const ReceiverState& st) {
       glClearNamedFramebufferfv(fb.id(), GL_DEPTH, 0, &depthClear);
       const glm::mat4 viewProj = cubeFaceViewProj(r.referencePoint, face, znear);
       cube.setMat4("u_viewProj", glm::value_ptr(viewProj));
-      ctx.gpu.drawMeshes(cube, true, [&](std::size_t i) { return own.count(static_cast<int>(i)) == 0; });
+      ctx.gpu.drawMeshes(cube, true, [&](std::size_t i) {  // the meshes in this face's frustum only
+        const Bounds& b = ctx.scene.meshes[i].bounds;
+        return own.count(static_cast<int>(i)) == 0 && sphereInCubeFace(r.referencePoint, face, b.center(), b.radius());
+      });
       gate.issued();
     }
     glMemoryBarrier(GL_ALL_BARRIER_BITS);

@@ -141,7 +141,12 @@ void ShadowMapsPass::execute(PassContext& ctx) {
     prog.set("u_lightDirection", &dir[0], 3);
     prog.set("u_orthographic", ortho ? 1 : 0);
     // With textures: MASK and BLEND materials' coverage comes from the base colour's alpha (shadow.frag).
-    ctx.gpu.drawMeshes(prog, true, [&](std::size_t m) { return !excluded_.count(static_cast<int>(m)); });
+    // A point light's cube face draws only the meshes in its 90-degree frustum (sphereInCubeFace).
+    ctx.gpu.drawMeshes(prog, true, [&](std::size_t m) {
+      if (excluded_.count(static_cast<int>(m))) return false;
+      const Bounds& b = ctx.scene.meshes[m].bounds;
+      return !d.cube || sphereInCubeFace(l.position, d.layer % 6, b.center(), b.radius());
+    });
   }
   res.setHolds("shadow_cube", digest_);  // after writing: a frame that fails before leaves them invalid
   ctx.stats.counters["map_size"] = size_;
