@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <functional>
 #include <limits>
 
 #include <tuple>
@@ -62,37 +63,48 @@ std::vector<std::array<float, 9>> triangles(const std::vector<glm::vec3>& p, con
   return t;
 }
 
-TEST(GltfCompression, DracoPrimitiveDecodesToTheEncodedMesh) {
-  const Cube cube;
+// The cube as a KHR_draco_mesh_compression primitive: POSITION (float x3) and a NORMAL attribute of
+// `normalType` with `normalComponents` per corner, `normal(face, corner)` its value; the GLB with
+// POSITION and NORMAL accessors (float VEC3) and, when `indexed`, the cube's index accessor, as a builder.
+GltfBuilder encodeDracoCube(const Cube& cube, draco::DataType normalType, int normalComponents,
+                          const std::function<const void*(std::size_t face, int corner)>& normal, bool indexed) {
   draco::TriangleSoupMeshBuilder builder;
   builder.Start(int(cube.idx.size() / 3));
   const int pos = builder.AddAttribute(draco::GeometryAttribute::POSITION, 3, draco::DT_FLOAT32);
-  const int nrm = builder.AddAttribute(draco::GeometryAttribute::NORMAL, 3, draco::DT_FLOAT32);
+  const int nrm = builder.AddAttribute(draco::GeometryAttribute::NORMAL, std::int8_t(normalComponents), normalType);
   for (std::size_t f = 0; f < cube.idx.size() / 3; ++f) {
     const auto* i = &cube.idx[f * 3];
     builder.SetAttributeValuesForFace(pos, draco::FaceIndex(std::uint32_t(f)), &cube.p[i[0]], &cube.p[i[1]], &cube.p[i[2]]);
-    builder.SetAttributeValuesForFace(nrm, draco::FaceIndex(std::uint32_t(f)), &cube.n[i[0]], &cube.n[i[1]], &cube.n[i[2]]);
+    builder.SetAttributeValuesForFace(nrm, draco::FaceIndex(std::uint32_t(f)), normal(f, 0), normal(f, 1), normal(f, 2));
   }
   std::unique_ptr<draco::Mesh> mesh = builder.Finalize();
-  ASSERT_TRUE(mesh);
+  EXPECT_TRUE(mesh);
   draco::Encoder encoder;  // no quantization set: floats are stored losslessly
   draco::EncoderBuffer encoded;
-  ASSERT_TRUE(encoder.EncodeMeshToBuffer(*mesh, &encoded).ok());
-
+  EXPECT_TRUE(encoder.EncodeMeshToBuffer(*mesh, &encoded).ok());
   GltfBuilder b;
   const int view = b.view(encoded.data(), encoded.size());
   const int posAcc = b.push("accessors", {{"componentType", 5126}, {"count", mesh->num_points()}, {"type", "VEC3"},
                                           {"min", {-0.5, -0.5, -0.5}}, {"max", {0.5, 0.5, 0.5}}});
   const int nrmAcc = b.push("accessors", {{"componentType", 5126}, {"count", mesh->num_points()}, {"type", "VEC3"}});
-  const int idxAcc = b.push("accessors", {{"componentType", 5125}, {"count", cube.idx.size()}, {"type", "SCALAR"}});
   const json draco = {{"bufferView", view},
                       {"attributes", {{"POSITION", mesh->GetNamedAttribute(draco::GeometryAttribute::POSITION)->unique_id()},
                                       {"NORMAL", mesh->GetNamedAttribute(draco::GeometryAttribute::NORMAL)->unique_id()}}}};
-  const int m = b.mesh(json::array({{{"attributes", {{"POSITION", posAcc}, {"NORMAL", nrmAcc}}}, {"indices", idxAcc},
-                                     {"extensions", {{"KHR_draco_mesh_compression", draco}}}}}));
+  json primitive = {{"attributes", {{"POSITION", posAcc}, {"NORMAL", nrmAcc}}},
+                    {"extensions", {{"KHR_draco_mesh_compression", draco}}}};
+  if (indexed)
+    primitive["indices"] = b.push("accessors", {{"componentType", 5125}, {"count", cube.idx.size()}, {"type", "SCALAR"}});
+  const int m = b.mesh(json::array({primitive}));
   b.scene({b.node({{"name", "cube"}, {"mesh", m}})});
   b.doc["extensionsUsed"] = {"KHR_draco_mesh_compression"};
   b.doc["extensionsRequired"] = {"KHR_draco_mesh_compression"};
+  return b;
+}
+
+TEST(GltfCompression, DracoPrimitiveDecodesToTheEncodedMesh) {
+  const Cube cube;
+  GltfBuilder b = encodeDracoCube(cube, draco::DT_FLOAT32, 3,
+                                  [&](std::size_t f, int k) { return static_cast<const void*>(&cube.n[cube.idx[f * 3 + k]]); }, true);
   for (const std::string& file : {b.glb(), b.gltf()}) {
     const Scene s = loadSceneFromMemory(file);
     ASSERT_EQ(s.meshes.size(), 1u);
@@ -115,36 +127,10 @@ TEST(GltfCompression, DracoPrimitiveDecodesToTheEncodedMesh) {
 TEST(GltfCompression, DracoAttributesOfAnotherTypeOrComponentCountAreRefused) {
   const Cube cube;
   auto file = [&](draco::DataType normalType, int normalComponents) {
-    draco::TriangleSoupMeshBuilder builder;
-    builder.Start(int(cube.idx.size() / 3));
-    const int pos = builder.AddAttribute(draco::GeometryAttribute::POSITION, 3, draco::DT_FLOAT32);
-    const int nrm = builder.AddAttribute(draco::GeometryAttribute::NORMAL, std::int8_t(normalComponents), normalType);
     const std::int32_t ints[3] = {1, 2, 3};
     const float floats[3] = {0.f, 0.f, 1.f};
     const void* n = normalType == draco::DT_INT32 ? static_cast<const void*>(ints) : static_cast<const void*>(floats);
-    for (std::size_t f = 0; f < cube.idx.size() / 3; ++f) {
-      const auto* i = &cube.idx[f * 3];
-      builder.SetAttributeValuesForFace(pos, draco::FaceIndex(std::uint32_t(f)), &cube.p[i[0]], &cube.p[i[1]], &cube.p[i[2]]);
-      builder.SetAttributeValuesForFace(nrm, draco::FaceIndex(std::uint32_t(f)), n, n, n);
-    }
-    std::unique_ptr<draco::Mesh> mesh = builder.Finalize();
-    draco::Encoder encoder;
-    draco::EncoderBuffer encoded;
-    EXPECT_TRUE(encoder.EncodeMeshToBuffer(*mesh, &encoded).ok());
-    GltfBuilder b;
-    const int view = b.view(encoded.data(), encoded.size());
-    const int posAcc = b.push("accessors", {{"componentType", 5126}, {"count", mesh->num_points()}, {"type", "VEC3"},
-                                            {"min", {-0.5, -0.5, -0.5}}, {"max", {0.5, 0.5, 0.5}}});
-    const int nrmAcc = b.push("accessors", {{"componentType", 5126}, {"count", mesh->num_points()}, {"type", "VEC3"}});
-    const json draco = {{"bufferView", view},
-                        {"attributes", {{"POSITION", mesh->GetNamedAttribute(draco::GeometryAttribute::POSITION)->unique_id()},
-                                        {"NORMAL", mesh->GetNamedAttribute(draco::GeometryAttribute::NORMAL)->unique_id()}}}};
-    const int m = b.mesh(json::array({{{"attributes", {{"POSITION", posAcc}, {"NORMAL", nrmAcc}}},
-                                       {"extensions", {{"KHR_draco_mesh_compression", draco}}}}}));
-    b.scene({b.node({{"mesh", m}})});
-    b.doc["extensionsUsed"] = {"KHR_draco_mesh_compression"};
-    b.doc["extensionsRequired"] = {"KHR_draco_mesh_compression"};
-    return b.glb();
+    return encodeDracoCube(cube, normalType, normalComponents, [&](std::size_t, int) { return n; }, false).glb();
   };
   const std::string pointer = "/meshes/0/primitives/0/extensions/KHR_draco_mesh_compression/attributes/NORMAL";
   EXPECT_NO_THROW(loadSceneFromMemory(file(draco::DT_FLOAT32, 3)));
