@@ -87,7 +87,7 @@ struct CompareSpec {
   std::string against = "reference";  // "reference" or "sha256:..." of an uploaded EXR
   std::string aov = "beauty";         // beauty | direct | indirect | ao | ...
   int spp = 256;                      // reference samples per pixel
-  int maxBounces = 8;
+  int maxBounces = 1024;
 };
 
 // Progressive refinement of an async job (render_request.json "refine"): independent batches, averaged.

@@ -188,7 +188,7 @@ void compare(FrameResources& resources, const Scene& scene, const FrameView& vie
     // A technique that computes a fixed bounce range declares it (env_diffuse: bounces + 1); otherwise
     // the compare block's path length limit applies.
     r.maxBounces = truth.reference.contains("max_bounces") ? r.maxBounces : c.maxBounces;
-    bool hit = false;
+    ReferenceRun run;
     const auto t0 = Clock::now();
     // The ground truth draws its own random numbers. With the frame's seed, sample s of pixel p would
     // be the same path in the truth as in a `reference` pass of the frame (rt::Sampler hashes
@@ -199,13 +199,15 @@ void compare(FrameResources& resources, const Scene& scene, const FrameView& vie
     // scored against the same, cached, truth.
     FrameView truthView = view;
     truthView.seed = kGroundTruthSeed;
-    reference = referenceImage(resources, scene, truthView, r, &hit);
+    reference = referenceImage(resources, scene, truthView, r, &run);
     if (!view.media.empty() && r.aov != "media" && r.aov != "media_transmittance")
       out.stats.warnings.push_back("the reference path tracer renders no participating media: compare.aov " + c.aov +
                                    " is scored without the frame's particle systems (compare.aov media scores them)");
     m["spp"] = c.spp;
     m["max_bounces"] = r.maxBounces;
-    m["reference_cached"] = hit;
+    m["reference_cached"] = run.cacheHit;
+    // Paths of the truth that the bounce cap ended (0 when cached or at the default cap in practice).
+    m["reference_paths_capped"] = run.pathsCapped;
     m["reference_ms"] = msSince(t0);
     if (r.aov == "media" || r.aov == "media_transmittance") m["media_mode"] = r.mediaMode;
   }

@@ -54,7 +54,10 @@ void tracePhoton(const RayScene& rays, const SceneLights& lights, const PhotonOp
       r.light = static_cast<std::uint32_t>(e.light);
       out.push_back(r);
     }
-    if (bounce == lastBounce) return;
+    if (bounce == lastBounce) {
+      ++counter.capped;
+      return;
+    }
     specularChain = specularChain && rays.materialOf(hit.mesh).isSpecular();
     const float uLobe = sampler.next(), uFresnel = sampler.next();
     const glm::vec2 uDir = sampler.next2();
@@ -90,7 +93,7 @@ void tracePhotons(const RayScene& rays, const SceneLights& lights, const PhotonO
   const std::uint64_t begin = set.emitted;
   const std::uint64_t blocks = (count - begin + kBlock - 1) / kBlock;
   std::vector<std::vector<PhotonRecord>> perBlock(blocks);
-  std::atomic<std::uint64_t> rayCount{0};
+  std::atomic<std::uint64_t> rayCount{0}, capped{0};
   auto run = [&] {
     tbb::parallel_for(tbb::blocked_range<std::uint64_t>(0, blocks, 1), [&](const tbb::blocked_range<std::uint64_t>& r) {
       RayCounter counter;
@@ -104,6 +107,7 @@ void tracePhotons(const RayScene& rays, const SceneLights& lights, const PhotonO
         }
       }
       rayCount += counter.rays;
+      capped += counter.capped;
     });
   };
   if (options.threads > 0) {
@@ -118,6 +122,7 @@ void tracePhotons(const RayScene& rays, const SceneLights& lights, const PhotonO
   for (auto& v : perBlock) set.records.insert(set.records.end(), v.begin(), v.end());
   set.emitted = count;
   set.rays += rayCount.load();
+  set.capped += capped.load();
 }
 
 }  // namespace radiant::rt

@@ -49,7 +49,7 @@ inline constexpr std::uint16_t kPhotonNarrowLobePath = 2u;
 struct PhotonOptions {
   // Most scattering events a path may have counting the surface the photon lands on as seen by the
   // camera, like the reference's max_bounces: records hold bounce <= maxBounces - 1.
-  int maxBounces = 8;
+  int maxBounces = kDefaultMaxBounces;  // a safety cap: Russian roulette ends photons first
   bool russianRoulette = true;
   std::uint64_t seed = 0;
   int threads = 0;  // 0 = TBB default
@@ -62,6 +62,7 @@ struct PhotonSet {
   std::vector<PhotonRecord> records;  // sorted by photon index
   std::uint64_t emitted = 0;          // photons 0 .. emitted - 1 are traced
   std::uint64_t rays = 0;             // rays traced in total
+  std::uint64_t capped = 0;           // photons maxBounces ended while alive (RayCounter::capped)
   // Records of the first n photons (a prefix of `records`).
   std::size_t recordsOfFirst(std::uint64_t n) const;
 };

@@ -37,8 +37,17 @@ struct SurfaceHit {
   float distance = 0.f;  // from the original ray origin
 };
 
+// The bounce cap every tracer defaults to (the schemas' max_bounces default: reference, photon_gi,
+// compare): a safety net far above what Russian roulette (survival at most 0.95 per event) lets a path
+// reach, so light transport is unbiased by default (issue 32).
+inline constexpr int kDefaultMaxBounces = 1024;
+
+// A tracer thread's tally: rays traced, and paths (or photons) that the bounce cap ended while they
+// were still alive (Russian roulette ends the others; a capped path is the truncation bias the cap adds,
+// reported in the stats as paths_capped / photons_capped).
 struct RayCounter {
   std::uint64_t rays = 0;
+  std::uint64_t capped = 0;
 };
 
 // The BSDF at a hit, in its shading frame.

@@ -79,7 +79,10 @@ struct Tracer {
       const glm::vec3 wpL = sh.frame.toLocal(wp);
       const bool classOk = caustics ? (deltas == k - 1 && k >= 2) : true;
       if (classOk && inRange(k) && sh.bsdf.hasNonDeltaLobe(wpL)) connect(hit, sh, wp, beta, interior, image, sampler, counter);
-      if (k == o.maxBounces) return;
+      if (k == o.maxBounces) {
+        ++counter.capped;
+        return;
+      }
       const float uLobe = sampler.next(), uFresnel = sampler.next();
       const glm::vec2 uDir = sampler.next2();
       GltfBsdf::Sample s;
@@ -100,6 +103,7 @@ LightTracer::LightTracer(const rt::RayScene& rays) : rays_(rays) {}
 LightTracer::~LightTracer() = default;
 
 std::uint64_t LightTracer::raysTraced() const { return lastRays_; }
+std::uint64_t LightTracer::pathsCapped() const { return lastCapped_; }
 
 Image LightTracer::render(const Camera& camera, int width, int height, const LightTracerOptions& options) const {
   if (width <= 0 || height <= 0)
@@ -119,7 +123,7 @@ Image LightTracer::render(const Camera& camera, int width, int height, const Lig
   const std::uint64_t blocks = (paths + pathsPerBlock - 1) / pathsPerBlock;
   std::vector<double> sum(pixels * 3, 0.0);
   std::vector<std::vector<float>> wave(std::min(blocks, kBlocksPerWave));
-  std::atomic<std::uint64_t> rayCount{0};
+  std::atomic<std::uint64_t> rayCount{0}, capped{0};
 
   auto run = [&] {
     for (std::uint64_t first = 0; first < blocks; first += kBlocksPerWave) {
@@ -136,6 +140,7 @@ Image LightTracer::render(const Camera& camera, int width, int height, const Lig
           }
         }
         rayCount += counter.rays;
+        capped += counter.capped;
       });
       for (std::uint64_t b = 0; b < count; ++b)  // block order: independent of the thread count
         for (std::size_t i = 0; i < sum.size(); ++i) sum[i] += wave[b][i];
@@ -152,6 +157,7 @@ Image LightTracer::render(const Camera& camera, int width, int height, const Lig
   const double scale = 1.0 / static_cast<double>(paths);
   for (std::size_t i = 0; i < sum.size(); ++i) image.pixels[i] = static_cast<float>(sum[i] * scale);
   lastRays_ = rayCount.load();
+  lastCapped_ = capped.load();
   return image;
 }
 

@@ -31,6 +31,7 @@
 
 #include "renderer/Image.h"
 #include "renderer/raytracing/Cancel.h"
+#include "renderer/raytracing/RayScene.h"
 #include "renderer/scene/Scene.h"
 
 namespace radiant::rt { class RayScene; }
@@ -39,7 +40,7 @@ namespace radiant::reference {
 
 struct LightTracerOptions {
   int pathsPerPixel = 16;  // light paths traced = pathsPerPixel * width * height
-  int maxBounces = 8;      // scattering events on a path, the connection vertex included
+  int maxBounces = rt::kDefaultMaxBounces;  // scattering events on a path, the connection vertex included
   bool russianRoulette = true;
   std::uint64_t seed = 0;
   enum class Paths { All, Caustics } paths = Paths::Caustics;
@@ -63,10 +64,12 @@ public:
   Image render(const Camera& camera, int width, int height, const LightTracerOptions& options) const;
   // Rays traced by the most recent render() (path segments and camera connections).
   std::uint64_t raysTraced() const;
+  // Paths of the most recent render() that maxBounces ended while alive (RayCounter::capped).
+  std::uint64_t pathsCapped() const;
 
 private:
   const rt::RayScene& rays_;
-  mutable std::uint64_t lastRays_ = 0;
+  mutable std::uint64_t lastRays_ = 0, lastCapped_ = 0;
 };
 
 // True when some material of the scene has a Dirac-delta lobe (roughness 0 reflection or

@@ -34,6 +34,7 @@ struct PathTracer::Impl {
   std::unique_ptr<RayScene> owned;  // when constructed from a Scene
   const RayScene* rays = nullptr;
   mutable std::atomic<std::uint64_t> lastRays{0};
+  mutable std::atomic<std::uint64_t> lastCapped{0};
 
   bool inRange(int k, const ReferenceOptions& o) const { return k >= o.minPathBounce && k <= o.maxPathBounce; }
 
@@ -167,7 +168,10 @@ struct PathTracer::Impl {
           L += beta * Le * w;
         }
       }
-      if (k >= lastVertex) break;
+      if (k >= lastVertex) {
+        if (k >= o.maxBounces) ++counter.capped;  // the cap, not the requested bounce range, ended it
+        break;
+      }
       ++k;
 
       const glm::vec3 wo = -ray.dir;
@@ -259,6 +263,7 @@ PathTracer::PathTracer(PathTracer&&) noexcept = default;
 PathTracer& PathTracer::operator=(PathTracer&&) noexcept = default;
 
 std::uint64_t PathTracer::raysTraced() const { return impl_->lastRays.load(); }
+std::uint64_t PathTracer::pathsCapped() const { return impl_->lastCapped.load(); }
 
 Image PathTracer::render(const Camera& camera, int width, int height, const ReferenceOptions& options) const {
   if (width <= 0 || height <= 0)
@@ -273,7 +278,7 @@ Image PathTracer::render(const Camera& camera, int width, int height, const Refe
   const char* aov = options.mode == ReferenceOptions::Mode::Radiance ? "beauty" : "ao";
   Image image = Image::make(aov, width, height, 3);
   const int tilesX = (width + kTileSize - 1) / kTileSize, tilesY = (height + kTileSize - 1) / kTileSize;
-  std::atomic<std::uint64_t> rays{0};
+  std::atomic<std::uint64_t> rays{0}, capped{0};
   std::atomic<int> tilesDone{0};
   const Impl& impl = *impl_;
   const CameraRays cameraRays(camera, width, height);
@@ -311,6 +316,7 @@ Image PathTracer::render(const Camera& camera, int width, int height, const Refe
         if (options.progress) options.progress(static_cast<double>(++tilesDone) / (tilesX * tilesY));
       }
       rays += counter.rays;
+      capped += counter.capped;
     });
   };
   if (options.threads > 0) {
@@ -320,6 +326,7 @@ Image PathTracer::render(const Camera& camera, int width, int height, const Refe
     renderTiles();
   }
   impl_->lastRays = rays.load();
+  impl_->lastCapped = capped.load();
   return image;
 }
 

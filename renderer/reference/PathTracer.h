@@ -64,6 +64,7 @@
 
 #include "renderer/Image.h"
 #include "renderer/raytracing/Cancel.h"
+#include "renderer/raytracing/RayScene.h"
 #include "renderer/scene/Scene.h"
 
 namespace radiant::rt {
@@ -75,7 +76,7 @@ namespace radiant::reference {
 
 struct ReferenceOptions {
   int spp = 64;
-  int maxBounces = 8;  // maximum number of scattering events on a path
+  int maxBounces = rt::kDefaultMaxBounces;  // scattering events on a path: a safety cap, roulette ends paths first
   bool russianRoulette = true;
   std::uint64_t seed = 0;
   int minPathBounce = 0, maxPathBounce = INT_MAX;  // inclusive range of k, see the header comment
@@ -117,6 +118,9 @@ public:
 
   // Rays (closest-hit + shadow) traced by the most recent render().
   std::uint64_t raysTraced() const;
+  // Paths of the most recent render() that maxBounces ended while alive (RayCounter::capped): the
+  // truncation the cap added; 0 in practice at the default cap with Russian roulette.
+  std::uint64_t pathsCapped() const;
 
 private:
   struct Impl;

@@ -137,7 +137,7 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   s.ppm = params.get<std::string>("h_schedule", "paper") == "ppm";
   s.ppmAlpha = params.get<double>("ppm_alpha", 2.0 / 3.0);
   s.ppmBase = params.get<double>("ppm_base_photons", 250000.0);
-  s.maxBounces = params.get<int>("max_bounces", 8);
+  s.maxBounces = params.get<int>("max_bounces", rt::kDefaultMaxBounces);
   s.environmentLightPhotons = params.get<float>("environment_light_photons", kDefaultEnvironmentLightPhotons);
   if (!(s.environmentLightPhotons >= 0.01f) || s.environmentLightPhotons > 1.f)
     badParam("environment_light_photons", "environment_light_photons must be in [0.01, 1]");
@@ -180,6 +180,7 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
     traceMs_ = msSince(t0);
   }
   records_ = cache.set.recordsOfFirst(s.photons);
+  capped_ = cache.set.capped;
 
   // --- The splats: which records, their kernel radius per surface (eq. 3), coverage points.
   const bool ownsSky = res.ownsLightPath("photon_gi", "L(sky)DE");
@@ -319,6 +320,8 @@ void PhotonGiPass::execute(PassContext& ctx) {
   c["trace_ms"] = traceMs_;
   c["splat_build_ms"] = buildMs_;
   c["records"] = static_cast<double>(records_);
+  // Photons of the cached set that max_bounces ended while Russian roulette would have let them go on.
+  c["photons_capped"] = static_cast<double>(capped_);
   c["photon_splats"] = static_cast<double>(photonSplats_);
   c["coverage_points"] = static_cast<double>(coveragePoints_);
   c["bytes_per_photon"] =

@@ -15,14 +15,20 @@ namespace radiant {
 
 namespace {
 
+constexpr int kMediaMaxScattering = 64;
+
 // The volumetric reference's image of the frame's media: RGB radiance ("media") or the transmittance
 // ("media_transmittance"), cached by what shapes it.
 const Image& mediaReferenceImage(FrameResources& res, const Scene& scene, const FrameView& view,
-                                 const ReferenceRequest& r, bool* cacheHit) {
+                                 const ReferenceRequest& r, ReferenceRun& run) {
   reference::VolumeOptions o;
   o.mode = reference::mediaModeFromString(r.mediaMode);
   o.spp = r.spp;
-  o.maxScattering = std::max(1, r.maxBounces);
+  // Full mode's scattering cap. The volume tracer's roulette keeps every path of throughput >= 0.25
+  // (VolumeTracer.cpp), so an albedo-1 medium runs each path to the cap: max_bounces' default (a safety
+  // cap for the surface tracers, whose roulette survival is at most 0.95) would make it 1024 events
+  // per path; the media reference keeps its own cap of kMediaMaxScattering.
+  o.maxScattering = std::clamp(r.maxBounces, 1, kMediaMaxScattering);
   o.seed = view.seed;
   o.sky = view.ambient;
   o.cancel = res.cancel();
@@ -41,7 +47,7 @@ const Image& mediaReferenceImage(FrameResources& res, const Scene& scene, const 
     return std::make_unique<Image>(
         reference::VolumeTracer(sharedRayScene(res, scene), medium).render(view.camera, view.width, view.height, o));
   });
-  if (cacheHit) *cacheHit = !built;
+  run.cacheHit = !built;
   const bool transmittance = r.aov == "media_transmittance";
   return res.cached<Image>("reference:" + r.aov, key.dump(), [&] {
     auto out = std::make_unique<Image>(Image::make("reference", rgba.width, rgba.height, transmittance ? 1 : 3));
@@ -54,13 +60,12 @@ const Image& mediaReferenceImage(FrameResources& res, const Scene& scene, const 
 }  // namespace
 
 const Image& referenceImage(FrameResources& res, const Scene& scene, const FrameView& view,
-                            const ReferenceRequest& r, bool* cacheHit, std::uint64_t* rays, bool* lightTraced,
+                            const ReferenceRequest& r, ReferenceRun* run,
                             const std::function<void(double)>& progress) {
-  if (r.aov == "media" || r.aov == "media_transmittance") {
-    if (rays) *rays = 0;
-    if (lightTraced) *lightTraced = false;
-    return mediaReferenceImage(res, scene, view, r, cacheHit);
-  }
+  ReferenceRun local;
+  ReferenceRun& out = run ? *run : local;
+  out = ReferenceRun{};
+  if (r.aov == "media" || r.aov == "media_transmittance") return mediaReferenceImage(res, scene, view, r, out);
   const rt::RayScene& rayScene = sharedRayScene(res, scene);
   const reference::PathTracer tracer(rayScene);
   reference::ReferenceOptions o;
@@ -115,7 +120,7 @@ const Image& referenceImage(FrameResources& res, const Scene& scene, const Frame
                         {"environment", view.environmentKey},
                         {"light_paths", lightTrace ? lo.pathsPerPixel : 0}, {"caustics_only", causticsOnly}};
   bool built = false;
-  std::uint64_t lightRays = 0;
+  std::uint64_t lightRays = 0, lightCapped = 0;
   Image& img = res.cached<Image>("reference:" + r.aov, key.dump(), [&] {
     built = true;
     std::unique_ptr<Image> image;
@@ -124,6 +129,7 @@ const Image& referenceImage(FrameResources& res, const Scene& scene, const Frame
       const reference::LightTracer lightTracer(rayScene);
       const Image caustics = lightTracer.render(view.camera, view.width, view.height, lo);
       lightRays = lightTracer.raysTraced();
+      lightCapped = lightTracer.pathsCapped();
       if (!image) image = std::make_unique<Image>(caustics);
       else
         for (std::size_t i = 0; i < image->pixels.size(); ++i) image->pixels[i] += caustics.pixels[i];
@@ -137,9 +143,10 @@ const Image& referenceImage(FrameResources& res, const Scene& scene, const Frame
     }
     return image;
   });
-  if (cacheHit) *cacheHit = !built;
-  if (rays) *rays = built ? (causticsOnly ? 0 : tracer.raysTraced()) + lightRays : 0;
-  if (lightTraced) *lightTraced = lightTrace;
+  out.cacheHit = !built;
+  out.rays = built ? (causticsOnly ? 0 : tracer.raysTraced()) + lightRays : 0;
+  out.pathsCapped = built ? (causticsOnly ? 0 : tracer.pathsCapped()) + lightCapped : 0;
+  out.lightTraced = lightTrace;
   return img;
 }
 
@@ -175,7 +182,7 @@ ReferenceRequest referenceRequestFrom(const Params& params) {
   r.spp = params.get<int>("spp", 64);
   r.lightPathsPerPixel = params.get<int>("light_paths_per_pixel", 0);
   r.caustics = params.get<bool>("caustics", true);
-  r.maxBounces = params.get<int>("max_bounces", 8);
+  r.maxBounces = params.get<int>("max_bounces", rt::kDefaultMaxBounces);
   r.russianRoulette = params.get<bool>("russian_roulette", true);
   r.aoRadius = params.get<float>("ao_radius", 0.5f);
   r.aoDefinition = params.get<std::string>("ao_definition", "cosine");
@@ -189,11 +196,8 @@ void ReferencePass::prepare(const Scene&, const Params& params, FrameResources& 
 }
 
 void ReferencePass::execute(PassContext& ctx) {
-  bool hit = false;
-  std::uint64_t rays = 0;
-  bool lightTraced = false;
-  const Image& img =
-      referenceImage(ctx.resources, ctx.scene, ctx.view, request_, &hit, &rays, &lightTraced, ctx.progress);
+  ReferenceRun run;
+  const Image& img = referenceImage(ctx.resources, ctx.scene, ctx.view, request_, &run, ctx.progress);
   // Upload as RGBA with GL's bottom-up rows so readback treats it like every other AOV.
   std::vector<float> rgba(static_cast<std::size_t>(img.width) * img.height * 4, 0.f);
   for (int y = 0; y < img.height; ++y)
@@ -202,10 +206,12 @@ void ReferencePass::execute(PassContext& ctx) {
         rgba[(static_cast<std::size_t>(img.height - 1 - y) * img.width + x) * 4 + c] = img.at(x, y)[c];
   ctx.resources.texture("reference").upload(0, 0, 0, 0, img.width, img.height, 1, GL_RGBA, GL_FLOAT, rgba.data());
   ctx.stats.counters["spp"] = request_.spp;
-  ctx.stats.counters["rays"] = static_cast<double>(rays);
-  ctx.stats.counters["cached"] = hit ? 1.0 : 0.0;
+  ctx.stats.counters["rays"] = static_cast<double>(run.rays);
+  ctx.stats.counters["cached"] = run.cacheHit ? 1.0 : 0.0;
+  // Paths that max_bounces ended while Russian roulette would have let them go on (0 when cached).
+  ctx.stats.counters["paths_capped"] = static_cast<double>(run.pathsCapped);
   // 1 when the light tracer added the caustic paths L S+ D E (the scene has a Dirac-delta lobe).
-  ctx.stats.counters["light_traced_caustics"] = lightTraced ? 1.0 : 0.0;
+  ctx.stats.counters["light_traced_caustics"] = run.lightTraced ? 1.0 : 0.0;
   ctx.resources.markWritten("reference");
 }
 

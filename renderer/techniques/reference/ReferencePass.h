@@ -25,7 +25,7 @@ struct ReferenceRequest {
   int spp = 64;
   int lightPathsPerPixel = 0;  // light tracer paths per pixel; 0 = spp
   bool caustics = true;
-  int maxBounces = 8;
+  int maxBounces = rt::kDefaultMaxBounces;
   bool russianRoulette = true;
   float aoRadius = 0.5f;
   std::string aoDefinition = "cosine";
@@ -34,9 +34,15 @@ struct ReferenceRequest {
 };
 // The reference pass's parameters (its schema, defaults filled in) as a ReferenceRequest.
 ReferenceRequest referenceRequestFrom(const Params& params);
+// What rendering (or finding) a reference image did.
+struct ReferenceRun {
+  bool cacheHit = false;
+  std::uint64_t rays = 0;         // traced by this call (0 when cached)
+  std::uint64_t pathsCapped = 0;  // paths max_bounces ended while alive (0 when cached)
+  bool lightTraced = false;       // the light tracer added the caustic paths L S+ D E
+};
 const Image& referenceImage(FrameResources& resources, const Scene& scene, const FrameView& view,
-                            const ReferenceRequest& request, bool* cacheHit = nullptr,
-                            std::uint64_t* rays = nullptr, bool* lightTraced = nullptr,
+                            const ReferenceRequest& request, ReferenceRun* run = nullptr,
                             const std::function<void(double)>& progress = {});
 
 class ReferencePass final : public Technique {

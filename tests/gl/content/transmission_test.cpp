@@ -82,7 +82,7 @@ void render(const Scene& scene, Regions& raster, Regions& reference) {
   req.width = req.height = kSize;
   req.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty"}, false}};
   req.camera = api::CameraOverride{{0, 0.6f, 2.2f}, {0, 0.6f, 0}, {0, 1, 0}, 32.f};  // the sphere: ~26 px radius
-  req.compare = api::CompareSpec{"reference", "beauty", 256, 8};
+  req.compare = api::CompareSpec{"reference", "beauty", 256};
   const RenderOutput out = renderer().render(scene, req);
   EXPECT_EQ(out.stats.lighting, "default");  // the studio environment (docs/API.md, "Default lighting")
   for (auto [img, r] : {std::pair{&aov(out, "beauty"), &raster}, std::pair{&aov(out, "reference"), &reference}})

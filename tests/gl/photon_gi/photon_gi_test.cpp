@@ -343,7 +343,7 @@ api::RenderRequest cornellRequest(int size, nlohmann::json params = nlohmann::js
 TEST(PhotonGi, CornellBoxIndirectAndBeautyAgainstTheReference) {
   const Scene scene = loadBuiltinScene("cornell_box");
   api::RenderRequest r = cornellRequest(48, {{"photons", 500000}});
-  r.compare = api::CompareSpec{"reference", "indirect", 512, 8};
+  r.compare = api::CompareSpec{"reference", "indirect", 512};
   const RenderOutput out = renderer().render(scene, r);
   const api::PassStats* p = pass(out, "photon_gi");
   ASSERT_NE(p, nullptr);
@@ -361,7 +361,7 @@ TEST(PhotonGi, CornellBoxIndirectAndBeautyAgainstTheReference) {
   EXPECT_LT(out.stats.metrics["rmse"].get<double>(), 0.2);
 
   api::RenderRequest rb = cornellRequest(48, {{"photons", 500000}});
-  rb.compare = api::CompareSpec{"reference", "beauty", 512, 8};
+  rb.compare = api::CompareSpec{"reference", "beauty", 512};
   const RenderOutput beauty = renderer().render(scene, rb);
   EXPECT_NEAR(mean(aov(beauty, "beauty")) / mean(aov(beauty, "reference")), 1.0, 0.04);
   EXPECT_EQ(testing::cacheEvent(beauty, "photon_gi_photons"), 1);  // same photons, re-splatted
@@ -389,7 +389,7 @@ TEST(PhotonGi, LayeredMaterialsReceiveIndirectLightAsTheReference) {
   scene.digest = "sha256:layered-cornell-box";
   api::RenderRequest r = cornellRequest(48, {{"photons", 500000}});
   r.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"indirect"}, false}};
-  r.compare = api::CompareSpec{"reference", "indirect", 512, 8};
+  r.compare = api::CompareSpec{"reference", "indirect", 512};
   const RenderOutput out = renderer().render(scene, r);
   const double ours = mean(aov(out, "indirect")), truth = mean(aov(out, "reference"));
   std::printf("layered Cornell box: photon_gi / reference indirect = %.3f, rmse %.4f\n", ours / truth,
@@ -404,7 +404,7 @@ void expectBlockGatherKeepsTheLight(int gatherStep) {
   const Scene scene = loadBuiltinScene("cornell_box");
   api::RenderRequest full = cornellRequest(64, {{"photons", 200000}, {"gather_step", 1}});
   full.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"indirect"}, false}};
-  full.compare = api::CompareSpec{"reference", "indirect", 256, 8};
+  full.compare = api::CompareSpec{"reference", "indirect", 256};
   api::RenderRequest blocks = full;
   blocks.passes["photon_gi"]["gather_step"] = gatherStep;
   const RenderOutput a = renderer().render(scene, full);
@@ -448,7 +448,7 @@ TEST(PhotonGi, GatherStepCountsOutputPixelsWhenSupersampled) {
   const Scene scene = loadBuiltinScene("cornell_box");
   api::RenderRequest one = cornellRequest(48, {{"photons", 200000}, {"gather_step", 2}});
   one.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"indirect"}, false}};
-  one.compare = api::CompareSpec{"reference", "indirect", 256, 8};
+  one.compare = api::CompareSpec{"reference", "indirect", 256};
   api::RenderRequest two = one;
   two.supersampling = 2;
   const RenderOutput a = renderer().render(scene, one);
@@ -478,7 +478,7 @@ TEST(PhotonGi, GlossyBoxIndirectAgainstTheReference) {
   const Scene scene = loadBuiltinScene("cornell_glossy");
   api::RenderRequest r = cornellRequest(48, {{"photons", 500000}});
   r.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"indirect", "material"}, false}};
-  r.compare = api::CompareSpec{"reference", "indirect", 512, 8};
+  r.compare = api::CompareSpec{"reference", "indirect", 512};
   const RenderOutput out = renderer().render(scene, r);
   const Image& ours = aov(out, "indirect");
   const Image& truth = aov(out, "reference");
@@ -509,7 +509,7 @@ TEST(PhotonGi, SkyLightIsCountedOnceWithAmbientOcclusion) {
   api::RenderRequest r = cornellRequest(32, {{"photons", 300000}});
   r.ambient = glm::vec3(2.f);
   r.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty", "indirect"}, false}};
-  r.compare = api::CompareSpec{"reference", "beauty", 512, 8};
+  r.compare = api::CompareSpec{"reference", "beauty", 512};
   const RenderOutput out = renderer().render(scene, r);
   ASSERT_NE(pass(out, "ambient_occlusion"), nullptr);
   const double ratio = mean(aov(out, "beauty")) / mean(aov(out, "reference"));

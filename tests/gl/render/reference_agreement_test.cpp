@@ -107,7 +107,7 @@ TEST(ReferenceAgreement, AReferencePassIsScoredAgainstAnIndependentReference) {
   req.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"reference"}, false}};
   Image frame;
   auto lowerHalfMse = [&](int truthSpp) {
-    req.compare = api::CompareSpec{"reference", "reference", truthSpp, 8};
+    req.compare = api::CompareSpec{"reference", "reference", truthSpp};
     const RenderOutput out = renderer().render(scene, req);
     EXPECT_EQ(out.stats.metrics.at("reference_mode"), "beauty");
     EXPECT_EQ(out.stats.metrics.at("max_bounces"), 1);  // the pass's own bounce range, not compare's 8

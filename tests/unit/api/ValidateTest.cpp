@@ -71,7 +71,7 @@ TEST(Validate, TechniqueDefaultsFilledFromTheirSchemaFiles) {
   EXPECT_DOUBLE_EQ(r.passes["shadow_maps"]["shadow_bias"].get<double>(), 1.0);
   EXPECT_DOUBLE_EQ(r.passes["shadow_maps"]["normal_offset"].get<double>(), 1.5);
   EXPECT_EQ(r.passes["reference"]["spp"], 64);
-  EXPECT_EQ(r.passes["reference"]["max_bounces"], 8);
+  EXPECT_EQ(r.passes["reference"]["max_bounces"], 1024);  // a safety cap: roulette ends paths (issue 32)
   EXPECT_EQ(r.passes["reference"]["russian_roulette"], true);
 }
 
@@ -90,7 +90,7 @@ TEST(Validate, CameraAndCompareDefaultsInsideGivenObjects) {
   ASSERT_TRUE(r.compare.has_value());
   EXPECT_EQ(r.compare->against, "reference");
   EXPECT_EQ(r.compare->spp, 256);
-  EXPECT_EQ(r.compare->maxBounces, 8);
+  EXPECT_EQ(r.compare->maxBounces, 1024);
 }
 
 TEST(Validate, FullRequestConverts) {
