@@ -154,6 +154,16 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   // samples wide, so the gather costs what it costs at k = 1 and the block's light is still spread over
   // the pixel's own surface samples (the estimator's surface test), which is what the anti-aliasing needs.
   splat_.gatherStep = params.get<int>("gather_step", 2) * std::max(1, view.supersampling);
+  // The denoiser (renderer/shading/Denoiser.h), guided by the estimator's relative noise: sqrt(int K^2)
+  // / C' with C' the photons per kernel over pi, i.e. C, or C (photons / ppm_base)^(alpha / 2) on the
+  // ppm schedule (docs/TECHNIQUES.md).
+  denoise_ = params.get<bool>("denoise", true);
+  denoiseSettings_.iterations = params.get<int>("denoise_iterations", 3);
+  const double kernelNoise = splat_.kernel == photon_gi::Kernel::Epanechnikov ? 0.651 : 0.757;
+  double effectiveC = s.C;
+  if (s.ppm) effectiveC *= std::pow(static_cast<double>(s.photons) / s.ppmBase, 0.5 * s.ppmAlpha);
+  denoiseSettings_.relativeNoise = static_cast<float>(kernelNoise / effectiveC);
+  if (denoise_) denoise::declareResources(res);
   // --- Photon records: derived data of the scene, its lights and environment, never of the camera.
   const rt::RayScene& rays = sharedRayScene(res, scene);
   std::string emissionKey;
@@ -312,7 +322,15 @@ void PhotonGiPass::execute(PassContext& ctx) {
   // The receivers' layered BSDF reads the sheen directional-albedo table (common/brdf.glsl).
   ctx.gpu.sheenAlbedo.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingSheenAlbedo);
   // prepare() uploaded the grid.
-  photon_gi::splatAndResolve(ctx.resources, ctx.shaders, ctx.view, splat_, *grid_, false, true);
+  if (denoise_) {
+    // The noisy estimate into indirect, filtered, then the filtered image into indirect and beauty.
+    photon_gi::splatAndResolve(ctx.resources, ctx.shaders, ctx.view, splat_, *grid_, false, false);
+    const gl::Texture& clean =
+        denoise::run(ctx.resources, ctx.shaders, ctx.view, ctx.resources.texture("indirect"), denoiseSettings_);
+    photon_gi::resolve(ctx.resources, ctx.shaders, ctx.view, clean, false, true);
+  } else {
+    photon_gi::splatAndResolve(ctx.resources, ctx.shaders, ctx.view, splat_, *grid_, false, true);
+  }
   auto& c = ctx.stats.counters;
   c["photons"] = static_cast<double>(settings_.photons);
   c["photons_traced"] = static_cast<double>(traced_);
@@ -332,6 +350,8 @@ void PhotonGiPass::execute(PassContext& ctx) {
   c["h_min"] = hMin_;
   c["h_max"] = hMax_;
   c["C"] = settings_.C;
+  c["denoise_iterations"] = denoise_ ? denoiseSettings_.iterations : 0;
+  c["denoise_relative_noise"] = denoiseSettings_.relativeNoise;
   c["environment_light_photons"] = lightPhotonWeight_;  // 1: sky photons drawn by the map itself
   c["gather"] = splat_.method == photon_gi::Method::Gather ? 1.0 : 0.0;
   c["gather_step"] = splat_.method == photon_gi::Method::Gather ? splat_.gatherStep : 1;

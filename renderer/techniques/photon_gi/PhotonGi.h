@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "renderer/frame/Technique.h"
+#include "renderer/shading/Denoiser.h"
 #include "renderer/techniques/photon_gi/Splatting.h"
 
 namespace radiant {
@@ -53,7 +54,9 @@ private:
   float lightPhotonWeight_ = 1.f;  // the environment lights' weight in the sky photons' emission  // this frame rebuilt a cached set that was not resident
   std::size_t records_ = 0, photonSplats_ = 0, coveragePoints_ = 0;
   std::uint64_t traced_ = 0;  // photons traced by this frame (0 when the set was cached)
-  std::uint64_t capped_ = 0;  // photons of the cached set ended by max_bounces (PhotonSet::capped)
+  std::uint64_t capped_ = 0;
+  bool denoise_ = true;
+  denoise::Settings denoiseSettings_;  // photons of the cached set ended by max_bounces (PhotonSet::capped)
   double traceMs_ = 0.0, buildMs_ = 0.0;
   float hMin_ = 0.f, hMax_ = 0.f;
 };

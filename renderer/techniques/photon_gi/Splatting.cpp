@@ -302,6 +302,12 @@ void splatAndResolve(FrameResources& res, gl::ShaderLibrary& shaders, const Fram
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
   }
 
+  resolve(res, shaders, view, accum, settings.renormalize, addToBeauty);
+}
+
+void resolve(FrameResources& res, gl::ShaderLibrary& shaders, const FrameView& view, const gl::Texture& accum,
+             bool renormalize, bool addToBeauty) {
+  const float zero[4] = {0.f, 0.f, 0.f, 0.f};
   gl::Framebuffer& resolveFb = res.framebuffer("photon_gi_resolve");
   resolveFb.bind();
   glViewport(0, 0, view.width, view.height);
@@ -313,10 +319,10 @@ void splatAndResolve(FrameResources& res, gl::ShaderLibrary& shaders, const Fram
     glColorMaski(1, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
   }
   accum.bindUnit(0);
-  const gl::Program& resolve = shaders.program({"common/fullscreen.vert", "photon_gi/resolve.frag"});
-  resolve.use();
-  resolve.set("u_renormalize", settings.renormalize ? 1 : 0);
-  resolve.set("u_minKernelMass", kMinKernelMass);
+  const gl::Program& prog = shaders.program({"common/fullscreen.vert", "photon_gi/resolve.frag"});
+  prog.use();
+  prog.set("u_renormalize", renormalize ? 1 : 0);
+  prog.set("u_minKernelMass", kMinKernelMass);
   glDrawArrays(GL_TRIANGLES, 0, 3);
   glDisable(GL_BLEND);
   glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);

@@ -74,5 +74,9 @@ void uploadSplatGrid(FrameResources& res, const SplatGrid& grid);
 // resolves into `indirect`, adding it to `beauty` when addToBeauty. Reads the G-buffer resources.
 void splatAndResolve(FrameResources& res, gl::ShaderLibrary& shaders, const FrameView& view,
                      const SplatSettings& settings, const SplatGrid& grid, bool upload, bool addToBeauty);
+// indirect = accum's radiance (divided by its kernel mass in alpha when renormalize), added to beauty
+// when addToBeauty. The last step of splatAndResolve; photon_gi calls it again on the denoised indirect.
+void resolve(FrameResources& res, gl::ShaderLibrary& shaders, const FrameView& view, const gl::Texture& accum,
+             bool renormalize, bool addToBeauty);
 
 }  // namespace radiant::photon_gi
