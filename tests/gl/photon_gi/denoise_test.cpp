@@ -88,25 +88,31 @@ TEST(Denoise, LowersTheCornellBoxErrorKeepsTheMeanAndTheCorners) {
   EXPECT_EQ(pass(raw, "photon_gi")->counters.at("denoise_iterations"), 0.0);
 }
 
+// A closed room [-2, 2] x [-0.01, 2] x [-2, 2] of a double-sided Lambertian of albedo rho, a point light
+// under its ceiling and an orthographic camera looking down at its floor.
+testing::SceneBuilder room(float rho, float intensity) {
+  testing::SceneBuilder b;
+  Material walls = testing::lambertian(glm::vec3(rho));
+  walls.doubleSided = true;
+  b.box({-2.f, -0.01f, -2.f}, {2.f, 2.f, 2.f}, b.material(walls), "room");
+  b.pointLight({0.f, 1.5f, 0.f}, intensity).topDownOrtho(1.9f, 1.5f);
+  return b;
+}
+
 // A floor of 0.8 / 0.2 albedo squares in a white room lit by a point light: the floor's irradiance is
 // smooth, so indirect / albedo must be continuous across every checker edge. The filter works on the
 // demodulated radiance, so the edge survives; a filter of the radiance itself would mix 0.8 and 0.2
 // across it (ratio ~4 off at the edge).
 TEST(Denoise, AlbedoEdgesStaySharp) {
-  testing::SceneBuilder b;
-  Material white = testing::lambertian(glm::vec3(0.8f));
-  white.doubleSided = true;
-  const int room = b.material(white);
+  testing::SceneBuilder b = room(0.8f, 10.f);
   const int light = b.material(testing::lambertian(glm::vec3(0.8f)));
   const int dark = b.material(testing::lambertian(glm::vec3(0.2f)));
-  b.box({-2.f, -0.01f, -2.f}, {2.f, 2.f, 2.f}, room, "room");
   const int n = 6;
   const float cell = 3.f / n;
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < n; ++j)
       b.quad({-1.5f + (i + 0.5f) * cell, 0.f, -1.5f + (j + 0.5f) * cell}, {0.5f * cell, 0, 0}, {0, 0, -0.5f * cell},
              (i + j) % 2 ? light : dark, "tile");
-  b.pointLight({0.f, 1.5f, 0.f}, 10.f).topDownOrtho(1.9f, 1.5f);
   const Scene scene = b.build("denoise-checker");
   api::RenderRequest r;
   r.width = r.height = 96;
@@ -135,15 +141,10 @@ TEST(Denoise, AlbedoEdgesStaySharp) {
 // Zero albedo everywhere but one surface, a light of 1e30: the filter divides by the floored albedo and
 // sums radiances near the float range; nothing it writes may be NaN or Inf.
 TEST(Denoise, ZeroAlbedoAndHugeRadianceStayFinite) {
-  testing::SceneBuilder b;
-  Material black = testing::lambertian(glm::vec3(0.f));
-  black.doubleSided = true;
-  const int room = b.material(black);
+  testing::SceneBuilder b = room(0.f, 1e30f);
   const int floor = b.material(testing::lambertian(glm::vec3(1.f)));
-  b.box({-2.f, -0.01f, -2.f}, {2.f, 2.f, 2.f}, room, "room");
   b.quad({0.f, 0.f, 0.f}, {1.f, 0, 0}, {0, 0, -1.f}, floor, "floor");
   b.quad({0.f, 1.9f, 0.f}, {1.f, 0, 0}, {0, 0, 1.f}, floor, "ceiling patch");  // lights the floor indirectly
-  b.pointLight({0.f, 1.5f, 0.f}, 1e30f).topDownOrtho(1.9f, 1.5f);
   const Scene scene = b.build("denoise-extremes");
   api::RenderRequest r;
   r.width = r.height = 32;
