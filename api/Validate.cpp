@@ -15,6 +15,9 @@ using nlohmann::json;
 
 namespace {
 
+// Path segments per sample the reference may run without Russian roulette (see normaliseRenderRequest).
+constexpr long long kUnrouletteBouncesPerSample = 64;
+
 // A value quoted in an error detail: at most ~80 bytes, never cut inside a UTF-8 sequence, and
 // invalid bytes replaced, so the problem writer can always encode it.
 std::string shown(const json& v) { return truncateUtf8(dumpSafe(v), 77); }
@@ -355,6 +358,23 @@ json normaliseRenderRequest(const json& body, const RequestLimits& limits) {
   limit("/width", v["width"].get<long long>(), limits.maxWidth, "width");
   limit("/height", v["height"].get<long long>(), limits.maxHeight, "height");
   capCosts(renderRequestSchema(), v, &input, "", limits);
+  // The reference without Russian roulette runs every path to max_bounces (or until it escapes): its
+  // work per pixel is spp x max_bounces path segments, not spp. Capped at what --max-samples allowed when
+  // the schema's bounce maximum was 64 (a closed scene's worst case then), since the cost models and
+  // x-cost caps charge samples only.
+  if (const auto p = v.find("passes"); p != v.end() && p->is_object())
+    if (const auto r = p->find("reference"); r != p->end() && r->is_object() &&
+                                             !r->value("russian_roulette", true)) {
+      const long long spp = r->value("spp", 64LL), bounces = r->value("max_bounces", 1024LL);
+      const long long max = static_cast<long long>(limits.maxSamples) * kUnrouletteBouncesPerSample;
+      if (spp * bounces > max)
+        throw ApiError(422, "limit-exceeded", "Server limit exceeded",
+                       "/passes/reference/max_bounces: with russian_roulette false every path runs to max_bounces, and spp x "
+                       "max_bounces = " + std::to_string(spp * bounces) + " path segments per pixel is above this server's limit " +
+                           std::to_string(max) + " (radiantd --max-samples x " + std::to_string(kUnrouletteBouncesPerSample) +
+                           "); lower max_bounces or spp, or keep russian_roulette",
+                       "/passes/reference/max_bounces");
+    }
 
   const json& outputs = v["outputs"];
   for (std::size_t i = 0; i < outputs.size(); ++i)

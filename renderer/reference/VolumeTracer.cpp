@@ -160,9 +160,13 @@ glm::vec3 pathTrace(const Context& c, Ray ray, float tmax, Sampler& sampler, Ray
                     std::vector<Chord>& chords) {
   glm::vec3 L(0.f), throughput(1.f);
   rt::SurfaceHit hit;
+  // Russian roulette from the fourth scattering event on, surviving with probability min(0.95, max
+  // throughput) as the path tracer's (PathTracer.cpp): every path ends, even in an albedo-1 medium, long
+  // before maxScattering, which stays a safety cap.
+  int events = 0;
   auto roulette = [&] {
-    const float q = std::min(1.f, rt::maxComponent(throughput));
-    if (q >= 0.25f) return true;
+    if (++events < 4) return true;
+    const float q = std::min(0.95f, rt::maxComponent(throughput));
     if (sampler.next() >= q) return false;
     throughput /= q;
     return true;

@@ -47,7 +47,7 @@ struct VolumeOptions {
   MediaMode mode = MediaMode::SingleScatterUnshadowed;
   int spp = 16;            // pixel jitter (and, in Full and SingleScatter with a sky, the paths)
   int pieces = 8;          // quadrature pieces per chord interval (deterministic modes)
-  int maxScattering = 64;  // Full: scattering events per path
+  int maxScattering = 1024;  // Full: scattering events per path, a safety cap (roulette ends paths first)
   std::uint64_t seed = 0;
   glm::vec3 sky{0.f};
   int threads = 0;  // 0 = TBB default

@@ -1,5 +1,6 @@
 #include "renderer/scene/GltfCompression.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <vector>
@@ -59,6 +60,106 @@ std::string joinGlb(const json& doc, std::string bin) {
   put32(result, 0x004E4942u);
   result += bin;
   return result;
+}
+
+// Reads the header and connectivity counts of a KHR_draco_mesh_compression stream before libdraco sees
+// it, and returns the bytes libdraco will allocate for them. libdraco sizes its corner table and point
+// arrays from these counts alone (a 150-byte stream asked it for 5.4 GB, tests/data/crashers/draco), so
+// they are bounded here against the decode budget. The extension is written against Draco bitstream 2.2
+// (KHR_draco_mesh_compression, "Overview"); older versions are refused, which also keeps libdraco's
+// backwards-compatibility paths (fixed-width counts, 1.x edgebreaker) away from hostile input.
+// Layout (draco/compression/point_cloud/point_cloud_decoder.cc, mesh/mesh_edgebreaker_decoder*.cc,
+// mesh/mesh_sequential_decoder.cc): "DRACO", major, minor, encoder type, method, u16 flags, metadata when
+// flags & 0x8000, then for edgebreaker: u8 traversal, varint vertices, varint faces, u8 attribute data,
+// varint symbols, varint split symbols; for sequential: varint faces, varint points.
+class DracoReader {
+ public:
+  DracoReader(const unsigned char* p, std::size_t n, const std::string& ptr) : p_(p), n_(n), ptr_(ptr) {}
+  std::size_t remaining() const { return n_ - at_; }
+  std::uint8_t byte() {
+    if (at_ >= n_) fail("the Draco stream ends inside its header");
+    return p_[at_++];
+  }
+  void skip(std::size_t bytes) {
+    if (bytes > remaining()) fail("the Draco stream ends inside its metadata");
+    at_ += bytes;
+  }
+  // LEB128 as draco/core/varint_decoding.h reads a uint32: at most 5 bytes, truncated to 32 bits.
+  std::uint32_t varint() {
+    std::uint64_t v = 0;
+    for (int i = 0; i < 5; ++i) {
+      const std::uint8_t b = byte();
+      v |= std::uint64_t(b & 127u) << (7 * i);
+      if (!(b & 128u)) return std::uint32_t(v);
+    }
+    fail("a Draco varint is longer than 5 bytes");
+  }
+  // draco/metadata/metadata_decoder.cc: metadata = varint entries {u8 name length, name, varint size > 0,
+  // bytes}, varint sub-metadata {u8 name length, name, metadata}; geometry metadata = varint attribute
+  // metadata {varint id, metadata}, then the geometry's metadata.
+  void skipMetadata(bool named) {
+    std::uint64_t pending = 1;  // metadata still to read; each costs at least two bytes, so the loop is bounded
+    for (bool first = true; pending > 0; first = false, --pending) {
+      if (named || !first) skip(byte());
+      const std::uint32_t entries = varint();
+      for (std::uint32_t e = 0; e < entries; ++e) {
+        skip(byte());
+        const std::uint32_t size = varint();
+        if (size == 0) fail("a Draco metadata entry is empty");
+        skip(size);
+      }
+      const std::uint32_t subs = varint();
+      if (subs > remaining()) fail("the Draco metadata names more sub-metadata than the stream holds");
+      pending += subs;
+    }
+  }
+  [[noreturn]] void fail(const std::string& why) const { throw SceneError(ptr_, why); }
+
+ private:
+  const unsigned char* p_;
+  std::size_t n_, at_ = 0;
+  const std::string& ptr_;
+};
+
+std::size_t dracoDecodeBytes(const unsigned char* data, std::size_t size, std::size_t attributes,
+                             const std::string& ptr) {
+  DracoReader r(data, size, ptr);
+  if (size < 5 || std::memcmp(data, "DRACO", 5) != 0) r.fail("the bufferView does not hold a Draco stream");
+  r.skip(5);
+  const int major = r.byte(), minor = r.byte();
+  if (major != 2 || minor != 2)
+    r.fail("Draco bitstream version " + std::to_string(major) + "." + std::to_string(minor) +
+           " is not 2.2, the version KHR_draco_mesh_compression specifies");
+  const std::uint8_t encoder = r.byte(), method = r.byte();
+  if (encoder != 1) r.fail("the Draco stream holds a point cloud, not a triangle mesh");
+  const std::uint16_t flags = std::uint16_t(r.byte() | r.byte() << 8);
+  if (flags & 0x8000u) {
+    const std::uint32_t attributeMetadata = r.varint();
+    if (attributeMetadata > r.remaining()) r.fail("the Draco metadata names more attributes than the stream holds");
+    for (std::uint32_t i = 0; i < attributeMetadata; ++i) {
+      r.varint();
+      r.skipMetadata(false);
+    }
+    r.skipMetadata(false);
+  }
+  // Bytes per face and per vertex libdraco holds while it decodes: edgebreaker's corner table (two ints
+  // per corner, one per vertex), its processed-corner lists, and the mesh's faces; 16 bytes per point per
+  // attribute for the decoded values.
+  const std::uint64_t perPoint = 16 * std::max<std::size_t>(attributes, 1);
+  std::uint64_t faces = 0, vertices = 0;
+  if (method == 1) {
+    r.byte();  // traversal decoder
+    vertices = r.varint();
+    faces = r.varint();
+    r.byte();  // attribute data
+    r.varint();  // symbols (libdraco checks faces against them)
+    vertices += r.varint();  // split symbols add vertices
+    return std::size_t(faces * 44 + vertices * (8 + perPoint));
+  }
+  if (method != 0) r.fail("unknown Draco encoder method " + std::to_string(method));
+  faces = r.varint();
+  vertices = r.varint();
+  return std::size_t(faces * 12 + vertices * perPoint);
 }
 
 }  // namespace
@@ -269,6 +370,12 @@ void decodeDraco(tinygltf::Model& model, std::size_t maxBytes) {
       if (view.buffer < 0 || std::size_t(view.buffer) >= model.buffers.size() ||
           view.byteOffset + view.byteLength > model.buffers[std::size_t(view.buffer)].data.size())
         throw SceneError(ptr + "/bufferView", "bufferView " + std::to_string(viewIndex) + " lies outside its buffer");
+      const unsigned char* stream = model.buffers[std::size_t(view.buffer)].data.data() + view.byteOffset;
+      const std::size_t expect = dracoDecodeBytes(stream, view.byteLength, e.Get("attributes").Keys().size(), ptr);
+      if (expect > budget)
+        throw SceneLimitError(ptr, "the Draco stream's counts need " + std::to_string(expect) +
+                                       " bytes to decode, over the size limit (" + std::to_string(budget) + " left)",
+                              "--max-decode-bytes");
       draco::DecoderBuffer buffer;
       buffer.Init(reinterpret_cast<const char*>(model.buffers[std::size_t(view.buffer)].data.data() + view.byteOffset),
                   view.byteLength);
@@ -278,7 +385,9 @@ void decodeDraco(tinygltf::Model& model, std::size_t maxBytes) {
       const std::unique_ptr<draco::Mesh> mesh = std::move(decoded).value();
       const std::size_t points = mesh->num_points(), faces = mesh->num_faces();
       const std::size_t need = faces * 3 * 4 + points * 16 * e.Get("attributes").Keys().size();
-      if (need > budget) throw SceneError(ptr, "the decoded mesh (" + std::to_string(need) + " bytes) is over the size limit");
+      if (need > budget)
+        throw SceneLimitError(ptr, "the decoded mesh (" + std::to_string(need) + " bytes) is over the size limit",
+                              "--max-decode-bytes");
       budget -= need;
 
       // One new buffer per primitive holding the decoded attributes (float) and indices (u32).

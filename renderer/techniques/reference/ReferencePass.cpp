@@ -15,8 +15,6 @@ namespace radiant {
 
 namespace {
 
-constexpr int kMediaMaxScattering = 64;
-
 // The volumetric reference's image of the frame's media: RGB radiance ("media") or the transmittance
 // ("media_transmittance"), cached by what shapes it.
 const Image& mediaReferenceImage(FrameResources& res, const Scene& scene, const FrameView& view,
@@ -24,11 +22,9 @@ const Image& mediaReferenceImage(FrameResources& res, const Scene& scene, const 
   reference::VolumeOptions o;
   o.mode = reference::mediaModeFromString(r.mediaMode);
   o.spp = r.spp;
-  // Full mode's scattering cap. The volume tracer's roulette keeps every path of throughput >= 0.25
-  // (VolumeTracer.cpp), so an albedo-1 medium runs each path to the cap: max_bounces' default (a safety
-  // cap for the surface tracers, whose roulette survival is at most 0.95) would make it 1024 events
-  // per path; the media reference keeps its own cap of kMediaMaxScattering.
-  o.maxScattering = std::clamp(r.maxBounces, 1, kMediaMaxScattering);
+  // Full mode's scattering cap: the shared safety cap (the volume tracer's roulette ends paths as the
+  // path tracer's does, VolumeTracer.cpp); 0 still lets a camera ray's first scattering count.
+  o.maxScattering = std::max(r.maxBounces, 1);
   o.seed = view.seed;
   o.sky = view.ambient;
   o.cancel = res.cancel();

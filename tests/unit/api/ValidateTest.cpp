@@ -270,6 +270,27 @@ TEST(Validate, ServerLimitsAreLowerThanTheSchema) {
   EXPECT_NO_THROW(parseRenderRequest(body, limits));
 }
 
+// Without Russian roulette the reference runs every path to max_bounces: spp x max_bounces path
+// segments per pixel are capped at --max-samples x 64 (the old schema's worst case, 64 bounces).
+TEST(Validate, ReferenceWithoutRouletteIsChargedItsBounces) {
+  RequestLimits limits;
+  limits.maxSamples = 100;
+  json body = minimal();
+  body["passes"] = {{"reference", {{"spp", 100}, {"max_bounces", 64}, {"russian_roulette", false}}}};
+  EXPECT_NO_THROW(parseRenderRequest(body, limits));  // 6400 = 100 x 64
+  body["passes"]["reference"]["max_bounces"] = 65;
+  ApiError e = errorOf(body, limits);
+  EXPECT_EQ(e.status, 422);
+  EXPECT_EQ(e.type, "limit-exceeded");
+  EXPECT_EQ(e.pointer, "/passes/reference/max_bounces");
+  EXPECT_NE(e.detail().find("6500 path segments per pixel is above this server's limit 6400"), std::string::npos) << e.detail();
+  body["passes"]["reference"]["russian_roulette"] = true;  // roulette ends the paths: the cap is a safety net
+  body["passes"]["reference"]["max_bounces"] = 4096;
+  EXPECT_NO_THROW(parseRenderRequest(body, limits));
+  body["passes"]["reference"] = {{"spp", 7}, {"russian_roulette", false}};  // default max_bounces 1024: 7168
+  EXPECT_EQ(errorOf(body, limits).pointer, "/passes/reference/max_bounces");
+}
+
 TEST(Validate, PointerEscaping) {
   EXPECT_EQ(radiant::api::pointerAppend("/passes", "a/b~c"), "/passes/a~1b~0c");
   json body = minimal();

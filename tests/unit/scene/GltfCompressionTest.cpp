@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <functional>
 #include <limits>
 
@@ -15,6 +16,7 @@
 #include <draco/compression/encode.h>
 #include <draco/mesh/triangle_soup_mesh_builder.h>
 #include <meshoptimizer.h>
+#include <tiny_gltf.h>  // shared library: no TINYGLTF_IMPLEMENTATION
 
 #include "renderer/scene/GltfCompression.h"
 #include "renderer/scene/GltfLimits.h"
@@ -67,7 +69,8 @@ std::vector<std::array<float, 9>> triangles(const std::vector<glm::vec3>& p, con
 // `normalType` with `normalComponents` per corner, `normal(face, corner)` its value; the GLB with
 // POSITION and NORMAL accessors (float VEC3) and, when `indexed`, the cube's index accessor, as a builder.
 GltfBuilder encodeDracoCube(const Cube& cube, draco::DataType normalType, int normalComponents,
-                          const std::function<const void*(std::size_t face, int corner)>& normal, bool indexed) {
+                          const std::function<const void*(std::size_t face, int corner)>& normal, bool indexed,
+                          int method = -1, bool metadata = false) {
   draco::TriangleSoupMeshBuilder builder;
   builder.Start(int(cube.idx.size() / 3));
   const int pos = builder.AddAttribute(draco::GeometryAttribute::POSITION, 3, draco::DT_FLOAT32);
@@ -77,9 +80,21 @@ GltfBuilder encodeDracoCube(const Cube& cube, draco::DataType normalType, int no
     builder.SetAttributeValuesForFace(pos, draco::FaceIndex(std::uint32_t(f)), &cube.p[i[0]], &cube.p[i[1]], &cube.p[i[2]]);
     builder.SetAttributeValuesForFace(nrm, draco::FaceIndex(std::uint32_t(f)), normal(f, 0), normal(f, 1), normal(f, 2));
   }
+  if (metadata) {  // a geometry entry with a sub-metadata, and an attribute's entry
+    auto geometry = std::make_unique<draco::GeometryMetadata>();
+    geometry->AddEntryString("author", "radiant tests");
+    auto sub = std::make_unique<draco::Metadata>();
+    sub->AddEntryInt("level", 3);
+    geometry->AddSubMetadata("nested", std::move(sub));
+    builder.AddMetadata(std::move(geometry));
+    auto attribute = std::make_unique<draco::AttributeMetadata>();
+    attribute->AddEntryString("space", "object");
+    builder.AddAttributeMetadata(pos, std::move(attribute));
+  }
   std::unique_ptr<draco::Mesh> mesh = builder.Finalize();
   EXPECT_TRUE(mesh);
   draco::Encoder encoder;  // no quantization set: floats are stored losslessly
+  if (method >= 0) encoder.SetEncodingMethod(method);
   draco::EncoderBuffer encoded;
   EXPECT_TRUE(encoder.EncodeMeshToBuffer(*mesh, &encoded).ok());
   GltfBuilder b;
@@ -117,6 +132,120 @@ TEST(GltfCompression, DracoPrimitiveDecodesToTheEncodedMesh) {
       for (int k = 0; k < 3; ++k) EXPECT_LT(glm::length(mi.normals[mi.indices[t + k]] - glm::normalize(glm::round(c * 2.f))), 1e-6f);
     }
     EXPECT_TRUE(s.warnings.empty());
+  }
+}
+
+// Issue 30, validate before decoding: libdraco sizes its corner table and attribute arrays from the
+// stream's face and vertex counts alone (a 150-byte Draco 1.1 stream found by tests/fuzz/draco_fuzzer.cpp
+// made it allocate 5.4 GB). decodeDraco() reads the header first: any version but 2.2, the one
+// KHR_draco_mesh_compression specifies, is refused, and the counts are charged against the decode budget
+// (44 bytes per face, 8 + 16 per attribute per vertex for edgebreaker) before libdraco allocates.
+GltfBuilder dracoStream(const std::string& bytes) {
+  GltfBuilder b;
+  const int view = b.view(bytes.data(), bytes.size());
+  const int posAcc = b.push("accessors", {{"componentType", 5126}, {"count", 3}, {"type", "VEC3"},
+                                          {"min", {0, 0, 0}}, {"max", {1, 1, 1}}});
+  const json draco = {{"bufferView", view}, {"attributes", {{"POSITION", 0}}}};
+  const int m = b.mesh(json::array({{{"attributes", {{"POSITION", posAcc}}},
+                                     {"extensions", {{"KHR_draco_mesh_compression", draco}}}}}));
+  b.scene({b.node({{"mesh", m}})});
+  b.doc["extensionsUsed"] = {"KHR_draco_mesh_compression"};
+  b.doc["extensionsRequired"] = {"KHR_draco_mesh_compression"};
+  return b;
+}
+
+std::string varint(std::uint32_t v) {
+  std::string out;
+  do {
+    out.push_back(char((v & 127u) | (v > 127 ? 128u : 0u)));
+    v >>= 7;
+  } while (v);
+  return out;
+}
+
+// limit: a SceneLimitError naming --max-decode-bytes (422 limit-exceeded), else 422 invalid-scene.
+void expectRefused(const std::string& file, const std::string& says, bool limit = false) {
+  try {
+    loadSceneFromMemory(file);
+    ADD_FAILURE() << "accepted; expected: " << says;
+  } catch (const SceneError& e) {
+    const auto* l = dynamic_cast<const SceneLimitError*>(&e);
+    EXPECT_EQ(l != nullptr, limit) << e.what();
+    if (l) {
+      EXPECT_EQ(l->flag, "--max-decode-bytes");
+    }
+    EXPECT_EQ(e.pointer, "/meshes/0/primitives/0/extensions/KHR_draco_mesh_compression");
+    EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+  }
+}
+
+TEST(GltfCompression, DracoStreamsOtherThanBitstream22AreRefusedBeforeDecoding) {
+  std::ifstream in(RADIANT_SOURCE_DIR "/tests/data/crashers/draco/corner_table_5gb_bitstream_1_1.drc", std::ios::binary);
+  const std::string crasher((std::istreambuf_iterator<char>(in)), {});
+  ASSERT_EQ(crasher.size(), 150u);
+  expectRefused(dracoStream(crasher).glb(), "Draco bitstream version 1.1 is not 2.2");
+  std::string pointCloud = std::string("DRACO\x02\x02\x00\x00\x00\x00", 11) + varint(3) + std::string(16, '\0');
+  expectRefused(dracoStream(pointCloud).glb(), "point cloud");
+  expectRefused(dracoStream("DRACO\x02\x02\x01").glb(), "ends inside its header");
+  expectRefused(dracoStream("NOTDRACO").glb(), "does not hold a Draco stream");
+}
+
+TEST(GltfCompression, DracoCountsAreChargedAgainstTheDecodeBudgetBeforeDecoding) {
+  // Edgebreaker, standard traversal: 100 million faces over 60 million vertices (libdraco's own checks
+  // pass: faces <= symbols * 4/3, vertices <= 3 * faces) in a 40-byte stream.
+  const std::uint32_t faces = 100'000'000, vertices = 60'000'000;
+  const std::string header = std::string("DRACO\x02\x02\x01\x01\x00\x00\x00", 12) + varint(vertices) +
+                             varint(faces) + std::string(1, '\x01') + varint(faces) + varint(0) + std::string(16, '\0');
+  const std::size_t need = std::size_t(faces) * 44 + std::size_t(vertices) * (8 + 16);
+  expectRefused(dracoStream(header).glb(), "need " + std::to_string(need) + " bytes", true);
+
+  // The same counts on a real cube, charged by decodeDraco itself: its stream (12 faces, 8 to 24
+  // vertices, two attributes) decodes within its charge and is refused one byte below it.
+  const Cube cube;
+  GltfBuilder b = encodeDracoCube(cube, draco::DT_FLOAT32, 3,
+                                  [&](std::size_t f, int k) { return static_cast<const void*>(&cube.n[cube.idx[f * 3 + k]]); },
+                                  false, draco::MESH_EDGEBREAKER_ENCODING);
+  auto model = [&] {
+    tinygltf::Model m;
+    tinygltf::TinyGLTF loader;
+    std::string err, warn;
+    const std::string glb = b.glb();
+    EXPECT_TRUE(loader.LoadBinaryFromMemory(&m, &err, &warn, reinterpret_cast<const unsigned char*>(glb.data()),
+                                            unsigned(glb.size())))
+        << err;
+    return m;
+  };
+  std::size_t charge = 0;
+  try {
+    tinygltf::Model m = model();
+    gltf::decodeDraco(m, 1);
+    ADD_FAILURE() << "decoded within 1 byte";
+  } catch (const SceneLimitError& e) {
+    const std::string what = e.what();
+    const auto at = what.find("need ");
+    ASSERT_NE(at, std::string::npos) << what;
+    charge = std::stoull(what.substr(at + 5));
+  }
+  EXPECT_GE(charge, 12u * 44 + 8u * (8 + 32));
+  EXPECT_LE(charge, 12u * 44 + 24u * (8 + 32));
+  tinygltf::Model m = model();
+  EXPECT_THROW(gltf::decodeDraco(m, charge - 1), SceneLimitError);
+  m = model();
+  EXPECT_NO_THROW(gltf::decodeDraco(m, 1u << 20));
+}
+
+// Metadata sits between the header and the counts; sequential streams count faces and points. Both
+// decode to the cube (the header reader must not refuse what libdraco decodes).
+TEST(GltfCompression, DracoStreamsWithMetadataDecodeByEitherMethod) {
+  const Cube cube;
+  for (int method : {draco::MESH_SEQUENTIAL_ENCODING, draco::MESH_EDGEBREAKER_ENCODING}) {
+    SCOPED_TRACE(method);
+    GltfBuilder b = encodeDracoCube(cube, draco::DT_FLOAT32, 3,
+                                    [&](std::size_t f, int k) { return static_cast<const void*>(&cube.n[cube.idx[f * 3 + k]]); },
+                                    true, method, true);
+    const Scene s = loadSceneFromMemory(b.glb());
+    ASSERT_EQ(s.meshes.size(), 1u);
+    EXPECT_EQ(triangles(s.meshes[0].positions, s.meshes[0].indices), triangles(cube.p, cube.idx));
   }
 }
 
