@@ -46,6 +46,33 @@ struct FidelityOptions {
 };
 int fidelityBench(const GlobalOptions& g, const FidelityOptions& o);
 
+// radiant bench --equal-error (commands/EqualError.cpp): issue 32's equal-error speed-up of each
+// scene's default frame over the reference path tracer.
+struct EqualErrorOptions {
+  std::string dir = "bench-out";  // writes DIR/equal_error.md (also printed) and DIR/equal_error.json
+  std::vector<std::string> scenes{"cornell_box", "cornell_glossy", "cornell_mirror"};
+  int size = 64, truthSpp = 4096;
+  std::vector<int> ladder{64, 256, 1024};  // the reference's spp whose errors are fitted
+  bool quiet = false;
+  std::vector<std::string> servers;  // the first is used (default the global one)
+};
+int equalErrorBench(const GlobalOptions& g, const EqualErrorOptions& o);
+// One rung of the reference's ladder: samples per pixel, MSE against the truth, pass time.
+struct LadderPoint {
+  double spp = 0, mse = 0, ms = 0;
+};
+// The reference's MSE(s) = a / s + b and time t(s) = t0 + msPerSpp s, least squares over the ladder (a
+// fit with b < 0 takes b = 0 and a = s MSE of the largest s); the frame's own MSE = frameMse - b, which
+// the reference reaches at spp = a / own in ms = t(spp); truthLimited (spp, ms unset) when own <= 0.
+// Throws UsageError for fewer than two distinct spp or a non-positive one.
+struct EqualErrorFit {
+  double a = 0, b = 0, t0 = 0, msPerSpp = 0;
+  double frameOwnMse = 0;
+  bool truthLimited = false;
+  double spp = 0, ms = 0;
+};
+EqualErrorFit fitEqualError(const std::vector<LadderPoint>& ladder, double frameMse);
+
 // Helpers shared by commands.
 std::string readFile(const std::string& path);            // throws UsageError
 void writeFile(const std::string& path, const std::string& bytes);  // throws UsageError

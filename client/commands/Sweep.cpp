@@ -106,6 +106,8 @@ struct BenchOptions {
   bool fidelity = false;
   CLI::Option* sizeGiven = nullptr;
   FidelityOptions fid;
+  bool equalError = false;
+  EqualErrorOptions eq;
 };
 
 int runSweep(const GlobalOptions& g, SweepOptions so) {
@@ -339,6 +341,16 @@ int runBench(const GlobalOptions& g, BenchOptions bo) {
     f.quiet = o.quiet;
     return fidelityBench(g, f);
   }
+  if (bo.equalError) {
+    if (service || bo.fidelity) throw UsageError("bench: --equal-error, --fidelity and --service are separate benchmarks");
+    EqualErrorOptions& e = bo.eq;
+    e.dir = bo.dir;
+    if (bo.sizeGiven && bo.sizeGiven->count()) e.size = size;
+    if (bo.sceneGiven && bo.sceneGiven->count()) e.scenes = {scene};
+    e.servers = o.servers;
+    e.quiet = o.quiet;
+    return equalErrorBench(g, e);
+  }
   if (service) return serviceBench(g, dir, requests, size, scene, throughputN, pngCompression);
   if (o.servers.empty()) o.servers.push_back(g.server);
   // The suite follows what the (first) server implements and ships.
@@ -455,7 +467,11 @@ void addSweepCommands(CLI::App& root, const GlobalOptions& g, Action& action) {
       "default frame (background transparent, tone_map aces) scored against the reference path tracer at\n"
       "--spp with model-viewer's render-fidelity metric (dB, lower is better), relMSE and SSIM; writes\n"
       "DIR/fidelity.md (also printed), DIR/fidelity.json and per scene a contact sheet default | reference |\n"
-      "error in DIR/fidelity/; references are cached in DIR/fidelity/reference/ (docs/PERFORMANCE.md).");
+      "error in DIR/fidelity/; references are cached in DIR/fidelity/reference/ (docs/PERFORMANCE.md).\n"
+      "--equal-error: per built-in scene (--scene, default cornell_box, cornell_glossy and cornell_mirror), the\n"
+      "default frame's RMSE against the reference at --truth-spp, the reference's RMSE at each --ladder spp,\n"
+      "and the reference's spp and time at the frame's error (the truth's own noise fitted and removed): the\n"
+      "equal-error speed-up; writes DIR/equal_error.md (also printed) and DIR/equal_error.json.");
   b->add_option("-o,--output,--out", bo->dir, "the output directory (default bench-out)")->type_name("DIR");
   b->add_flag("--quick", bo->quick, "three scenes, smaller frames, fewer repeats");
   b->add_flag("--service", bo->service, "measure the service's overhead and throughput instead");
@@ -466,7 +482,8 @@ void addSweepCommands(CLI::App& root, const GlobalOptions& g, Action& action) {
       ->type_name("URL");
   b->add_option("--inflight", bo->run.inflight, "requests in flight per server")->type_name("N")->check(CLI::Range(1, 64));
   b->add_option("--requests", bo->requests, "--service: sequential requests (default 20)")->type_name("N")->check(CLI::Range(1, 10000));
-  bo->sizeGiven = b->add_option("--size", bo->size, "--service: frame size in pixels (default 256); --fidelity: (default 128)")
+  bo->sizeGiven = b->add_option("--size", bo->size,
+                                "--service: frame size in pixels (default 256); --fidelity: (default 128); --equal-error: (default 64)")
                       ->type_name("PX")
                       ->check(CLI::Range(1, 4096));
   b->add_flag("--fidelity", bo->fidelity, "the render-fidelity benchmark of the default frame against the reference");
@@ -481,6 +498,14 @@ void addSweepCommands(CLI::App& root, const GlobalOptions& g, Action& action) {
   repeated(b->add_option("--model", bo->fid.onlyModels, "--fidelity: only this model folder (repeatable)"))->type_name("NAME");
   repeated(b->add_option("--environment", bo->fid.onlyEnvironments, "--fidelity: only this map, by file stem (repeatable)"))
       ->type_name("NAME");
+  b->add_flag("--equal-error", bo->equalError, "the equal-error speed-up of the default frame over the reference");
+  b->add_option("--truth-spp", bo->eq.truthSpp, "--equal-error: the truth's samples per pixel (default 4096)")
+      ->type_name("N")
+      ->check(CLI::Range(1, 65536));
+  b->add_option("--ladder", bo->eq.ladder, "--equal-error: the reference's spp to fit (default 64,256,1024)")
+      ->delimiter(',')
+      ->type_name("LIST")
+      ->check(CLI::Range(1, 65536));
   b->add_flag("--convergence", bo->fid.convergence,
               "--fidelity: also render a second reference seed and score it against the first");
   bo->sceneGiven = b->add_option("--scene", bo->scene,
