@@ -42,10 +42,16 @@ nlohmann::json scoreMean(const nlohmann::json& batchMetrics, const Image& mean, 
 
 // What GET /v1/renders/{id} shows of a refining job: the mean so far and its estimated error; with a
 // compare block also the mean's true error against the ground truth (scoreMean; null otherwise).
+// The estimate (issue 32): with a compare block on refine.aov, the mean's RMSE against the ground truth,
+// which holds the bias a biased pass has (photon_gi's kernel blur) as well as the noise
+// (kind "against_ground_truth"); otherwise the batches' standard error, the noise alone ("noise_only").
+// target_rmse stops on it.
 struct RefineSnapshot {
   std::vector<Image> mean;
   int batches = 0;
   double estimatedRmse = std::numeric_limits<double>::quiet_NaN();
+  double noiseRmse = std::numeric_limits<double>::quiet_NaN();  // BatchMean::estimatedRmse, always
+  const char* estimateKind = "noise_only";
   double elapsedMs = 0;
   nlohmann::json metrics;
 };

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <iostream>
 #include <random>
+#include <string_view>
 
 namespace radiant::server {
 
@@ -141,7 +142,8 @@ json RenderService::describe(const Job& job) {
     const RefineSnapshot& c = *job.current;
     j["refinement"] = {{"batches", c.batches}, {"elapsed_ms", c.elapsedMs},
                        {"estimated_rmse", std::isfinite(c.estimatedRmse) ? json(c.estimatedRmse) : json(nullptr)},
-                       {"estimate_kind", "noise_only"}, {"current", "/v1/renders/" + job.id + "?current=exr"}};
+                       {"noise_rmse", std::isfinite(c.noiseRmse) ? json(c.noiseRmse) : json(nullptr)},
+                       {"estimate_kind", c.estimateKind}, {"current", "/v1/renders/" + job.id + "?current=exr"}};
     if (c.metrics.is_object()) j["refinement"]["metrics"] = c.metrics;  // the current mean against the ground truth
   }
   j["progress"] = progress;
@@ -212,10 +214,15 @@ RenderOutput RenderService::refine(RenderBackend& backend, const std::shared_ptr
     auto snap = std::make_shared<RefineSnapshot>();
     snap->mean = acc.mean();
     snap->batches = acc.batches();
-    snap->estimatedRmse = acc.estimatedRmse(spec.aov);
+    snap->noiseRmse = snap->estimatedRmse = acc.estimatedRmse(spec.aov);
     if (compare && !truth.pixels.empty())
       for (const Image& m : snap->mean)
         if (m.aov == compare->aov) snap->metrics = scoreMean(batchMetrics, m, truth, job->request.exposure, snap->batches);
+    // The ground truth scores the refined AOV: its error holds the bias too (RefineSnapshot).
+    if (snap->metrics.is_object() && compare->aov == spec.aov && snap->metrics.value("rmse", json()).is_number()) {
+      snap->estimatedRmse = snap->metrics["rmse"].get<double>();
+      snap->estimateKind = "against_ground_truth";
+    }
     snap->elapsedMs = msBetween(start, Clock::now());
     const double estimate = snap->estimatedRmse;
     const double elapsed = snap->elapsedMs;
@@ -261,13 +268,22 @@ RenderOutput RenderService::refine(RenderBackend& backend, const std::shared_ptr
     out.compareReference = std::move(truth);
   }
   const double estimate = acc.estimatedRmse(spec.aov);
+  std::shared_ptr<const RefineSnapshot> lastSnapshot;
+  {
+    std::lock_guard lock(mutex_);
+    lastSnapshot = job->current;
+  }
+  const bool againstTruth = lastSnapshot && std::string_view(lastSnapshot->estimateKind) == "against_ground_truth";
+  const double reported = againstTruth ? lastSnapshot->estimatedRmse : estimate;
   out.stats.refinement = {{"batches", acc.batches()}, {"aov", spec.aov}, {"stopped_by", stop},
                           {"elapsed_ms", msBetween(start, Clock::now())},
-                          {"estimated_rmse", std::isfinite(estimate) ? json(estimate) : json(nullptr)},
+                          {"estimated_rmse", std::isfinite(reported) ? json(reported) : json(nullptr)},
+                          {"noise_rmse", std::isfinite(estimate) ? json(estimate) : json(nullptr)},
                           {"seeds", {job->request.seed, batch.seed}},
-                          // The estimate is the batches' variance only (server/Refinement.h): a biased
-                          // pass (photon_gi's kernel) has a larger true error.
-                          {"estimate_kind", "noise_only"}};
+                          // noise_only: the batches' variance (server/Refinement.h), blind to a biased
+                          // pass's bias (photon_gi's kernel); against_ground_truth: the compare block's
+                          // score of the mean, bias included (RefineSnapshot).
+                          {"estimate_kind", againstTruth ? "against_ground_truth" : "noise_only"}};
   // Scored against a ground truth on the refined AOV: the error splits as bias^2 + noise^2, so the part
   // the noise estimate does not explain (the bias, plus the ground truth's own noise) is measured.
   if (out.stats.metrics.is_object() && out.stats.metrics.value("aov", "") == spec.aov && std::isfinite(estimate)) {
