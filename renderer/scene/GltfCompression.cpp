@@ -97,10 +97,12 @@ class DracoReader {
   // draco/metadata/metadata_decoder.cc: metadata = varint entries {u8 name length, name, varint size > 0,
   // bytes}, varint sub-metadata {u8 name length, name, metadata}; geometry metadata = varint attribute
   // metadata {varint id, metadata}, then the geometry's metadata.
-  void skipMetadata(bool named) {
+  // The stream holds each sub-metadata whole, in order, so reading them one after the other consumes
+  // what libdraco's stack-ordered reader does.
+  void skipMetadata() {
     std::uint64_t pending = 1;  // metadata still to read; each costs at least two bytes, so the loop is bounded
     for (bool first = true; pending > 0; first = false, --pending) {
-      if (named || !first) skip(byte());
+      if (!first) skip(byte());  // a sub-metadata's name
       const std::uint32_t entries = varint();
       for (std::uint32_t e = 0; e < entries; ++e) {
         skip(byte());
@@ -138,9 +140,9 @@ std::size_t dracoDecodeBytes(const unsigned char* data, std::size_t size, std::s
     if (attributeMetadata > r.remaining()) r.fail("the Draco metadata names more attributes than the stream holds");
     for (std::uint32_t i = 0; i < attributeMetadata; ++i) {
       r.varint();
-      r.skipMetadata(false);
+      r.skipMetadata();
     }
-    r.skipMetadata(false);
+    r.skipMetadata();
   }
   // Bytes per face and per vertex libdraco holds while it decodes: edgebreaker's corner table (two ints
   // per corner, one per vertex), its processed-corner lists, and the mesh's faces; 16 bytes per point per
