@@ -10,6 +10,7 @@
 #include <future>
 #include <iostream>
 #include <sstream>
+#include <tuple>
 
 #include "client/Cli.h"
 #include "client/report/Report.h"
@@ -416,6 +417,11 @@ int runBench(const GlobalOptions& g, BenchOptions bo) {
   ro.title = std::string("Radiant benchmark") + (quick ? " (quick)" : "");
   ro.source = results.string();
   ro.command = o.command;
+  // The tables of the suite's sibling benchmarks run into the same DIR (bench --equal-error, --fidelity).
+  for (const auto& [file, id, title] :
+       {std::tuple{"equal_error.md", "equal-error", "Equal-error speed-up (radiant bench --equal-error)"},
+        std::tuple{"fidelity.md", "fidelity", "Render fidelity of real models (radiant bench --fidelity)"}})
+    if (fs::is_regular_file(dir / file)) ro.extra.push_back({id, title, readFile((dir / file).string())});
   const report::Summary s = report::write(sweep::readRecords(results), dir, ro);
   std::cout << "wrote " << s.html.string() << " and " << s.markdown.string() << " (" << s.records << " points, "
             << s.errors << " failed, " << s.plots << " plots)\n";
@@ -459,7 +465,8 @@ void addSweepCommands(CLI::App& root, const GlobalOptions& g, Action& action) {
   b->footer(
       "The standard suite: every built-in scene x every implemented technique at its presets x two\n"
       "resolutions, with error against the reference. Writes DIR/bench.spec.json, DIR/results.jsonl (+.csv),\n"
-      "DIR/report.html and DIR/report.md. Re-running resumes. Each technique is scored on its first output\n"
+      "DIR/report.html and DIR/report.md (with DIR/equal_error.md and DIR/fidelity.md when those benchmarks\n"
+      "wrote them into DIR first). Re-running resumes. Each technique is scored on its first output\n"
       "AOV that has a ground truth in the server's /v1/info (ground_truths).\n"
       "--service: the service's overhead (end-to-end latency against the renderer's frame time) and the\n"
       "throughput of back-to-back small requests; writes DIR/service.json and prints a Markdown table.\n"

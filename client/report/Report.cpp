@@ -195,6 +195,63 @@ struct Section {
 
 }  // namespace
 
+std::string markdownToHtml(const std::string& markdown) {
+  std::istringstream in(markdown);
+  std::ostringstream out;
+  std::vector<std::vector<std::string>> rows;
+  std::string paragraph;
+  auto cells = [](const std::string& line) {
+    std::vector<std::string> c;
+    std::string cur;
+    for (std::size_t i = 1; i < line.size(); ++i) {  // after the leading '|'
+      if (line[i] == '\\' && i + 1 < line.size() && line[i + 1] == '|') {
+        cur += '|';
+        ++i;
+      } else if (line[i] == '|') {
+        const auto b = cur.find_first_not_of(' '), e = cur.find_last_not_of(' ');
+        c.push_back(b == std::string::npos ? "" : cur.substr(b, e - b + 1));
+        cur.clear();
+      } else {
+        cur += line[i];
+      }
+    }
+    return c;
+  };
+  auto flushTable = [&] {
+    if (rows.empty()) return;
+    out << "<div class=\"table-wrap\"><table>\n<thead><tr>";
+    for (const auto& c : rows[0]) out << "<th>" << html(c) << "</th>";
+    out << "</tr></thead>\n<tbody>\n";
+    for (std::size_t r = 1; r < rows.size(); ++r) {
+      out << "<tr>";
+      for (const auto& c : rows[r]) out << "<td>" << html(c) << "</td>";
+      out << "</tr>\n";
+    }
+    out << "</tbody></table></div>\n";
+    rows.clear();
+  };
+  auto flushParagraph = [&] {
+    if (!paragraph.empty()) out << "<p>" << html(paragraph) << "</p>\n";
+    paragraph.clear();
+  };
+  for (std::string line; std::getline(in, line);) {
+    if (!line.empty() && line[0] == '|') {
+      flushParagraph();
+      if (line.find_first_not_of("|-: ") == std::string::npos) continue;  // the header rule
+      rows.push_back(cells(line));
+    } else if (line.find_first_not_of(' ') == std::string::npos) {
+      flushTable();
+      flushParagraph();
+    } else {
+      flushTable();
+      paragraph += (paragraph.empty() ? "" : " ") + line;
+    }
+  }
+  flushTable();
+  flushParagraph();
+  return out.str();
+}
+
 Summary write(const std::vector<json>& all, const fs::path& dir, const Options& o) {
   fs::create_directories(dir);
   const std::vector<json> records = sweep::latestRecords(all);
@@ -621,6 +678,12 @@ Summary write(const std::vector<json>& all, const fs::path& dir, const Options& 
     mdBody << "\n";
   }
   body << "</tbody></table></div>\n";
+  std::ostringstream extraToc;
+  for (const ExtraSection& e : o.extra) {
+    body << "<h2 id=\"" << html(e.id) << "\">" << html(e.title) << "</h2>\n" << markdownToHtml(e.markdown);
+    mdBody << "\n## " << e.title << "\n\n" << e.markdown << (e.markdown.empty() || e.markdown.back() == '\n' ? "" : "\n");
+    extraToc << "<li><a href=\"#" << html(e.id) << "\">" << html(e.title) << "</a></li>";
+  }
 
   // Header: where the numbers come from.
   std::set<std::string> devices, commands, servers;
@@ -675,7 +738,7 @@ Summary write(const std::vector<json>& all, const fs::path& dir, const Options& 
           "</style></head>\n<body>\n<h1>"
        << html(o.title) << "</h1>\n"
        << head.str() << "<nav><ul>\n" << toc.str() << "<li><a href=\"#axes\">Cost against each axis</a></li>"
-       << "<li><a href=\"#table\">All points</a></li></ul></nav>\n"
+       << "<li><a href=\"#table\">All points</a></li>" << extraToc.str() << "</ul></nav>\n"
        << body.str() << "</body></html>\n";
   summary.html = dir / "report.html";
   summary.markdown = dir / "report.md";
