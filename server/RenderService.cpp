@@ -7,7 +7,6 @@
 #include <cmath>
 #include <iostream>
 #include <random>
-#include <string_view>
 
 namespace radiant::server {
 
@@ -246,13 +245,14 @@ RenderOutput RenderService::refine(RenderBackend& backend, const std::shared_ptr
   RenderOutput out;
   out.aovs = acc.mean();
   out.stats = std::move(last.stats);  // the last batch's passes and counters
+  // The last batch's snapshot holds the mean's scores and estimates (the accumulator has not changed since).
+  std::shared_ptr<const RefineSnapshot> now;
+  {
+    std::lock_guard lock(mutex_);
+    now = job->current;
+  }
   if (compare && !truth.pixels.empty()) {
     // The mean's scores, error map and ground truth, as a compare block gives them for one frame.
-    std::shared_ptr<const RefineSnapshot> now;
-    {
-      std::lock_guard lock(mutex_);
-      now = job->current;
-    }
     out.stats.metrics = now->metrics;
     for (const Image& m : out.aovs)
       if (m.aov == compare->aov) {
@@ -267,23 +267,17 @@ RenderOutput RenderService::refine(RenderBackend& backend, const std::shared_ptr
     }
     out.compareReference = std::move(truth);
   }
-  const double estimate = acc.estimatedRmse(spec.aov);
-  std::shared_ptr<const RefineSnapshot> lastSnapshot;
-  {
-    std::lock_guard lock(mutex_);
-    lastSnapshot = job->current;
-  }
-  const bool againstTruth = lastSnapshot && std::string_view(lastSnapshot->estimateKind) == "against_ground_truth";
-  const double reported = againstTruth ? lastSnapshot->estimatedRmse : estimate;
+  const double estimate = now->noiseRmse;
+  auto number = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
   out.stats.refinement = {{"batches", acc.batches()}, {"aov", spec.aov}, {"stopped_by", stop},
                           {"elapsed_ms", msBetween(start, Clock::now())},
-                          {"estimated_rmse", std::isfinite(reported) ? json(reported) : json(nullptr)},
-                          {"noise_rmse", std::isfinite(estimate) ? json(estimate) : json(nullptr)},
+                          {"estimated_rmse", number(now->estimatedRmse)},
+                          {"noise_rmse", number(estimate)},
                           {"seeds", {job->request.seed, batch.seed}},
                           // noise_only: the batches' variance (server/Refinement.h), blind to a biased
                           // pass's bias (photon_gi's kernel); against_ground_truth: the compare block's
                           // score of the mean, bias included (RefineSnapshot).
-                          {"estimate_kind", againstTruth ? "against_ground_truth" : "noise_only"}};
+                          {"estimate_kind", now->estimateKind}};
   // Scored against a ground truth on the refined AOV: the error splits as bias^2 + noise^2, so the part
   // the noise estimate does not explain (the bias, plus the ground truth's own noise) is measured.
   if (out.stats.metrics.is_object() && out.stats.metrics.value("aov", "") == spec.aov && std::isfinite(estimate)) {
