@@ -78,6 +78,51 @@ void resolveSupersampled(const std::vector<float>& rgba, int width, int height, 
     }
 }
 
+// resolveSupersampled on the GPU (shaders/common/supersample_resolve.comp): the k x k samples are
+// resolved into an output-sized RGBA32F texture and only that is read back, k^2 times fewer bytes and
+// no per-sample loop on the CPU (at 1920x1080, k = 2 on an H200 the readback of the full frame and its
+// CPU resolve took 150-250 ms, the passes 70-120 ms; docs/PERFORMANCE.md, "GPU check"). False (nothing
+// done) for a texture that texelFetch of a float sampler cannot read: integer formats.
+bool resolveSupersampledOnGpu(FrameResources& resources, gl::ShaderLibrary& shaders, const gl::Texture& samples,
+                              int k, const AovSource& src, Image& out) {
+  switch (samples.format()) {
+    case GL_RGBA16F: case GL_RGBA32F: case GL_RGB16F: case GL_RGB32F: case GL_RG16F: case GL_RG32F:
+    case GL_R16F: case GL_R32F: case GL_RGBA8: case GL_R11F_G11F_B10F: break;
+    default: return false;
+  }
+  const bool average = api::findAov(out.aov)->resolve == api::AovResolve::Average;
+  gl::Texture& resolved = resources.texture("supersample_resolve", GL_TEXTURE_2D, GL_RGBA32F, out.width, out.height);
+  const gl::Program& prog = shaders.program({"common/supersample_resolve.comp"});
+  prog.use();
+  const int outSize[2] = {out.width, out.height};
+  const int first[2] = {average ? 0 : k / 2, average ? 0 : k - 1 - k / 2};
+  glUniform2iv(glGetUniformLocation(prog.id(), "u_outSize"), 1, outSize);
+  glUniform2iv(glGetUniformLocation(prog.id(), "u_first"), 1, first);
+  prog.set("u_k", k);
+  prog.set("u_count", average ? k : 1);
+  // A sampler object with a non-mipmapped filter, so the samples' texture is complete for texelFetch
+  // whatever its own filter state.
+  GLuint sampler = 0;
+  glCreateSamplers(1, &sampler);
+  glSamplerParameteri(sampler, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glSamplerParameteri(sampler, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  samples.bindUnit(0);
+  glBindSampler(0, sampler);
+  resolved.bindImage(0, GL_WRITE_ONLY);
+  glDispatchCompute(static_cast<GLuint>((out.width + 7) / 8), static_cast<GLuint>((out.height + 7) / 8), 1);
+  glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
+  glBindSampler(0, 0);
+  glDeleteSamplers(1, &sampler);
+  std::vector<float> rgba(static_cast<std::size_t>(out.width) * out.height * 4);
+  resolved.download(0, GL_RGBA, GL_FLOAT, rgba.data(), rgba.size() * sizeof(float));
+  for (int y = 0; y < out.height; ++y) {
+    const float* row = &rgba[static_cast<std::size_t>(out.height - 1 - y) * out.width * 4];
+    for (int x = 0; x < out.width; ++x)
+      for (int c = 0; c < src.channels; ++c) out.at(x, y)[c] = row[x * 4 + src.firstChannel + c];
+  }
+  return true;
+}
+
 // The beauty as the camera sees it against the request's background (api::Background): each sample
 // that hit no surface (the G-buffer's position w is 0 there: the sky, an alpha-masked cut-out) shows the
 // background colour, or 0 when it is transparent, instead of the sky; then the k x k samples are resolved
@@ -684,7 +729,7 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
         if (std::find(aovs.begin(), aovs.end(), a) == aovs.end()) aovs.push_back(a);
     if (request.compare && std::find(aovs.begin(), aovs.end(), request.compare->aov) == aovs.end())
       aovs.push_back(request.compare->aov);
-    std::vector<float> rgba(static_cast<std::size_t>(view.width) * view.height * 4);
+    std::vector<float> rgba;  // the samples of an AOV resolved on the CPU (k = 1, or presentBackground)
     std::size_t nonFinite = 0;
     std::vector<ZeroedValues> zeroed;
     // The background (api::Background), applied to the beauty after compare (which scores the frame with
@@ -695,9 +740,15 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
       const AovSource src = aovSource(aov);
       Image img = Image::make(aov, outView.width, outView.height, src.channels);
       const bool drawn = im.resources.hasTexture(src.texture) && im.resources.written(aov);
+      // The beauty shown against another background needs its samples on the CPU (presentBackground).
+      const bool samplesNeeded = k == 1 || (aov == "beauty" && !environmentBehind);
       if (drawn) {
-        im.resources.texture(src.texture).download(0, GL_RGBA, GL_FLOAT, rgba.data(), rgba.size() * sizeof(float));
-        resolveSupersampled(rgba, view.width, view.height, k, src, img);
+        if (samplesNeeded ||
+            !resolveSupersampledOnGpu(im.resources, im.shaders, im.resources.texture(src.texture), k, src, img)) {
+          if (rgba.empty()) rgba.resize(static_cast<std::size_t>(view.width) * view.height * 4);
+          im.resources.texture(src.texture).download(0, GL_RGBA, GL_FLOAT, rgba.data(), rgba.size() * sizeof(float));
+          resolveSupersampled(rgba, view.width, view.height, k, src, img);
+        }
       } else if (aov == "beauty" || aov == "direct") {
         // Nothing was drawn (no geometry): the frame shows the sky.
         for (int i = 0; i < outView.width * outView.height; ++i)
