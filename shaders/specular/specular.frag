@@ -42,7 +42,7 @@ void main() {
   if (P.w <= 0.0 || abs(P.w - viewDepth) > 1e-3 * max(viewDepth, 1e-6) + 1e-6) discard;
 
   vec3 p = P.xyz;
-  vec3 n = texelFetch(t_normal, px, 0).xyz;
+  vec3 n = normalize(texelFetch(t_normal, px, 0).xyz);  // RGBA16F: unit only to ~5e-4 (direct.frag)
   vec4 mat = texelFetch(t_material, px, 0);  // metallic, roughness, occlusion, transmission
   vec3 albedo = texelFetch(t_albedo, px, 0).rgb;
   float ior = texelFetch(t_emission, px, 0).a;
