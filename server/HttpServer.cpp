@@ -911,7 +911,8 @@ int HttpServer::bind() {
     port = impl_->http.bind_to_any_port(impl_->config.host);
     if (port < 0) throw std::runtime_error("HttpServer::bind(): cannot bind " + impl_->config.host + " to any port");
   } else if (!impl_->http.bind_to_port(impl_->config.host, port)) {
-    throw std::runtime_error("HttpServer::bind(): cannot bind " + impl_->config.host + ":" + std::to_string(port));
+    throw std::runtime_error("HttpServer::bind(): cannot bind " + impl_->config.host + ":" + std::to_string(port) +
+                             " (in use by another process? --port 0 takes a free one)");
   }
   return port;
 }

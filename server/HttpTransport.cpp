@@ -106,6 +106,17 @@ private:
 
 void markCloseConnection() { tCloseConnection = true; }
 
+// cpp-httplib's default socket options add SO_REUSEPORT, so a second daemon started on a port already
+// in use bound it too and the kernel split the connections between the two: a render answered by one,
+// its frame fetched from the other, 404 (seen 2026-12-04 with two radiantd on one port). SO_REUSEADDR
+// alone still lets a restarted daemon bind over TIME_WAIT, and the second bind fails (HttpServer::bind).
+BoundedServer::BoundedServer() {
+  set_socket_options([](socket_t sock) {
+    int yes = 1;
+    setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, reinterpret_cast<const void*>(&yes), sizeof(yes));
+  });
+}
+
 bool BoundedServer::process_and_close_socket(socket_t sock) {
   const int one = 1;
   setsockopt(sock, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);

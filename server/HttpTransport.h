@@ -28,6 +28,7 @@ namespace radiant::server {
 
 class BoundedServer : public httplib::Server {
 public:
+  BoundedServer();
   struct Timeouts {
     double readS = 30;       // one request's headers and body, in total
     double keepAliveS = 2;   // idle between requests on one connection

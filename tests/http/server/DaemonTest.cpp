@@ -120,6 +120,27 @@ TEST(FakeDaemon, BadFlagsExitTwoAndTheTokenIsNeverAFlag) {
   }
 }
 
+// A second daemon on a port already in use exits 1 naming the port, and the first keeps it alone:
+// with cpp-httplib's default SO_REUSEPORT both bound it and the kernel split the connections between
+// them (a render on one, its frame fetched from the other: 404).
+TEST(FakeDaemon, ASecondDaemonOnAPortInUseExitsAndTheFirstKeepsIt) {
+  Daemon first(FAKE_RADIANTD_PATH, {"--port", "0"});
+  ASSERT_GT(first.port(), 0) << first.firstLine();
+  const auto dir = scratch("port-in-use");
+  Daemon second(FAKE_RADIANTD_PATH, {"--port", std::to_string(first.port())}, {}, dir / "stderr.log");
+  EXPECT_EQ(second.port(), 0) << "it said: " << second.firstLine();
+  EXPECT_EQ(second.wait(), 1);
+  const std::string log = slurp(dir / "stderr.log");
+  EXPECT_NE(log.find("cannot bind 127.0.0.1:" + std::to_string(first.port())), std::string::npos) << log;
+  for (int i = 0; i < 8; ++i) {  // every connection reaches the first daemon
+    auto r = first.client().Get("/v1/health");
+    ASSERT_TRUE(r);
+    EXPECT_EQ(r->status, 200);
+  }
+  first.signal(SIGTERM);
+  EXPECT_EQ(first.wait(), 0);
+}
+
 TEST(FakeDaemon, TokenFileAndConfigFile) {
   const auto dir = scratch("token");
   std::ofstream(dir / "token") << "hunter2\n";
