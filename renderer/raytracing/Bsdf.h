@@ -338,6 +338,25 @@ struct GltfBsdf {
   float clearcoatRoughness = 0.f;
   glm::vec3 coatNormal{0.f, 0.f, 1.f};
 
+  // The BSDF of a decoded material (MaterialDecode.h's decodeBsdfInputs; eta = ior, as seen from outside:
+  // RayScene::shade turns it for hits from inside).
+  static GltfBsdf fromParams(const gpu::MaterialParams& p, TransportMode mode = TransportMode::Radiance) {
+    GltfBsdf b;
+    b.baseColor = glm::vec3(p.baseColor);
+    b.metallic = p.surface.x;
+    b.roughness = p.surface.y;
+    b.transmission = p.surface.z;
+    b.mode = mode;
+    b.ior = b.eta = p.surface.w;
+    b.clearcoat = p.clearcoat.x;
+    b.clearcoatRoughness = p.clearcoat.y;
+    b.sheenColor = glm::vec3(p.sheen);
+    b.sheenRoughness = p.sheen.w;
+    b.specularColor = glm::vec3(p.specular);
+    b.specularWeight = p.specular.w;
+    return b;
+  }
+
   // 1 / eta^2 on refraction for radiance, 1 for importance.
   float refractionScale() const { return mode == TransportMode::Radiance ? 1.f / (eta * eta) : 1.f; }
 

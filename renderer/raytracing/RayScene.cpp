@@ -268,18 +268,7 @@ Shading RayScene::shade(const SurfaceHit& hit, const glm::vec3& wo, TransportMod
   // Factors x textures: the one C++ decoder (renderer/scene/MaterialDecode.h, twin of material.glsl).
   const gpu::MaterialParams params =
       decodeBsdfInputs(mat, [&](const TextureRef& ref, bool srgb) { return textureAt(ref, hit, srgb); });
-  s.bsdf.baseColor = glm::vec3(params.baseColor);
-  s.bsdf.metallic = params.surface.x;
-  s.bsdf.roughness = params.surface.y;
-  s.bsdf.transmission = params.surface.z;
-  s.bsdf.mode = mode;
-  s.bsdf.ior = params.surface.w;
-  s.bsdf.clearcoat = params.clearcoat.x;
-  s.bsdf.clearcoatRoughness = params.clearcoat.y;
-  s.bsdf.sheenColor = glm::vec3(params.sheen);
-  s.bsdf.sheenRoughness = params.sheen.w;
-  s.bsdf.specularColor = glm::vec3(params.specular);
-  s.bsdf.specularWeight = params.specular.w;
+  s.bsdf = GltfBsdf::fromParams(params, mode);
   const bool front = glm::dot(wo, hit.ng) >= 0.f;
   s.bsdf.eta = front ? s.bsdf.ior : 1.f / s.bsdf.ior;
   s.ngFacing = front ? hit.ng : -hit.ng;

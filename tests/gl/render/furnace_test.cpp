@@ -22,6 +22,7 @@
 
 #include "renderer/Renderer.h"
 #include "renderer/raytracing/Bsdf.h"
+#include "renderer/scene/MaterialDecode.h"
 #include "renderer/techniques/photon_gi/PhotonGi.h"
 #include "tests/support/RenderTestSupport.h"
 #include "tests/support/SceneBuilder.h"
@@ -180,15 +181,9 @@ double quadratureRadiance(const rt::GltfBsdf& f, double e0) {
   return l0;
 }
 
+// The reference's BSDF of the material: its one decoder, no textures.
 rt::GltfBsdf bsdfOf(const Material& m) {
-  rt::GltfBsdf f;
-  f.baseColor = glm::vec3(m.baseColorFactor);
-  f.metallic = m.metallicFactor;
-  f.roughness = m.roughnessFactor;
-  f.ior = f.eta = m.ior > 0.f ? m.ior : 1.5f;
-  f.specularWeight = m.specularFactor;
-  f.specularColor = m.specularColorFactor;
-  return f;
+  return rt::GltfBsdf::fromParams(decodeBsdfInputs(m, [](const TextureRef&, bool) { return glm::vec4(1.f); }));
 }
 
 Scene furnaceOf(const Material& m, const char* digest) {
