@@ -1,5 +1,8 @@
 #include "api/Types.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace radiant::api {
 
 namespace {
@@ -56,6 +59,12 @@ void to_json(nlohmann::json& j, const FrameStats& s) {
   }
   if (!s.budget.is_null()) j["budget"] = s.budget;
   if (!s.refinement.is_null()) j["refinement"] = s.refinement;
+}
+
+int defaultSupersampling(int width, int height) {
+  constexpr double kSamplesPerAxis = 512.0;
+  const double side = std::sqrt(std::max(1.0, double(width) * double(height)));
+  return std::clamp(int(std::ceil(kSamplesPerAxis / side - 1e-9)), 2, 4);
 }
 
 }  // namespace radiant::api

@@ -120,9 +120,9 @@ struct RenderRequest {
   // own light (black without lights or emission).
   bool defaultLighting = true;
   // Samples per pixel axis of the raster passes (the schema's "supersampling"): they run at (k width) x
-  // (k height) and readback resolves each AOV to width x height (api::AovResolve). The schema's default
-  // is 2 (what an HTTP request without the field gets, from parseRenderRequest); a RenderRequest built
-  // in C++ (the renderer's tests and benches) keeps 1, the single sample its expected values assume.
+  // (k height) and readback resolves each AOV to width x height (api::AovResolve). An HTTP request
+  // without the field gets defaultSupersampling(width, height) from parseRenderRequest; a RenderRequest
+  // built in C++ (the renderer's tests and benches) keeps 1, the single sample its expected values assume.
   int supersampling = 1;
   std::optional<CompareSpec> compare;
   bool async = false;
@@ -136,6 +136,13 @@ struct RenderRequest {
   // Particle systems added to the scene's own for this frame (api/Media.h), generators expanded.
   std::vector<ParticleSystem> media;
 };
+
+// The raster's samples per pixel axis when a request does not choose: at least 2, and enough that the
+// raster takes about 512 x 512 samples in all, up to 4 (128 x 128 px: 4; 200 x 200: 3; 256 x 256 and
+// larger: 2). A small frame's pixels each cover much of the scene: sub-pixel sun glints on normal-mapped
+// metal and whole environments reflected in a few pixels of a mirror sphere alias at 2 x 2 samples
+// (docs/PERFORMANCE.md, render fidelity), while its cost is mostly per frame, not per pixel.
+int defaultSupersampling(int width, int height);
 
 // Timing and counters for one pass that ran.
 struct PassStats {

@@ -45,11 +45,28 @@ TEST(Validate, MinimalRequestGetsEveryDefault) {
   EXPECT_FALSE(v.contains("compare"));
 }
 
-// The raster's anti-aliasing is on by default (issue 12's 30 dB goal, docs/PERFORMANCE.md), except under
-// a quality preset or a time budget, whose table (api/presets.json) was measured at one sample per pixel;
-// an explicit value always wins.
-TEST(Validate, SupersamplingDefaultsToTwoAndToOneUnderPresetsUnlessGiven) {
-  EXPECT_EQ(parseRenderRequest(minimal()).supersampling, 2);
+// The raster's anti-aliasing is on by default (issue 12's 30 dB goal, issue 29's fidelity goal,
+// docs/PERFORMANCE.md): enough samples per pixel axis for about 512 x 512 raster samples, 2 to 4;
+// except under a quality preset or a time budget, whose table (api/presets.json) was measured at one
+// sample per pixel; an explicit value always wins.
+TEST(Validate, SupersamplingDefaultsByFrameSizeAndToOneUnderPresetsUnlessGiven) {
+  EXPECT_EQ(parseRenderRequest(minimal()).supersampling, 2);  // 256 x 256
+  auto sized = [](int w, int h) {
+    json r = minimal();
+    r["width"] = w;
+    r["height"] = h;
+    return parseRenderRequest(r).supersampling;
+  };
+  EXPECT_EQ(sized(128, 128), 4);   // 512 / 128 = 4
+  EXPECT_EQ(sized(32, 32), 4);     // capped at 4
+  EXPECT_EQ(sized(200, 200), 3);   // ceil(2.56)
+  EXPECT_EQ(sized(171, 171), 3);   // ceil(2.994)
+  EXPECT_EQ(sized(170, 170), 4);   // ceil(3.01)
+  EXPECT_EQ(sized(256, 256), 2);   // exactly 2
+  EXPECT_EQ(sized(512, 128), 2);   // sqrt(512 128) = 256: by pixel count, not the short side
+  EXPECT_EQ(sized(1920, 1080), 2);  // floored at 2
+  EXPECT_EQ(radiant::api::defaultSupersampling(1, 1), 4);
+  EXPECT_EQ(radiant::api::defaultSupersampling(4096, 4096), 2);
   json q = minimal();
   q["quality"] = "final";
   EXPECT_EQ(parseRenderRequest(q).supersampling, 1);
