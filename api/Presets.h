@@ -98,6 +98,16 @@ struct BudgetChoice {
 //
 // `counts`: the frame's scene counts (the models' "particles" and "beams"); stats.scene_counts echoes them.
 //
+// Pixels: `request` is the supersampled one (width and height times its `supersampling` k): every model
+// is charged the raster's pixels but photon_gi's, charged the output's (costPixels).
+//
+// The server's default frame budget (limits->defaultFrameBudgetMs > 0, radiantd
+// --default-frame-budget-ms): a request with neither quality nor time_budget_ms that names no passes
+// (request.passesNamed false: the planner's default frame), whose default configuration is predicted
+// (times `speed`) above it, gets the choice for time_budget_ms = that budget, active, with
+// stats.default_frame_budget {budget_ms, predicted_default_ms, flag} and a first warning saying so. A
+// frame with an unmodelled technique (no prediction) or that names its passes runs as asked.
+//
 // `speed`: this machine's measured time over the table's prediction (MachineSpeed::factor): every
 // predicted ms (the techniques', the overhead's, the frame's) is the table's times `speed`, so that a
 // budget is met on a machine slower or faster than the one the table was measured on. Budget B at
@@ -108,9 +118,15 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
 
 // Predicted ms of a whole frame in the table's units (speed 1): the overhead plus every planned
 // technique's model with `params` (technique -> complete parameters); < 0 when a planned technique has
-// no model (the frame cannot be compared with the table).
+// no model (the frame cannot be compared with the table). `pixels`: the raster's, at `supersampling`.
 double predictFrameMs(const PresetTable& table, const std::vector<std::string>& planned,
-                      const std::map<std::string, nlohmann::json>& params, double pixels, const SceneCounts& counts);
+                      const std::map<std::string, nlohmann::json>& params, double pixels, const SceneCounts& counts,
+                      int supersampling = 1);
+
+// The `pixels` a technique's cost model is evaluated at, for a frame whose raster has `rasterPixels`
+// at supersampling k: the raster's for every pass but photon_gi, whose gather follows the output
+// pixels (its gather_step is in output pixels), so rasterPixels / k^2 there.
+double costPixels(const std::string& technique, double rasterPixels, int supersampling);
 
 // How fast this machine runs the preset table's frames: measured frame ms over the table's prediction
 // for the same frame (both without a compare block's reference). The budget chooser multiplies every

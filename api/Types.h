@@ -107,6 +107,9 @@ struct RenderRequest {
   std::map<std::string, nlohmann::json> passes;
   // Techniques the request turned off ("passes": {"specular": false}); the planner skips them.
   std::set<std::string> disabledPasses;
+  // The request gave a "passes" object of its own (named, turned on or off, or parameterised a pass):
+  // it runs as asked, never lowered to the server's default frame budget (api/Presets.h).
+  bool passesNamed = false;
   std::vector<OutputSpec> outputs{OutputSpec{}};
   float exposure = 0.f;  // EV; PNG = sRGB(toneMap(L * 2^exposure))
   ToneMap toneMap = ToneMap::Aces;  // the view transform of PNG output (also in each OutputSpec)

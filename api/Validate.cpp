@@ -505,6 +505,7 @@ RenderRequest parseRenderRequest(const json& body, const RequestLimits& limits) 
   }
   r.async = v["async"];
   // The parameters the request gave itself win over quality and time_budget_ms (api/Presets.h, chooseConfiguration).
+  r.passesNamed = body.contains("passes");
   if (body.contains("passes"))
     for (const auto& [name, params] : body["passes"].items())
       if (params.is_object())

@@ -59,6 +59,11 @@ struct RequestLimits {
   // Iterations of an iterative solver in one request (x-cost "iterations": illumination_network's
   // passes over every node and direction) (radiantd --max-iterations).
   int maxIterations = 1024;
+  // The server's default frame budget in ms (radiantd --default-frame-budget-ms; 0 = none): a request
+  // that names no quality, no time_budget_ms and no passes, whose default configuration the preset
+  // table predicts above it, is rendered as if it had asked for time_budget_ms = this, with a warning
+  // (api::chooseConfiguration). Not a cap: a request that names its passes runs as asked.
+  double defaultFrameBudgetMs = 0;
 };
 
 // The limit an "x-cost" kind is capped by, and the radiantd flag that sets it; nullopt for "none".

@@ -615,6 +615,7 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     api::RenderRequest supersampled = request;
     supersampled.width *= k;
     supersampled.height *= k;
+    supersampled.supersampling = k;  // the k used (capped; 1 with the reference): api::costPixels reads it
     FrameView supersampledView = makeFrameView(scene, supersampled, inputs.environment);
     supersampledView.supersampling = k;
     // The environment's compact bright regions become shadowed directional lights of the raster when
@@ -769,7 +770,7 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     // This frame's time against the table's prediction (before compare's reference, which the table
     // does not model): the speed factor's evidence when the frame is comparable with the table.
     im.lastFrame = {msSince(frameStart), api::predictFrameMs(api::PresetTable::builtin(), planned, choice.params,
-                                                             double(supersampled.width) * supersampled.height, counts)};
+                                                             double(supersampled.width) * supersampled.height, counts, k)};
     if (choice.active) {
       stats.budget = std::move(choice.stats);
       stats.budget["speed"] = speedState;

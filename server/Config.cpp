@@ -57,6 +57,12 @@ std::string usage() {
                             budgets scale every predicted cost by; auto (the default) measures it: a
                             calibration frame before the first budgeted frame, then recent frames
                             (docs/API.md, "Presets and budgets"); a number pins it
+  --default-frame-budget-ms MS
+                            a request that names no quality, time_budget_ms or passes, whose default
+                            configuration the preset table (times the speed factor) predicts above MS,
+                            renders the time budget's choice for MS instead, with a warning; 0 = off
+                            (default 10000, sized for a 256x256 default frame on a 2-core llvmpipe machine;
+                            docs/API.md, "Presets and budgets")
   --read-timeout S          seconds to receive one request, headers and body (default 30)
   --keep-alive-timeout S    seconds an idle keep-alive connection stays open (default 2)
   --shutdown-grace S        after SIGTERM, seconds frame and job GETs are still served (default 10)
@@ -143,6 +149,7 @@ void apply(ServerConfig& c, const std::string& name, const std::string& v, std::
       throw std::invalid_argument(flag + ": " + v + " is outside [1/64, 64]");
   }
   else if (name == "scene-cache-bytes") c.sceneCacheBytes = static_cast<std::size_t>(toInt(flag, v, 1 << 20, 1ll << 40));
+  else if (name == "default-frame-budget-ms") c.limits.defaultFrameBudgetMs = v == "0" ? 0.0 : toDouble(flag, v);
   else if (name == "read-timeout") c.readTimeoutS = toDouble(flag, v);
   else if (name == "keep-alive-timeout") c.keepAliveTimeoutS = toDouble(flag, v);
   else if (name == "shutdown-grace") c.shutdownGraceS = v == "0" ? 0.0 : toDouble(flag, v);

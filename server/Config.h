@@ -18,7 +18,7 @@ struct ServerConfig {
   std::string assetRoot;               // scene.asset paths resolve here ("" = scene.asset refused)
   std::string token;                   // bearer token ("" = no auth), read from token_file
   std::size_t maxBodyBytes = 64u << 20;
-  api::RequestLimits limits;
+  api::RequestLimits limits{.defaultFrameBudgetMs = 10000};  // --default-frame-budget-ms: on in the daemon
   int maxQueue = 16;                   // jobs waiting (the running one not counted)
   double requestTimeoutS = 300;        // submit -> frames encoded; a timed-out job frees its slot
   double frameTtlS = 600;              // frames and finished async jobs are kept this long

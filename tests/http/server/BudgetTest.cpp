@@ -219,6 +219,58 @@ TEST(Budgets, LargerBudgetsNeverGiveLargerErrorsAndRunTheChoosersChoice) {
 // A daemon capped below the table's dearer photon_gi points (radiantd --max-photons): the preset and
 // the budget run the best point within the cap, the pass traces that many photons, and the stats say
 // what the cap excluded. An explicit request above the cap is still refused (422, the field named).
+// Issue 31's default frame budget (radiantd --default-frame-budget-ms): the planner's default frame of
+// cornell_box (photon_gi at its schema default: about 2 s predicted at 256 x 256, over a second at
+// 32 x 32, mostly photon tracing) against a 50 ms budget renders what the chooser picks for
+// time_budget_ms 50, says so first in stats.warnings and in stats.budget.default_frame_budget; the same
+// request naming its passes runs as asked (no budget block, photon_gi's own parameters).
+TEST(Budgets, TheDefaultFrameBudgetLowersOnlyTheDefaultFrame) {
+  RealDaemon d("default-budget", {"--speed-factor", "1", "--default-frame-budget-ms", "50"});
+  ASSERT_TRUE(d.ready()) << testing::slurp(d.dir / "stderr.log");
+  const json body = cornell(32, 0);
+  const json r = d.render(body);
+  ASSERT_TRUE(r.contains("stats")) << r.dump();
+  const json& stats = r["stats"];
+  const json& b = stats["budget"];
+  ASSERT_TRUE(b.is_object()) << stats.dump();
+  ASSERT_TRUE(b.contains("default_frame_budget")) << b.dump();
+  EXPECT_EQ(b["default_frame_budget"]["budget_ms"], 50.0);
+  EXPECT_EQ(b["default_frame_budget"]["flag"], "--default-frame-budget-ms");
+  const double predictedDefault = b["default_frame_budget"]["predicted_default_ms"];
+  EXPECT_GT(predictedDefault, 50.0);
+  EXPECT_LT(b["predicted_ms"].get<double>(), predictedDefault);
+  ASSERT_FALSE(stats["warnings"].empty());
+  EXPECT_NE(stats["warnings"][0].get<std::string>().find("--default-frame-budget-ms"), std::string::npos)
+      << stats["warnings"].dump();
+  // The chooser's choice for the same frame under the same limit, at the k the daemon used.
+  api::RenderRequest request = api::parseRenderRequest(body);
+  const int k = stats["supersampling"];
+  EXPECT_EQ(k, api::defaultSupersampling(32, 32));
+  request.width *= k;
+  request.height *= k;
+  request.supersampling = k;
+  std::vector<std::string> planned;
+  for (const auto& p : stats["passes"]) planned.push_back(p["name"]);
+  api::SceneCounts counts;
+  counts.particles = b["scene_counts"]["particles"];
+  counts.beams = b["scene_counts"]["beams"];
+  api::RequestLimits limits;
+  limits.defaultFrameBudgetMs = 50;
+  const api::BudgetChoice local = api::chooseConfiguration(api::PresetTable::builtin(), planned, request, &limits, counts, 1.0);
+  ASSERT_TRUE(local.active);
+  EXPECT_EQ(b["techniques"]["photon_gi"]["params"], local.stats["techniques"]["photon_gi"]["params"]) << b.dump();
+  EXPECT_NEAR(predictedDefault, local.stats["default_frame_budget"]["predicted_default_ms"].get<double>(), 1e-9 * predictedDefault);
+
+  // Named passes: as asked.
+  json named = body;
+  named["passes"] = {{"photon_gi", json::object()}};
+  const json n = d.render(named);
+  ASSERT_TRUE(n.contains("stats")) << n.dump();
+  EXPECT_TRUE(!n["stats"].contains("budget") || n["stats"]["budget"].is_null()) << n["stats"].dump();
+  for (const auto& w : n["stats"]["warnings"])
+    EXPECT_EQ(w.get<std::string>().find("--default-frame-budget-ms"), std::string::npos) << w;
+}
+
 TEST(Budgets, PresetsAndBudgetsStayWithinTheDaemonsCaps) {
   const json& front = tableEntry("photon_gi")["front"];
   ASSERT_TRUE(front.is_array() && front.size() >= 3);

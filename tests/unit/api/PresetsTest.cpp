@@ -498,6 +498,83 @@ TEST(Presets, ASpeedFactorScalesEveryPredictionAndTheBudgetWithIt) {
   EXPECT_LT(predictFrameMs(t, kPlanned, c.params, 1e4, {}), 0.0);
 }
 
+// photon_gi's gather follows the output pixels (its gather_step is in output pixels), every other model
+// the raster's: a frame at supersampling k charges photon_gi pixels / k^2 (measured on cornell_box at
+// 256 x 256: k = 2 cost 1.14x of k = 1 where the raster's pixels predicted 4x).
+TEST(Presets, PhotonGiIsChargedTheOutputPixelsAndTheOthersTheRasters) {
+  const PresetTable t(syntheticTable());
+  EXPECT_DOUBLE_EQ(costPixels("photon_gi", 4e4, 2), 1e4);
+  EXPECT_DOUBLE_EQ(costPixels("photon_gi", 9e4, 3), 1e4);
+  EXPECT_DOUBLE_EQ(costPixels("direct", 4e4, 2), 4e4);
+  EXPECT_DOUBLE_EQ(costPixels("photon_gi", 1e4, 0), 1e4);  // k < 1 is 1
+  // A supersampled request (raster 200 x 200 at k = 2) under a budget: direct at 4e4 pixels, photon_gi at 1e4.
+  RenderRequest r = request({{"time_budget_ms", 1}, {"supersampling", 2}});
+  r.width = r.height = 200;
+  const BudgetChoice c = chooseConfiguration(t, kPlanned, r);
+  EXPECT_DOUBLE_EQ(c.stats["techniques"]["direct"]["predicted_ms"].get<double>(), 0.5 + 1e-5 * 4e4);
+  EXPECT_DOUBLE_EQ(c.stats["techniques"]["photon_gi"]["predicted_ms"].get<double>(), 2 + 1e-4 * 20000 + 1e-5 * 1e4 * 100);
+  const std::vector<std::string> modelled{"direct", "photon_gi"};
+  EXPECT_DOUBLE_EQ(predictFrameMs(t, modelled, c.params, 4e4, {}, 2),
+                   3 + 0.5 + 1e-5 * 4e4 + 2 + 1e-4 * 20000 + 1e-5 * 1e4 * 100);
+}
+
+// The server's default frame budget (radiantd --default-frame-budget-ms): the planner's default frame
+// (no quality, no budget, no passes named) predicted above it renders the budget's choice, says so in
+// its first warning and in stats.default_frame_budget; under it, or with passes named, or without the
+// limit, the request's own parameters run and nothing is active.
+TEST(Presets, TheDefaultFrameBudgetLowersOnlyAnUnnamedDefaultFramePredictedAboveIt) {
+  const PresetTable t(syntheticTable());
+  const std::vector<std::string> modelled{"direct", "photon_gi", "ambient_occlusion"};
+  RenderRequest plain = request({{"supersampling", 1}});  // 100 x 100 at k = 1
+  ASSERT_FALSE(plain.passesNamed);
+  const BudgetChoice asked = chooseConfiguration(t, modelled, plain);
+  ASSERT_FALSE(asked.active);
+  // The default configuration's prediction (photon_gi's schema default, ambient_occlusion's, direct).
+  const double predicted = predictFrameMs(t, modelled, asked.params, 1e4, {});
+  ASSERT_GT(predicted, 30.0);
+  RequestLimits limits;
+  for (double speed : {1.0, 2.5}) {
+    SCOPED_TRACE(speed);
+    // Above the budget: the time budget's choice, active, with the default's prediction in the stats.
+    limits.defaultFrameBudgetMs = 0.5 * predicted * speed;
+    const BudgetChoice lowered = chooseConfiguration(t, modelled, plain, &limits, {}, speed);
+    ASSERT_TRUE(lowered.active);
+    RenderRequest budgeted = plain;
+    budgeted.timeBudgetMs = limits.defaultFrameBudgetMs;
+    const BudgetChoice same = chooseConfiguration(t, modelled, budgeted, &limits, {}, speed);
+    for (const auto& name : modelled) EXPECT_EQ(lowered.params.at(name), same.params.at(name)) << name;
+    const json& d = lowered.stats["default_frame_budget"];
+    EXPECT_EQ(d["budget_ms"], limits.defaultFrameBudgetMs);
+    EXPECT_NEAR(d["predicted_default_ms"].get<double>(), predicted * speed, 1e-9 * predicted * speed);
+    EXPECT_EQ(d["flag"], "--default-frame-budget-ms");
+    EXPECT_FALSE(lowered.stats.contains("time_budget_ms"));
+    EXPECT_LE(lowered.stats["predicted_ms"].get<double>(), predicted * speed);
+    ASSERT_FALSE(lowered.warnings.empty());
+    EXPECT_NE(lowered.warnings[0].find("--default-frame-budget-ms"), std::string::npos) << lowered.warnings[0];
+    // At or above the prediction: as asked.
+    limits.defaultFrameBudgetMs = predicted * speed * 1.0001;
+    const BudgetChoice fits = chooseConfiguration(t, modelled, plain, &limits, {}, speed);
+    EXPECT_FALSE(fits.active);
+    for (const auto& name : modelled) EXPECT_EQ(fits.params.at(name), asked.params.at(name)) << name;
+    EXPECT_TRUE(fits.warnings.empty());
+  }
+  // Passes named: never lowered, however small the budget.
+  limits.defaultFrameBudgetMs = 1;
+  RenderRequest named = request({{"supersampling", 1}, {"passes", {{"photon_gi", json::object()}}}});
+  ASSERT_TRUE(named.passesNamed);
+  EXPECT_FALSE(chooseConfiguration(t, modelled, named, &limits).active);
+  // An unmodelled technique planned (gbuffer here): no prediction, so no lowering.
+  EXPECT_FALSE(chooseConfiguration(t, kPlanned, plain, &limits).active);
+  // No limit: off.
+  limits.defaultFrameBudgetMs = 0;
+  EXPECT_FALSE(chooseConfiguration(t, modelled, plain, &limits).active);
+  // An explicit quality or budget is the request's own choice, not the default's.
+  limits.defaultFrameBudgetMs = 1;
+  const BudgetChoice q = chooseConfiguration(t, modelled, request({{"quality", "final"}}), &limits);
+  EXPECT_TRUE(q.active);
+  EXPECT_FALSE(q.stats.contains("default_frame_budget"));
+}
+
 // The speed factor's estimate: pinned wins; else the median of the calibration and the last kWindow
 // frames (one stray frame does not move it, a lasting change of load does within half the window);
 // ratios are clamped to [1/64, 64] and times that are not positive finite numbers are ignored.
