@@ -393,6 +393,24 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
   return c;
 }
 
+int supersamplingWithinDefaultBudget(const PresetTable& table, const std::vector<std::string>& planned,
+                                     const RenderRequest& request, int k, const RequestLimits* limits,
+                                     const SceneCounts& counts, double speed) {
+  const double budget = limits ? limits->defaultFrameBudgetMs : 0.0;
+  if (!(budget > 0) || k <= 1 || request.supersamplingGiven || request.passesNamed || !request.quality.empty() ||
+      request.timeBudgetMs > 0)
+    return k;
+  if (!(speed > 0.0) || !std::isfinite(speed)) speed = 1.0;
+  const BudgetChoice defaults = chooseConfiguration(table, planned, request, nullptr, counts, speed);
+  const double outputPixels = double(request.width) * request.height;
+  for (; k > 1; --k) {
+    const double ms = predictFrameMs(table, planned, defaults.params, outputPixels * k * k, counts, k);
+    if (ms < 0) return k;  // a pass the table does not model: no prediction, as asked
+    if (ms * speed <= budget) return k;
+  }
+  return 1;
+}
+
 double predictFrameMs(const PresetTable& table, const std::vector<std::string>& planned,
                       const std::map<std::string, json>& params, double pixels, const SceneCounts& counts,
                       int supersampling) {

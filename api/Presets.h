@@ -116,6 +116,16 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
                                  const RenderRequest& request, const RequestLimits* limits = nullptr,
                                  const SceneCounts& counts = {}, double speed = 1.0);
 
+// The default frame budget's first knob (see chooseConfiguration): for a default frame (no quality, no
+// time_budget_ms, no passes named) whose supersampling is the default one, the largest k' <= k at which
+// the default configuration's predicted ms (times `speed`) fits limits->defaultFrameBudgetMs, or 1;
+// k itself otherwise. `request` is the output-size one; `planned` the frame's passes. Supersampling
+// goes first because the budget binds on large frames, where the raster's extra samples buy the least
+// (its cost is k^2 of every raster pass and of the readback).
+int supersamplingWithinDefaultBudget(const PresetTable& table, const std::vector<std::string>& planned,
+                                     const RenderRequest& request, int k, const RequestLimits* limits,
+                                     const SceneCounts& counts = {}, double speed = 1.0);
+
 // Predicted ms of a whole frame in the table's units (speed 1): the overhead plus every planned
 // technique's model with `params` (technique -> complete parameters); < 0 when a planned technique has
 // no model (the frame cannot be compared with the table). `pixels`: the raster's, at `supersampling`.

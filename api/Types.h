@@ -127,6 +127,7 @@ struct RenderRequest {
   // without the field gets defaultSupersampling(width, height) from parseRenderRequest; a RenderRequest
   // built in C++ (the renderer's tests and benches) keeps 1, the single sample its expected values assume.
   int supersampling = 1;
+  bool supersamplingGiven = false;  // the request chose it (the default frame budget may lower a default one)
   std::optional<CompareSpec> compare;
   bool async = false;
   // A quality preset ("" none, draft, preview, final, reference) or a frame time budget (0 none), both

@@ -495,7 +495,8 @@ RenderRequest parseRenderRequest(const json& body, const RequestLimits& limits) 
   r.ambient = vec3(v["ambient"]);
   r.environment = v["environment"].get<std::string>();
   r.defaultLighting = v["default_lighting"].get<bool>();
-  r.supersampling = body.contains("supersampling") ? v["supersampling"].get<int>() : defaultSupersampling(r.width, r.height);
+  r.supersamplingGiven = body.contains("supersampling");
+  r.supersampling = r.supersamplingGiven ? v["supersampling"].get<int>() : defaultSupersampling(r.width, r.height);
   if (!r.environment.empty() && r.ambient != glm::vec3(0.f))
     throw ApiError(422, "invalid-value", "Invalid value",
                    "/environment: give the sky either as ambient or as an environment map, not both", "/environment");

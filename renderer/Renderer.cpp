@@ -608,9 +608,22 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     FramePlan plan = planFrame(all, scene, request);
     // The passes run on the supersampled view; readback resolves to outView (the request's size), on
     // which compare() renders the reference.
-    const int k = rasterSupersampling(
+    int k = rasterSupersampling(
         request.supersampling, request.width, request.height,
         std::any_of(plan.passes.begin(), plan.passes.end(), [](const Technique* t) { return t->info().name == "reference"; }));
+    std::vector<std::string> planned;
+    for (Technique* t : plan.passes) planned.push_back(t->info().name);
+    // The cost models' scene variables (particles of the scene and the request's media, light_volumes' beams).
+    const api::SceneCounts counts = sceneCostCounts(scene, request.media);
+    // The server's default frame budget lowers a default supersampling first (api/Presets.h).
+    if (const int within = api::supersamplingWithinDefaultBudget(api::PresetTable::builtin(), planned, request, k,
+                                                                 inputs.limits, counts, im.speed.factor());
+        within < k) {
+      stats.warnings.push_back("supersampling " + std::to_string(within) + " instead of the default " + std::to_string(k) +
+                               ": at " + std::to_string(k) + " the default frame is predicted above this server's default "
+                               "frame budget (radiantd --default-frame-budget-ms); give \"supersampling\" to choose");
+      k = within;
+    }
     stats.supersampling = k;
     api::RenderRequest supersampled = request;
     supersampled.width *= k;
@@ -657,10 +670,6 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     std::vector<Params> params(plan.passes.size());
     // quality / time_budget_ms: each planned technique's parameters from the preset table (api/Presets.h);
     // without them, the request's own.
-    std::vector<std::string> planned;
-    for (Technique* t : plan.passes) planned.push_back(t->info().name);
-    // The cost models' scene variables (particles of the scene and the request's media, light_volumes' beams).
-    const api::SceneCounts counts = sceneCostCounts(scene, request.media);
     stats.scene["counts"] = counts.toJson();
     // The supersampled request: the cost models' `pixels` are the raster's (the table was measured at
     // k = 1, so a request that keeps its own supersampling under a budget is charged k^2 the pixels:

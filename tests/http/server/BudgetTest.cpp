@@ -221,9 +221,10 @@ TEST(Budgets, LargerBudgetsNeverGiveLargerErrorsAndRunTheChoosersChoice) {
 // what the cap excluded. An explicit request above the cap is still refused (422, the field named).
 // Issue 31's default frame budget (radiantd --default-frame-budget-ms): the planner's default frame of
 // cornell_box (photon_gi at its schema default: about 2 s predicted at 256 x 256, over a second at
-// 32 x 32, mostly photon tracing) against a 50 ms budget renders what the chooser picks for
-// time_budget_ms 50, says so first in stats.warnings and in stats.budget.default_frame_budget; the same
-// request naming its passes runs as asked (no budget block, photon_gi's own parameters).
+// 32 x 32, mostly photon tracing) against a 50 ms budget first drops its default supersampling to 1
+// (no k fits) and then renders what the chooser picks for time_budget_ms 50, saying both in
+// stats.warnings and stats.budget.default_frame_budget; the same request naming its passes runs as
+// asked (no budget block, the default supersampling, photon_gi's own parameters).
 TEST(Budgets, TheDefaultFrameBudgetLowersOnlyTheDefaultFrame) {
   RealDaemon d("default-budget", {"--speed-factor", "1", "--default-frame-budget-ms", "50"});
   ASSERT_TRUE(d.ready()) << testing::slurp(d.dir / "stderr.log");
@@ -239,13 +240,15 @@ TEST(Budgets, TheDefaultFrameBudgetLowersOnlyTheDefaultFrame) {
   const double predictedDefault = b["default_frame_budget"]["predicted_default_ms"];
   EXPECT_GT(predictedDefault, 50.0);
   EXPECT_LT(b["predicted_ms"].get<double>(), predictedDefault);
-  ASSERT_FALSE(stats["warnings"].empty());
-  EXPECT_NE(stats["warnings"][0].get<std::string>().find("--default-frame-budget-ms"), std::string::npos)
+  ASSERT_GE(stats["warnings"].size(), 2u);
+  EXPECT_NE(stats["warnings"][0].get<std::string>().find("supersampling 1 instead of the default 4"), std::string::npos)
+      << stats["warnings"].dump();
+  EXPECT_NE(stats["warnings"][1].get<std::string>().find("--default-frame-budget-ms"), std::string::npos)
       << stats["warnings"].dump();
   // The chooser's choice for the same frame under the same limit, at the k the daemon used.
   api::RenderRequest request = api::parseRenderRequest(body);
   const int k = stats["supersampling"];
-  EXPECT_EQ(k, api::defaultSupersampling(32, 32));
+  EXPECT_EQ(k, 1);
   request.width *= k;
   request.height *= k;
   request.supersampling = k;
@@ -267,6 +270,7 @@ TEST(Budgets, TheDefaultFrameBudgetLowersOnlyTheDefaultFrame) {
   const json n = d.render(named);
   ASSERT_TRUE(n.contains("stats")) << n.dump();
   EXPECT_TRUE(!n["stats"].contains("budget") || n["stats"]["budget"].is_null()) << n["stats"].dump();
+  EXPECT_EQ(n["stats"]["supersampling"], api::defaultSupersampling(32, 32));
   for (const auto& w : n["stats"]["warnings"])
     EXPECT_EQ(w.get<std::string>().find("--default-frame-budget-ms"), std::string::npos) << w;
 }

@@ -575,6 +575,39 @@ TEST(Presets, TheDefaultFrameBudgetLowersOnlyAnUnnamedDefaultFramePredictedAbove
   EXPECT_FALSE(q.stats.contains("default_frame_budget"));
 }
 
+// The default frame budget's first knob: a default supersampling is lowered to the largest k whose
+// predicted default frame fits the budget (1 when none does); an explicit one, named passes, a quality
+// or a time budget keep theirs, as does a frame with an unmodelled pass.
+TEST(Presets, TheDefaultFrameBudgetLowersADefaultSupersamplingFirst) {
+  const PresetTable t(syntheticTable());
+  const std::vector<std::string> modelled{"direct", "photon_gi", "ambient_occlusion"};
+  RenderRequest plain = request(json::object());  // 100 x 100, default supersampling 4
+  ASSERT_FALSE(plain.supersamplingGiven);
+  ASSERT_EQ(plain.supersampling, 4);
+  const BudgetChoice asked = chooseConfiguration(t, modelled, plain);
+  auto at = [&](int k) { return predictFrameMs(t, modelled, asked.params, 1e4 * k * k, {}, k); };
+  ASSERT_LT(at(2), at(3));
+  ASSERT_LT(at(3), at(4));
+  RequestLimits limits;
+  for (int want : {1, 2, 3, 4}) {
+    limits.defaultFrameBudgetMs = at(want) * 1.0001;
+    EXPECT_EQ(supersamplingWithinDefaultBudget(t, modelled, plain, 4, &limits), want) << want;
+    // At speed 2 the same budget fits what half of it fits at speed 1.
+    limits.defaultFrameBudgetMs = 2 * at(want) * 1.0001;
+    EXPECT_EQ(supersamplingWithinDefaultBudget(t, modelled, plain, 4, &limits, {}, 2.0), want) << want;
+  }
+  limits.defaultFrameBudgetMs = 0.5 * at(1);
+  EXPECT_EQ(supersamplingWithinDefaultBudget(t, modelled, plain, 4, &limits), 1);
+  EXPECT_EQ(supersamplingWithinDefaultBudget(t, modelled, plain, 4, nullptr), 4);
+  EXPECT_EQ(supersamplingWithinDefaultBudget(t, kPlanned, plain, 4, &limits), 4);  // gbuffer: no model
+  RenderRequest given = request({{"supersampling", 4}});
+  EXPECT_EQ(supersamplingWithinDefaultBudget(t, modelled, given, 4, &limits), 4);
+  RenderRequest named = request({{"passes", {{"direct", json::object()}}}});
+  EXPECT_EQ(supersamplingWithinDefaultBudget(t, modelled, named, 4, &limits), 4);
+  RenderRequest budgeted = request({{"time_budget_ms", 1000}, {"supersampling", 3}});
+  EXPECT_EQ(supersamplingWithinDefaultBudget(t, modelled, budgeted, 3, &limits), 3);
+}
+
 // The speed factor's estimate: pinned wins; else the median of the calibration and the last kWindow
 // frames (one stray frame does not move it, a lasting change of load does within half the window);
 // ratios are clamped to [1/64, 64] and times that are not positive finite numbers are ignored.
