@@ -38,10 +38,14 @@ struct BackendHooks {
   // Runs on the render thread; throws when no context can be created (the server retries with
   // backoff and /v1/ready says why).
   std::function<std::unique_ptr<RenderBackend>()> createBackend;
+  // Memory admission for decoding (radiantd --decode-memory-bytes): a decoder calls it with each
+  // allocation's size before making it; it may wait for memory other decodes hold and throws
+  // api::ApiError 503 decode-busy when none frees in time, which the decoder passes on.
+  using Reserve = std::function<void(std::size_t bytes)>;
   // glTF JSON or GLB bytes -> Scene. Throws api::ApiError (422) for files it cannot load.
-  std::function<Scene(std::string_view bytes)> decodeScene;
+  std::function<Scene(std::string_view bytes, const Reserve& reserve)> decodeScene;
   // EXR/HDR/PNG bytes -> Image, for compare.against an uploaded image. Throws api::ApiError (422).
-  std::function<Image(std::string_view bytes)> decodeImage;
+  std::function<Image(std::string_view bytes, const Reserve& reserve)> decodeImage;
   std::function<std::vector<std::string>()> builtinSceneNames;
   std::function<std::string(const std::string& name)> builtinSceneSource;  // glTF/GLB bytes
   // One output file: EXR of every AOV in spec.aovs, or PNG of the single one with exposure applied.

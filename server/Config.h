@@ -33,7 +33,7 @@ struct ServerConfig {
   bool glDebug = false;
   // Hardening (docs/API.md, "Limits"): every budget a hostile input could exhaust is a flag.
   std::size_t maxDecodeBytes = std::size_t(512) << 20;     // decoded images + expanded accessors of one scene or image
-  // All decodes at once: max(1, decodeMemoryBytes / maxDecodeBytes) run concurrently (HttpServer.cpp DecodeGate).
+  // Bytes all decodes in flight may reserve together, at least maxDecodeBytes (HttpServer.cpp DecodeMemory).
   std::size_t decodeMemoryBytes = std::size_t(1024) << 20;
   std::size_t sceneCacheBytes = std::size_t(1024) << 20;   // decoded scenes kept in memory, in bytes
   double speedFactor = 0.0;            // time budgets' speed factor: 0 measures it, > 0 pins it (--speed-factor)

@@ -205,50 +205,65 @@ using DecodedScenes = DecodedCache<Scene, sceneBytes>;
 // request): the last 4 at most, within half of --scene-cache-bytes.
 using DecodedImages = DecodedCache<Image, imageBytes>;
 
-// Memory admission for decoding (issue 30): each decode of an uploaded or named scene or image may use
-// up to --max-decode-bytes, so at most max(1, --decode-memory-bytes / --max-decode-bytes) run at once.
-// A decode that finds no slot waits up to a second for one, then is refused with 503 decode-busy and
-// Retry-After: concurrent uploads cannot add up to more than the budget (3 meshopt uploads decoding
-// 256 MiB each took the daemon to 1.8 GB).
-class DecodeGate {
+// Memory admission for decoding (issue 30): every decode of an uploaded or named scene or image
+// reserves the bytes it is about to allocate (its decoder calls the reservation before each image's
+// pixels and each expanded accessor: BackendHooks::Reserve) from one budget shared by all decodes in
+// flight, max(--decode-memory-bytes, --max-decode-bytes) bytes. A reservation that does not fit waits up
+// to a second for others to finish, then the decode is refused with 503 decode-busy and Retry-After:
+// concurrent uploads cannot add up to more than the budget (3 meshopt uploads decoding 256 MiB each
+// took the daemon to 1.8 GB), while small ones are not held back by one large one.
+class DecodeMemory {
 public:
-  explicit DecodeGate(int slots) : free_(std::max(1, slots)), slots_(std::max(1, slots)) {}
-  int slots() const { return slots_; }
-  class Slot {
+  explicit DecodeMemory(std::size_t bytes) : total_(std::max<std::size_t>(1, bytes)) {}
+  std::size_t total() const { return total_; }
+  std::size_t reserved() {
+    std::lock_guard lock(mutex_);
+    return used_;
+  }
+  // One decode's bytes, released when it ends (success or not).
+  class Reservation {
   public:
-    explicit Slot(DecodeGate& g) : g_(&g) {}
-    Slot(const Slot&) = delete;
-    Slot& operator=(const Slot&) = delete;
-    ~Slot() {
+    explicit Reservation(DecodeMemory& m) : m_(&m) {}
+    Reservation(const Reservation&) = delete;
+    Reservation& operator=(const Reservation&) = delete;
+    ~Reservation() {
       {
-        std::lock_guard lock(g_->mutex_);
-        ++g_->free_;
+        std::lock_guard lock(m_->mutex_);
+        m_->used_ -= held_;
       }
-      g_->cv_.notify_one();
+      m_->cv_.notify_all();
+    }
+    // Adds `bytes`, waiting up to `wait` for them; throws ApiError 503 decode-busy when they do not free.
+    void grow(std::size_t bytes, std::chrono::milliseconds wait = std::chrono::seconds(1)) {
+      std::unique_lock lock(m_->mutex_);
+      const std::size_t total = m_->total_;
+      // Never more than the whole budget: a decode the per-decode limit allows always fits on its own.
+      if (bytes > total - std::min(total, held_) ||
+          !m_->cv_.wait_for(lock, wait, [&] { return m_->used_ + bytes <= total; })) {
+        ++m_->refused_;
+        throw api::ApiError(503, "decode-busy", "Busy decoding",
+                            "decoding needs " + std::to_string(bytes) + " more bytes and " +
+                                std::to_string(m_->used_) + " of the " + std::to_string(total) +
+                                " bytes that decodes in flight may use together are taken (--decode-memory-bytes): "
+                                "retry after the Retry-After seconds");
+      }
+      m_->used_ += bytes;
+      held_ += bytes;
+    }
+    BackendHooks::Reserve hook() {
+      return [this](std::size_t bytes) { grow(bytes); };
     }
 
   private:
-    DecodeGate* g_;
+    DecodeMemory* m_;
+    std::size_t held_ = 0;
   };
-  // Throws ApiError 503 decode-busy when no slot frees within `wait`.
-  Slot acquire(std::chrono::milliseconds wait = std::chrono::seconds(1)) {
-    std::unique_lock lock(mutex_);
-    if (!cv_.wait_for(lock, wait, [&] { return free_ > 0; })) {
-      ++refused_;
-      throw api::ApiError(503, "decode-busy", "Busy decoding",
-                          std::to_string(slots_) +
-                              " scenes or images are being decoded, the most this server decodes at once "
-                              "(--decode-memory-bytes / --max-decode-bytes): retry after the Retry-After seconds");
-    }
-    --free_;
-    return Slot(*this);
-  }
   std::uint64_t refused() const { return refused_.load(); }
 
 private:
   std::mutex mutex_;
   std::condition_variable cv_;
-  int free_, slots_;
+  std::size_t total_, used_ = 0;
   std::atomic<std::uint64_t> refused_{0};
 };
 
@@ -263,7 +278,7 @@ struct HttpServer::Impl {
   ContentStore images;  // comparison targets (compare.against = their digest)
   DecodedScenes decoded;
   DecodedImages decodedImages;
-  DecodeGate decodeGate;
+  DecodeMemory decodeMemory;
   RenderService service;
   BoundedServer http;
   std::atomic<bool> shuttingDown{false};
@@ -285,7 +300,7 @@ struct HttpServer::Impl {
         images(config.cacheDir, config.maxSceneBytes, "images"),
         decoded(config.sceneCacheEntries, config.sceneCacheBytes),
         decodedImages(std::min<std::size_t>(4, config.sceneCacheEntries), config.sceneCacheBytes / 2),
-        decodeGate(static_cast<int>(std::min<std::size_t>(1024, config.decodeMemoryBytes / std::max<std::size_t>(1, config.maxDecodeBytes)))),
+        decodeMemory(std::max(config.decodeMemoryBytes, config.maxDecodeBytes)),
         service(config, hooks, frames, metrics) {
     routes();
   }
@@ -322,8 +337,8 @@ struct HttpServer::Impl {
     if (!hooks.decodeScene) throw std::logic_error("no scene decoder configured");
     std::shared_ptr<Scene> scene;
     try {
-      const auto slot = decodeGate.acquire();
-      scene = std::make_shared<Scene>(hooks.decodeScene(bytes));
+      DecodeMemory::Reservation memory(decodeMemory);
+      scene = std::make_shared<Scene>(hooks.decodeScene(bytes, memory.hook()));
     } catch (const api::ApiError& e) {
       // A render request points at its own field (/scene/inline_glb); an upload, whose body is the
       // glTF document, at the place in the document the decoder names.
@@ -412,8 +427,8 @@ struct HttpServer::Impl {
                           pointer + ": no image " + digest + " (upload it to /v1/images first)", pointer);
     if (auto image = decodedImages.get(digest)) return image;
     if (!hooks.decodeImage) throw std::logic_error("no image decoder configured");
-    const auto slot = decodeGate.acquire();
-    auto image = std::make_shared<const Image>(hooks.decodeImage(*bytes));
+    DecodeMemory::Reservation memory(decodeMemory);
+    auto image = std::make_shared<const Image>(hooks.decodeImage(*bytes, memory.hook()));
     metrics.countImageDecode();
     decodedImages.put(digest, image);
     return image;
@@ -496,7 +511,7 @@ struct HttpServer::Impl {
                 {"max_json_depth", config.limits.maxJsonDepth},
                 {"max_decode_bytes", config.maxDecodeBytes},
                 {"decode_memory_bytes", config.decodeMemoryBytes},
-                {"concurrent_decodes", decodeGate.slots()},
+                {"decode_memory_effective_bytes", decodeMemory.total()},
                 {"max_frame_bytes", config.maxFrameBytes},
                 {"scene_cache_bytes", config.sceneCacheBytes},
                 {"gpu_scenes", config.gpuScenes},
@@ -672,7 +687,8 @@ struct HttpServer::Impl {
           {"radiant_image_store_bytes", {"Bytes of uploaded comparison images stored.", double(images.totalBytes())}},
           {"radiant_image_cache_bytes", {"Bytes of decoded images kept in memory (half of --scene-cache-bytes).", double(decodedImages.totalBytes())}},
           {"radiant_frame_store_bytes", {"Bytes of encoded frames stored.", double(frames.totalBytes())}},
-          {"radiant_decodes_refused", {"Decodes refused with 503 decode-busy since start (--decode-memory-bytes).", double(decodeGate.refused())}}};
+          {"radiant_decode_bytes_reserved", {"Bytes decodes in flight have reserved of --decode-memory-bytes.", double(decodeMemory.reserved())}},
+          {"radiant_decodes_refused", {"Decodes refused with 503 decode-busy since start (--decode-memory-bytes).", double(decodeMemory.refused())}}};
       res.status = 200;
       res.set_content(metrics.text(gauges), "text/plain; version=0.0.4; charset=utf-8");
     }));
@@ -747,8 +763,8 @@ struct HttpServer::Impl {
       bool created = false;
       if (!images.get(digest)) {
         if (!hooks.decodeImage) throw std::logic_error("no image decoder configured");
-        const auto slot = decodeGate.acquire();
-        const Image decoded = hooks.decodeImage(body);  // refuse what cannot be read before storing it
+        DecodeMemory::Reservation memory(decodeMemory);
+        const Image decoded = hooks.decodeImage(body, memory.hook());  // refuse what cannot be read before storing it
         created = images.put(digest, body);
       }
       res.set_header("Location", "/v1/images/" + digest);

@@ -58,11 +58,12 @@ BackendHooks rendererHooks(const ServerConfig& config) {
   const std::size_t maxBytes = config.maxBodyBytes;
   const std::size_t maxDecoded = config.maxDecodeBytes;
   const std::size_t maxDepth = config.limits.maxJsonDepth;
-  h.decodeScene = [maxBytes, maxDecoded, maxDepth](std::string_view bytes) {
+  h.decodeScene = [maxBytes, maxDecoded, maxDepth](std::string_view bytes, const BackendHooks::Reserve& reserve) {
     LoadOptions options;  // empty asset root: uploads may not reference external files
     options.maxBytes = std::max<std::size_t>(maxBytes, std::size_t(256) << 20);
     options.maxDecodedBytes = maxDecoded;
     options.maxJsonDepth = maxDepth;
+    options.reserveDecoded = reserve;
     // The pointer is into the glTF document; for an upload that is the request body.
     try {
       return loadSceneFromMemory(bytes, options);
@@ -78,10 +79,12 @@ BackendHooks rendererHooks(const ServerConfig& config) {
                           e.pointer);
     }
   };
-  h.decodeImage = [maxDecoded](std::string_view bytes) {
+  h.decodeImage = [maxDecoded](std::string_view bytes, const BackendHooks::Reserve& reserve) {
     Image image;
     try {
-      image = io::decodeImage(bytes, "beauty", maxDecoded);
+      image = io::decodeImage(bytes, "beauty", maxDecoded, reserve);
+    } catch (const api::ApiError&) {
+      throw;  // the shared decode memory's 503
     } catch (const io::DecodeLimitExceeded& e) {
       throw api::ApiError(422, "limit-exceeded", "Server limit exceeded", e.what());
     } catch (const std::exception& e) {

@@ -190,8 +190,8 @@ namespace {
 // 256 scanlines whatever the image's height: a 95-byte Radiance HDR declaring one row of 2,222,222
 // pixels had it allocate 6.8 GB (image fuzzer, 2026-12-04; tests/data/crashers/images/hdr_one_wide_row_takes_6_8gb.hdr).
 // Over `maxDecodedBytes` (0: no limit) it is refused, naming the flag.
-void chargeDecode(const std::string& what, std::int64_t width, std::int64_t height, std::int64_t channels,
-                  std::size_t maxDecodedBytes) {
+std::uint64_t chargeDecode(const std::string& what, std::int64_t width, std::int64_t height, std::int64_t channels,
+                           std::size_t maxDecodedBytes) {
   const std::uint64_t pixels = std::uint64_t(width) * std::uint64_t(height);
   const std::uint64_t readBuffer = std::uint64_t(width) * 256u * std::uint64_t(channels) * 4;
   const std::uint64_t need = pixels * std::uint64_t(channels) * 4 + pixels * 3 * 4 + readBuffer;
@@ -200,13 +200,16 @@ void chargeDecode(const std::string& what, std::int64_t width, std::int64_t heig
                               std::to_string(channels) + " channels: decoding needs " + std::to_string(need) +
                               " bytes, above this server's decode budget of " + std::to_string(maxDecodedBytes) +
                               " bytes (radiantd --max-decode-bytes)");
+  return need;
 }
 
-Image readFrom(OIIO::ImageInput* in, const std::string& what, const std::string& aov, std::size_t maxDecodedBytes = 0) {
+Image readFrom(OIIO::ImageInput* in, const std::string& what, const std::string& aov, std::size_t maxDecodedBytes = 0,
+               const std::function<void(std::size_t)>& reserve = {}) {
   if (!in) throw std::runtime_error("io: cannot read " + what + ": " + OIIO::geterror());
   const OIIO::ImageSpec& spec = in->spec();
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0) throw std::runtime_error("io: " + what + " is empty");
-  chargeDecode(what, spec.width, spec.height, spec.nchannels, maxDecodedBytes);
+  const std::uint64_t need = chargeDecode(what, spec.width, spec.height, spec.nchannels, maxDecodedBytes);
+  if (reserve) reserve(std::size_t(need));
   // Which channels: the layer `aov` by name (aov.R/G/B, or aov.Y); for "beauty" also unprefixed R/G/B
   // (or Y), a file's only layer, and at last the first three channels or the first one. EXR stores channels
   // in alphabetical order (B before G before R), so names, not positions, decide.
@@ -421,7 +424,8 @@ void checkPngChunks(std::string_view b) {
 
 }  // namespace
 
-Image decodeImage(std::string_view bytes, const std::string& aov, std::size_t maxDecodedBytes) {
+Image decodeImage(std::string_view bytes, const std::string& aov, std::size_t maxDecodedBytes,
+                  const std::function<void(std::size_t)>& reserve) {
   auto starts = [&](std::string_view magic) { return bytes.substr(0, magic.size()) == magic; };
   const char* name = starts(std::string_view("\x76\x2f\x31\x01", 4)) ? "image.exr"
                      : starts("#?RADIANCE") || starts("#?RGBE") ? "image.hdr"
@@ -432,7 +436,7 @@ Image decodeImage(std::string_view bytes, const std::string& aov, std::size_t ma
   if (name == std::string_view("image.png")) checkPngChunks(bytes);
   MemoryReader reader(bytes);
   auto in = OIIO::ImageInput::open(name, nullptr, &reader);
-  return readFrom(in.get(), std::string("the uploaded ") + (name + 6) + " image", aov, maxDecodedBytes);
+  return readFrom(in.get(), std::string("the uploaded ") + (name + 6) + " image", aov, maxDecodedBytes, reserve);
 }
 
 }  // namespace radiant::io

@@ -3,6 +3,7 @@
 // render thread so the GPU keeps working while frames are written).
 
 #include <stdexcept>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -46,8 +47,10 @@ void writeFile(const std::string& path, const std::string& bytes);
 Image readImage(const std::string& path, const std::string& aov = "beauty");
 // The same from bytes in memory; the format comes from the magic bytes (EXR, Radiance HDR, PNG).
 // maxDecodedBytes > 0: the header's width x height x channels is checked against it before any
-// pixel is read (DecodeLimitExceeded).
-Image decodeImage(std::string_view bytes, const std::string& aov = "beauty", std::size_t maxDecodedBytes = 0);
+// pixel is read (DecodeLimitExceeded). `reserve`, when given, is then called with the bytes the decode
+// will allocate, before it does (the daemon's shared decode memory; its exception passes through).
+Image decodeImage(std::string_view bytes, const std::string& aov = "beauty", std::size_t maxDecodedBytes = 0,
+                  const std::function<void(std::size_t)>& reserve = {});
 struct DecodeLimitExceeded : std::runtime_error {
   using std::runtime_error::runtime_error;
 };

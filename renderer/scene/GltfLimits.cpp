@@ -268,6 +268,7 @@ void DecodeBudget::charge(std::size_t bytes, const std::string& pointer, const s
                               std::to_string(remaining_) + " of this server's decode budget of " +
                               std::to_string(limit_) + " bytes are left (radiantd " + kDecodeFlag + ")",
                           kDecodeFlag);
+  if (reserve_) reserve_(bytes);
   remaining_ -= bytes;
 }
 
@@ -343,11 +344,21 @@ bool DecodeBudget::chargeImage(const unsigned char* bytes, std::size_t size, int
     if (err) *err += imageError_->what() + std::string("\n");
     return false;
   }
+  if (reserve_) {
+    try {
+      reserve_(std::size_t(need));
+    } catch (...) {  // tinygltf's callback must not throw: rethrown by rethrowImageError()
+      reserveError_ = std::current_exception();
+      if (err) *err += ptr + ": no decode memory\n";
+      return false;
+    }
+  }
   remaining_ -= std::size_t(need);
   return true;
 }
 
 void DecodeBudget::rethrowImageError() const {
+  if (reserveError_) std::rethrow_exception(reserveError_);
   if (!imageError_) return;
   if (!imageError_->flag.empty()) throw *imageError_;
   throw SceneError(imageError_->pointer, imageError_->what());
@@ -367,7 +378,7 @@ void checkGltfText(std::string_view jsonText, const LoadOptions& options) {
 DecodeBudget checkGltfDocument(const json& doc, const LoadOptions& options) {
   checkNumbersFit(doc);
   checkTransforms(doc);
-  DecodeBudget budget(options.maxDecodedBytes);
+  DecodeBudget budget(options.maxDecodedBytes, options.reserveDecoded);
   chargeAccessorExpansion(doc, budget);
   return budget;
 }

@@ -18,6 +18,8 @@
 // anything else -> SceneError (422 invalid-scene). Both carry a JSON pointer into the glTF.
 
 #include <cstddef>
+#include <exception>
+#include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -42,21 +44,26 @@ struct SceneLimitError : SceneError {
 // Bytes of decoded data one load may still allocate (images, expanded accessors).
 class DecodeBudget {
 public:
-  explicit DecodeBudget(std::size_t bytes) : limit_(bytes), remaining_(bytes) {}
+  explicit DecodeBudget(std::size_t bytes, std::function<void(std::size_t)> reserve = {})
+      : limit_(bytes), remaining_(bytes), reserve_(std::move(reserve)) {}
   std::size_t remaining() const { return remaining_; }
   std::size_t limit() const { return limit_; }
-  // Takes `bytes` or throws SceneLimitError at `pointer`.
+  // Takes `bytes` or throws SceneLimitError at `pointer`; then reserves them (LoadOptions::reserveDecoded),
+  // whose exception passes through.
   void charge(std::size_t bytes, const std::string& pointer, const std::string& what);
   // For tinygltf's image callback (which must not throw): reads the image header, charges the
   // decoded size (RGBA at the file's bit depth, plus the 8-bit copy the Scene keeps) and returns
   // true, or records the error (rethrown by rethrowImageError()) and returns false.
   bool chargeImage(const unsigned char* bytes, std::size_t size, int imageIndex, std::string* err);
-  // After a failed tinygltf load: throws the SceneLimitError/SceneError chargeImage() recorded.
+  // After a failed tinygltf load: throws what chargeImage() recorded (the reservation's own exception
+  // first, else the SceneLimitError/SceneError).
   void rethrowImageError() const;
 
 private:
   std::size_t limit_, remaining_;
+  std::function<void(std::size_t)> reserve_;
   std::optional<SceneLimitError> imageError_;
+  std::exception_ptr reserveError_;
 };
 
 // Decoded RGBA bytes of an image, from its header: nullopt when stb_image cannot read it.

@@ -27,6 +27,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <stdexcept>
+#include <functional>
 #include <string>
 #include <string_view>
 
@@ -52,6 +53,10 @@ struct LoadOptions {
   // Upper bound on decoded memory: every image's pixels and every mesh instance's expanded
   // accessors, charged before allocation (GltfLimits.h). radiantd --max-decode-bytes.
   std::size_t maxDecodedBytes = std::size_t(512) << 20;
+  // Called with each decoded allocation's size before it is made, after it fits maxDecodedBytes (the
+  // daemon's shared decode memory, radiantd --decode-memory-bytes: it may wait for memory and throw,
+  // e.g. api::ApiError 503 decode-busy, which the load passes on unchanged). Empty: not called.
+  std::function<void(std::size_t)> reserveDecoded;
   // Deepest nesting of the JSON (GltfLimits.h). radiantd --max-json-depth.
   std::size_t maxJsonDepth = 64;
 };

@@ -7,6 +7,7 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <cstdlib>
 #include <mutex>
 #include <sstream>
 #include <stdexcept>
@@ -101,7 +102,10 @@ inline server::BackendHooks fakeHooks(FakeControl& c) {
     if (c.failCreate) throw std::runtime_error("eglInitialize failed: EGL_NOT_INITIALIZED (fake)");
     return std::make_unique<FakeBackend>(c);
   };
-  h.decodeScene = [&c](std::string_view bytes) {
+  h.decodeScene = [&c](std::string_view bytes, const server::BackendHooks::Reserve& reserve) {
+    // {"extras": {"reserve-mib": N}}: the decode takes N MiB of the shared decode memory first.
+    if (const auto at = bytes.find("\"reserve-mib\":"); at != std::string_view::npos && reserve)
+      reserve(std::size_t(std::atoi(std::string(bytes.substr(at + 14, 8)).c_str())) << 20);
     if (bytes.find("hold-decode") != std::string_view::npos) {
       ++c.decoding;
       while (c.holdDecode) std::this_thread::sleep_for(std::chrono::milliseconds(2));

@@ -654,19 +654,21 @@ TEST(ServerCore, TimeoutFreesTheQueueSlot) {
   s.control.open();
 }
 
-// Issue 30, memory admission: with --decode-memory-bytes equal to --max-decode-bytes one decode runs at a
-// time; an upload that finds the slot taken waits up to a second, then gets 503 decode-busy with
-// Retry-After, and succeeds once the slot is free.
-TEST(ServerCore, DecodesBeyondTheDecodeMemoryAreRefusedWithRetryAfter) {
+// Issue 30, memory admission by bytes: decodes in flight share --decode-memory-bytes (64 MiB here). A
+// decode holding 48 MiB leaves room for a 1 MiB one at the same time, while one that needs 32 MiB more
+// waits up to a second and gets 503 decode-busy with Retry-After; once the first ends it succeeds. One
+// decode asking for more than the whole budget is refused at once. /metrics shows the bytes reserved
+// and the refusals; /v1/info the effective budget (never below --max-decode-bytes).
+TEST(ServerCore, DecodesShareTheDecodeMemoryByBytes) {
   ServerConfig config;
   config.maxDecodeBytes = 64u << 20;
   config.decodeMemoryBytes = 64u << 20;
   TestServer s(config);
   s.waitReady();
   auto info = body(s.client().Get("/v1/info"));
-  EXPECT_EQ(info["limits"]["concurrent_decodes"], 1);
+  EXPECT_EQ(info["limits"]["decode_memory_effective_bytes"], 64u << 20);
   s.control.holdDecode = true;
-  const std::string held = R"({"asset":{"version":"2.0"},"extras":{"hold-decode":1}})";
+  const std::string held = R"({"asset":{"version":"2.0"},"extras":{"reserve-mib":48,"hold-decode":1}})";
   std::thread first([&] {
     auto c = s.client();
     auto r = c.Put("/v1/scenes", held, "model/gltf+json");
@@ -676,15 +678,32 @@ TEST(ServerCore, DecodesBeyondTheDecodeMemoryAreRefusedWithRetryAfter) {
   for (int i = 0; i < 2000 && s.control.decoding.load() == 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(2));
   ASSERT_EQ(s.control.decoding.load(), 1);
   auto c = s.client();
-  const std::string other = R"({"asset":{"version":"2.0"},"extras":{"n":7}})";
-  auto busy = c.Put("/v1/scenes", other, "model/gltf+json");
-  expectProblem(busy, 503, "decode-busy", "");
-  EXPECT_EQ(busy->get_header_value("Retry-After"), "1");
   auto metrics = c.Get("/metrics");
   ASSERT_TRUE(metrics);
-  EXPECT_NE(metrics->body.find("radiant_decodes_refused 1\n"), std::string::npos) << metrics->body;
+  EXPECT_NE(metrics->body.find("radiant_decode_bytes_reserved 50331648\n"), std::string::npos) << metrics->body;
+  // A small decode runs beside the held one.
+  const std::string small = R"({"asset":{"version":"2.0"},"extras":{"reserve-mib":1,"n":1}})";
+  auto fits = c.Put("/v1/scenes", small, "model/gltf+json");
+  ASSERT_TRUE(fits);
+  EXPECT_EQ(fits->status, 201) << fits->body;
+  // One that does not fit beside it waits, then is refused.
+  const std::string other = R"({"asset":{"version":"2.0"},"extras":{"reserve-mib":32,"n":7}})";
+  const auto t0 = std::chrono::steady_clock::now();
+  auto busy = c.Put("/v1/scenes", other, "model/gltf+json");
+  const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  expectProblem(busy, 503, "decode-busy", "");
+  EXPECT_EQ(busy->get_header_value("Retry-After"), "1");
+  EXPECT_GE(waited, 0.9);
+  // More than the whole budget: refused without waiting for anything.
+  const std::string huge = R"({"asset":{"version":"2.0"},"extras":{"reserve-mib":65,"n":8}})";
+  expectProblem(c.Put("/v1/scenes", huge, "model/gltf+json"), 503, "decode-busy", "");
+  metrics = c.Get("/metrics");
+  ASSERT_TRUE(metrics);
+  EXPECT_NE(metrics->body.find("radiant_decodes_refused 2\n"), std::string::npos) << metrics->body;
   s.control.holdDecode = false;
   first.join();
+  metrics = c.Get("/metrics");
+  EXPECT_NE(metrics->body.find("radiant_decode_bytes_reserved 0\n"), std::string::npos) << metrics->body;
   auto ok = c.Put("/v1/scenes", other, "model/gltf+json");
   ASSERT_TRUE(ok);
   EXPECT_EQ(ok->status, 201) << ok->body;

@@ -251,3 +251,26 @@ TEST(ImageIO, ExrDeclaredSizeIsChargedFromTheHeader) {
 
 }  // namespace
 }  // namespace radiant
+
+namespace radiant {
+namespace {
+
+// The daemon's shared decode memory (radiantd --decode-memory-bytes): decodeImage reserves, before reading
+// pixels, what the header says the decode allocates (the float channels, the RGB copy and OpenImageIO's
+// buffer of up to 256 scanlines), and what the reservation throws passes through.
+TEST(ImageIO, DecodeReservesTheHeadersBytesFirstAndItsRefusalPassesThrough) {
+  const Image beauty = row("beauty", 3, {1.f, 2.f, 3.f, 4.f, 5.f, 6.f});  // 2 x 1, 3 channels
+  const std::string exr = io::encodeExr({beauty}, false, nullptr);
+  std::vector<std::size_t> reserved;
+  const Image b = io::decodeImage(exr, "beauty", 0, [&](std::size_t n) { reserved.push_back(n); });
+  EXPECT_EQ(b.pixels, beauty.pixels);
+  // 2 pixels x 3 channels x 4 bytes + 2 x 12 (the RGB copy) + 2 x 256 x 3 x 4 (the read buffer).
+  EXPECT_EQ(reserved, (std::vector<std::size_t>{24 + 24 + 6144}));
+  struct Busy : std::runtime_error {
+    using std::runtime_error::runtime_error;
+  };
+  EXPECT_THROW(io::decodeImage(exr, "beauty", 0, [](std::size_t) { throw Busy("busy"); }), Busy);
+}
+
+}  // namespace
+}  // namespace radiant

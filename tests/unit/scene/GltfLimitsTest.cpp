@@ -314,4 +314,43 @@ TEST(GltfLimits, DecodeBudgetCountsImageBytesExactly) {
   EXPECT_THROW(short1.rethrowImageError(), SceneLimitError);
 }
 
+// The daemon's shared decode memory (LoadOptions::reserveDecoded, radiantd --decode-memory-bytes): every
+// byte the budget charges is reserved first, accessor expansion and image pixels alike, and what the
+// reservation throws (the server's 503 decode-busy) leaves the load unchanged, also from inside
+// tinygltf's image callback.
+struct NoDecodeMemory : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+TEST(GltfLimits, EveryChargedByteIsReservedAndTheReservationsRefusalPassesThrough) {
+  // An image: 2x2 RGBA8, 16 decoded bytes plus the Scene's 16-byte copy.
+  const std::string gltf = withImage(test::encodePng(2, 2, std::vector<std::uint8_t>(16, 9)), "image/png");
+  LoadOptions o;
+  std::vector<std::size_t> reserved;
+  o.reserveDecoded = [&](std::size_t n) { reserved.push_back(n); };
+  const Scene s = loadSceneFromMemory(gltf, o);
+  ASSERT_EQ(s.textures.size(), 1u);
+  ASSERT_FALSE(reserved.empty());
+  EXPECT_EQ(reserved.back(), 32u);
+  o.reserveDecoded = [](std::size_t n) {
+    if (n == 32) throw NoDecodeMemory("no decode memory");
+  };
+  EXPECT_THROW(loadSceneFromMemory(gltf, o), NoDecodeMemory);
+  // Accessor expansion: one instance of 999999 float3 positions, 59999940 bytes charged and reserved.
+  GltfBuilder one;
+  const int a1 = one.push("accessors", {{"componentType", 5126}, {"count", 999999}, {"type", "VEC3"}});
+  one.scene({one.node({{"mesh", one.mesh(json::array({{{"attributes", {{"POSITION", a1}}}}}))}})});
+  std::size_t total = 0;
+  o.reserveDecoded = [&](std::size_t n) { total += n; };
+  EXPECT_NO_THROW(loadSceneFromMemory(one.gltf(), o));
+  EXPECT_EQ(total, 59999940u);
+  o.reserveDecoded = [](std::size_t) { throw NoDecodeMemory("no decode memory"); };
+  EXPECT_THROW(loadSceneFromMemory(one.gltf(), o), NoDecodeMemory);
+  // Over the per-decode limit, the limit's own error comes first and nothing is reserved.
+  total = 0;
+  o.maxDecodedBytes = 59999939;
+  o.reserveDecoded = [&](std::size_t n) { total += n; };
+  EXPECT_THROW(loadSceneFromMemory(one.gltf(), o), SceneLimitError);
+  EXPECT_EQ(total, 0u);
+}
+
 }  // namespace radiant
