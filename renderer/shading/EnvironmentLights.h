@@ -13,7 +13,9 @@
 // map's power becomes one directional light:
 //   E = sum over its texels of S dw   (the irradiance it gives a surface facing it; the cosine is taken
 //                                      at the region's centre, exact to 1 - cos(radius)),
-//   direction: the E-weighted mean of its texel directions, angular radius: acos(1 - Omega / 2 pi).
+//   direction: the E-weighted mean of its texel directions, angular radius: the uniform cap with the same
+//                                      E-weighted mean cosine about it, acos(2 mean cos - 1) (a uniform
+//                                      disc: its own radius; a core in a halo: the core's), at least a texel.
 // The raster lights with R through image-based lighting and the lights through `direct` with shadow
 // maps; regions not taken (too broad, too weak, beyond maxLights) keep their full radiance in R. Every
 // texel's light is counted once: R + sum of the lights' S = L per texel, per channel (tested). The
