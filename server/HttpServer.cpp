@@ -9,6 +9,7 @@
 #include <iostream>
 #include <list>
 #include <map>
+#include <future>
 #include <mutex>
 #include <random>
 #include <set>
@@ -427,12 +428,39 @@ struct HttpServer::Impl {
                           pointer + ": no image " + digest + " (upload it to /v1/images first)", pointer);
     if (auto image = decodedImages.get(digest)) return image;
     if (!hooks.decodeImage) throw std::logic_error("no image decoder configured");
-    DecodeMemory::Reservation memory(decodeMemory);
-    auto image = std::make_shared<const Image>(hooks.decodeImage(*bytes, memory.hook()));
-    metrics.countImageDecode();
-    decodedImages.put(digest, image);
-    return image;
+    // Decoded once per digest: requests naming an image that is being decoded wait for that decode
+    // (eight renders naming one new 4096 x 4096 map decoded it eight times at once), and share its
+    // result or its error.
+    std::promise<std::shared_ptr<const Image>> mine;
+    const std::shared_future<std::shared_ptr<const Image>> result = mine.get_future().share();
+    std::shared_future<std::shared_ptr<const Image>> pending;
+    {
+      std::lock_guard lock(imageDecodesMutex);
+      if (auto it = imageDecodes.find(digest); it != imageDecodes.end()) pending = it->second;
+      else imageDecodes.emplace(digest, result);
+    }
+    if (pending.valid()) return pending.get();
+    try {
+      if (auto cached = decodedImages.get(digest)) {  // finished between the first look and the claim
+        mine.set_value(cached);
+      } else {
+        DecodeMemory::Reservation memory(decodeMemory);
+        auto decodedImage = std::make_shared<const Image>(hooks.decodeImage(*bytes, memory.hook()));
+        metrics.countImageDecode();
+        decodedImages.put(digest, decodedImage);
+        mine.set_value(decodedImage);
+      }
+    } catch (...) {
+      mine.set_exception(std::current_exception());
+    }
+    {
+      std::lock_guard lock(imageDecodesMutex);
+      imageDecodes.erase(digest);
+    }
+    return result.get();
   }
+  std::mutex imageDecodesMutex;
+  std::map<std::string, std::shared_future<std::shared_ptr<const Image>>> imageDecodes;  // in flight
 
   // ---- helpers --------------------------------------------------------------------------------
   // The body of a POST/PUT, counted while it is read: chunked and gzip/deflate bodies (which httplib

@@ -31,6 +31,9 @@ struct FakeControl {
   // Scene decodes of a document holding "hold-decode" wait while holdDecode is set (decoding counts them).
   std::atomic<bool> holdDecode{false};
   std::atomic<int> decoding{0};
+  // Image decodes (uploads and the images renders name); one of bytes holding "hold-image" waits while
+  // holdDecode is set (imageDecoding counts those waiting).
+  std::atomic<int> imageDecodes{0}, imageDecoding{0};
 
   void close() { std::lock_guard l(m); gateOpen = false; }
   void open() { { std::lock_guard l(m); gateOpen = true; } cv.notify_all(); }
@@ -121,6 +124,17 @@ inline server::BackendHooks fakeHooks(FakeControl& c) {
     s.name = glb ? "glb" : "gltf";
     s.features.triangles = bytes.size();  // lets a test see which bytes reached the renderer
     return s;
+  };
+  h.decodeImage = [&c](std::string_view bytes, const server::BackendHooks::Reserve&) {
+    ++c.imageDecodes;
+    if (bytes.find("hold-image") != std::string_view::npos) {
+      ++c.imageDecoding;
+      while (c.holdDecode) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+      --c.imageDecoding;
+    }
+    Image im = Image::make("beauty", 2, 1, 3);
+    for (float& v : im.pixels) v = 0.5f;
+    return im;
   };
   h.builtinSceneNames = [] { return std::vector<std::string>{"tiny", "tiny2"}; };
   h.builtinSceneSource = [](const std::string& name) {

@@ -659,6 +659,48 @@ TEST(ServerCore, TimeoutFreesTheQueueSlot) {
 // waits up to a second and gets 503 decode-busy with Retry-After; once the first ends it succeeds. One
 // decode asking for more than the whole budget is refused at once. /metrics shows the bytes reserved
 // and the refusals; /v1/info the effective budget (never below --max-decode-bytes).
+// Issue 30, images decoded once: renders that name an image being decoded wait for that decode and
+// share it (eight renders naming one new 4096 x 4096 map decoded it eight times at once, 2.5 GB).
+TEST(ServerCore, RendersNamingOneImageShareItsDecode) {
+  TestServer s;
+  s.waitReady();
+  auto c = s.client();
+  // The upload decodes it once to check it (not kept decoded).
+  const std::string exr = std::string("\x76\x2f\x31\x01", 4) + "hold-image";
+  auto up = c.Put("/v1/images", exr, "image/x-exr");
+  ASSERT_TRUE(up);
+  ASSERT_EQ(up->status, 201) << up->body;
+  const std::string digest = body(up)["digest"];
+  ASSERT_EQ(s.control.imageDecodes.load(), 1);
+  s.control.holdDecode = true;
+  json b = renderBody();
+  b["environment"] = digest;
+  b["async"] = true;
+  std::vector<std::thread> renders;
+  std::atomic<int> accepted{0};
+  for (int i = 0; i < 4; ++i)
+    renders.emplace_back([&, i] {
+      json mine = b;
+      mine["seed"] = 100 + i;
+      auto cc = s.client();
+      auto r = post(cc, "/v1/renders", mine);
+      if (r && r->status == 202) ++accepted;
+      else ADD_FAILURE() << (r ? r->body : std::string("no response"));
+    });
+  for (int i = 0; i < 2000 && s.control.imageDecoding.load() == 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  ASSERT_EQ(s.control.imageDecoding.load(), 1);
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // the others reach the image meanwhile
+  EXPECT_EQ(s.control.imageDecoding.load(), 1);
+  EXPECT_EQ(s.control.imageDecodes.load(), 2);
+  s.control.holdDecode = false;
+  for (auto& t : renders) t.join();
+  EXPECT_EQ(accepted.load(), 4);
+  EXPECT_EQ(s.control.imageDecodes.load(), 2);
+  auto metrics = c.Get("/metrics");
+  ASSERT_TRUE(metrics);
+  EXPECT_NE(metrics->body.find("radiant_image_decodes_total 1\n"), std::string::npos) << metrics->body;
+}
+
 TEST(ServerCore, DecodesShareTheDecodeMemoryByBytes) {
   ServerConfig config;
   config.maxDecodeBytes = 64u << 20;
