@@ -545,6 +545,7 @@ struct HttpServer::Impl {
                 {"gpu_scenes", config.gpuScenes},
                 {"derived_cache_bytes", config.derivedCacheBytes},
                 {"speed_factor", config.speedFactor > 0 ? json(config.speedFactor) : json("auto")},
+                {"default_frame_budget_ms", config.limits.defaultFrameBudgetMs},
                 {"read_timeout_s", config.readTimeoutS},
                 {"keep_alive_timeout_s", config.keepAliveTimeoutS},
                 {"shutdown_grace_s", config.shutdownGraceS},

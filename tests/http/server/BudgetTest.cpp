@@ -228,6 +228,12 @@ TEST(Budgets, LargerBudgetsNeverGiveLargerErrorsAndRunTheChoosersChoice) {
 TEST(Budgets, TheDefaultFrameBudgetLowersOnlyTheDefaultFrame) {
   RealDaemon d("default-budget", {"--speed-factor", "1", "--default-frame-budget-ms", "50"});
   ASSERT_TRUE(d.ready()) << testing::slurp(d.dir / "stderr.log");
+  {
+    auto c = d.daemon.client();
+    auto info = c.Get("/v1/info");
+    ASSERT_TRUE(info);
+    EXPECT_EQ(json::parse(info->body)["limits"]["default_frame_budget_ms"], 50.0) << info->body;
+  }
   const json body = cornell(32, 0);
   const json r = d.render(body);
   ASSERT_TRUE(r.contains("stats")) << r.dump();
