@@ -174,6 +174,15 @@ int PresetTable::presetIndex(const std::string& technique, const std::string& qu
   return p.contains(quality) ? p[quality].get<int>() : -1;
 }
 
+namespace {
+// The server's default frame budget applies to the planner's default frame only: no quality, no time
+// budget, no passes named (api/Presets.h); 0 when it does not.
+double defaultFrameBudget(const RenderRequest& request, const RequestLimits* limits) {
+  if (!limits || request.passesNamed || !request.quality.empty() || request.timeBudgetMs > 0) return 0.0;
+  return limits->defaultFrameBudgetMs > 0 ? limits->defaultFrameBudgetMs : 0.0;
+}
+}  // namespace
+
 double costPixels(const std::string& technique, double rasterPixels, int supersampling) {
   // photon_gi's gather runs once per gather_step x gather_step block of output pixels (PhotonGi.cpp
   // scales the step by k), its fix-ups mostly borrow a neighbour's estimate: measured on cornell_box at
@@ -206,8 +215,7 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
     lowerDefaultsToCaps();
     // The server's default frame budget: only for the planner's default frame (no passes named), and
     // only when every planned technique has a model (else the frame's cost is not known).
-    const double defaultBudget = limits ? limits->defaultFrameBudgetMs : 0.0;
-    if (defaultBudget > 0 && !request.passesNamed) {
+    if (const double defaultBudget = defaultFrameBudget(request, limits); defaultBudget > 0) {
       const double predicted =
           predictFrameMs(table, planned, c.params, double(request.width) * request.height, counts, request.supersampling) *
           speed;
@@ -396,10 +404,8 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
 int supersamplingWithinDefaultBudget(const PresetTable& table, const std::vector<std::string>& planned,
                                      const RenderRequest& request, int k, const RequestLimits* limits,
                                      const SceneCounts& counts, double speed) {
-  const double budget = limits ? limits->defaultFrameBudgetMs : 0.0;
-  if (!(budget > 0) || k <= 1 || request.supersamplingGiven || request.passesNamed || !request.quality.empty() ||
-      request.timeBudgetMs > 0)
-    return k;
+  const double budget = defaultFrameBudget(request, limits);
+  if (!(budget > 0) || k <= 1 || request.supersamplingGiven) return k;
   if (!(speed > 0.0) || !std::isfinite(speed)) speed = 1.0;
   const BudgetChoice defaults = chooseConfiguration(table, planned, request, nullptr, counts, speed);
   const double outputPixels = double(request.width) * request.height;

@@ -672,8 +672,8 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     // without them, the request's own.
     stats.scene["counts"] = counts.toJson();
     // The supersampled request: the cost models' `pixels` are the raster's (the table was measured at
-    // k = 1, so a request that keeps its own supersampling under a budget is charged k^2 the pixels:
-    // conservative for passes whose work follows the output size, as photon_gi's gather_step does).
+    // k = 1, so a request that keeps its own supersampling under a budget is charged k^2 the pixels),
+    // except photon_gi's, whose gather follows the output pixels (api::costPixels).
     const nlohmann::json speedState = im.speed.toJson();  // what this frame's choice used
     api::BudgetChoice choice = api::chooseConfiguration(api::PresetTable::builtin(), planned, supersampled,
                                                         inputs.limits, counts, im.speed.factor());

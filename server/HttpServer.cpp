@@ -6,10 +6,10 @@
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
+#include <future>
 #include <iostream>
 #include <list>
 #include <map>
-#include <future>
 #include <mutex>
 #include <random>
 #include <set>
