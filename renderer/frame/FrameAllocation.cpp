@@ -38,8 +38,14 @@ void declareEnvironmentMap(FrameResources& res, const FrameView& view) {
     return;
   }
   const Image& env = *view.environment;
-  gl::Texture& t = res.texture(kEnvironmentMap, GL_TEXTURE_2D, GL_RGBA32F, env.width, env.height);
-  t.setFilter(GL_NEAREST, GL_NEAREST);
+  // A full mip chain (box-filtered: each level keeps the mean radiance): the specular pass looks a
+  // reflected ray up over its footprint's cone (common/environment.glsl environmentRadianceCone); a
+  // level-0 texelFetch (every other lookup) is the nearest texel as before.
+  int levels = 1;
+  while ((std::max(env.width, env.height) >> levels) > 0) ++levels;
+  gl::Texture& t = res.texture(kEnvironmentMap, GL_TEXTURE_2D, GL_RGBA32F, env.width, env.height, 1, levels);
+  t.setFilter(GL_LINEAR_MIPMAP_LINEAR, GL_LINEAR);
+  t.setWrap(GL_REPEAT, GL_CLAMP_TO_EDGE);
   const std::string digest = view.environmentKey + "|" + std::to_string(env.width) + "x" + std::to_string(env.height);
   if (res.holds(kEnvironmentMap, digest)) return;
   res.setHolds(kEnvironmentMap, digest);
@@ -48,6 +54,7 @@ void declareEnvironmentMap(FrameResources& res, const FrameView& view) {
     for (int c = 0; c < 3; ++c) rgba[p * 4 + c] = env.pixels[p * env.channels + std::min(c, env.channels - 1)];
   // Rows in image order (row 0 = up): texel row v * height is image row v * height.
   t.upload(0, 0, 0, 0, env.width, env.height, 1, GL_RGBA, GL_FLOAT, rgba.data());
+  if (levels > 1) t.generateMipmaps();
 }
 
 }  // namespace radiant

@@ -249,6 +249,11 @@ void Texture::setWrap(GLenum wrap) {
   glTextureParameteri(id_, GL_TEXTURE_WRAP_R, static_cast<GLint>(wrap));
 }
 
+void Texture::setWrap(GLenum wrapS, GLenum wrapT) {
+  glTextureParameteri(id_, GL_TEXTURE_WRAP_S, static_cast<GLint>(wrapS));
+  glTextureParameteri(id_, GL_TEXTURE_WRAP_T, static_cast<GLint>(wrapT));
+}
+
 void Texture::setCompare(GLenum func) {
   glTextureParameteri(id_, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
   glTextureParameteri(id_, GL_TEXTURE_COMPARE_FUNC, static_cast<GLint>(func));

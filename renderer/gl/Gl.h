@@ -73,6 +73,7 @@ public:
   int levels() const { return levels_; }
   void setFilter(GLenum minFilter, GLenum magFilter);
   void setWrap(GLenum wrap);
+  void setWrap(GLenum wrapS, GLenum wrapT);  // 2-D: s and t apart (an equirect map wraps in u only)
   // Depth textures: enable hardware comparison (sampler2DShadow) with the given func.
   void setCompare(GLenum func);
   void upload(int level, int x, int y, int z, int w, int h, int d, GLenum format, GLenum type,
