@@ -20,7 +20,7 @@ const json& emptyArray() {
   return a;
 }
 
-// sum of coef * product of vars; a var is "pixels", a scene count ("particles", "beams") or a numeric
+// sum of coef * product of vars; a var is "pixels", a scene count ("particles", "beams", "specular_objects") or a numeric
 // parameter (a boolean counts as 0/1).
 double evalTerms(const json& terms, const json& params, double pixels, const SceneCounts& counts = {}) {
   double ms = 0.0;
@@ -31,6 +31,7 @@ double evalTerms(const json& terms, const json& params, double pixels, const Sce
       if (n == "pixels") v *= pixels;
       else if (n == "particles") v *= counts.particles;
       else if (n == "beams") v *= counts.beams;
+      else if (n == "specular_objects") v *= counts.specularObjects;
       else if (params.contains(n) && params[n].is_number()) v *= params[n].get<double>();
       else if (params.contains(n) && params[n].is_boolean()) v *= params[n].get<bool>() ? 1.0 : 0.0;
       else throw std::logic_error("preset table: cost term names '" + n + "', which is no numeric parameter");

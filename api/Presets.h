@@ -6,7 +6,7 @@
 // The table holds, per technique:
 //   - a cost model: ms = sum of terms coef * product(vars), vars being "pixels" (the raster's: width x
 //     height x k^2 under supersampling k; the Renderer passes the supersampled request), the frame's
-//     scene counts (SceneCounts below: "particles", "beams") and the technique's numeric parameters
+//     scene counts (SceneCounts below: "particles", "beams", "specular_objects") and the technique's numeric parameters
 //     (e.g. "spp", "photons", "C", "samples", "photon_resolution", "cube_resolution", "layers",
 //     "nodes", "directions", "iterations"), fitted by least squares to the measured cost of the pass
 //     (passCostMs below) over sweeps that vary the counts too;
@@ -46,7 +46,20 @@ struct SceneCounts {
   // upper bound known before the pass runs: its `beams` counter leaves out the triangles facing away
   // from the light and TIR, and adds the negative shadow beams (1570 of 1920 on cornell_glass).
   double beams = 0;
-  nlohmann::json toJson() const { return {{"particles", particles}, {"beams", beams}}; }
+  // The specular pass's objects (renderer/shading/SpecularObjects.h specularMeshes: every mesh with a
+  // mirror-like or transmissive material): it renders layered distance maps per object.
+  double specularObjects = 0;
+  nlohmann::json toJson() const {
+    return {{"particles", particles}, {"beams", beams}, {"specular_objects", specularObjects}};
+  }
+  // toJson's inverse (stats.scene.counts, stats.budget.scene_counts); a missing key counts 0.
+  static SceneCounts fromJson(const nlohmann::json& j) {
+    SceneCounts c;
+    c.particles = j.value("particles", 0.0);
+    c.beams = j.value("beams", 0.0);
+    c.specularObjects = j.value("specular_objects", 0.0);
+    return c;
+  }
 };
 
 class PresetTable {

@@ -35,9 +35,10 @@ What is measured (TECHNIQUES below; each technique on its canonical built-in sce
                a cost model and no front: a budget charges its cost and leaves its parameters alone.
 
   scene counts the cost models' scene variables (api::SceneCounts: "particles" of the scene and the
-               request's media, light_volumes' "beams") are varied by extra cost sweeps ("variants": the
-               request's media with generated particles on explosion, other built-in scenes with other
-               scatterers for light_volumes), and read per record from stats.scene.counts (the sweep
+               request's media, light_volumes' "beams", specular's "specular_objects") are varied by extra
+               cost sweeps ("variants": the request's media with generated particles on explosion, other
+               built-in scenes with other scatterers for light_volumes, bench/glass_metal_field.py's
+               fields of 4 and 12 spheres, uploaded, for specular), and read per record from stats.scene.counts (the sweep
                record's scene_counts), the same numbers the daemon's budget chooser evaluates.
 
 The fit (Python standard library only):
@@ -66,7 +67,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from photon_gi_goal import call, render  # noqa: E402  (the same HTTP helpers)
 
 SIZES = [32, 64]
-SCENE_COUNTS = ("particles", "beams")  # api::SceneCounts
+SCENE_COUNTS = ("particles", "beams", "specular_objects")  # api::SceneCounts
 ERROR_SIZE = 64
 TRUTH_SPP = 1024
 
@@ -129,8 +130,14 @@ TECHNIQUES = {
         # Not linear_steps: the layered maps are cached by scene, cube_resolution and layers (not the seed), so
         # a point that changes only the search steps reuses the previous point's maps and is not a cold cost.
         "configs": [{"cube_resolution": c, "layers": n} for c in (64, 128, 256, 512) for n in (3, 6)],
-        # layered distance maps (6 C^2 texels per layer), then the per-pixel search.
-        "terms": [[], ["pixels"], ["cube_resolution", "cube_resolution", "layers"]],
+        # layered distance maps per specular object (6 C^2 texels per layer, each face drawing what it
+        # sees), a per-object set-up, then the per-pixel search. The objects (api::SceneCounts) are varied by
+        # bench/glass_metal_field.py's fields of 4 and 12 spheres (uploaded by `spec`; cornell_glass has 1);
+        # cube_resolution up to 256 and 3 layers there (12 objects x 6 layers of 512^2 cube maps is 3 GB).
+        "terms": [[], ["pixels"], ["specular_objects"], ["specular_objects", "cube_resolution", "cube_resolution", "layers"]],
+        "variants": [{"field": 4}, {"field": 12}],
+        "variant_configs": [{"cube_resolution": c, "layers": 3} for c in (64, 128, 256)],
+        "variant_seed": 7000,  # after every other technique's variant seeds, which stay as they were
         "compare": None,
         "no_front": "the reference has no ground truth for the specular AOV (docs/API.md, compare: no path-class "
                     "filter keeps exactly E S+ D L and E S+ L, no per-pixel mask of the specular pixels)",
@@ -242,6 +249,18 @@ def base_request(name, t, size, seed):
     return r
 
 
+def resolve_variant(server, variant):
+    """A variant as a request fragment: {"field": N} is bench/glass_metal_field.py's field of N spheres
+    (with its point light), uploaded to the daemon and named by its digest."""
+    if "field" not in variant:
+        return variant
+    import glass_metal_field  # noqa: E402  (bench/, on sys.path above)
+    gltf = glass_metal_field.field(int(variant["field"])).encode()
+    r = call(server, "/v1/scenes", gltf, method="PUT", ctype="model/gltf+json")
+    r = json.loads(r) if isinstance(r, bytes) else r
+    return {"scene": {"digest": r["digest"]}}
+
+
 def variant_request(base, variant):
     r = json.loads(json.dumps(base))
     r.update(json.loads(json.dumps(variant)))
@@ -266,14 +285,17 @@ def zip_group(name, points, technique_seed=False):
 def make_spec(server, out_dir, names):
     os.makedirs(out_dir, exist_ok=True)
     sweeps = []
+    uploaded = {}  # (technique, variant index) -> the variant as sent (a generated scene by its digest)
     techniques = {n: TECHNIQUES[n] for n in names}
     # Shader compilation and scene upload happen once per daemon: one untimed render per technique.
     for name, t in techniques.items():
         sweeps.append({"name": f"presets-warm-{name}", "technique": name, "base": base_request(name, t, 32, 7),
                        "repeats": 1, "warmup": 0})
         for k, v in enumerate(t.get("variants", [])):  # each variant's scene, medium (depth_impostors' blocks)
+            uploaded[(name, k)] = resolve_variant(server, v)
             sweeps.append({"name": f"presets-warm-{name}~{k + 1}", "technique": name,
-                           "base": variant_request(base_request(name, t, 32, 7), v), "repeats": 1, "warmup": 0})
+                           "base": variant_request(base_request(name, t, 32, 7), uploaded[(name, k)]),
+                           "repeats": 1, "warmup": 0})
     seed = 1000
     for name, t in TECHNIQUES.items():  # every technique's seeds, so that a subset run uses the same ones
         if name not in techniques:
@@ -290,17 +312,23 @@ def make_spec(server, out_dir, names):
     # The scene-count variants: seeds from 5000 on, so that the canonical points keep the seeds of earlier runs.
     vseed = 5000
     for name, t in TECHNIQUES.items():
+        own = t.get("variant_seed")  # a technique given its own base leaves the shared counter alone
+        oseed = own
         for k, v in enumerate(t.get("variants", [])):
             configs = t.get("variant_configs", t["configs"])
             points = []
             for size in SIZES:
                 for config in configs:
-                    points.append((config, size, vseed))
-                    vseed += 1
+                    if own is None:
+                        points.append((config, size, vseed))
+                        vseed += 1
+                    else:
+                        points.append((config, size, oseed))
+                        oseed += 1
             if name not in techniques:
                 continue
             sweeps.append({"name": f"presets-cost-{name}~{k + 1}", "technique": name,
-                           "base": variant_request(base_request(name, t, 32, 0), v),
+                           "base": variant_request(base_request(name, t, 32, 0), uploaded[(name, k)]),
                            "zip": [zip_group(name, points, t.get("technique_seed", False))], "repeats": 1,
                            "warmup": t.get("warmup", 0)})
     for name, t in techniques.items():
@@ -450,7 +478,7 @@ def fit(records, command, runs=()):
         "command": command, "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "device": device,
         "sizes": SIZES, "error_size": ERROR_SIZE,
         "note": "cost = api::passCostMs of a cold first render (own seed); error = RMSE against the reference at "
-                "error_size on the technique's canonical built-in scene; a model's scene variables (particles, beams: "
+                "error_size on the technique's canonical built-in scene; a model's scene variables (particles, beams, specular_objects: "
                 "api::SceneCounts) were varied by its sweep's variants (model.scene_counts: the values measured); "
                 "other scene properties (triangles, a caustics generator's size) are constants of the model",
         "runs": list(runs)}, "techniques": {}}

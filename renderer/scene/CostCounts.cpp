@@ -1,5 +1,7 @@
 #include "renderer/scene/CostCounts.h"
 
+#include "renderer/shading/SpecularObjects.h"
+
 namespace radiant {
 
 api::SceneCounts sceneCostCounts(const Scene& scene, const std::vector<api::ParticleSystem>& media) {
@@ -13,6 +15,7 @@ api::SceneCounts sceneCostCounts(const Scene& scene, const std::vector<api::Part
     if (mat.scattersNarrowLobe()) scatterers += double(m.triangleCount()) * (mat.isTransmissive() ? 2.0 : 1.0);
   }
   c.beams = scatterers * double(scene.lights.size());
+  c.specularObjects = static_cast<double>(specularMeshes(scene).size());
   return c;
 }
 

@@ -1,8 +1,10 @@
 // Renders one layer of one face of a layered distance map (thesis 5.1.1): material data, normal and
 // distance from the reference point. Diffuse surfaces store their reflected radiance towards the
 // reference point: emission plus direct lighting of the punctual lights with the shared
-// shadow-mapped code (common/direct_lighting.glsl).
+// shadow-mapped code (common/direct_lighting.glsl), plus the environment's glossy reflection (the
+// split-sum `direct` adds on screen, L(sky)GE, when u_iblMode is set).
 #include "common/direct_lighting.glsl"
+#include "common/ibl.glsl"
 #include "common/material.glsl"
 #include "specular/ldm.glsl"
 
@@ -18,6 +20,8 @@ uniform int u_peel;        // 1: keep only surfaces beyond the previous layer (d
 uniform int u_objectCode;  // specular object index + 1 of this mesh, 0 = diffuse
 
 layout(binding = kUnitPeel) uniform sampler2D t_peel;  // previous layer of this face (z = distance, 0 = empty)
+layout(binding = kUnitIblDfg) uniform sampler2D t_dfg;
+layout(binding = kUnitIblPrefiltered) uniform sampler2DArray t_prefiltered;
 
 layout(location = 0) out vec4 o_material;
 layout(location = 1) out vec4 o_geometry;
@@ -61,6 +65,11 @@ void main() {
     // glTF emission leaves the front face only unless the material is double-sided (as the reference).
     bool emits = gl_FrontFacing || materialDoubleSided(m);
     vec3 L = (emits ? p.emission.rgb : vec3(0.0)) + directLighting(v_position, ns, ng, wo, p);
+    // The environment's glossy lobe (its diffuse lobe is photon_gi's photons, gathered into the maps
+    // with the Lambertian term): without it a rough metal seen in a mirror was black but for its sun
+    // glints (MetalRoughSpheres' mirror spheres reflecting their rough neighbours). Times the
+    // material's baked occlusion, as on screen; the coat normal is the shading normal here.
+    if (u_iblMode != IBL_NONE && !materialUnlit(m)) L += p.emission.a * iblSpecular(t_dfg, t_prefiltered, ns, ns, wo, p);
     if (materialUnlit(m)) L = p.baseColor.rgb;  // KHR_materials_unlit: its base colour, lit by nothing
     o_material = vec4(L, 0.0);
   }

@@ -11,6 +11,7 @@
 #include "renderer/frame/PassContext.h"
 #include "renderer/shading/CubeFaces.h"
 #include "renderer/shading/DirectLighting.h"
+#include "renderer/shading/ImageBasedLighting.h"
 #include "renderer/shading/PhotonGrid.h"
 #include "renderer/shading/SpecularObjects.h"
 #include "renderer/shading/Stretches.h"
@@ -178,8 +179,15 @@ void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResour
   // shape, and on the photons that light their diffuse texels (execute(): photon_gi publishes its grid
   // in its prepare, after this one). Not on the tracing knobs (steps, depth, minmax): a sweep over
   // those reuses them.
+  // And on the environment: its lights shade the texels and its residual their glossy lobe (the photon
+  // set's digest covers it only when photon_gi runs).
+  ibl::prepare(res);
+  mapsIbl_ = res.ownsLightPath("direct", "L(sky)GE") && ibl::modeFor(res) != ibl::kNone;
+  const FrameView& v = res.view();
   digest_ = res.sceneKey() + "|res=" + std::to_string(resolution_) + "|layers=" + std::to_string(layers_) +
-            "|objects=" + std::to_string(objects_.size()) + "|indirect_block=" + std::to_string(indirectBlock_);
+            "|objects=" + std::to_string(objects_.size()) + "|indirect_block=" + std::to_string(indirectBlock_) +
+            "|env=" + v.lightingEnvironmentKey() + "|ambient=" + std::to_string(v.ambient.x) + "," +
+            std::to_string(v.ambient.y) + "," + std::to_string(v.ambient.z) + "|ibl=" + (mapsIbl_ ? "1" : "0");
 }
 
 void SpecularPass::execute(PassContext& ctx) {
@@ -216,6 +224,11 @@ void SpecularPass::execute(PassContext& ctx) {
     const gl::Program& prog = ctx.shaders.program({"specular/map.vert", "specular/map.frag"});
     prog.use();
     bindDirectLighting(prog, res, ctx.gpu, static_cast<int>(ctx.view.lights.size()), 1);
+    // The sky's glossy reflection on the maps' non-specular texels: the split-sum `direct` adds on
+    // screen, under the same rule (direct owns L(sky)GE; otherwise photon_gi's glossy splats carry it
+    // on screen and nothing in the maps).
+    ibl::bind(res, prog, gpu::kUnitIblDfg, gpu::kUnitIblPrefiltered);
+    if (!mapsIbl_) prog.set("u_iblMode", ibl::kNone);
     peel.bindUnit(kMapTextureUnitPeel);
     glViewport(0, 0, resolution_, resolution_);
     glEnable(GL_DEPTH_TEST);

@@ -68,6 +68,7 @@ private:
   int indirectBlock_ = 8;             // map_indirect_block     // caustics traces its photons through the maps: cube_resolution
   bool minmax_ = true;
   bool mapsValid_ = false;
+  bool mapsIbl_ = false;  // the maps carry the sky's glossy lobe (direct owns L(sky)GE and there is a sky)
   std::string digest_;  // the maps' key without the photon set (execute() appends it; FrameResources::holds)
 };
 

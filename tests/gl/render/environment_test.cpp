@@ -10,6 +10,7 @@
 #include "renderer/Renderer.h"
 #include "renderer/io/ImageIO.h"
 #include "renderer/scene/Environment.h"
+#include "renderer/shading/ImageBasedLighting.h"
 #include "tests/support/RenderTestSupport.h"
 #include "tests/support/SceneBuilder.h"
 
@@ -322,6 +323,61 @@ TEST(Environment, SunOfAnHdrMapCastsTheReferencesShadows) {
 // reference does. The specular pass draws its layered distance maps with drawMeshes, which must not
 // rebind the scene's light buffer over the frame's (the plane in the mirror came out unlit by the sun,
 // 0.5 of the reference, when it did).
+// The sky's glossy reflection reaches what a mirror shows (L(sky) G S E): a white rough metal wall
+// (roughness 0.5) standing on a white mirror floor (Schlick F = 1) under a uniform sky of 1. The specular
+// pass's maps store for the wall what `direct` adds on screen, the split-sum L (A + B)(mu), with mu
+// taken towards the floor's reference point (its bounds' centre, the origin: the distance-map
+// approximation of view-dependent terms); the wall's metal has no Lambertian albedo, so photon_gi's
+// gather adds nothing there. Until map.frag added the split-sum the maps held only emission, the
+// lights' direct light and that gather: the wall came out black in the mirror (0 of the expected).
+TEST(Environment, AMirrorShowsTheSkysGlossyReflectionOnRoughMetal) {
+  testing::SceneBuilder b;
+  Material mirror = testing::lambertian(glm::vec3(1.f));
+  mirror.metallicFactor = 1.f;
+  mirror.roughnessFactor = 0.f;
+  Material rough = testing::lambertian(glm::vec3(1.f));
+  rough.metallicFactor = 1.f;
+  rough.roughnessFactor = 0.5f;
+  const int floorMat = b.material(mirror), wallMat = b.material(rough);
+  b.quad({0, 0, 0}, {5, 0, 0}, {0, 0, -5}, floorMat, "mirror floor").quad({0, 2.5f, -2}, {5, 0, 0}, {0, 2.5f, 0}, wallMat, "wall");
+  Scene scene = b.build("env-mirror-rough-metal");
+  api::RenderRequest req;
+  req.width = req.height = 48;
+  req.ambient = glm::vec3(1.f);
+  api::CameraOverride cam;
+  cam.position = glm::vec3(0.f, 2.f, 6.f);
+  cam.target = glm::vec3(0.f, 0.5f, -2.f);
+  cam.yfovDegrees = 50.f;
+  req.camera = cam;
+  req.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"specular", "gbuffer_position"}, false}};
+  RenderOutput out = renderer().render(scene, req);
+  ASSERT_TRUE(testing::allFinite(out));
+  const Image& spec = aov(out, "specular");
+  const Image& pos = aov(out, "gbuffer_position");
+  double measured = 0, expected = 0;
+  int n = 0;
+  for (int y = 0; y < 48; ++y)
+    for (int x = 0; x < 48; ++x) {
+      const float* p = pos.at(x, y);
+      if (!(p[3] > 0.f) || std::abs(p[1]) > 1e-3f) continue;
+      // The floor's reflection of the eye ray: where does it meet the wall (away from its edges)?
+      const glm::vec3 P(p[0], p[1], p[2]);
+      const glm::vec3 d = glm::normalize(P - cam.position);
+      const glm::vec3 r(d.x, -d.y, d.z);
+      if (!(r.z < 0.f) || P.z < -1.9f) continue;
+      const glm::vec3 h = P + r * ((-2.f - P.z) / r.z);
+      if (!(h.y > 0.5f && h.y < 4.5f && std::abs(h.x) < 4.f)) continue;
+      const float mu = glm::normalize(-h).z;  // towards the reference point, against the wall's normal +z
+      const glm::vec3 ab = ibl::dfgAt(mu, 0.5f);
+      measured += spec.at(x, y)[1];
+      expected += ab.x + ab.y;
+      ++n;
+    }
+  ASSERT_GT(n, 50);
+  // 5%: the DFG table's interpolation (32 x 32) against dfgAt's direct evaluation, and the maps' texels.
+  EXPECT_NEAR(measured / expected, 1.0, 0.05) << n << " pixels, mean " << measured / n << ", expected " << expected / n;
+}
+
 TEST(Environment, AMirrorShowsThePlaneLitByTheMapsSun) {
   const std::filesystem::path dir = RADIANT_ENVIRONMENTS_DIR;
   if (!std::filesystem::exists(dir / "qwantani_afternoon_puresky_1k.hdr")) GTEST_SKIP() << "no " << dir;

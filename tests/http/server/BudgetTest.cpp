@@ -81,9 +81,7 @@ void expectTheChoosersChoice(const json& body, const json& response) {
   request.height *= k;
   std::vector<std::string> planned;
   for (const auto& p : stats["passes"]) planned.push_back(p["name"]);
-  api::SceneCounts counts;
-  counts.particles = b["scene_counts"]["particles"];
-  counts.beams = b["scene_counts"]["beams"];
+  const api::SceneCounts counts = api::SceneCounts::fromJson(b["scene_counts"]);
   const double speed = b["speed_factor"];
   EXPECT_EQ(speed, b["speed"]["factor"].get<double>()) << b.dump();
   const api::BudgetChoice local = api::chooseConfiguration(api::PresetTable::builtin(), planned, request, nullptr, counts, speed);
@@ -260,9 +258,7 @@ TEST(Budgets, TheDefaultFrameBudgetLowersOnlyTheDefaultFrame) {
   request.supersampling = k;
   std::vector<std::string> planned;
   for (const auto& p : stats["passes"]) planned.push_back(p["name"]);
-  api::SceneCounts counts;
-  counts.particles = b["scene_counts"]["particles"];
-  counts.beams = b["scene_counts"]["beams"];
+  const api::SceneCounts counts = api::SceneCounts::fromJson(b["scene_counts"]);
   api::RequestLimits limits;
   limits.defaultFrameBudgetMs = 50;
   const api::BudgetChoice local = api::chooseConfiguration(api::PresetTable::builtin(), planned, request, &limits, counts, 1.0);

@@ -98,7 +98,8 @@ TEST(Presets, TheEmbeddedModelsScaleWithTheSceneCountsAsMeasured) {
   const std::map<std::string, std::string> scaled{{"spherical_billboards", "particles"},
                                                   {"depth_impostors", "particles"},
                                                   {"illumination_network", "particles"},
-                                                  {"light_volumes", "beams"}};
+                                                  {"light_volumes", "beams"},
+                                                  {"specular", "specular_objects"}};
   for (const auto& [name, var] : scaled) {
     const json& model = t.data()["techniques"][name]["model"];
     ASSERT_TRUE(model.contains("count_checks")) << name << ": fitted without its scene-count variants";
@@ -107,7 +108,8 @@ TEST(Presets, TheEmbeddedModelsScaleWithTheSceneCountsAsMeasured) {
     std::vector<double> predicted;
     for (const json& c : checks) {
       SceneCounts counts;
-      (var == "particles" ? counts.particles : counts.beams) = c["counts"][var].get<double>();
+      (var == "particles" ? counts.particles : var == "beams" ? counts.beams : counts.specularObjects) =
+          c["counts"][var].get<double>();
       double sum = 0;
       for (const json& p : c["params"]) sum += t.predictMs(name, techniqueParams(name, p), c["pixels"], counts);
       EXPECT_NEAR(sum, c["predicted_ms"].get<double>(), 1e-6 * sum + 1e-9) << name;

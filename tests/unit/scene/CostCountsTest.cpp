@@ -1,6 +1,7 @@
 // The preset table's scene variables (api::SceneCounts) as renderer/scene/CostCounts.cpp computes them
-// for the budget chooser: the particles of the scene's systems plus the request's, and light_volumes'
-// beams (per light, one per triangle of a narrow-lobe scatterer, two on a transmissive one), exactly.
+// for the budget chooser: the particles of the scene's systems plus the request's, light_volumes'
+// beams (per light, one per triangle of a narrow-lobe scatterer, two on a transmissive one) and the
+// specular pass's objects, exactly.
 #include <gtest/gtest.h>
 
 #include "renderer/scene/BuiltinScenes.h"
@@ -45,6 +46,7 @@ TEST(CostCounts, ParticlesOfSceneAndRequestAndBeamsOfNarrowLobeScatterers) {
   const api::SceneCounts bare = sceneCostCounts(scene, {});
   EXPECT_EQ(bare.particles, 5.0);
   EXPECT_EQ(bare.beams, 2.0 * (4 + 2 * 3));  // 2 lights x (4 mirror + 3 glass reflected and refracted)
+  EXPECT_EQ(bare.specularObjects, 2.0);      // the mirror and the glass mesh (roughness 0.8 metal is no mirror)
   const api::SceneCounts withMedia = sceneCostCounts(scene, {system(7), system(0)});
   EXPECT_EQ(withMedia.particles, 12.0);
   EXPECT_EQ(withMedia.beams, bare.beams);
@@ -58,6 +60,9 @@ TEST(CostCounts, TheBuiltinScenesCounts) {
   EXPECT_EQ(sceneCostCounts(loadBuiltinScene("cornell_glass"), {}).beams, 1920.0);  // 960-triangle glass sphere
   EXPECT_EQ(sceneCostCounts(loadBuiltinScene("cornell_mirror"), {}).beams, 960.0);
   EXPECT_EQ(sceneCostCounts(loadBuiltinScene("cornell_glossy"), {}).beams, 12.0);
+  EXPECT_EQ(sceneCostCounts(loadBuiltinScene("cornell_glass"), {}).specularObjects, 1.0);  // specular's canonical scene
+  EXPECT_EQ(sceneCostCounts(loadBuiltinScene("cornell_mirror"), {}).specularObjects, 1.0);
+  EXPECT_EQ(sceneCostCounts(loadBuiltinScene("cornell_box"), {}).specularObjects, 0.0);
 }
 
 }  // namespace radiant
