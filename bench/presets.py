@@ -116,8 +116,14 @@ TECHNIQUES = {
         "scene": "cornell_glass",
         "passes": {"photon_gi": False},
         "configs": [{"photon_resolution": p, "cube_resolution": c} for p in (32, 64, 128, 256) for c in (64, 128, 256, 512)],
-        # caustic photons traced on the GPU (P^2 texels per light face), the distance cube (6 C^2), splats.
-        "terms": [[], ["pixels"], ["photon_resolution", "photon_resolution"], ["cube_resolution", "cube_resolution"]],
+        # caustic photons traced on the GPU (P^2 texels per light face, per generator: every specular object),
+        # the distance cube (6 C^2), splats. The generators (api::SceneCounts "specular_objects") are varied by
+        # bench/glass_metal_field.py's fields of 4 and 12 spheres (cornell_glass has 1).
+        "terms": [[], ["pixels"], ["specular_objects"], ["specular_objects", "photon_resolution", "photon_resolution"],
+                  ["cube_resolution", "cube_resolution"]],
+        "variants": [{"field": 4}, {"field": 12}],
+        "variant_configs": [{"photon_resolution": p, "cube_resolution": 128} for p in (32, 64, 128)],
+        "variant_seed": 7200,
         "compare": {"aov": "caustics", "spp": 1024},  # the light tracer's L S+ D E class
         # At 64x64 every configuration scored 0.105-0.108 (the caustic is a few pixels wide: the error is
         # the ground truth's noise and the kernel's bias); at 128x128 photon_resolution buys accuracy.
