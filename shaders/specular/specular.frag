@@ -50,7 +50,9 @@ vec3 neighbourReflection(ivec2 q, vec3 n) {
 // The cone of directions a sample's reflected ray stands for: its footprint (one sample spacing, the
 // chord between its reflected direction r and the neighbours', the nearer side per axis, the wider
 // axis) widened by the glossy lobe of a surface the pass traces as a mirror (roughness below 0.2, GGX's
-// D falls to half at tan(theta_h) = 0.64 alpha: a reflected full width at half maximum of 2.56 alpha).
+// D falls to half at tan(theta_h) = 0.64 alpha: a reflected full width at half maximum of 2.56 alpha;
+// a glint's half-energy radius is then 0.82 of the reference's, and 1.65 with the half-mass cone of
+// 4 alpha: Environment.AGlossyMirrorSpreadsTheSunOverItsLobeAsTheReference).
 // Without it each sample read one texel: on a mirror sphere a few pixels wide a sample sees about
 // 3-4 degrees of sky and a sun of half a degree was all or nothing in the pixel (MetalRoughSpheres'
 // worst pixels in the fidelity benchmark, where the reference integrates the pixel).
