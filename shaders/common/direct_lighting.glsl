@@ -67,13 +67,22 @@ float shadowVisibility(int li, vec3 p, vec3 ng, float lightDist) {
 // A light with an angular radius (an environment light: a disc of the sky, not a delta) is reflected
 // by a lobe at least as wide as the disc's mirror image: GGX's D falls to half at tan(theta_h) = 0.64
 // alpha, and the disc's half-vectors reach radius / 2, so alpha >= 0.78 radius (roughness = sqrt).
-vec3 directLighting(vec3 p, vec3 n, vec3 nc, vec3 ng, vec3 wo, MaterialParams material, int count) {
+// lightsWithoutSpecular: lights from this index on are evaluated with Dirac specular and coat lobes
+// (roughness 0: only the diffuse lobe, under their Fresnel weights, carries light to a light's
+// direction). `direct` passes u_sceneLightCount on pixels the specular pass owns: that pass reflects the
+// whole environment map, its lights included, so their glossy lobes are its; their diffuse lobe (a
+// metal of metallic 0.67 is a third dielectric) is this pass's.
+vec3 directLighting(vec3 p, vec3 n, vec3 nc, vec3 ng, vec3 wo, MaterialParams material, int count,
+                    int lightsWithoutSpecular) {
   vec3 L = vec3(0.0);
   for (int i = 0; i < count; ++i) {
     LightSample s = sampleLight(lights[i], p);
     MaterialParams m = material;
     float radius = lights[i].spotCone.z;
-    if (radius > 0.0) {
+    if (i >= lightsWithoutSpecular) {
+      m.surface.y = 0.0;
+      m.clearcoat.y = 0.0;
+    } else if (radius > 0.0) {
       float floorRoughness = sqrt(0.78 * radius);
       m.surface.y = max(m.surface.y, floorRoughness);
       m.clearcoat.y = max(m.clearcoat.y, floorRoughness);
@@ -83,6 +92,9 @@ vec3 directLighting(vec3 p, vec3 n, vec3 nc, vec3 ng, vec3 wo, MaterialParams ma
     L += f * s.intensity * shadowVisibility(i, p, ng, s.dist);
   }
   return L;
+}
+vec3 directLighting(vec3 p, vec3 n, vec3 nc, vec3 ng, vec3 wo, MaterialParams material, int count) {
+  return directLighting(p, n, nc, ng, wo, material, count, count);
 }
 vec3 directLighting(vec3 p, vec3 n, vec3 nc, vec3 ng, vec3 wo, MaterialParams material) {
   return directLighting(p, n, nc, ng, wo, material, u_lightCount);

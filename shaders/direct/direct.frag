@@ -77,9 +77,11 @@ void main() {
   // path L(sky)GE, which this pass owns (u_iblMode is IBL_NONE otherwise). Mirror-like metals and
   // transmissive materials belong to the specular pass (Material::isSpecular(), the same per-material
   // rule the planner and that pass use; the G-buffer carries it in ng.w): it sees the whole map in
-  // their reflections, the environment's lights (after the scene's) included, so they are not added here.
+  // their reflections, the environment's lights (after the scene's) included, so those lights reach
+  // only their diffuse lobe here (a metallic 0.67 mirror is a third diffuse dielectric; it was black on
+  // its sunlit side until 2026-12-05).
   bool specularOwned = gbufferSpecularOwned(ngOwned);
-  vec3 L = emission + directLighting(p, n, nc, ng, wo, params, specularOwned ? u_sceneLightCount : u_lightCount);
+  vec3 L = emission + directLighting(p, n, nc, ng, wo, params, u_lightCount, specularOwned ? u_sceneLightCount : u_lightCount);
   if (u_iblMode != IBL_NONE && !specularOwned)
     L += mat.z * iblSpecular(t_dfg, t_prefiltered, n, nc, wo, params);
   o_direct = vec4(L, 1.0);
