@@ -93,11 +93,8 @@ vec3 directLighting(vec3 p, vec3 n, vec3 nc, vec3 ng, vec3 wo, MaterialParams ma
   }
   return L;
 }
-vec3 directLighting(vec3 p, vec3 n, vec3 nc, vec3 ng, vec3 wo, MaterialParams material, int count) {
-  return directLighting(p, n, nc, ng, wo, material, count, count);
-}
 vec3 directLighting(vec3 p, vec3 n, vec3 nc, vec3 ng, vec3 wo, MaterialParams material) {
-  return directLighting(p, n, nc, ng, wo, material, u_lightCount);
+  return directLighting(p, n, nc, ng, wo, material, u_lightCount, u_lightCount);
 }
 vec3 directLighting(vec3 p, vec3 n, vec3 ng, vec3 wo, MaterialParams material) {
   return directLighting(p, n, n, ng, wo, material);
