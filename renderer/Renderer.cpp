@@ -37,10 +37,12 @@ namespace {
 // what `direct` lights with, and photon_gi and image-based lighting follow.
 EnvironmentLightOptions environmentLightOptions(const api::RenderRequest& request) {
   EnvironmentLightOptions o;
+  o.skyLights = 16;  // direct.json's default
   const auto it = request.passes.find("direct");
   if (it != request.passes.end() && it->second.is_object()) {
     o.maxLights = it->second.value("environment_lights", o.maxLights);
     o.threshold = it->second.value("environment_light_threshold", o.threshold);
+    o.skyLights = it->second.value("sky_lights", o.skyLights);
   }
   return o;
 }
@@ -638,11 +640,19 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     const bool directPlanned =
         std::any_of(plan.passes.begin(), plan.passes.end(), [](const Technique* t) { return t->info().name == "direct"; });
     if (supersampledView.environment && directPlanned) {
-      const EnvironmentLightOptions o = environmentLightOptions(request);
+      EnvironmentLightOptions o = environmentLightOptions(request);
+      // Sky lights stand for photon_gi's first-hit sky photons (the residual's L(sky)DE): only when it
+      // owns that class (ambient_occlusion's SH irradiance times AO otherwise; docs/TECHNIQUES.md,
+      // direct, "Sky lights").
+      const auto skyOwner = plan.lightPaths.find("L(sky)DE");
+      if (skyOwner == plan.lightPaths.end() || skyOwner->second != "photon_gi") o.skyLights = 0;
       supersampledView.environmentLights = im.environmentLights(supersampledView, o, stats, cancelToken);
       supersampledView.environmentLightsKey = o.key();
       const auto& taken = supersampledView.environmentLights->lights;
       supersampledView.lights.insert(supersampledView.lights.end(), taken.begin(), taken.end());
+      const auto& sky = supersampledView.environmentLights->skyLights;
+      supersampledView.lights.insert(supersampledView.lights.end(), sky.begin(), sky.end());
+      supersampledView.skyLights = static_cast<int>(sky.size());
     }
     const FrameView& view = supersampledView;
     FrameView outView = view;

@@ -35,15 +35,20 @@ struct FrameView {
   // nothing was taken. The background and the reference see `environment` itself.
   std::shared_ptr<const EnvironmentLights> environmentLights;
   std::string environmentLightsKey;    // its options' key (with environmentKey: the split's digest)
-  // The frame's lights: the scene's (same indices as scene.lights), then the environment's.
+  // The frame's lights: the scene's (same indices as scene.lights), then the environment's compact
+  // lights, then its sky lights (EnvironmentLights::skyLights), which light diffuse lobes only.
   std::vector<Light> lights;
   int sceneLights = 0;  // how many of `lights` are the scene's
+  int skyLights = 0;    // how many of `lights` (the last ones) are sky lights
   // What image-based lighting integrates: the residual when the map was split, else the map.
   const Image* lightingEnvironment() const {
     return environmentLights && environmentLights->split() ? &environmentLights->residual : environment;
   }
+  // The key of what the raster lights with: the map, and the split's options when it took lights.
   std::string lightingEnvironmentKey() const {
-    return environmentLights && environmentLights->split() ? environmentKey + "|" + environmentLightsKey : environmentKey;
+    return environmentLights && (environmentLights->split() || !environmentLights->skyLights.empty())
+               ? environmentKey + "|" + environmentLightsKey
+               : environmentKey;
   }
   glm::vec3 target{0.f};               // the point looked at (for stats.camera)
   std::string cameraSource;            // "file", "auto", "request", or "request+file" / "request+auto" when partial

@@ -20,6 +20,18 @@
 // maps; regions not taken (too broad, too weak, beyond maxLights) keep their full radiance in R. Every
 // texel's light is counted once: R + sum of the lights' S = L per texel, per channel (tested). The
 // reference path tracer and the background see L itself.
+//
+// Sky lights (skyLights > 0): the residual R itself, partitioned by median cut (P. Debevec, "A Median
+// Cut Algorithm for Light Probe Sampling", SIGGRAPH 2005 poster): the map's rectangle is split
+// recursively along its longer side (the width measured at the rectangle's mean latitude, cos-scaled)
+// where the luminous power Y(R) dw halves, always splitting the region of most power, until there are
+// skyLights regions (the first cut is the horizon); each becomes a directional light from its
+// power-weighted mean direction d with the region's vector irradiance along d, sum R (w . d) dw (rgb),
+// shaded as the cap of the region's mean cosine clipped by the receiver's horizon. They carry R's
+// diffuse light only (L(sky)DE; the frame shades them
+// with Dirac specular lobes, its glossy part staying image-based lighting's L(sky)GE): with shadow maps
+// the broad sky then has visibility (contact shadows), which photon_gi's first-hit sky photons had only
+// at the scale of their kernel (docs/TECHNIQUES.md, direct, "Sky lights").
 #include <string>
 #include <vector>
 
@@ -36,6 +48,7 @@ struct EnvironmentLightOptions {
   float threshold = 10.f;           // T in multiples of the map's mean luminance
   float maxSolidAngle = 0.1f;       // sr (a cone of about 10 degrees' radius)
   float minPowerFraction = 0.01f;   // of the map's luminous power
+  int skyLights = 0;                // median-cut lights of the residual (0: none)
   std::string key() const;          // for cache keys
 };
 
@@ -44,6 +57,11 @@ struct EnvironmentLights {
   Image residual;             // R, the map's size and channels (empty when no light was taken)
   float threshold = 0.f;      // T (luminance)
   float fraction = 0.f;       // the lights' share of the map's luminous power
+  // The residual's median-cut lights (directional, color = sum R (w . d) dw, intensity 1; angularRadius
+  // the cap with the region's mean cosine): empty unless options.skyLights > 0 (the map itself when no
+  // compact light was taken). Together they give a surface that sees whole regions the residual's
+  // cosine-weighted irradiance (their vector irradiances sum to the residual's).
+  std::vector<Light> skyLights;
   bool split() const { return !lights.empty(); }
   // The share of `map`'s radiance in direction `dir` (towards the sky) that the residual keeps: T / Y
   // in the lights' texels, 1 elsewhere (photon_gi scales its first-hit sky photons by it).

@@ -10,6 +10,10 @@ layout(binding = kUnitShadowCube) uniform samplerCubeArray t_shadowCube;
 layout(binding = kUnitShadow2D) uniform sampler2DArray t_shadow2D;
 uniform int u_lightCount;
 uniform int u_sceneLightCount;  // lights[u_sceneLightCount ..] are the environment's (EnvironmentLights.h)
+// lights[u_diffuseOnlyFrom ..] are the sky lights (EnvironmentLights::skyLights): the residual map's
+// diffuse light, shaded with Dirac specular and coat lobes (its glossy part is image-based lighting's).
+// Programs that do not bind the frame's lights keep the initialiser: none.
+uniform int u_diffuseOnlyFrom = 1073741824;
 uniform int u_hasShadows;
 uniform int u_pcfRadius;
 
@@ -61,6 +65,25 @@ float shadowVisibility(int li, vec3 p, vec3 ng, float lightDist) {
   return lit / count;
 }
 
+// The cosine factor of a sky light (EnvironmentLights::skyLights): its region of the sky as a uniform
+// cap of angular radius sigma (the cap with the region's mean cosine about its direction) clipped by
+// the receiver's horizon, over the unclipped cap's pi sin^2 sigma. Equal to max(0, cos theta) where
+// the whole cap is above the horizon (the light's irradiance is the region's vector irradiance), and
+// smooth across it, where a direction alone would switch a broad region's light on or off (walls lit
+// by half of a region; contact shadows lit by the regions on the horizon). The clipped cap's
+// illuminance is Lagarde and de Rousiers' ("Moving Frostbite to PBR", SIGGRAPH 2014, sphere and disk
+// lights with the horizon), from Snyder's closed form.
+float skyCapCosine(float cosTheta, float sigma) {
+  float sin2 = min(1.0, sin(sigma) * sin(sigma));
+  if (sin2 < 1e-6 || cosTheta * cosTheta > sin2) return max(cosTheta, 0.0);
+  float sinTheta = sqrt(max(0.0, 1.0 - cosTheta * cosTheta));
+  float x = sqrt(max(0.0, 1.0 / sin2 - 1.0));
+  float y = clamp(-x * cosTheta / max(sinTheta, 1e-6), -1.0, 1.0);
+  float sinThetaSqrtY = sinTheta * sqrt(max(0.0, 1.0 - y * y));
+  float e = (cosTheta * acos(y) - x * sinThetaSqrtY) * sin2 + atan(sinThetaSqrtY, x);
+  return max(e, 0.0) / (3.14159265358979 * sin2);
+}
+
 // Sum over the first `count` lights of f(wi, wo) cos(theta_i) E_light V_shadow (no emission). n is the
 // shading normal (facing wo), ng the geometric normal on the same side (used for the shadow normal
 // offset). nc is the clear coat's normal (KHR_materials_clearcoat; n when there is no coat).
@@ -75,6 +98,7 @@ float shadowVisibility(int li, vec3 p, vec3 ng, float lightDist) {
 vec3 directLighting(vec3 p, vec3 n, vec3 nc, vec3 ng, vec3 wo, MaterialParams material, int count,
                     int lightsWithoutSpecular) {
   vec3 L = vec3(0.0);
+  lightsWithoutSpecular = min(lightsWithoutSpecular, u_diffuseOnlyFrom);
   for (int i = 0; i < count; ++i) {
     LightSample s = sampleLight(lights[i], p);
     MaterialParams m = material;
@@ -87,7 +111,18 @@ vec3 directLighting(vec3 p, vec3 n, vec3 nc, vec3 ng, vec3 wo, MaterialParams ma
       m.surface.y = max(m.surface.y, floorRoughness);
       m.clearcoat.y = max(m.clearcoat.y, floorRoughness);
     }
-    vec3 f = gltfBsdfCos(n, nc, wo, s.wi, m, m.surface.w);
+    vec3 f;
+    if (i >= u_diffuseOnlyFrom && radius > 0.0) {
+      // A sky light: its region's cap clipped by the horizon (skyCapCosine). The diffuse lobe is
+      // evaluated towards the light, or just above the horizon when the light's centre is below it.
+      float c = dot(n, s.wi);
+      float k = skyCapCosine(c, radius);
+      if (k <= 0.0) continue;
+      vec3 wi = c >= 0.05 ? s.wi : normalize(s.wi + n * (0.05 - c));
+      f = gltfBsdfCos(n, nc, wo, wi, m, m.surface.w) * (k / max(dot(n, wi), 1e-4));
+    } else {
+      f = gltfBsdfCos(n, nc, wo, s.wi, m, m.surface.w);
+    }
     if (all(equal(f, vec3(0.0)))) continue;
     L += f * s.intensity * shadowVisibility(i, p, ng, s.dist);
   }

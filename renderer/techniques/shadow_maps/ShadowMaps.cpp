@@ -5,6 +5,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "api/Types.h"
 #include "renderer/frame/FrameView.h"
 #include "renderer/frame/PassContext.h"
 #include "renderer/shading/CubeFaces.h"
@@ -80,6 +81,17 @@ void ShadowMapsPass::prepare(const Scene& scene, const Params& params, FrameReso
     }
   }
 
+  // The maps' memory is bounded whatever the lights: a 4096^2 map is 64 MiB, and a frame may hold the
+  // scene's lights, 8 environment lights and 64 sky lights (direct's environment_lights, sky_lights).
+  const double bytes = 4.0 * double(size_) * size_ * (6.0 * cubes + maps2d);
+  if (bytes > kMaxBytes)
+    throw api::ApiError(422, "limit-exceeded", "Server limit exceeded",
+                        "/passes/shadow_maps/shadow_map_size: " + std::to_string(cubes + maps2d) + " shadow maps (" +
+                            std::to_string(cubes) + " point-light cubes) of " + std::to_string(size_) + "^2 need " +
+                            std::to_string(static_cast<long long>(bytes / (1 << 20))) + " MiB, above the limit of " +
+                            std::to_string(static_cast<long long>(kMaxBytes / (1 << 20))) +
+                            " MiB: lower shadow_map_size, or direct's sky_lights or environment_lights",
+                        "/passes/shadow_maps/shadow_map_size");
   // Both arrays always exist (samplers must be complete even when unused); an unused one is 1 x 1.
   const int cubeSize = cubes > 0 ? size_ : 1, flatSize = maps2d > 0 ? size_ : 1;
   gl::Texture& cube = res.texture("shadow_cube", GL_TEXTURE_CUBE_MAP_ARRAY, GL_R32F, cubeSize, cubeSize, 6 * std::max(1, cubes));

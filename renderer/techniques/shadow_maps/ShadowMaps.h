@@ -28,6 +28,8 @@ public:
     return radiant::cubeFaceViewProj(lightPos, face, znear);  // renderer/shading/CubeFaces.h
   }
 
+  static constexpr double kMaxBytes = 1024.0 * 1024.0 * 1024.0;  // every map of a frame together (1 GiB)
+
 private:
   bool mapsValid_ = false;
   std::string digest_;  // what the maps hold once execute() rendered them (FrameResources::holds)

@@ -729,10 +729,12 @@ TEST(ImageBasedLighting, EnvironmentDistributionIsBuiltOncePerEnvironmentDigest)
   b.sphere({0, 0, 0}, 1.f, b.material(testing::lambertian()), 32, 16);
   const Scene scene = b.build("env-distribution");
   // Lookups of the map's distribution (the reference's) and photon_gi's (drawn by the residual plus
-  // half the sun: sunSky's sun is split off as a light), as hits and misses.
+  // half the sun: sunSky's sun is split off as a light, and sky_lights 0 leaves the sky's first hits to
+  // photons), as hits and misses.
   struct Lookups { int hits = 0, misses = 0, photonHits = 0, photonMisses = 0; };
-  auto render = [&](const std::string& digest, int spp) {
+  auto render = [&](const std::string& digest, int spp, int skyLights = 0) {
     api::RenderRequest req = exrRequest(32);
+    req.passes["direct"] = {{"sky_lights", skyLights}};
     req.environment = "sha256:" + digest;
     req.camera = api::CameraOverride{{0, 0, 4}, {0, 0, 0}, {0, 1, 0}, 35.f};
     req.compare = api::CompareSpec{"reference", "beauty", spp, 1};  // a new spp: the reference re-renders
@@ -755,6 +757,11 @@ TEST(ImageBasedLighting, EnvironmentDistributionIsBuiltOncePerEnvironmentDigest)
   const Lookups third = render(other, 2);  // another digest: built again
   EXPECT_EQ(third.misses, 1);
   EXPECT_EQ(third.photonMisses, 1);
+  // With the sky lights (the default) no first hit of the sky is splatted: photon_gi draws by the map
+  // itself and shares its distribution, which is built already.
+  const Lookups fourth = render(other, 3, 32);
+  EXPECT_EQ(fourth.misses + fourth.photonMisses + fourth.photonHits, 0);
+  EXPECT_GE(fourth.hits, 2);
 }
 
 // ---- KHR_materials_clearcoat, _sheen, _specular: raster against the reference ---------------------

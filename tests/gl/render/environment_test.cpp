@@ -21,6 +21,23 @@ using testing::aov;
 using testing::renderer;
 
 // Upper hemisphere red (1, 0, 0), lower hemisphere blue (0, 0, 2): rows split exactly at the horizon.
+// A square frame of a scene under an environment map (digest `environment`) from an orbit camera at
+// theta 30 degrees around `target`, with beauty, the reference at `spp` and the G-buffer's positions.
+api::RenderRequest orbitRequest(int size, const std::string& environment, double phiDeg, double radius,
+                                glm::vec3 target, int spp) {
+  api::RenderRequest req;
+  req.width = req.height = size;
+  req.environment = environment;
+  api::CameraOverride cam;
+  cam.hasPosition = false;
+  cam.orbit = api::CameraOverride::Orbit{30.0, phiDeg, radius};
+  cam.target = target;
+  req.camera = cam;
+  req.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty", "reference", "gbuffer_position"}, false}};
+  req.passes["reference"] = {{"spp", spp}};
+  return req;
+}
+
 Image twoHemispheres() {
   Image env = Image::make("environment", 16, 8, 3);
   for (int y = 0; y < env.height; ++y)
@@ -115,8 +132,12 @@ TEST(Environment, ReferenceAndRasterLightByTheMapNotItsAverage) {
       EXPECT_NEAR(beauty.at(x, y)[0], 1.0f, 1e-2f);
       EXPECT_NEAR(beauty.at(x, y)[2], 0.0f, 1e-2f);
     }
-  // With photon_gi (on by default) the map's direct light comes from environment photons, which see
-  // its directions: the upward-facing plane gets the red upper hemisphere only, like the reference.
+  // With photon_gi (on by default) the map's direct light comes from `direct`'s sky lights (its median
+  // cut, the first cut at the horizon), each shaded as a cap clipped by the receiver's horizon: the
+  // upward-facing plane gets the red upper hemisphere, like the reference, and of the blue lower one
+  // what its caps next to the horizon reach above it (0.0038: the caps are not clipped at the map's
+  // horizon, which walls need; EnvironmentLights.cpp). With sky_lights 0, photon_gi's environment
+  // photons, which see the map's directions: none of it.
   req.disabledPasses.clear();
   req.passes["photon_gi"] = {{"photons", 400000}, {"C", 20}};
   RenderOutput gi = renderer().render(scene, req, nullptr, FrameInputs{nullptr, &env});
@@ -129,7 +150,17 @@ TEST(Environment, ReferenceAndRasterLightByTheMapNotItsAverage) {
   // The 16 pixels share one kernel (h ~ 4 m on the 100 m plane), so their mean carries the estimate's
   // noise 0.757 / C = 3.8% (C = 20): 10% is 2.6 sigma.
   EXPECT_NEAR(giRed, red, 0.1);
-  EXPECT_NEAR(giBlue, 0.0, 1e-6);
+  EXPECT_NEAR(giBlue, 0.0, 0.005);
+  req.passes["direct"] = {{"sky_lights", 0}};
+  RenderOutput photons = renderer().render(scene, req, nullptr, FrameInputs{nullptr, &env});
+  double photonRed = 0, photonBlue = 0;
+  for (int y = 2; y < 6; ++y)
+    for (int x = 2; x < 6; ++x) {
+      photonRed += aov(photons, "beauty").at(x, y)[0] / 16.0;
+      photonBlue += aov(photons, "beauty").at(x, y)[2] / 16.0;
+    }
+  EXPECT_NEAR(photonRed, red, 0.1);
+  EXPECT_NEAR(photonBlue, 0.0, 1e-6);
 }
 
 // A mirror sphere seen by an orthographic camera maps directions onto the image with a constant
@@ -280,20 +311,21 @@ TEST(Environment, MirrorsReflectTheMapNotItsAverage) {
 // Issue 29, item 3: the environment casts shadows in the raster. A white sphere resting on a white
 // plane under the two shared CC0 maps, each with a small sun holding 70-79% of its power
 // (qwantani_afternoon_puresky: a clear sky; chinese_garden: a garden with sun), default frame against
-// the reference path tracer, 128 px. Regions are compared on the pixels whose 8 neighbours lie in the
-// same region: a pixel across a silhouette or the sun shadow's edge is the reference's area integral
-// (jittered rays) against the raster's one sample, aliasing whatever the lighting, and counting only
-// the edge pixels on one side of a threshold biased the shadow's ratio to 0.76 (2026-12-04).
-// Measured (2026-12-04, llvmpipe), raster / reference, qwantani / chinese_garden, seed 0:
+// the reference path tracer, 128 px, region sums over seeds 0-3 (raster and reference alike). Regions
+// are compared on the pixels whose 8 neighbours lie in the same region: a pixel across a silhouette or
+// the sun shadow's edge is the reference's area integral (jittered rays) against the raster's one
+// sample, aliasing whatever the lighting, and counting only the edge pixels on one side of a threshold
+// biased the shadow's ratio to 0.76 (2026-12-04).
+// Measured (2026-12-05, llvmpipe), raster / reference, qwantani / chinese_garden:
 //                          sunlit plane  upper sphere  lower half   sun shadow   contact (r < 0.5)
-//   two-sided coverage     1.00 / 1.01   0.98 / 1.00   0.95 / 1.00  0.86 / 1.05  0.52 / 0.55
-//   default                1.01 / 1.01   0.98 / 0.99   0.94 / 1.03  0.87 / 1.06  1.16 / 1.21
-// The contact was photon_gi's edge renormalisation counting the sphere's coverage points on the plane
-// (photon_gi/photon.glsl coverageKernel). What is left in the shadows is photon_gi's: the sky photons'
-// noise (a single seed's shadow ranges 0.86-1.08) and, at the contact, the kernel's blur (h = 0.35-0.45,
-// the contact region's own size; over 4 seeds the contact is 1.12 / 1.16 of the reference): the
-// issue's 10% for the contact needs visibility finer than a kernel (docs/TECHNIQUES.md, direct,
-// "Environment lights").
+//   photon sky, seed 0     1.01 / 1.01   0.98 / 0.99   0.94 / 1.03  0.87 / 1.06  1.16 / 1.21
+//   photon sky, seeds 0-3                                           1.08 / 1.11  1.12 / 1.16
+//   sky lights, seeds 0-3  1.01 / 1.01   0.99 / 0.99   0.95 / 0.94  0.99 / 1.01  0.99 / 0.98
+// With photon_gi's first-hit sky photons the shadow and the contact were the kernel's: the sky's own
+// light at the contact came out 1.3-2.0x the reference's (h = 0.35-0.45 is the contact region's size)
+// and a seed's shadow anywhere in 0.86-1.3. The sky lights (direct's sky_lights: the residual's median
+// cut with shadow maps) give the sky's first bounce its visibility; what varies from seed to seed is
+// photon_gi's later bounces (the lower half is mostly light from the sunlit plane).
 TEST(Environment, SunOfAnHdrMapCastsTheReferencesShadows) {
   const std::filesystem::path dir = RADIANT_ENVIRONMENTS_DIR;
   if (!std::filesystem::exists(dir / "chinese_garden_1k.hdr")) GTEST_SKIP() << "no " << dir;
@@ -301,78 +333,76 @@ TEST(Environment, SunOfAnHdrMapCastsTheReferencesShadows) {
   const int white = b.material(testing::lambertian(glm::vec3(0.7f)));
   b.quad({0, 0, 0}, {5, 0, 0}, {0, 0, -5}, white, "plane").sphere({0, 1, 0}, 1.f, white);
   Scene scene = b.build("env-sun-sphere-on-plane");
-  constexpr int kSize = 128;
+  constexpr int kSize = 128, kSeeds = 4;
   for (const char* name : {"qwantani_afternoon_puresky_1k.hdr", "chinese_garden_1k.hdr"}) {
     SCOPED_TRACE(name);
     const Image env = io::readImage((dir / name).string());
-    api::RenderRequest req;
-    req.width = req.height = kSize;
-    req.environment = "sha256:" + std::string(63, 'a') + (name[0] == 'q' ? "1" : "2");
-    api::CameraOverride cam;
-    cam.hasPosition = false;
-    cam.orbit = api::CameraOverride::Orbit{30.0, 60.0, 7.0};
-    cam.target = glm::vec3(0.f, 0.6f, 0.f);
-    req.camera = cam;
-    req.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty", "reference", "gbuffer_position"}, false}};
-    req.passes["reference"] = {{"spp", 256}};
-    RenderOutput out = renderer().render(scene, req, nullptr, FrameInputs{nullptr, &env});
-    ASSERT_TRUE(testing::allFinite(out));
-    const api::PassStats* direct = testing::pass(out, "direct");
-    ASSERT_NE(direct, nullptr);
-    EXPECT_EQ(direct->counters.at("environment_lights"), 1.0);
-    const Image& ref = aov(out, "reference");
-    const Image& beauty = aov(out, "beauty");
-    const Image& pos = aov(out, "gbuffer_position");
-    auto lum = [](const Image& im, int x, int y) {
-      const float* p = im.at(x, y);
-      return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
-    };
-    // The plane's sunlit level: the median of the reference on the plane away from the sphere.
-    std::vector<double> lit;
-    for (int y = 0; y < kSize; ++y)
-      for (int x = 0; x < kSize; ++x) {
-        const float* p = pos.at(x, y);
-        if (p[3] > 0.f && std::abs(p[1]) < 1e-3f && glm::length(glm::vec2(p[0], p[2])) > 2.5f) lit.push_back(lum(ref, x, y));
-      }
-    ASSERT_GT(lit.size(), 200u);
-    std::nth_element(lit.begin(), lit.begin() + lit.size() / 2, lit.end());
-    const double sunlit = lit[lit.size() / 2];
     struct Region { const char* what; double ref = 0, raster = 0; int n = 0; } shadow{"sun shadow"},
         contact{"contact"}, lower{"sphere's lower half"}, sunlitPlane{"sunlit plane"}, upper{"upper half"};
-    // 0 none, 1 plane in the sun, 2 plane in the shadow, 3 sphere's lower half, 4 its upper half.
-    auto classOf = [&](int x, int y) {
-      if (x < 0 || y < 0 || x >= kSize || y >= kSize) return 0;
-      const float* p = pos.at(x, y);
-      if (!(p[3] > 0.f)) return 0;
-      if (std::abs(p[1]) < 1e-3f) return lum(ref, x, y) < 0.5 * sunlit ? 2 : 1;
-      return p[1] < 1.f ? 3 : 4;
-    };
-    for (int y = 0; y < kSize; ++y)
-      for (int x = 0; x < kSize; ++x) {
-        const int c = classOf(x, y);
-        bool interior = c != 0;
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) interior = interior && classOf(x + dx, y + dy) == c;
-        if (!interior) continue;
+    for (int seed = 0; seed < kSeeds; ++seed) {
+      api::RenderRequest req = orbitRequest(kSize, "sha256:" + std::string(63, 'a') + (name[0] == 'q' ? "1" : "2"),
+                                            60.0, 7.0, glm::vec3(0.f, 0.6f, 0.f), 256);
+      req.seed = static_cast<std::uint64_t>(seed);
+      RenderOutput out = renderer().render(scene, req, nullptr, FrameInputs{nullptr, &env});
+      ASSERT_TRUE(testing::allFinite(out));
+      const api::PassStats* direct = testing::pass(out, "direct");
+      ASSERT_NE(direct, nullptr);
+      EXPECT_EQ(direct->counters.at("environment_lights"), 1.0);
+      EXPECT_EQ(direct->counters.at("sky_lights"), 16.0);
+      const Image& ref = aov(out, "reference");
+      const Image& beauty = aov(out, "beauty");
+      const Image& pos = aov(out, "gbuffer_position");
+      auto lum = [](const Image& im, int x, int y) {
+        const float* p = im.at(x, y);
+        return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+      };
+      // The plane's sunlit level: the median of the reference on the plane away from the sphere.
+      std::vector<double> lit;
+      for (int y = 0; y < kSize; ++y)
+        for (int x = 0; x < kSize; ++x) {
+          const float* p = pos.at(x, y);
+          if (p[3] > 0.f && std::abs(p[1]) < 1e-3f && glm::length(glm::vec2(p[0], p[2])) > 2.5f)
+            lit.push_back(lum(ref, x, y));
+        }
+      ASSERT_GT(lit.size(), 200u);
+      std::nth_element(lit.begin(), lit.begin() + lit.size() / 2, lit.end());
+      const double sunlit = lit[lit.size() / 2];
+      // 0 none, 1 plane in the sun, 2 plane in the shadow, 3 sphere's lower half, 4 its upper half.
+      auto classOf = [&](int x, int y) {
+        if (x < 0 || y < 0 || x >= kSize || y >= kSize) return 0;
         const float* p = pos.at(x, y);
-        const double r = glm::length(glm::vec2(p[0], p[2]));
-        Region* in = nullptr;
-        if (c == 2) in = r < 0.5 ? &contact : &shadow;
-        else if (c == 1 && r > 2.5 && lum(ref, x, y) > 0.8 * sunlit) in = &sunlitPlane;
-        else if (c == 3) in = &lower;
-        else if (c == 4) in = &upper;
-        if (!in) continue;
-        in->ref += lum(ref, x, y);
-        in->raster += lum(beauty, x, y);
-        ++in->n;
-      }
+        if (!(p[3] > 0.f)) return 0;
+        if (std::abs(p[1]) < 1e-3f) return lum(ref, x, y) < 0.5 * sunlit ? 2 : 1;
+        return p[1] < 1.f ? 3 : 4;
+      };
+      for (int y = 0; y < kSize; ++y)
+        for (int x = 0; x < kSize; ++x) {
+          const int c = classOf(x, y);
+          bool interior = c != 0;
+          for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) interior = interior && classOf(x + dx, y + dy) == c;
+          if (!interior) continue;
+          const float* p = pos.at(x, y);
+          const double r = glm::length(glm::vec2(p[0], p[2]));
+          Region* in = nullptr;
+          if (c == 2) in = r < 0.5 ? &contact : &shadow;
+          else if (c == 1 && r > 2.5 && lum(ref, x, y) > 0.8 * sunlit) in = &sunlitPlane;
+          else if (c == 3) in = &lower;
+          else if (c == 4) in = &upper;
+          if (!in) continue;
+          in->ref += lum(ref, x, y);
+          in->raster += lum(beauty, x, y);
+          ++in->n;
+        }
+    }
     const std::pair<const Region*, double> bounds[] = {
-        {&sunlitPlane, 0.03}, {&upper, 0.05}, {&lower, 0.10}, {&shadow, 0.15}, {&contact, 0.25}};
+        {&sunlitPlane, 0.03}, {&upper, 0.05}, {&lower, 0.10}, {&shadow, 0.10}, {&contact, 0.10}};
     for (const auto& [g, tolerance] : bounds) {
       SCOPED_TRACE(g->what);
-      ASSERT_GT(g->n, 8);
-      EXPECT_NEAR(g->raster / g->ref, 1.0, tolerance) << g->n << " pixels, reference mean " << g->ref / g->n
-                                                        << ", sunlit plane " << sunlit;
+      ASSERT_GT(g->n, 8 * kSeeds);
+      std::printf("%s, %s: %.3f of the reference (%d pixels over %d seeds)\n", name, g->what, g->raster / g->ref, g->n,
+                  kSeeds);
+      EXPECT_NEAR(g->raster / g->ref, 1.0, tolerance) << g->n << " pixels, reference mean " << g->ref / g->n;
     }
   }
 }
@@ -489,16 +519,8 @@ TEST(Environment, AMirrorShowsThePlaneLitByTheMapsSun) {
   b.quad({0, 0, 0}, {5, 0, 0}, {0, 0, -5}, white, "plane").sphere({0, 1, 0}, 1.f, chrome);
   Scene scene = b.build("env-sun-mirror-on-plane");
   const Image env = io::readImage((dir / "qwantani_afternoon_puresky_1k.hdr").string());
-  api::RenderRequest req;
-  req.width = req.height = 48;
-  req.environment = "sha256:" + std::string(63, 'a') + "1";
-  api::CameraOverride cam;
-  cam.hasPosition = false;
-  cam.orbit = api::CameraOverride::Orbit{30.0, 75.0, 6.0};
-  cam.target = glm::vec3(0.f, 0.8f, 0.f);
-  req.camera = cam;
-  req.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty", "reference", "gbuffer_position"}, false}};
-  req.passes["reference"] = {{"spp", 128}};
+  const api::RenderRequest req =
+      orbitRequest(48, "sha256:" + std::string(63, 'a') + "1", 75.0, 6.0, glm::vec3(0.f, 0.8f, 0.f), 128);
   RenderOutput out = renderer().render(scene, req, nullptr, FrameInputs{nullptr, &env});
   ASSERT_TRUE(testing::allFinite(out));
   ASSERT_NE(testing::pass(out, "specular"), nullptr);
@@ -521,6 +543,34 @@ TEST(Environment, AMirrorShowsThePlaneLitByTheMapsSun) {
     }
   ASSERT_GT(n, 20);
   EXPECT_NEAR(raster / r, 1.0, 0.15) << n << " pixels, reference mean " << r / n;
+}
+
+// The shadow maps' memory is bounded whatever the lights (ShadowMapsPass::kMaxBytes, 1 GiB): 64 sky
+// lights and the sun at shadow_map_size 4096 would be 65 maps of 64 MiB. A 422 naming the field, before
+// anything is allocated; the next frame renders.
+TEST(Environment, ShadowMapsBeyondTheMemoryLimitAreRefused) {
+  Image env = Image::make("environment", 64, 32, 3);
+  for (float& v : env.pixels) v = 1.f;
+  testing::SceneBuilder b;
+  b.sphere({0, 0, 0}, 1.f, b.material(testing::lambertian()), 16, 8);
+  const Scene scene = b.build("shadow-map-limit");
+  api::RenderRequest req;
+  req.width = req.height = 16;
+  req.environment = "sha256:" + std::string(64, 'e');
+  req.passes["direct"] = {{"sky_lights", 64}};
+  req.passes["shadow_maps"] = {{"shadow_map_size", 4096}};
+  try {
+    renderer().render(scene, req, nullptr, FrameInputs{nullptr, &env});
+    FAIL() << "65 maps of 4096^2 rendered";
+  } catch (const api::ApiError& e) {
+    EXPECT_EQ(e.status, 422);
+    EXPECT_EQ(e.pointer, "/passes/shadow_maps/shadow_map_size");
+    EXPECT_NE(std::string(e.what()).find("sky_lights"), std::string::npos) << e.what();
+  }
+  req.passes["shadow_maps"] = {{"shadow_map_size", 1024}};  // 65 MiB x 4 = 260 MiB: within the limit
+  const RenderOutput out = renderer().render(scene, req, nullptr, FrameInputs{nullptr, &env});
+  ASSERT_NE(testing::pass(out, "direct"), nullptr);
+  EXPECT_EQ(testing::pass(out, "direct")->counters.at("sky_lights"), 64.0);
 }
 
 }  // namespace

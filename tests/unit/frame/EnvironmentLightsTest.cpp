@@ -221,6 +221,72 @@ TEST(EnvironmentLights, NonFiniteAndEmptyMapsAreLeftAlone) {
   const EnvironmentLights s = extractEnvironmentLights(m);
   for (const Light& l : s.lights) EXPECT_TRUE(std::isfinite(l.color.x + l.color.y + l.color.z));
   EXPECT_FALSE(extractEnvironmentLights(Image{}).split());
+  EnvironmentLightOptions withSky;
+  withSky.skyLights = 16;
+  const EnvironmentLights sky = extractEnvironmentLights(m, withSky);
+  EXPECT_FALSE(sky.skyLights.empty());
+  for (const Light& l : sky.skyLights) {
+    EXPECT_TRUE(std::isfinite(l.color.x + l.color.y + l.color.z));
+    EXPECT_TRUE(std::isfinite(l.direction.x + l.direction.y + l.direction.z));
+  }
+  EXPECT_TRUE(extractEnvironmentLights(Image::make("environment", 32, 16, 3), withSky).skyLights.empty());  // black
+}
+
+// The sky lights (median cut of the residual, Debevec 2005): each carries its region's vector
+// irradiance (sum R w dw) along its direction, so together they give any surface that sees whole
+// regions the residual's cosine-weighted irradiance, and the first cut is the horizon, so a surface
+// facing up or down sees whole regions (one across the horizon would light an upward plane from its
+// centroid near the horizon, with a fraction of its upper half's light).
+TEST(EnvironmentLights, SkyLightsCarryTheResidualAndLightAPlaneAsTheMapDoes) {
+  const glm::vec3 sun = glm::normalize(glm::vec3(0.4f, 0.7f, -0.3f));
+  Image map = sunnySky(sun, 0.05f);
+  // A sky brighter at the horizon than at the zenith and a darker ground, as daylight maps are.
+  for (int y = 0; y < map.height; ++y)
+    for (int x = 0; x < map.width; ++x) {
+      const glm::vec3 d = texelDir(map, x, y);
+      float* p = map.at(x, y);
+      if (p[0] > 100.f) continue;  // the sun
+      const float k = d.y >= 0.f ? 1.5f - d.y : 0.3f;
+      p[0] *= k, p[1] *= k, p[2] *= k;
+    }
+  EnvironmentLightOptions o;
+  o.skyLights = 16;
+  const EnvironmentLights split = extractEnvironmentLights(map, o);
+  ASSERT_TRUE(split.split());
+  ASSERT_EQ(split.skyLights.size(), 16u);
+  glm::dvec3 residualVector(0.0), lightVector(0.0);  // luminance-weighted vector irradiance
+  double upMap = 0.0, downMap = 0.0, upLights = 0.0, downLights = 0.0;
+  for (int y = 0; y < map.height; ++y)
+    for (int x = 0; x < map.width; ++x) {
+      const float* r = split.residual.at(x, y);
+      const glm::dvec3 R(r[0], r[1], r[2]);
+      const double dw = texelSolidAngle(map, y), cy = texelDir(map, x, y).y;
+      residualVector += glm::dvec3(texelDir(map, x, y)) * (0.2126 * R.x + 0.7152 * R.y + 0.0722 * R.z) * dw;
+      upMap += R.y * dw * std::max(0.0, cy);
+      downMap += R.y * dw * std::max(0.0, -cy);
+    }
+  for (const Light& l : split.skyLights) {
+    const glm::dvec3 from = -glm::dvec3(l.direction);  // the light comes from -direction
+    const double Y = 0.2126 * l.color.x + 0.7152 * l.color.y + 0.0722 * l.color.z;
+    lightVector += from * Y;
+    upLights += l.color.y * std::max(0.0, from.y);
+    downLights += l.color.y * std::max(0.0, -from.y);
+    EXPECT_GT(l.angularRadius, 0.f);
+  }
+  EXPECT_LT(glm::length(lightVector - residualVector), 2e-3 * glm::length(residualVector));
+  EXPECT_NEAR(upLights / upMap, 1.0, 0.01) << upLights << " against " << upMap;
+  EXPECT_NEAR(downLights / downMap, 1.0, 0.01) << downLights << " against " << downMap;
+  // Without compact lights the sky lights cut the whole map, sun included: the upward irradiance holds.
+  EnvironmentLightOptions none = o;
+  none.maxLights = 0;
+  const EnvironmentLights whole = extractEnvironmentLights(map, none);
+  EXPECT_FALSE(whole.split());
+  double upWhole = 0.0, upWholeMap = 0.0;
+  for (int y = 0; y < map.height; ++y)
+    for (int x = 0; x < map.width; ++x)
+      upWholeMap += map.at(x, y)[1] * texelSolidAngle(map, y) * std::max(0.f, texelDir(map, x, y).y);
+  for (const Light& l : whole.skyLights) upWhole += l.color.y * std::max(0.f, -l.direction.y);
+  EXPECT_NEAR(upWhole / upWholeMap, 1.0, 0.01);
 }
 
 }  // namespace
