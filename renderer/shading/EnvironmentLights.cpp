@@ -152,11 +152,52 @@ EnvironmentLights extractCompactLights(const Image& map, const EnvironmentLightO
 }
 
 // Median cut of `m` (the residual) into at most n rectangles of texels (Debevec 2005; see the header).
+std::vector<Light> medianCutLights(const Image& m, int n, const rt::Cancel& cancel);
+
+// `map` with blocks of sx x sy texels averaged by solid angle (non-finite texels carry nothing), so
+// each coarse texel holds the block's mean radiance and the map's power is kept: the median cut of a
+// large map works on at most kMaxCutTexels (its summed-area table is 8 bytes a texel: a 1 x 22-million
+// map, within the decode limits, would have taken 350 MB).
+constexpr std::size_t kMaxCutTexels = std::size_t(1) << 20;
+Image coarsened(const Image& map, const rt::Cancel& cancel) {
+  const int w = map.width, h = map.height, c = map.channels;
+  int sx = 1, sy = 1;
+  while (static_cast<std::size_t>((w + sx - 1) / sx) * ((h + sy - 1) / sy) > kMaxCutTexels) {
+    if ((w + sx - 1) / sx >= (h + sy - 1) / sy) sx *= 2;
+    else sy *= 2;
+  }
+  const int cw = (w + sx - 1) / sx, ch = (h + sy - 1) / sy;
+  Image out = Image::make("environment", cw, ch, c);
+  std::vector<double> sum(static_cast<std::size_t>(c));
+  for (int cy = 0; cy < ch; ++cy) {
+    cancel.check("the environment's sky lights (sky_lights)");
+    for (int cx = 0; cx < cw; ++cx) {
+      std::fill(sum.begin(), sum.end(), 0.0);
+      double wsum = 0.0;
+      for (int y = cy * sy; y < std::min(h, (cy + 1) * sy); ++y) {
+        const double dw = std::sin(kPi * (y + 0.5) / h);
+        for (int x = cx * sx; x < std::min(w, (cx + 1) * sx); ++x) {
+          const float* p = map.at(x, y);
+          bool finite = true;
+          for (int k = 0; k < c; ++k) finite = finite && std::isfinite(p[k]);
+          wsum += dw;
+          if (finite)
+            for (int k = 0; k < c; ++k) sum[k] += p[k] * dw;
+        }
+      }
+      float* q = out.at(cx, cy);
+      for (int k = 0; k < c; ++k) q[k] = wsum > 0.0 ? static_cast<float>(sum[k] / wsum) : 0.f;
+    }
+  }
+  return out;
+}
+
 std::vector<Light> medianCutLights(const Image& m, int n, const rt::Cancel& cancel) {
   constexpr const char* kWhere = "the environment's sky lights (sky_lights)";
   std::vector<Light> out;
   const int w = m.width, h = m.height, c = m.channels;
   if (n <= 0 || w <= 0 || h <= 0 || c <= 0 || m.pixels.size() < static_cast<std::size_t>(w) * h * c) return out;
+  if (static_cast<std::size_t>(w) * h > kMaxCutTexels) return medianCutLights(coarsened(m, cancel), n, cancel);
   // Summed-area table of the power Y dw (non-finite and negative texels carry none).
   std::vector<double> sat(static_cast<std::size_t>(w + 1) * (h + 1), 0.0);
   auto S = [&](int x, int y) -> double& { return sat[static_cast<std::size_t>(y) * (w + 1) + x]; };

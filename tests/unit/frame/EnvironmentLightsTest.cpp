@@ -289,5 +289,35 @@ TEST(EnvironmentLights, SkyLightsCarryTheResidualAndLightAPlaneAsTheMapDoes) {
   EXPECT_NEAR(upWhole / upWholeMap, 1.0, 0.01);
 }
 
+// A map over 2^20 texels is cut on a copy averaged by solid angle (its summed-area table would be 8
+// bytes a texel): the lights still give an upward surface the map's cosine-weighted irradiance, and a
+// 1 x 2^22 strip (within the decode limits' pixel count) is cut without a table of its size.
+TEST(EnvironmentLights, SkyLightsOfALargeMapAreCutOnACoarseCopy) {
+  Image map = Image::make("environment", 2048, 1024, 3);
+  double upMap = 0.0;
+  for (int y = 0; y < map.height; ++y)
+    for (int x = 0; x < map.width; ++x) {
+      const glm::vec3 d = texelDir(map, x, y);
+      const float k = d.y >= 0.f ? 1.5f - d.y + 0.5f * d.x : 0.3f;
+      float* p = map.at(x, y);
+      p[0] = 0.5f * k, p[1] = 0.6f * k, p[2] = 0.8f * k;
+      upMap += p[1] * texelSolidAngle(map, y) * std::max(0.f, d.y);
+    }
+  EnvironmentLightOptions o;
+  o.skyLights = 16;
+  const EnvironmentLights split = extractEnvironmentLights(map, o);
+  ASSERT_EQ(split.skyLights.size(), 16u);
+  double upLights = 0.0;
+  for (const Light& l : split.skyLights) upLights += l.color.y * std::max(0.f, -l.direction.y);
+  EXPECT_NEAR(upLights / upMap, 1.0, 0.01);
+  Image strip = Image::make("environment", 1, 1 << 22, 3);
+  for (float& v : strip.pixels) v = 1.f;
+  const EnvironmentLights stripSplit = extractEnvironmentLights(strip, o);
+  ASSERT_FALSE(stripSplit.skyLights.empty());
+  double total = 0.0;
+  for (const Light& l : stripSplit.skyLights) total += l.color.x * std::max(0.f, -l.direction.y);
+  EXPECT_NEAR(total / kPi, 1.0, 0.01) << "a uniform sky of 1 gives an upward surface pi";
+}
+
 }  // namespace
 }  // namespace radiant
