@@ -95,9 +95,13 @@ float skyCapCosine(float cosTheta, float sigma) {
 // direction). `direct` passes u_sceneLightCount on pixels the specular pass owns: that pass reflects the
 // whole environment map, its lights included, so their glossy lobes are its; their diffuse lobe (a
 // metal of metallic 0.67 is a third dielectric) is this pass's.
+// skyVisibility: the shadow maps' visibility of the sky lights, weighted by the light each gives the
+// surface (luminance of E times skyCapCosine), 1 where no sky light reaches it: the residual sky's
+// diffuse visibility, which `direct` turns into specular occlusion (specularOcclusion below).
 vec3 directLighting(vec3 p, vec3 n, vec3 nc, vec3 ng, vec3 wo, MaterialParams material, int count,
-                    int lightsWithoutSpecular) {
+                    int lightsWithoutSpecular, out float skyVisibility) {
   vec3 L = vec3(0.0);
+  float skyOpen = 0.0, skySeen = 0.0;
   lightsWithoutSpecular = min(lightsWithoutSpecular, u_diffuseOnlyFrom);
   for (int i = 0; i < count; ++i) {
     LightSample s = sampleLight(lights[i], p);
@@ -118,18 +122,37 @@ vec3 directLighting(vec3 p, vec3 n, vec3 nc, vec3 ng, vec3 wo, MaterialParams ma
       float c = dot(n, s.wi);
       float k = skyCapCosine(c, radius);
       if (k <= 0.0) continue;
+      float y = k * dot(s.intensity, vec3(0.2126, 0.7152, 0.0722));
+      float v = shadowVisibility(i, p, ng, s.dist);
+      skyOpen += y;
+      skySeen += y * v;
       vec3 wi = c >= 0.05 ? s.wi : normalize(s.wi + n * (0.05 - c));
-      f = gltfBsdfCos(n, nc, wo, wi, m, m.surface.w) * (k / max(dot(n, wi), 1e-4));
-    } else {
-      f = gltfBsdfCos(n, nc, wo, s.wi, m, m.surface.w);
+      L += gltfBsdfCos(n, nc, wo, wi, m, m.surface.w) * (k / max(dot(n, wi), 1e-4)) * s.intensity * v;
+      continue;
     }
+    f = gltfBsdfCos(n, nc, wo, s.wi, m, m.surface.w);
     if (all(equal(f, vec3(0.0)))) continue;
     L += f * s.intensity * shadowVisibility(i, p, ng, s.dist);
   }
+  skyVisibility = skyOpen > 0.0 ? clamp(skySeen / skyOpen, 0.0, 1.0) : 1.0;
   return L;
+}
+vec3 directLighting(vec3 p, vec3 n, vec3 nc, vec3 ng, vec3 wo, MaterialParams material, int count,
+                    int lightsWithoutSpecular) {
+  float unused;
+  return directLighting(p, n, nc, ng, wo, material, count, lightsWithoutSpecular, unused);
 }
 vec3 directLighting(vec3 p, vec3 n, vec3 nc, vec3 ng, vec3 wo, MaterialParams material) {
   return directLighting(p, n, nc, ng, wo, material, u_lightCount, u_lightCount);
+}
+
+// Specular occlusion from a diffuse visibility `ao` (Lagarde and de Rousiers, "Moving Frostbite to
+// PBR", SIGGRAPH 2014, section 4.10.2): saturate((n.v + ao)^(2^(-16 alpha - 1)) - 1 + ao), alpha the
+// GGX roughness (glTF roughness squared). It is ao for rough lobes and tends to 1 for smooth ones seen
+// head-on; 1 where ao is 1.
+float specularOcclusion(float nv, float ao, float roughness) {
+  float alpha = roughness * roughness;
+  return clamp(pow(max(nv, 0.0) + ao, exp2(-16.0 * alpha - 1.0)) - 1.0 + ao, 0.0, 1.0);
 }
 vec3 directLighting(vec3 p, vec3 n, vec3 ng, vec3 wo, MaterialParams material) {
   return directLighting(p, n, n, ng, wo, material);
