@@ -652,7 +652,6 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
       supersampledView.lights.insert(supersampledView.lights.end(), taken.begin(), taken.end());
       const auto& sky = supersampledView.environmentLights->skyLights;
       supersampledView.lights.insert(supersampledView.lights.end(), sky.begin(), sky.end());
-      supersampledView.skyLights = static_cast<int>(sky.size());
     }
     const FrameView& view = supersampledView;
     FrameView outView = view;

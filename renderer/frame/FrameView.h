@@ -31,19 +31,20 @@ struct FrameView {
   std::string environmentKey;          // its digest, for cache keys
   // The raster's split of the map (renderer/shading/EnvironmentLights.h): its compact bright regions as
   // directional lights, which `direct` shadows, and the map without them (the residual), which
-  // image-based lighting integrates and photon_gi splats at first hits. Null, or without lights, when
-  // nothing was taken. The background and the reference see `environment` itself.
+  // image-based lighting integrates and whose diffuse first hits the sky lights shade (photon_gi's
+  // splats with sky_lights 0). Null, or without lights, when nothing was taken. The background and the reference see `environment` itself.
   std::shared_ptr<const EnvironmentLights> environmentLights;
   std::string environmentLightsKey;    // its options' key (with environmentKey: the split's digest)
   // The frame's lights: the scene's (same indices as scene.lights), then the environment's compact
   // lights, then its sky lights (EnvironmentLights::skyLights), which light diffuse lobes only.
   std::vector<Light> lights;
   int sceneLights = 0;  // how many of `lights` are the scene's
-  int skyLights = 0;    // how many of `lights` (the last ones) are sky lights
   // What image-based lighting integrates: the residual when the map was split, else the map.
   const Image* lightingEnvironment() const {
     return environmentLights && environmentLights->split() ? &environmentLights->residual : environment;
   }
+  // How many of `lights` (the last ones) are sky lights.
+  int skyLights() const { return environmentLights ? static_cast<int>(environmentLights->skyLights.size()) : 0; }
   // The key of what the raster lights with: the map, and the split's options when it took lights.
   std::string lightingEnvironmentKey() const {
     return environmentLights && (environmentLights->split() || !environmentLights->skyLights.empty())

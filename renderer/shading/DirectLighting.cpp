@@ -30,7 +30,7 @@ void bindDirectLighting(const gl::Program& program, FrameResources& res, const G
   if (res.hasBuffer("frame_lights")) res.buffer("frame_lights").bindBase(GL_SHADER_STORAGE_BUFFER, GpuScene::kLightBinding);
   program.set("u_sceneLightCount", std::min(lightCount, res.view().sceneLights));
   const int lights = static_cast<int>(res.view().lights.size());
-  program.set("u_diffuseOnlyFrom", std::min(lightCount, lights - res.view().skyLights));
+  program.set("u_diffuseOnlyFrom", std::min(lightCount, lights - res.view().skyLights()));
   res.buffer("shadow_info").bindBase(GL_SHADER_STORAGE_BUFFER, 2);
   program.set("u_lightCount", lightCount);
   program.set("u_hasShadows", res.written("shadow_maps") ? 1 : 0);

@@ -28,9 +28,8 @@
 // skyLights regions (the first cut is the horizon); each becomes a directional light from its
 // power-weighted mean direction d with the region's vector irradiance along d, sum R (w . d) dw (rgb),
 // shaded as the cap of the region's mean cosine clipped by the receiver's horizon. They carry R's
-// diffuse light only (L(sky)DE; the frame shades them
-// with Dirac specular lobes, its glossy part staying image-based lighting's L(sky)GE): with shadow maps
-// the broad sky then has visibility (contact shadows), which photon_gi's first-hit sky photons had only
+// diffuse light only (L(sky)DE; the frame shades them with Dirac specular lobes, its glossy part
+// staying image-based lighting's L(sky)GE): with shadow maps the broad sky then has visibility (contact shadows), which photon_gi's first-hit sky photons had only
 // at the scale of their kernel (docs/TECHNIQUES.md, direct, "Sky lights").
 #include <string>
 #include <vector>

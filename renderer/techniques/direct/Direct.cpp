@@ -81,7 +81,7 @@ void DirectPass::execute(PassContext& ctx) {
   const auto& split = view.environmentLights;
   ctx.stats.counters["environment_lights"] = split ? static_cast<double>(split->lights.size()) : 0.0;
   ctx.stats.counters["environment_light_share"] = split ? split->fraction : 0.0;
-  ctx.stats.counters["sky_lights"] = static_cast<double>(view.skyLights);
+  ctx.stats.counters["sky_lights"] = static_cast<double>(view.skyLights());
   ctx.stats.counters["ibl_mode"] = iblSpecular ? ibl::modeFor(res) : 0;
   res.markWritten("direct");
   res.markWritten("beauty");

@@ -58,7 +58,7 @@ std::shared_ptr<const rt::EnvironmentDistribution> photonEnvironmentDistribution
   key = view.environmentKey;
   // With sky lights (direct's sky_lights) no first hit of the sky is splatted: draw by L, for the bounces.
   if (!view.environment || !view.environmentLights || !view.environmentLights->split() || weight >= 1.f ||
-      view.skyLights > 0)
+      view.skyLights() > 0)
     return environmentDistribution(res, view);
   const Image& map = *view.environment;
   const Image& residual = view.environmentLights->residual;
@@ -200,7 +200,7 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   // with shadow maps, EnvironmentLights::skyLights) when the frame has them: the photons' estimate of
   // them had visibility only at the kernel's scale (contact shadows 1.3-2x the reference's light).
   // Their later bounces stay photons.
-  const bool skyFirstHits = ownsSky && view.skyLights == 0;
+  const bool skyFirstHits = ownsSky && view.skyLights() == 0;
   // The glossy reflection of the sky (L(sky)GE) may belong to a prefiltered environment term in
   // `direct`, which comes first in the registry: then sky photons at their first hit are splatted with
   // the diffuse lobe only.
