@@ -157,7 +157,7 @@ void main() {
       return;
     }
     n = octDecode(geo.xy);
-    texel = hitTexel;
+    texel = mapSpecularTexel(hitTexel, dir, cube);
     object = code - 1;
     pos = hit;
   }

@@ -20,7 +20,6 @@ layout(binding = 1) uniform sampler2D t_normal;
 layout(binding = 2) uniform sampler2D t_albedo;
 layout(binding = 3) uniform sampler2D t_material;
 layout(binding = 4) uniform sampler2D t_emission;
-layout(binding = kUnitLdmAlbedo) uniform samplerCubeArray t_ldmAlbedo;
 
 uniform int u_object;  // index of the specular object being drawn
 uniform vec3 u_eye;
@@ -33,7 +32,7 @@ layout(location = 0) out vec4 o_beauty;
 vec3 g_firstHit;        // p, the rasterised specular point
 float g_eyeDistance;    // |p - eye| (perspective), 0 (orthographic)
 
-vec3 missRadiance(vec3 dir) { return vec3(0.0); }
+vec3 missRadiance(vec3 dir, float cone) { return vec3(0.0); }
 
 vec3 diffuseHitRadiance(vec3 hit, vec3 rayDir, vec3 dir, float cube, vec4 texel) {
   vec3 albedo = texture(t_ldmAlbedo, vec4(dir, cube)).rgb;
@@ -52,6 +51,10 @@ vec3 diffuseHitRadiance(vec3 hit, vec3 rayDir, vec3 dir, float cube, vec4 texel)
   return albedo * INV_PI * E;
 }
 
+// The caustics on a mirror's diffuse lobe are not modelled (the maps keep no diffuse albedo for mirror
+// texels): the lobe's direct light is the specular pass's, its caustic none.
+vec3 mirrorDiffuseRadiance(vec4 texel) { return vec3(0.0); }
+
 #include "specular/trace.glsl"
 
 void main() {
@@ -69,7 +72,7 @@ void main() {
   g_firstHit = p;
   g_eyeDistance = u_orthographic != 0 ? 0.0 : length(p - u_eye);
   int traced;
-  vec3 L = traceSpecularTree(p, R, n, specularTexel(albedo, mat.x, mat.w, ior), u_object, gl_FrontFacing, traced);
+  vec3 L = traceSpecularTree(p, R, n, specularTexel(albedo, mat.x, mat.w, ior), u_object, gl_FrontFacing, 0.0, 0.0, traced);
   if (any(isnan(L)) || any(isinf(L))) L = vec3(0.0);
   o_beauty = vec4(L, 0.0);
 }

@@ -76,7 +76,7 @@ RADIANT_CONST int kUnitAoEmission = 21;   // ambient_occlusion resolve: the emis
 RADIANT_CONST int kUnitGbufferLayers = 22;    // direct: the G-buffer's gbuffer_layers (KHR_materials_clearcoat, sheen)
 RADIANT_CONST int kUnitGbufferSpecular = 23;  // direct: the G-buffer's gbuffer_specular (KHR_materials_specular)
 RADIANT_CONST int kUnitCausticCube = 24;  // caustics: the caustic cube maps (irradiance per receiver area)
-RADIANT_CONST int kUnitLdmAlbedo = 25;  // specular: the maps' diffuse albedo (read by caustics at specular's secondary hits)
+RADIANT_CONST int kUnitLdmAlbedo = 25;  // specular: the maps' diffuse albedo (caustics, at secondary hits) and mirrors' F0
 RADIANT_CONST int kUnitMaterialLayer0 = 26;  // material slots kSlotLayer0.. (units 26-32)
 // Units used. A binding must be below GL_MAX_COMBINED_TEXTURE_IMAGE_UNITS (GL 4.5 guarantees 80); a
 // stage may read at most GL_MAX_TEXTURE_IMAGE_UNITS samplers (16 guaranteed, 32 on llvmpipe), which

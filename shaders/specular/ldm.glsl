@@ -6,14 +6,17 @@
 //   l = 0 its own front faces as seen from its reference point, l = 1 its back faces, l = 2 the
 //   environment (every other mesh, closest surface), l >= 3 depth-peeled environment layers.
 // Two cube maps per layer as thesis 5.2 describes, plus a filtered copy of the distance:
-//   t_ldmMaterial: rgb = reflected radiance (diffuse), F0 (mirror) or transmission tint (refractor);
+//   t_ldmMaterial: rgb = reflected radiance (diffuse), the radiance of a mirror's diffuse lobe (its
+//                  emission and the lights' direct light on the dielectric part of a metallic 0.5-1
+//                  mirror) or transmission tint (refractor);
 //                  a = signed index of refraction: < 0 mirror, 0 diffuse, > 0 refractor.
 //   t_ldmGeometry: xy = octahedral-encoded surface normal (as modelled: outward), z = distance from
 //                  the reference point (0 = empty texel, no surface), w = specular object index + 1
 //                  of the surface (0 for diffuse): a ray leaving a mirror or refractor continues in the
 //                  maps of the object it hit.
 //   t_ldmAlbedo:   rgb = diffuse albedo (1 - metallic)(1 - transmission) baseColor of a lit non-specular
-//                  surface, 0 elsewhere (RGBA8; read by the caustics pass at the secondary hits).
+//                  surface (a = 1), a mirror's F0 (a = 0), 0 elsewhere (RGBA8; the caustics pass reads
+//                  the albedo at its secondary hits; mapSpecularTexel the F0).
 //   t_ldmDistance:   the distance again (R32F), sampled with linear filtering for the search: the
 //                  secant steps then converge on a piecewise-linear surface instead of the staircase
 //                  of nearest texels. Empty texels hold kEmptyDistance, so a blend with an empty
@@ -21,6 +24,7 @@
 //                  read with nearest texels: filtering normals or object indices is meaningless).
 #ifndef RADIANT_SPECULAR_LDM
 #define RADIANT_SPECULAR_LDM
+#include "common/cube_texels.glsl"  // cubeTexelCentre
 #include "common/octahedral.glsl"
 #include "common/shared.h"
 
@@ -51,6 +55,14 @@ const float kEmptyDistance = 3.0e38;
 layout(binding = kUnitLdmMaterial) uniform samplerCubeArray t_ldmMaterial;
 layout(binding = kUnitLdmGeometry) uniform samplerCubeArray t_ldmGeometry;
 layout(binding = kUnitLdmDistance) uniform samplerCubeArray t_ldmDistance;  // linear filtering, see below
+layout(binding = kUnitLdmAlbedo) uniform samplerCubeArray t_ldmAlbedo;
+
+// The scattering data (specularTexel's form) of a specular texel found in the maps, from its material
+// texel: a mirror's F0 is stored in t_ldmAlbedo, since its material texel holds its diffuse lobe's
+// radiance; a refractor's material texel is its specularTexel.
+vec4 mapSpecularTexel(vec4 materialTexel, vec3 dir, float cube) {
+  return materialTexel.a < 0.0 ? vec4(texture(t_ldmAlbedo, vec4(dir, cube)).rgb, -1.0) : materialTexel;
+}
 
 struct SpecularObject {
   vec4 referenceRadius;  // xyz reference point (world), w bounding radius of the object
@@ -211,6 +223,36 @@ bool traceLayer(int object, int layer, vec3 x, vec3 R, out float dHit) {
     prev = cur;
   }
   return false;
+}
+
+// The curvature (1 / radius) of a convex surface at a texel found in the maps, or 0 where it is flat,
+// concave or unknown: the turn of the stored normal towards each of two neighbouring texels (a texel
+// along two tangents of the cube direction, the same surface by object code) per unit of distance
+// between the texels' surface points, (n' - n).(S' - S) / |S' - S|^2, positive where the normals
+// diverge; the larger of the two. The points are the texels' centre directions times their stored
+// distances, the points their normals were stored for (a sphere of radius r gives 1 / r whatever the
+// resolution). spacing: the distance between those points, the texel's size on the surface (the
+// normal at a hit is known to that: the nearest texel's).
+float mapConvexCurvature(vec3 dir, float cube, vec4 geo, out float spacing) {
+  vec3 d = normalize(cubeTexelCentre(dir, u_cubeResolution));
+  vec3 t1 = normalize(cross(abs(d.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0), d));
+  vec3 t2 = cross(d, t1);
+  vec3 n = normalize(octDecode(geo.xy));
+  vec3 S = d * geo.z;
+  float k = 0.0;
+  spacing = 0.0;
+  for (int a = 0; a < 2; ++a) {
+    // One texel's width at a face centre, 2 / res, is at least one texel anywhere on the face.
+    vec3 dq = normalize(cubeTexelCentre(d + (a == 0 ? t1 : t2) * (2.0 / u_cubeResolution), u_cubeResolution));
+    vec4 gq = texture(t_ldmGeometry, vec4(dq, cube));
+    if (!(gq.z > 0.0 && gq.z < 1e30) || abs(gq.w - geo.w) > 0.5) continue;
+    vec3 dS = dq * gq.z - S;
+    float len2 = dot(dS, dS);
+    if (!(len2 > 0.0)) continue;
+    k = max(k, dot(normalize(octDecode(gq.xy)) - n, dS) / len2);
+    spacing = max(spacing, sqrt(len2));
+  }
+  return k;
 }
 
 // Algorithm 3's "for each layer ... find the closest intersection".

@@ -2,7 +2,8 @@
 // distance from the reference point. Diffuse surfaces store their reflected radiance towards the
 // reference point: emission plus direct lighting of the punctual lights with the shared
 // shadow-mapped code (common/direct_lighting.glsl), plus the environment's glossy reflection (the
-// split-sum `direct` adds on screen, L(sky)GE, when u_iblMode is set).
+// split-sum `direct` adds on screen, L(sky)GE, when u_iblMode is set). Mirrors store their F0 and the
+// radiance of their diffuse lobe (ldm.glsl).
 #include "common/direct_lighting.glsl"
 #include "common/ibl.glsl"
 #include "common/material.glsl"
@@ -26,7 +27,7 @@ layout(binding = kUnitIblPrefiltered) uniform sampler2DArray t_prefiltered;
 layout(location = 0) out vec4 o_material;
 layout(location = 1) out vec4 o_geometry;
 layout(location = 2) out float o_distance;  // cleared to kEmptyDistance
-layout(location = 3) out vec4 o_albedo;     // rgb diffuse albedo of a non-specular, lit surface, else 0
+layout(location = 3) out vec4 o_albedo;     // rgb diffuse albedo of a non-specular, lit surface (a 1), a mirror's F0 (a 0), else 0
 
 void main() {
   SurfaceUv uv = SURFACE_UV_FRAGMENT(v_uv0, v_uv1);  // before any discard (common/material.glsl)
@@ -50,20 +51,31 @@ void main() {
 
   MaterialParams p = decodeMaterial(m, uv);
   o_albedo = vec4(0.0);
+  // Two-sided shading towards the viewer of the map, the reference point (view-dependent terms
+  // are therefore evaluated for that viewer: the usual distance-map approximation).
+  vec3 wo = dist > 1e-30 ? -toP / dist : n;
+  vec3 ns = dot(n, wo) < 0.0 ? -n : n;
+  vec3 ng = dot(faceNormal, wo) < 0.0 ? -faceNormal : faceNormal;
+  float nv = dot(ns, wo);
+  if (nv < 1e-3) ns = normalize(ns + wo * (1e-3 - nv));
+  // glTF emission leaves the front face only unless the material is double-sided (as the reference).
+  bool emits = gl_FrontFacing || materialDoubleSided(m);
   if (u_objectCode > 0 && specularInMaps(p.surface.x, p.surface.z)) {
     o_material = specularTexel(p.baseColor.rgb, p.surface.x, p.surface.z, p.surface.w);
+    if (o_material.a < 0.0) {
+      // A mirror keeps its F0 in the albedo map (a = 0: not a lit diffuse texel) and the radiance of
+      // its diffuse lobe in the material map: its emission and the lights' direct light with Dirac
+      // specular and coat lobes (lightsWithoutSpecular 0), which the trace adds to what the mirror
+      // reflects, as `direct` lights the diffuse lobe of the mirror pixels on screen. Without it a
+      // metallic 0.67 sphere seen in another mirror reflected only the dark ground where the
+      // reference saw its sunlit dielectric third (MetalRoughSpheres' worst pixel).
+      o_albedo = vec4(o_material.rgb, 0.0);
+      vec3 L = (emits ? p.emission.rgb : vec3(0.0)) + directLighting(v_position, ns, ns, ng, wo, p, u_lightCount, 0);
+      o_material = vec4(L, -1.0);
+    }
   } else {
     // The Lambertian part of the glTF BRDF (what the caustics pass lights at the maps' texels).
     if (!materialUnlit(m)) o_albedo = vec4(p.baseColor.rgb * (1.0 - p.surface.x) * (1.0 - p.surface.z), 1.0);
-    // Two-sided shading towards the viewer of the map, the reference point (view-dependent terms
-    // are therefore evaluated for that viewer: the usual distance-map approximation).
-    vec3 wo = dist > 1e-30 ? -toP / dist : n;
-    vec3 ns = dot(n, wo) < 0.0 ? -n : n;
-    vec3 ng = dot(faceNormal, wo) < 0.0 ? -faceNormal : faceNormal;
-    float nv = dot(ns, wo);
-    if (nv < 1e-3) ns = normalize(ns + wo * (1e-3 - nv));
-    // glTF emission leaves the front face only unless the material is double-sided (as the reference).
-    bool emits = gl_FrontFacing || materialDoubleSided(m);
     vec3 L = (emits ? p.emission.rgb : vec3(0.0)) + directLighting(v_position, ns, ng, wo, p);
     // The environment's glossy lobe (its diffuse lobe is photon_gi's photons, gathered into the maps
     // with the Lambertian term): without it a rough metal seen in a mirror was black but for its sun

@@ -7,6 +7,7 @@
 // The surface point is the reference point plus the texel's centre direction times its stored
 // distance; its normal faces the reference point (the map's viewer, as map.frag shades it). One gather
 // per block of texels, spread over the block's texels on the same surface (u_mode below).
+#include "common/cube_texels.glsl"  // faceDirection
 #include "common/octahedral.glsl"
 #include "photon_gi/grid.glsl"
 #include "photon_gi/photon.glsl"
@@ -36,16 +37,6 @@ uniform float u_minKernelMass;
 uniform int u_mode;
 uniform int u_block;
 uniform int u_fixupOnly;
-
-// Direction of the point (s, t) in [-1, 1]^2 of cube face `face` (GL 4.5 table 8.19, inverted).
-vec3 faceDirection(int face, vec2 st) {
-  if (face == 0) return vec3(1.0, -st.y, -st.x);
-  if (face == 1) return vec3(-1.0, -st.y, st.x);
-  if (face == 2) return vec3(st.x, 1.0, st.y);
-  if (face == 3) return vec3(st.x, -1.0, -st.y);
-  if (face == 4) return vec3(st.x, -st.y, 1.0);
-  return vec3(-st.x, -st.y, -1.0);
-}
 
 vec3 texelPoint(ivec2 px, vec4 g) {
   return u_reference + normalize(faceDirection(u_face, (vec2(px) + 0.5) / float(u_size) * 2.0 - 1.0)) * g.z;

@@ -26,23 +26,24 @@ layout(binding = kUnitEnvironment) uniform sampler2D t_environment;
 
 layout(location = 0) out vec4 o_specular;
 
-// The width (radians) of the cone of directions this sample's rays stand for (footprintCone below).
-float g_missCone = 0.0;
-
-// A ray that leaves the scene sees the sky in its direction, averaged over the sample's cone; a diffuse
-// hit its stored radiance.
-vec3 missRadiance(vec3 dir) {
-  return u_hasEnvironment != 0 ? environmentRadianceCone(t_environment, dir, g_missCone) : u_background;
+// A ray that leaves the scene sees the sky in its direction, averaged over its cone (the sample's
+// footprintCone below, widened by the convex mirrors on its path: specular/trace.glsl); a diffuse hit
+// its stored radiance.
+vec3 missRadiance(vec3 dir, float cone) {
+  return u_hasEnvironment != 0 ? environmentRadianceCone(t_environment, dir, cone) : u_background;
 }
 
 // The reflected direction at G-buffer sample q, or vec3(0) when q is not a surface that continues the
-// one at p with normal n (the background, or a surface more than 60 degrees off: another object).
-vec3 neighbourReflection(ivec2 q, vec3 n) {
+// one at p with normal n (the background, or a surface more than 60 degrees off: another object);
+// its surface point in `at`.
+vec3 neighbourReflection(ivec2 q, vec3 n, out vec3 at) {
+  at = vec3(0.0);
   if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, textureSize(t_position, 0)))) return vec3(0.0);
   vec4 Q = texelFetch(t_position, q, 0);
   if (Q.w <= 0.0) return vec3(0.0);
   vec3 nq = normalize(texelFetch(t_normal, q, 0).xyz);
   if (dot(nq, n) < 0.5) return vec3(0.0);
+  at = Q.xyz;
   vec3 v = u_orthographic != 0 ? u_viewForward : normalize(Q.xyz - u_eye);
   return reflect(v, nq);
 }
@@ -56,22 +57,31 @@ vec3 neighbourReflection(ivec2 q, vec3 n) {
 // Without it each sample read one texel: on a mirror sphere a few pixels wide a sample sees about
 // 3-4 degrees of sky and a sun of half a degree was all or nothing in the pixel (MetalRoughSpheres'
 // worst pixels in the fidelity benchmark, where the reference integrates the pixel).
-float footprintCone(ivec2 px, vec3 n, vec3 r, float roughness) {
-  float axis[2];
+// width: the beam's width at p, the same way: the distance to the neighbours' surface points across
+// the incident direction R (a sample spacing; the ray cone's start, specular/trace.glsl).
+float footprintCone(ivec2 px, vec3 p, vec3 R, vec3 n, vec3 r, float roughness, out float width) {
+  float axis[2], across[2];
   for (int a = 0; a < 2; ++a) {
     ivec2 step = a == 0 ? ivec2(1, 0) : ivec2(0, 1);
-    float best = 1e30;
+    float best = 1e30, nearest = 1e30;
     for (int side = -1; side <= 1; side += 2) {
-      vec3 rq = neighbourReflection(px + side * step, n);
-      if (dot(rq, rq) > 0.0) best = min(best, length(rq - r));
+      vec3 q;
+      vec3 rq = neighbourReflection(px + side * step, n, q);
+      if (!(dot(rq, rq) > 0.0)) continue;
+      best = min(best, length(rq - r));
+      vec3 dq = q - p;
+      nearest = min(nearest, length(dq - dot(dq, R) * R));
     }
     axis[a] = best < 1e30 ? best : 0.0;
+    across[a] = nearest < 1e30 ? nearest : 0.0;
   }
+  width = max(across[0], across[1]);
   float alpha = roughness * roughness;
   float lobe = 2.56 * alpha;
   return sqrt(max(axis[0], axis[1]) * max(axis[0], axis[1]) + lobe * lobe);
 }
 vec3 diffuseHitRadiance(vec3 hit, vec3 rayDir, vec3 dir, float cube, vec4 texel) { return texel.rgb; }
+vec3 mirrorDiffuseRadiance(vec4 texel) { return texel.rgb; }
 
 #include "specular/trace.glsl"
 
@@ -88,11 +98,13 @@ void main() {
   vec3 albedo = texelFetch(t_albedo, px, 0).rgb;
   float ior = texelFetch(t_emission, px, 0).a;
   vec3 R = u_orthographic != 0 ? u_viewForward : normalize(p - u_eye);
-  if (u_hasEnvironment != 0) g_missCone = footprintCone(px, n, reflect(R, n), mat.y);
+  float cone = 0.0, width = 0.0;
+  if (u_hasEnvironment != 0) cone = footprintCone(px, p, R, n, reflect(R, n), mat.y, width);
 
   // The G-buffer normal faces the viewer; whether the ray enters or leaves the object is the face's
   // orientation (a camera inside a glass object sees its back faces).
   int traced;
-  vec3 L = traceSpecularTree(p, R, n, specularTexel(albedo, mat.x, mat.w, ior), u_object, gl_FrontFacing, traced);
+  vec3 L = traceSpecularTree(p, R, n, specularTexel(albedo, mat.x, mat.w, ior), u_object, gl_FrontFacing, cone, width,
+                             traced);
   o_specular = vec4(L, float(traced));
 }

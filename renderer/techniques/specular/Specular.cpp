@@ -405,6 +405,7 @@ void SpecularPass::execute(PassContext& ctx) {
     material.bindUnit(gpu::kUnitLdmMaterial);
     geometry.bindUnit(gpu::kUnitLdmGeometry);
     distance.bindUnit(gpu::kUnitLdmDistance);
+    albedo.bindUnit(gpu::kUnitLdmAlbedo);  // mirrors' F0 (specular/ldm.glsl, mapSpecularTexel)
     objectBuffer.bindBase(GL_SHADER_STORAGE_BUFFER, 3);
     minmax.bindBase(GL_SHADER_STORAGE_BUFFER, 4);
     const gl::Program& prog = ctx.shaders.program({"specular/map.vert", "specular/specular.frag"});
