@@ -11,6 +11,7 @@
 #include "renderer/io/ImageIO.h"
 #include "renderer/scene/Environment.h"
 #include "renderer/shading/ImageBasedLighting.h"
+#include "tests/gl/specular/SpecularTestSupport.h"  // orthoCamera, mirror
 #include "tests/support/RenderTestSupport.h"
 #include "tests/support/SceneBuilder.h"
 
@@ -299,10 +300,7 @@ TEST(Environment, AMirrorSphereSeenInAMirrorReflectsTheSunAsTheReference) {
   constexpr int kW = 256, kH = 128, kSize = 32, kSunX = 228, kSunRow = 51;
   constexpr float kSun = 1000.f, kHalf = 1.5f, kR = 0.5f;
   testing::SceneBuilder b;
-  Material mirror = testing::lambertian(glm::vec3(1.f));
-  mirror.metallicFactor = 1.f;
-  mirror.roughnessFactor = 0.f;
-  const int chrome = b.material(mirror);
+  const int chrome = b.material(testing::mirror(glm::vec3(1.f)));
   b.quad({0, 0, 1.3f}, {0, 0, 1.2f}, {1.2f, 0, 0}, chrome, "mirror floor").sphere({0, 1, 0}, kR, chrome);
   Scene scene = b.build("env-mirror-sphere-in-mirror");
   // Orthographic along (0, -1, -1) onto (0, 0.5, 0.5): the floor's reflected rays run along `up` and
@@ -310,14 +308,7 @@ TEST(Environment, AMirrorSphereSeenInAMirrorReflectsTheSunAsTheReference) {
   // them (the camera rays pass sqrt2 from its centre).
   const glm::vec3 f = glm::normalize(glm::vec3(0, -1, -1));
   const glm::vec3 up = glm::normalize(glm::vec3(0, 1, -1)), centre(0.f, 0.5f, 0.5f);
-  Camera cam;
-  cam.projection = ProjectionType::Orthographic;
-  cam.xmag = cam.ymag = kHalf;
-  cam.znear = 0.01f;
-  cam.zfar = 20.f;
-  cam.world = glm::mat4(glm::vec4(1, 0, 0, 0), glm::vec4(up, 0), glm::vec4(-f, 0), glm::vec4(centre - 6.f * f, 1));
-  cam.fromFile = true;
-  scene.camera = cam;
+  scene.camera = testing::orthoCamera(centre - 6.f * f, f, up, kHalf, 20.f);
   // The sun one texel 17 degrees up towards +z and +x: seen in the sphere from the floor's rays, and
   // neither in the floor directly (it reflects `up` only) nor below the horizon.
   Image env = Image::make("environment", kW, kH, 3);
