@@ -45,10 +45,12 @@ std::string usage() {
   --max-json-depth N        deepest nesting of a request or a glTF document (default 64)
   --max-decode-bytes N      memory one scene or image may decode into: pixels of every image,
                             expanded accessors of every mesh instance (default 536870912)
-  --decode-memory-bytes N   bytes all decodes in flight may allocate together (at least
-                            --max-decode-bytes): each reserves its images' and accessors' bytes
-                            before allocating them; one that does not fit waits up to 1 s, then
-                            gets 503 decode-busy (default 1073741824)
+  --decode-memory-bytes N   bytes all decodes in flight and the decoded scenes and images kept
+                            (cached, or held by queued and running renders) may take together (at
+                            least --max-decode-bytes): each decode reserves its images' and
+                            accessors' bytes before allocating them; one that does not fit drops
+                            unheld cached results, waits up to 1 s, then gets 503 decode-busy
+                            (default 1073741824)
   --scene-cache-bytes N     decoded scenes kept in memory, in bytes (default 1073741824)
   --gpu-scenes N            scenes kept uploaded to the GPU with their derived data (BVH, shadow maps,
                             photon maps), least recently used evicted (default 4, at most 256)

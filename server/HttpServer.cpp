@@ -6,6 +6,7 @@
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
+#include <functional>
 #include <future>
 #include <iostream>
 #include <list>
@@ -180,6 +181,25 @@ public:
     lru_.splice(lru_.begin(), lru_, it->second);
     return it->second->second;
   }
+  // Drops least recently used entries that nothing else holds (no job, no request in flight) until
+  // `bytes` are freed or none is left: their decode memory is released with them (DecodeMemory).
+  void dropUnshared(std::size_t bytes) {
+    std::vector<std::shared_ptr<const T>> dropped;  // destroyed after the lock is released
+    {
+      std::lock_guard lock(mutex_);
+      std::size_t freed = 0;
+      for (auto it = lru_.end(); it != lru_.begin() && freed < bytes;) {
+        --it;
+        if (it->second.use_count() != 1) continue;
+        const std::size_t size = SizeOf(*it->second);
+        freed += size;
+        bytes_ -= size;
+        index_.erase(it->first);
+        dropped.push_back(std::move(it->second));
+        it = lru_.erase(it);
+      }
+    }
+  }
   void put(const std::string& digest, std::shared_ptr<const T> value) {
     const std::size_t size = SizeOf(*value);
     std::lock_guard lock(mutex_);
@@ -208,11 +228,14 @@ using DecodedImages = DecodedCache<Image, imageBytes>;
 
 // Memory admission for decoding (issue 30): every decode of an uploaded or named scene or image
 // reserves the bytes it is about to allocate (its decoder calls the reservation before each image's
-// pixels and each expanded accessor: BackendHooks::Reserve) from one budget shared by all decodes in
-// flight, max(--decode-memory-bytes, --max-decode-bytes) bytes. A reservation that does not fit waits up
-// to a second for others to finish, then the decode is refused with 503 decode-busy and Retry-After:
-// concurrent uploads cannot add up to more than the budget (3 meshopt uploads decoding 256 MiB each
-// took the daemon to 1.8 GB), while small ones are not held back by one large one.
+// pixels and each expanded accessor: BackendHooks::Reserve) from one budget,
+// max(--decode-memory-bytes, --max-decode-bytes) bytes. What a decode produced stays charged to the same
+// budget for as long as it lives (keep(): the decoded-scene and image caches and every queued or running
+// job that holds it), so queued jobs are bounded by the bytes they hold, not only by their count. A
+// reservation that does not fit first drops cached results nothing else holds, then waits up to a
+// second for jobs to end, then the decode is refused with 503 decode-busy and Retry-After: concurrent
+// uploads cannot add up to more than the budget (3 meshopt uploads decoding 256 MiB each took the daemon
+// to 1.8 GB), nor can renders queued behind a long one, each holding a scene of its own.
 class DecodeMemory {
 public:
   explicit DecodeMemory(std::size_t bytes) : total_(std::max<std::size_t>(1, bytes)) {}
@@ -221,35 +244,43 @@ public:
     std::lock_guard lock(mutex_);
     return used_;
   }
+  // Called (without this object's lock) to free `bytes` by dropping cached results nobody holds.
+  void setEvict(std::function<void(std::size_t)> evict) { evict_ = std::move(evict); }
+
   // One decode's bytes, released when it ends (success or not).
   class Reservation {
   public:
     explicit Reservation(DecodeMemory& m) : m_(&m) {}
     Reservation(const Reservation&) = delete;
     Reservation& operator=(const Reservation&) = delete;
-    ~Reservation() {
-      {
-        std::lock_guard lock(m_->mutex_);
-        m_->used_ -= held_;
-      }
-      m_->cv_.notify_all();
-    }
+    ~Reservation() { m_->release(held_); }
     // Adds `bytes`, waiting up to `wait` for them; throws ApiError 503 decode-busy when they do not free.
     void grow(std::size_t bytes, std::chrono::milliseconds wait = std::chrono::seconds(1)) {
-      std::unique_lock lock(m_->mutex_);
       const std::size_t total = m_->total_;
       // Never more than the whole budget: a decode the per-decode limit allows always fits on its own.
-      if (bytes > total - std::min(total, held_) ||
-          !m_->cv_.wait_for(lock, wait, [&] { return m_->used_ + bytes <= total; })) {
-        ++m_->refused_;
-        throw api::ApiError(503, "decode-busy", "Busy decoding",
-                            "decoding needs " + std::to_string(bytes) + " more bytes and " +
-                                std::to_string(m_->used_) + " of the " + std::to_string(total) +
-                                " bytes that decodes in flight may use together are taken (--decode-memory-bytes): "
-                                "retry after the Retry-After seconds");
+      bool fits = bytes <= total - std::min(total, held_);
+      const auto until = std::chrono::steady_clock::now() + wait;
+      while (fits) {
+        if (m_->evict_ && m_->reserved() + bytes > total) m_->evict_(m_->reserved() + bytes - total);
+        std::unique_lock lock(m_->mutex_);
+        if (m_->used_ + bytes <= total) {
+          m_->used_ += bytes;
+          held_ += bytes;
+          return;
+        }
+        // A job ending releases its charges (notify); a cached result it held becomes droppable.
+        const auto next = std::min(until, std::chrono::steady_clock::now() + std::chrono::milliseconds(100));
+        if (std::chrono::steady_clock::now() >= until) break;
+        m_->cv_.wait_until(lock, next);
       }
-      m_->used_ += bytes;
-      held_ += bytes;
+      std::lock_guard lock(m_->mutex_);
+      ++m_->refused_;
+      throw api::ApiError(503, "decode-busy", "Busy decoding",
+                          "decoding needs " + std::to_string(bytes) + " more bytes and " + std::to_string(m_->used_) +
+                              " of the " + std::to_string(total) +
+                              " bytes that decodes in flight and the decoded scenes and images held by queued "
+                              "and running renders may use together are taken (--decode-memory-bytes): retry "
+                              "after the Retry-After seconds");
     }
     BackendHooks::Reserve hook() {
       return [this](std::size_t bytes) { grow(bytes); };
@@ -259,13 +290,43 @@ public:
     DecodeMemory* m_;
     std::size_t held_ = 0;
   };
+
+  // A decoded value charged to the budget (`bytes`, what it holds) until its last holder lets it go.
+  // Taken whole, without waiting: the decode that made it had reserved at least as much.
+  template <class T>
+  std::shared_ptr<const T> keep(T value, std::size_t bytes) {
+    struct Held {
+      Held(T v, DecodeMemory* memory, std::size_t n) : value(std::move(v)), m(memory), bytes(n) {}
+      Held(const Held&) = delete;
+      Held& operator=(const Held&) = delete;
+      ~Held() { m->release(bytes); }
+      T value;
+      DecodeMemory* m;
+      std::size_t bytes;
+    };
+    {
+      std::lock_guard lock(mutex_);
+      used_ += bytes;
+    }
+    auto held = std::make_shared<Held>(std::move(value), this, bytes);
+    return std::shared_ptr<const T>(held, &held->value);
+  }
   std::uint64_t refused() const { return refused_.load(); }
 
 private:
+  void release(std::size_t bytes) {
+    if (bytes == 0) return;
+    {
+      std::lock_guard lock(mutex_);
+      used_ -= bytes;
+    }
+    cv_.notify_all();
+  }
   std::mutex mutex_;
   std::condition_variable cv_;
   std::size_t total_, used_ = 0;
   std::atomic<std::uint64_t> refused_{0};
+  std::function<void(std::size_t)> evict_;
 };
 
 }  // namespace
@@ -277,9 +338,9 @@ struct HttpServer::Impl {
   FrameStore frames;
   ContentStore scenes;
   ContentStore images;  // comparison targets (compare.against = their digest)
+  DecodeMemory decodeMemory;  // before the caches: what they hold releases its charge here when dropped
   DecodedScenes decoded;
   DecodedImages decodedImages;
-  DecodeMemory decodeMemory;
   RenderService service;
   BoundedServer http;
   std::atomic<bool> shuttingDown{false};
@@ -299,10 +360,14 @@ struct HttpServer::Impl {
         frames(config.maxFrameBytes, config.frameTtlS),
         scenes(config.cacheDir, config.maxSceneBytes, "scenes"),
         images(config.cacheDir, config.maxSceneBytes, "images"),
+        decodeMemory(std::max(config.decodeMemoryBytes, config.maxDecodeBytes)),
         decoded(config.sceneCacheEntries, config.sceneCacheBytes),
         decodedImages(std::min<std::size_t>(4, config.sceneCacheEntries), config.sceneCacheBytes / 2),
-        decodeMemory(std::max(config.decodeMemoryBytes, config.maxDecodeBytes)),
         service(config, hooks, frames, metrics) {
+    decodeMemory.setEvict([this](std::size_t bytes) {
+      decodedImages.dropUnshared(bytes);
+      decoded.dropUnshared(bytes);
+    });
     routes();
   }
 
@@ -336,10 +401,13 @@ struct HttpServer::Impl {
     if (auto s = decoded.get(digest)) return s;
     const auto start = Clock::now();
     if (!hooks.decodeScene) throw std::logic_error("no scene decoder configured");
-    std::shared_ptr<Scene> scene;
+    std::shared_ptr<const Scene> scene;
     try {
       DecodeMemory::Reservation memory(decodeMemory);
-      scene = std::make_shared<Scene>(hooks.decodeScene(bytes, memory.hook()));
+      Scene s = hooks.decodeScene(bytes, memory.hook());
+      if (s.digest.empty()) s.digest = digest;
+      const std::size_t size = sceneBytes(s);
+      scene = decodeMemory.keep(std::move(s), size);
     } catch (const api::ApiError& e) {
       // A render request points at its own field (/scene/inline_glb); an upload, whose body is the
       // glTF document, at the place in the document the decoder names.
@@ -348,7 +416,6 @@ struct HttpServer::Impl {
       throw api::ApiError(422, "invalid-scene", "Invalid scene", std::string("the scene cannot be loaded: ") + e.what(),
                           pointer);
     }
-    if (scene->digest.empty()) scene->digest = digest;
     tSceneLoadMs = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
     decoded.put(digest, scene);
     return scene;
@@ -445,7 +512,9 @@ struct HttpServer::Impl {
         mine.set_value(cached);
       } else {
         DecodeMemory::Reservation memory(decodeMemory);
-        auto decodedImage = std::make_shared<const Image>(hooks.decodeImage(*bytes, memory.hook()));
+        Image image = hooks.decodeImage(*bytes, memory.hook());
+        const std::size_t size = imageBytes(image);
+        auto decodedImage = decodeMemory.keep(std::move(image), size);
         metrics.countImageDecode();
         decodedImages.put(digest, decodedImage);
         mine.set_value(decodedImage);
@@ -716,7 +785,7 @@ struct HttpServer::Impl {
           {"radiant_image_store_bytes", {"Bytes of uploaded comparison images stored.", double(images.totalBytes())}},
           {"radiant_image_cache_bytes", {"Bytes of decoded images kept in memory (half of --scene-cache-bytes).", double(decodedImages.totalBytes())}},
           {"radiant_frame_store_bytes", {"Bytes of encoded frames stored.", double(frames.totalBytes())}},
-          {"radiant_decode_bytes_reserved", {"Bytes decodes in flight have reserved of --decode-memory-bytes.", double(decodeMemory.reserved())}},
+          {"radiant_decode_bytes_reserved", {"Bytes of --decode-memory-bytes taken: decodes in flight, and the decoded scenes and images cached or held by renders.", double(decodeMemory.reserved())}},
           {"radiant_decodes_refused", {"Decodes refused with 503 decode-busy since start (--decode-memory-bytes).", double(decodeMemory.refused())}}};
       res.status = 200;
       res.set_content(metrics.text(gauges), "text/plain; version=0.0.4; charset=utf-8");
@@ -841,6 +910,9 @@ struct HttpServer::Impl {
                          "/scene");
       auto scene = resolveScene(request.scene);
       if (!named) checkSceneHeader(req, scene->digest, "/scene");
+      // A queued job holds the decoded scene (charged to the decode memory), not the upload's bytes
+      // again: an inline scene's base64 (up to --max-body-bytes) is dropped once decoded.
+      if (request.scene.kind == api::SceneRef::Kind::Inline) std::string().swap(request.scene.value);
       std::shared_ptr<const Image> compareTarget, environment;
       if (request.compare && request.compare->against != "reference")
         compareTarget = resolveImage(request.compare->against, "/compare/against");

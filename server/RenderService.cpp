@@ -168,7 +168,8 @@ std::shared_ptr<const RefineSnapshot> RenderService::current(const Job& job) {
   return job.current;
 }
 
-RenderOutput RenderService::refine(RenderBackend& backend, const std::shared_ptr<Job>& job, const FrameInputs& inputs) {
+RenderOutput RenderService::refine(RenderBackend& backend, const std::shared_ptr<Job>& job, const Scene& scene,
+                                   const FrameInputs& inputs) {
   const api::RefineSpec spec = *job->request.refine;
   api::RenderRequest batch = job->request;
   BatchMean acc;
@@ -198,7 +199,7 @@ RenderOutput RenderService::refine(RenderBackend& backend, const std::shared_ptr
       };
     batch.seed = (job->request.seed + static_cast<std::uint64_t>(k)) % (kMaxSeed + 1);
     const auto t0 = Clock::now();
-    last = backend.render(*job->scene, batch, &job->cancel, in);
+    last = backend.render(scene, batch, &job->cancel, in);
     slowestBatchMs = std::max(slowestBatchMs, msBetween(t0, Clock::now()));
     if (compare) {
       // Every batch runs the compare block (its ground truth is rendered once, then cached), so that
@@ -341,6 +342,11 @@ void RenderService::finishLocked(Job& job, JobState state, std::optional<Problem
   job.state = state;
   job.finished = Clock::now();
   job.error = std::move(error);
+  // A finished job (kept --frame-ttl for its frames) holds no decoded scene or image: they are charged
+  // to the decode memory while held (docs/API.md, "Limits"). The render thread holds its own.
+  job.scene.reset();
+  job.compareTarget.reset();
+  job.environment.reset();
   if (state == JobState::Done) metrics_.countRender("done");
   else if (job.timedOut) metrics_.countRender("timeout");
   else metrics_.countRender(state == JobState::Canceled ? "canceled" : "failed");
@@ -377,12 +383,18 @@ void RenderService::renderLoop() {
     }
 
     std::shared_ptr<Job> job;
+    // What the render reads, held here: a job that ends meanwhile (timed out) lets go of its own.
+    std::shared_ptr<const Scene> scene;
+    std::shared_ptr<const Image> compareTarget, environment;
     {
       std::unique_lock lock(mutex_);
       changed_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
       if (queue_.empty()) break;  // stopping and nothing left
       job = queue_.front();
       queue_.pop_front();
+      scene = job->scene;
+      compareTarget = job->compareTarget;
+      environment = job->environment;
       job->state = JobState::Running;
       job->started = Clock::now();
       job->queueMs = msBetween(job->submitted, job->started);
@@ -397,10 +409,10 @@ void RenderService::renderLoop() {
     try {
       Job* raw = job.get();
       // The caps: presets and budgets choose within this daemon's limits.
-      FrameInputs inputs{job->compareTarget.get(), job->environment.get(),
+      FrameInputs inputs{compareTarget.get(), environment.get(),
                          [raw](double f) { raw->renderProgress.store(f); }, &config_.limits};
-      output = job->request.refine ? refine(*backend, job, inputs)
-                                   : backend->render(*job->scene, job->request, &job->cancel, inputs);
+      output = job->request.refine ? refine(*backend, job, *scene, inputs)
+                                   : backend->render(*scene, job->request, &job->cancel, inputs);
     } catch (const api::ApiError& e) {
       problem = Problem{e.status, e.type, e.title, e.detail(), e.pointer};
     } catch (const std::exception& e) {

@@ -49,8 +49,9 @@ struct FrameInfo {
 struct Job {
   std::string id;
   api::RenderRequest request;
+  // The decoded scene, and the images the request names by digest (null when it names none); charged
+  // to the decode memory while held, so released when the job ends (guarded by the mutex from then).
   std::shared_ptr<const Scene> scene;
-  // The decoded images the request names by digest (null when it names none).
   std::shared_ptr<const Image> compareTarget;  // compare.against
   std::shared_ptr<const Image> environment;    // environment
   double sceneLoadMs = 0;                      // decoding the scene for this request (0: it was cached)
@@ -112,7 +113,7 @@ private:
   void finishLocked(Job& job, JobState state, std::optional<Problem> error);
   void encode(const std::shared_ptr<Job>& job, RenderOutput output);
   // Renders a refine job's batches (seeds seed, seed + 1, ...) until its stop rule and returns their mean.
-  RenderOutput refine(RenderBackend& backend, const std::shared_ptr<Job>& job, const FrameInputs& inputs);
+  RenderOutput refine(RenderBackend& backend, const std::shared_ptr<Job>& job, const Scene& scene, const FrameInputs& inputs);
 
   const ServerConfig config_;
   const BackendHooks hooks_;

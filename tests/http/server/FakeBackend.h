@@ -115,6 +115,17 @@ inline server::BackendHooks fakeHooks(FakeControl& c) {
       --c.decoding;
     }
     Scene s;
+    // {"extras": {"scene-mib": N}}: the decoded scene holds an N MiB texture, reserved first as the
+    // real decoder does.
+    if (const auto at = bytes.find("\"scene-mib\":"); at != std::string_view::npos) {
+      const std::size_t n = std::size_t(std::atoi(std::string(bytes.substr(at + 12, 8)).c_str())) << 20;
+      if (reserve) reserve(n);
+      Texture t;
+      t.width = int(n / 4);
+      t.height = 1;
+      t.rgba8.assign(n, 0);
+      s.textures.push_back(std::move(t));
+    }
     const bool glb = bytes.size() >= 4 && bytes.substr(0, 4) == "glTF";
     if (!glb) {
       nlohmann::json j = nlohmann::json::parse(bytes, nullptr, false);

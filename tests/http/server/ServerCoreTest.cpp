@@ -751,6 +751,71 @@ TEST(ServerCore, DecodesShareTheDecodeMemoryByBytes) {
   EXPECT_EQ(ok->status, 201) << ok->body;
 }
 
+// Issue 30, queued jobs bounded by bytes: a decoded scene stays charged to the decode memory (64 MiB
+// here) while the cache or a job holds it. Two renders holding 24 MiB scenes each (one running at the
+// gate, one queued) leave no room for a third scene: its decode drops what only the cache holds, waits a
+// second, and is refused with 503 decode-busy (it was queued before, every job holding its own scene).
+// Once the queued job is cancelled its scene is only cached, and the third render gets its room.
+TEST(ServerCore, QueuedRendersHoldTheirScenesInTheDecodeMemory) {
+  ServerConfig config;
+  config.maxDecodeBytes = 64u << 20;
+  config.decodeMemoryBytes = 64u << 20;
+  TestServer s(config);
+  s.waitReady();
+  auto c = s.client();
+  std::vector<std::string> digests;
+  for (int i = 0; i < 3; ++i) {
+    const std::string doc = R"({"asset":{"version":"2.0"},"extras":{"scene-mib":24,"n":)" + std::to_string(i) + "}}";
+    auto up = c.Put("/v1/scenes", doc, "model/gltf+json");
+    ASSERT_TRUE(up);
+    ASSERT_EQ(up->status, 201) << up->body;  // the third drops the first from the cache
+    digests.push_back(body(up)["digest"]);
+  }
+  auto reserved = [&] {
+    auto m = c.Get("/metrics");
+    const std::string key = "\nradiant_decode_bytes_reserved ";
+    const auto at = m->body.find(key);
+    return at == std::string::npos ? -1.0 : std::stod(m->body.substr(at + key.size()));
+  };
+  EXPECT_EQ(reserved(), double(48u << 20));  // two scenes cached
+  s.control.close();
+  auto render = [&](int i) {
+    json b = renderBody(10 + i);
+    b["scene"] = {{"digest", digests[i]}};
+    b["async"] = true;
+    return post(c, "/v1/renders", b);
+  };
+  auto running = render(0);
+  ASSERT_EQ(running->status, 202) << running->body;
+  ASSERT_TRUE(s.control.waitStarted(1));
+  auto queued = render(1);
+  ASSERT_EQ(queued->status, 202) << queued->body;
+  EXPECT_EQ(reserved(), double(48u << 20));  // the two held by the jobs; the third dropped from the cache
+  const auto t0 = std::chrono::steady_clock::now();
+  auto refused = render(2);
+  EXPECT_GE(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 0.9);
+  expectProblem(refused, 503, "decode-busy", "/scene/digest");
+  EXPECT_EQ(refused->get_header_value("Retry-After"), "1");
+  EXPECT_EQ(reserved(), double(48u << 20));
+  auto del = c.Delete(("/v1/renders/" + body(queued)["id"].get<std::string>()).c_str());
+  ASSERT_EQ(del->status, 200);
+  auto admitted = render(2);
+  ASSERT_EQ(admitted->status, 202) << admitted->body;
+  EXPECT_EQ(reserved(), double(48u << 20));
+  s.control.open();
+  for (const auto& id : {body(running)["id"].get<std::string>(), body(admitted)["id"].get<std::string>()}) {
+    json st;
+    for (int i = 0; i < 1000; ++i) {
+      st = body(c.Get(("/v1/renders/" + id).c_str()));
+      if (st["state"] == "done") break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    EXPECT_EQ(st["state"], "done") << st.dump();
+  }
+  // Finished jobs (kept for their frames) hold no scene: only the cache's two remain charged.
+  EXPECT_EQ(reserved(), double(48u << 20));
+}
+
 TEST(ServerCore, MetricsCountRequestsPassesAndQueue) {
   TestServer s;
   s.waitReady();
