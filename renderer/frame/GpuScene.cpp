@@ -1,6 +1,7 @@
 #include "renderer/frame/GpuScene.h"
 
 #include "renderer/raytracing/Bsdf.h"
+#include "renderer/scene/MeshLod.h"
 
 #include <atomic>
 #include <cmath>
@@ -120,6 +121,7 @@ GpuScene::GpuScene(const Scene& scene, const rt::Cancel& cancel) : sceneKey(next
   mats.push_back(toGpuMaterial(Material{}));
   materials = makeBuffer("materials", mats);
 
+  lodBaseError = radiant::lodBaseError(scene.features.bounds);
   for (const MeshInstance& mi : scene.meshes) {
     cancel.check("the scene's upload (gpu_scene)");
     GpuMesh g;
@@ -147,6 +149,20 @@ GpuScene::GpuScene(const Scene& scene, const rt::Cancel& cancel) : sceneKey(next
     g.vao.attribute(3, 3, g.uv1, 2, sizeof(glm::vec2));
     g.vao.attribute(4, 4, g.tangents, 4, sizeof(glm::vec4));
     g.vao.elements(g.indices);
+    for (MeshLodLevel& level : buildMeshLods(mi, lodBaseError)) {
+      GpuMesh::Lod lod;
+      lod.indices = makeBuffer(label + " lod indices", level.indices);
+      lod.indexCount = static_cast<GLsizei>(level.indices.size());
+      lod.error = level.error;
+      lod.vao = gl::VertexArray(label + " lod");
+      lod.vao.attribute(0, 0, g.positions, 3, sizeof(glm::vec3));
+      lod.vao.attribute(1, 1, g.normals, 3, sizeof(glm::vec3));
+      lod.vao.attribute(2, 2, g.uv0, 2, sizeof(glm::vec2));
+      lod.vao.attribute(3, 3, g.uv1, 2, sizeof(glm::vec2));
+      lod.vao.attribute(4, 4, g.tangents, 4, sizeof(glm::vec4));
+      lod.vao.elements(lod.indices);
+      g.lods.push_back(std::move(lod));
+    }
     g.material = mi.material >= 0 && mi.material < defaultMaterial ? mi.material : defaultMaterial;
     const Material& m = scene.material(mi.material);
     const auto slots = materialTextureSlots(m);
@@ -183,20 +199,31 @@ void GpuScene::draw(const gl::Program& program, bool withTextures) const {
   drawMeshes(program, withTextures, [](std::size_t) { return true; });
 }
 
-void GpuScene::drawMeshes(const gl::Program& program, bool withTextures,
-                          const std::function<bool(std::size_t meshIndex)>& select) const {
+std::size_t GpuScene::drawMeshes(const gl::Program& program, bool withTextures,
+                                 const std::function<bool(std::size_t meshIndex)>& select,
+                                 const std::function<float(std::size_t meshIndex)>& allowance) const {
   // Not the lights: a pass may have bound the frame's (the scene's and the environment's,
   // bindDirectLighting) for the program it draws with.
   bindMaterialBuffers();
   const GLint materialLoc = program.uniformLocation("u_material");
+  std::size_t drawn = 0;
   for (std::size_t i = 0; i < meshes.size(); ++i) {
     if (!select(i)) continue;
     const GpuMesh& m = meshes[i];
     if (materialLoc >= 0) glProgramUniform1i(program.id(), materialLoc, m.material);
     if (withTextures) bindMaterialTextures(i);
-    m.vao.bind();
-    glDrawElements(GL_TRIANGLES, m.indexCount, GL_UNSIGNED_INT, nullptr);
+    const GpuMesh::Lod* lod = nullptr;
+    if (allowance && !m.lods.empty()) {
+      const float allowed = allowance(i);
+      for (const GpuMesh::Lod& l : m.lods)
+        if (l.error <= allowed) lod = &l;
+    }
+    (lod ? lod->vao : m.vao).bind();
+    const GLsizei count = lod ? lod->indexCount : m.indexCount;
+    glDrawElements(GL_TRIANGLES, count, GL_UNSIGNED_INT, nullptr);
+    drawn += static_cast<std::size_t>(count) / 3;
   }
+  return drawn;
 }
 
 }  // namespace radiant

@@ -18,6 +18,14 @@ struct GpuMesh {
   gl::Buffer positions, normals, uv0, uv1, tangents, indices;
   gl::VertexArray vao;
   GLsizei indexCount = 0;
+  // Levels of detail (renderer/scene/MeshLod.h), finest first: the same vertices, fewer triangles.
+  struct Lod {
+    gl::Buffer indices;
+    gl::VertexArray vao;
+    GLsizei indexCount = 0;
+    float error = 0.f;  // bound on the distance to the full surface (world units)
+  };
+  std::vector<Lod> lods;
   int material = -1;  // index into the materials buffer (the default material is appended last)
   std::array<int, gpu::kSlotCount> textures = noTextures();  // index into GpuScene::textures, -1 = none
   static std::array<int, gpu::kSlotCount> noTextures() {
@@ -52,6 +60,7 @@ public:
   gl::Buffer sheenAlbedo;             // rt::sheenAlbedoTable(), binding gpu::kBindingSheenAlbedo
   std::vector<gpu::Light> lightData;  // CPU copy of `lights` (at least one entry: zero-size SSBOs are invalid)
   std::size_t triangles = 0;
+  float lodBaseError = 0.f;  // the finest level's bound (MeshLod.h lodBaseError)
 
   static constexpr GLuint kMaterialBinding = gpu::kBindingMaterials;
   static constexpr GLuint kLightBinding = gpu::kBindingLights;
@@ -68,8 +77,13 @@ public:
   void draw(const gl::Program& program, bool withTextures) const;
   // Same, for the meshes whose index `select` accepts; `select` runs just before each mesh's draw, so
   // it may also set per-mesh uniforms (the specular pass draws per-object layers with it).
-  void drawMeshes(const gl::Program& program, bool withTextures,
-                  const std::function<bool(std::size_t meshIndex)>& select) const;
+  // With `allowance`: each mesh drawn at its coarsest level of detail whose error bound is within
+  // allowance(mesh) (world units; 0 or below: the full mesh), for passes that render the scene many
+  // times into texels far coarser than the screen's (shadow maps, the specular pass's maps). Returns
+  // the triangles drawn.
+  std::size_t drawMeshes(const gl::Program& program, bool withTextures,
+                         const std::function<bool(std::size_t meshIndex)>& select,
+                         const std::function<float(std::size_t meshIndex)>& allowance = {}) const;
 };
 
 }  // namespace radiant

@@ -20,49 +20,54 @@ uniform int u_pcfRadius;
 // Fraction of the PCF kernel that sees the light. Biases are in shadow-map texels converted to world
 // units at the receiver, so they scale with the scene: the receiver is pushed along its geometric
 // normal by `normalOffset` texels, then compared with a constant `bias` texels of slack.
-float shadowVisibility(int li, vec3 p, vec3 ng, float lightDist) {
+// The 2D map's kernel (spot and directional lights), r texels around the receiver's texel.
+float shadowVisibility2D(int li, vec3 p, vec3 ng, float lightDist, int r) {
   ShadowInfo si = shadows[li];
-  int kind = int(si.params.x);
-  if (u_hasShadows == 0 || kind == SHADOW_NONE) return 1.0;
+  if (u_hasShadows == 0 || int(si.params.x) == SHADOW_NONE) return 1.0;
   Light l = lights[li];
   bool ortho = si.params2.x > 0.5;
   float texel = ortho ? si.params.z : si.params.z * lightDist;
   vec3 q = p + ng * (si.params.w * texel);
   float bias = si.params2.y * texel;
-  float layer = si.params.y;
-  int r = u_pcfRadius;
+  vec4 c = si.viewProj * vec4(q, 1.0);
+  if (c.w <= 0.0) return 1.0;
+  vec2 uv = c.xy / c.w * 0.5 + 0.5;
+  float dist = ortho ? dot(q, l.directionRange.xyz) : length(q - l.positionType.xyz);
+  vec2 texelUv = 1.0 / vec2(textureSize(t_shadow2D, 0).xy);
   float lit = 0.0;
-  float count = 0.0;
-  if (kind == SHADOW_CUBE) {
-    vec3 d = q - l.positionType.xyz;
-    float dist = length(d);
-    vec3 dir = d / max(dist, 1e-30);
-    vec3 t = normalize(abs(dir.y) < 0.99 ? cross(dir, vec3(0, 1, 0)) : cross(dir, vec3(1, 0, 0)));
-    vec3 b = cross(dir, t);
-    for (int i = -r; i <= r; ++i)
-      for (int j = -r; j <= r; ++j) {
-        vec3 sd = dir + (t * float(i) + b * float(j)) * si.params.z;
-        float stored = texture(t_shadowCube, vec4(sd, layer)).r;
-        lit += dist - bias <= stored ? 1.0 : 0.0;
-        count += 1.0;
-      }
-  } else {
-    vec4 c = si.viewProj * vec4(q, 1.0);
-    if (c.w <= 0.0) return 1.0;
-    vec2 uv = c.xy / c.w * 0.5 + 0.5;
-    float dist = ortho ? dot(q, l.directionRange.xyz) : length(q - l.positionType.xyz);
-    vec2 texelUv = 1.0 / vec2(textureSize(t_shadow2D, 0).xy);
-    for (int i = -r; i <= r; ++i)
-      for (int j = -r; j <= r; ++j) {
-        vec2 s = uv + vec2(i, j) * texelUv;
-        // Outside the map: nothing was rendered there, so nothing occludes.
-        float stored = any(lessThan(s, vec2(0.0))) || any(greaterThan(s, vec2(1.0)))
-                           ? 1e30 : texture(t_shadow2D, vec3(s, layer)).r;
-        lit += dist - bias <= stored ? 1.0 : 0.0;
-        count += 1.0;
-      }
-  }
-  return lit / count;
+  for (int i = -r; i <= r; ++i)
+    for (int j = -r; j <= r; ++j) {
+      vec2 s = uv + vec2(i, j) * texelUv;
+      // Outside the map: nothing was rendered there, so nothing occludes.
+      float stored = any(lessThan(s, vec2(0.0))) || any(greaterThan(s, vec2(1.0)))
+                         ? 1e30 : texture(t_shadow2D, vec3(s, si.params.y)).r;
+      lit += dist - bias <= stored ? 1.0 : 0.0;
+    }
+  return lit / float((2 * r + 1) * (2 * r + 1));
+}
+float shadowVisibility(int li, vec3 p, vec3 ng, float lightDist) {
+  ShadowInfo si = shadows[li];
+  int kind = int(si.params.x);
+  if (u_hasShadows == 0 || kind == SHADOW_NONE) return 1.0;
+  int r = u_pcfRadius;
+  if (kind != SHADOW_CUBE) return shadowVisibility2D(li, p, ng, lightDist, r);
+  Light l = lights[li];
+  float texel = si.params.z * lightDist;
+  vec3 q = p + ng * (si.params.w * texel);
+  float bias = si.params2.y * texel;
+  vec3 d = q - l.positionType.xyz;
+  float dist = length(d);
+  vec3 dir = d / max(dist, 1e-30);
+  vec3 t = normalize(abs(dir.y) < 0.99 ? cross(dir, vec3(0, 1, 0)) : cross(dir, vec3(1, 0, 0)));
+  vec3 b = cross(dir, t);
+  float lit = 0.0;
+  for (int i = -r; i <= r; ++i)
+    for (int j = -r; j <= r; ++j) {
+      vec3 sd = dir + (t * float(i) + b * float(j)) * si.params.z;
+      float stored = texture(t_shadowCube, vec4(sd, si.params.y)).r;
+      lit += dist - bias <= stored ? 1.0 : 0.0;
+    }
+  return lit / float((2 * r + 1) * (2 * r + 1));
 }
 
 // The cosine factor of a sky light (EnvironmentLights::skyLights): its region of the sky as a uniform
@@ -101,9 +106,10 @@ float skyCapCosine(float cosTheta, float sigma) {
 vec3 directLighting(vec3 p, vec3 n, vec3 nc, vec3 ng, vec3 wo, MaterialParams material, int count,
                     int lightsWithoutSpecular, out float skyVisibility) {
   vec3 L = vec3(0.0);
-  float skyOpen = 0.0, skySeen = 0.0;
   lightsWithoutSpecular = min(lightsWithoutSpecular, u_diffuseOnlyFrom);
-  for (int i = 0; i < count; ++i) {
+  // The scene's lights and the environment's compact lights.
+  int skyFrom = min(count, u_diffuseOnlyFrom);
+  for (int i = 0; i < skyFrom; ++i) {
     LightSample s = sampleLight(lights[i], p);
     MaterialParams m = material;
     float radius = lights[i].spotCone.z;
@@ -115,24 +121,30 @@ vec3 directLighting(vec3 p, vec3 n, vec3 nc, vec3 ng, vec3 wo, MaterialParams ma
       m.surface.y = max(m.surface.y, floorRoughness);
       m.clearcoat.y = max(m.clearcoat.y, floorRoughness);
     }
-    vec3 f;
-    if (i >= u_diffuseOnlyFrom && radius > 0.0) {
-      // A sky light: its region's cap clipped by the horizon (skyCapCosine). The diffuse lobe is
-      // evaluated towards the light, or just above the horizon when the light's centre is below it.
-      float c = dot(n, s.wi);
-      float k = skyCapCosine(c, radius);
-      if (k <= 0.0) continue;
-      float y = k * dot(s.intensity, vec3(0.2126, 0.7152, 0.0722));
-      float v = shadowVisibility(i, p, ng, s.dist);
-      skyOpen += y;
-      skySeen += y * v;
-      vec3 wi = c >= 0.05 ? s.wi : normalize(s.wi + n * (0.05 - c));
-      L += gltfBsdfCos(n, nc, wo, wi, m, m.surface.w) * (k / max(dot(n, wi), 1e-4)) * s.intensity * v;
-      continue;
-    }
-    f = gltfBsdfCos(n, nc, wo, s.wi, m, m.surface.w);
+    vec3 f = gltfBsdfCos(n, nc, wo, s.wi, m, m.surface.w);
     if (all(equal(f, vec3(0.0)))) continue;
     L += f * s.intensity * shadowVisibility(i, p, ng, s.dist);
+  }
+  // The sky lights, in a loop of their own: directional, 2D shadow maps, Dirac specular lobes. (A
+  // software rasteriser runs every branch of a loop body for every light: one shared loop made each
+  // sky light pay for the cube-map kernel and a second BSDF evaluation; docs/PERFORMANCE.md.)
+  MaterialParams m = material;
+  m.surface.y = 0.0;
+  m.clearcoat.y = 0.0;
+  float skyOpen = 0.0, skySeen = 0.0;
+  for (int i = skyFrom; i < count; ++i) {
+    // A sky light: its region's cap clipped by the horizon (skyCapCosine). The diffuse lobe is
+    // evaluated towards the light, or just above the horizon when the light's centre is below it.
+    LightSample s = sampleLight(lights[i], p);
+    float c = dot(n, s.wi);
+    float k = skyCapCosine(c, max(lights[i].spotCone.z, 0.0));
+    if (k <= 0.0) continue;
+    float y = k * dot(s.intensity, vec3(0.2126, 0.7152, 0.0722));
+    float v = shadowVisibility2D(i, p, ng, s.dist, u_pcfRadius);
+    skyOpen += y;
+    skySeen += y * v;
+    vec3 wi = c >= 0.05 ? s.wi : normalize(s.wi + n * (0.05 - c));
+    L += gltfBsdfCos(n, nc, wo, wi, m, m.surface.w) * (k / max(dot(n, wi), 1e-4)) * s.intensity * v;
   }
   skyVisibility = skyOpen > 0.0 ? clamp(skySeen / skyOpen, 0.0, 1.0) : 1.0;
   return L;

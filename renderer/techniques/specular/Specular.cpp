@@ -245,6 +245,7 @@ void SpecularPass::execute(PassContext& ctx) {
     // One face of one layer of one object's maps is a stretch of GPU work (TransmissionTest's maps ran
     // minutes, deaf to the cancel flag).
     StretchGate gate(ctx.cancel);
+    std::size_t drawnTriangles = 0, fullTriangles = 0;
     for (int k = 0; k < objectCount; ++k) {
       const Object& o = objects_[k];
       const glm::vec3 ref(o.gpu.referenceRadius);
@@ -276,7 +277,7 @@ void SpecularPass::execute(PassContext& ctx) {
           prog.setMat4("u_viewProj", &vp[0][0]);
           prog.set("u_faceMode", l == 0 ? 0 : l == 1 ? 1 : 2);
           prog.set("u_peel", l >= 3 ? 1 : 0);
-          ctx.gpu.drawMeshes(prog, true, [&](std::size_t mesh) {
+          drawnTriangles += ctx.gpu.drawMeshes(prog, true, [&](std::size_t mesh) {
             const bool own = mesh == o.mesh;
             if ((l < 2) != own) return false;
             // Only what this face can see: a face spans 90 degrees (on MetalRoughSpheres, 12 objects x
@@ -284,7 +285,16 @@ void SpecularPass::execute(PassContext& ctx) {
             const Bounds& mb = ctx.scene.meshes[mesh].bounds;
             if (!own && !sphereInCubeFace(ref, f, mb.center(), mb.radius())) return false;
             glProgramUniform1i(prog.id(), codeLoc, objectOfMesh_[mesh] + 1);
+            fullTriangles += ctx.scene.meshes[mesh].triangleCount();
             return true;
+          }, [&](std::size_t mesh) {
+            // The coarsest level of detail within a quarter of the face's texel (2 / resolution per unit
+            // distance at the face's centre, larger towards its edges) where the mesh is nearest the
+            // reference point. The object itself in full: its surface may pass through the reference
+            // point (a flat mirror's centre).
+            if (mesh == o.mesh) return 0.f;
+            const Bounds& mb = ctx.scene.meshes[mesh].bounds;
+            return 0.25f * (2.f / resolution_) * std::max(glm::length(mb.center() - ref) - mb.radius(), 0.f);
           });
           gate.issued();
           ++draws;
@@ -378,6 +388,9 @@ void SpecularPass::execute(PassContext& ctx) {
     }
     glMemoryBarrier(GL_ALL_BARRIER_BITS);
     ctx.stats.counters["maps_rendered"] = draws;
+    // The levels of detail drawn (GpuScene::drawMeshes): triangles over all faces, against the full meshes'.
+    ctx.stats.counters["triangles_drawn"] = static_cast<double>(drawnTriangles);
+    ctx.stats.counters["triangles_full"] = static_cast<double>(fullTriangles);
     res.setHolds("specular_ldm_distance", digest);  // after writing them
   }
   res.markWritten("specular_maps");
