@@ -1,7 +1,6 @@
 // The gather baseline: per pixel, the sum over the photons (and coverage points) of the 27 grid cells
 // around its surface point (photon_gi/grid.glsl), with the same kernel and surface test as the splats
-// (photon.glsl). Cells are at least the largest kernel's reach, so no photon whose kernel reaches the
-// pixel is missed.
+// (photon.glsl). The walk meets every photon whose kernel reaches the pixel exactly once (grid.glsl).
 #include "photon_gi/grid.glsl"
 #include "photon_gi/photon.glsl"
 #include "photon_gi/surface.glsl"

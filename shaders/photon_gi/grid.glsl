@@ -1,6 +1,6 @@
 // The splat grid's walk, shared by the gather (photon_gi/gather.comp) and the specular pass's distance
-// maps (specular/map_indirect.comp): cells are at least the largest kernel's reach (Splatting.cpp
-// buildSplatGrid), so the 27 cells around a point hold every splat whose kernel reaches it.
+// maps (specular/map_indirect.comp): the 27 cells around a point hold every splat whose kernel reaches
+// it exactly once (Splatting.cpp buildSplatGrid: a kernel wider than a cell is copied every third cell).
 // llvmpipe ends an invocation's loops after 65535 iterations in total (its loop limiter), so the CPU
 // splits the cells into slices of at most 27 * u_sliceLength candidates per point and dispatches once
 // per slice, accumulating (docs/DEVELOPMENT.md): a walk covers entries [u_sliceBegin, u_sliceBegin +

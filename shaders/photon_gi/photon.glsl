@@ -14,7 +14,7 @@
 struct GpuPhoton {
   vec4 positionRadius;  // xyz world position, w kernel radius h
   vec4 normal;          // xyz unit normal on the side the photon arrived from; w = 1: diffuse lobe only
-  vec4 wi;              // xyz unit direction towards where it came from
+  vec4 wi;              // xyz unit direction towards where it came from; w = 1: a copy (the grid's, splat.vert)
   vec4 power;           // rgb phi_j = flux / photons used; a > 0: a coverage point of weight A / n
 };
 

@@ -359,6 +359,9 @@ void PhotonGiPass::execute(PassContext& ctx) {
   c["bytes_per_photon"] =
       settings_.photons ? double(records_ * sizeof(rt::PhotonRecord)) / double(settings_.photons) : 0.0;
   c["splat_bytes"] = static_cast<double>(grid_->count * sizeof(photon_gi::GpuSplat));
+  // The gather grid (Splatting.h buildSplatGrid): its cell, and the wide kernels' copies in other cells.
+  c["grid_cell_size"] = grid_->cellSize;
+  c["grid_copies"] = static_cast<double>(grid_->count - grid_->originals);
   c["splats_uploaded"] = upload_ ? 1.0 : 0.0;
   c["splats_rebuilt"] = rebuilt_ ? 1.0 : 0.0;
   c["h_min"] = hMin_;

@@ -78,32 +78,97 @@ SplatGrid buildSplatGrid(std::vector<GpuSplat> splats) {
     hMax = std::max(hMax, s.positionRadius.w);
     g.hMin = g.hMin > 0.f ? std::min(g.hMin, s.positionRadius.w) : s.positionRadius.w;
   }
+  g.originals = splats.size();
   if (splats.empty()) {
     g.cellStart = {0, 0};
     return g;
   }
   const glm::vec3 extent = b.extent();
   const float longest = std::max({extent.x, extent.y, extent.z});
-  // Cells hold the reach of the largest kernel: the surface test accepts in-plane distances below h and
-  // plane distances below kPlaneTolerance h, so a splat reaches h sqrt(1 + tolerance^2) in 3-D.
-  const float reach = hMax * std::sqrt(1.f + kPlaneTolerance * kPlaneTolerance) * (1.f + 1e-5f);
-  g.cellSize = std::max({reach, longest / kMaxCellsPerAxis, 1e-30f});
-  g.origin = b.min;
-  g.dims = glm::clamp(glm::ivec3(glm::floor(extent / g.cellSize)) + 1, glm::ivec3(1), glm::ivec3(kMaxCellsPerAxis));
+  // A splat reaches h sqrt(1 + tolerance^2) in 3-D: the surface test accepts in-plane distances below h
+  // and plane distances below kPlaneTolerance h.
+  const float reachScale = std::sqrt(1.f + kPlaneTolerance * kPlaneTolerance) * (1.f + 1e-5f);
+  const float minCell = std::max(longest / kMaxCellsPerAxis, 1e-30f);
+  // A splat whose reach spans m cells beyond its own (m = ceil(reach / cell)) is stored in its cell c
+  // and, per axis, in c + 3k for |k| <= K = floor((m + 1) / 3): a point m or fewer cells away walks the
+  // 3 x 3 x 3 cells around its own, and exactly one of them per axis is c + 3k (one of any three
+  // consecutive cells is), so the walk meets the splat once, never twice. Copies carry wi.w = 1: the
+  // splat method (one quad per splat) draws originals only.
+  auto copiesPerAxis = [&](float h, float cell) {
+    const int m = static_cast<int>(std::ceil(h * reachScale / cell));
+    return 2 * ((std::max(m, 1) + 1) / 3) + 1;
+  };
+  // The cell: the reach of the largest kernel (every splat stored once) or of a percentile one, whichever
+  // gives the least walk: a point's 27 cells hold about entries x (3 cell)^3 / volume candidates, so the
+  // choice minimises entries x cell^3, with the copies at most 3 x the splats and 2^20 (64 MiB). Kernels
+  // of very different sizes (photon_gi's kernel is per surface: a wide floor's beside small spheres')
+  // made every pixel walk cells as wide as the widest.
+  std::vector<float> radii;
+  radii.reserve(splats.size());
+  for (const GpuSplat& s : splats) radii.push_back(s.positionRadius.w);
+  std::sort(radii.begin(), radii.end());
+  g.cellSize = std::max(hMax * reachScale, minCell);
+  double best = double(splats.size()) * std::pow(double(g.cellSize), 3.0);
+  const std::size_t maxEntries = splats.size() + std::min<std::size_t>(3 * splats.size(), std::size_t(1) << 20);
+  // With copies the grid is padded by 3 K cells on every side (K of the widest kernel), so that every
+  // copy lies inside it: a copy dropped at the border was missed by the points next to it (a test's
+  // find). A candidate that would need more than kMaxCellsPerAxis cells is not taken.
+  auto padding = [&](float cell) { return 3 * ((copiesPerAxis(hMax, cell) - 1) / 2); };
+  auto fits = [&](float cell) {
+    return glm::all(glm::lessThanEqual(glm::ivec3(glm::floor(extent / cell)) + 1 + 2 * padding(cell),
+                                       glm::ivec3(kMaxCellsPerAxis)));
+  };
+  for (double q : {0.25, 0.5, 0.75, 0.9, 0.97, 0.99}) {
+    const float cell = std::max(radii[static_cast<std::size_t>(q * double(radii.size() - 1))] * reachScale, minCell);
+    if (!(cell < g.cellSize) || !fits(cell)) continue;
+    std::size_t entries = 0;
+    for (float h : radii) {
+      const std::size_t c = static_cast<std::size_t>(copiesPerAxis(h, cell));
+      entries += c * c * c;
+      if (entries > maxEntries) break;
+    }
+    const double walk = double(entries) * std::pow(double(cell), 3.0);
+    if (entries <= maxEntries && walk < best) {
+      best = walk;
+      g.cellSize = cell;
+    }
+  }
+  const int pad = g.cellSize < hMax * reachScale ? padding(g.cellSize) : 0;
+  g.origin = b.min - glm::vec3(float(pad) * g.cellSize);
+  g.dims = glm::clamp(glm::ivec3(glm::floor(extent / g.cellSize)) + 1 + 2 * pad, glm::ivec3(1),
+                      glm::ivec3(kMaxCellsPerAxis));
   const std::size_t cells = static_cast<std::size_t>(g.dims.x) * g.dims.y * g.dims.z;
-  auto cellOf = [&](const GpuSplat& s) {
+  auto cellOf = [&](const glm::ivec3& c) { return (static_cast<std::size_t>(c.z) * g.dims.y + c.y) * g.dims.x + c.x; };
+  // Every entry (splat, cell): the originals, then their copies in cells inside the grid.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> entries;  // (splat index, cell), copies flagged below
+  std::vector<std::uint8_t> isCopy;
+  entries.reserve(splats.size());
+  for (std::size_t i = 0; i < splats.size(); ++i) {
+    const GpuSplat& s = splats[i];
     const glm::ivec3 c = glm::clamp(glm::ivec3(glm::floor((glm::vec3(s.positionRadius) - g.origin) / g.cellSize)),
                                     glm::ivec3(0), g.dims - 1);
-    return (static_cast<std::size_t>(c.z) * g.dims.y + c.y) * g.dims.x + c.x;
-  };
+    const int K = (copiesPerAxis(s.positionRadius.w, g.cellSize) - 1) / 2;
+    for (int kz = -K; kz <= K; ++kz)
+      for (int ky = -K; ky <= K; ++ky)
+        for (int kx = -K; kx <= K; ++kx) {
+          const glm::ivec3 q = c + 3 * glm::ivec3(kx, ky, kz);
+          if (glm::any(glm::lessThan(q, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(q, g.dims))) continue;
+          entries.emplace_back(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(cellOf(q)));
+          isCopy.push_back(kx != 0 || ky != 0 || kz != 0);
+        }
+  }
   // Counting sort by cell: O(N), stable (photon order is kept within a cell).
   g.cellStart.assign(cells + 1, 0);
-  for (const GpuSplat& s : splats) ++g.cellStart[cellOf(s) + 1];
+  for (const auto& e : entries) ++g.cellStart[e.second + 1];
   for (std::size_t c = 0; c < cells; ++c) g.maxPerCell = std::max(g.maxPerCell, g.cellStart[c + 1]);
   for (std::size_t c = 0; c < cells; ++c) g.cellStart[c + 1] += g.cellStart[c];
   std::vector<std::uint32_t> next(g.cellStart.begin(), g.cellStart.end() - 1);
-  g.splats.resize(splats.size());
-  for (const GpuSplat& s : splats) g.splats[next[cellOf(s)]++] = s;
+  g.splats.resize(entries.size());
+  for (std::size_t e = 0; e < entries.size(); ++e) {
+    GpuSplat& out = g.splats[next[entries[e].second]++];
+    out = splats[entries[e].first];
+    out.wi.w = isCopy[e] ? 1.f : 0.f;
+  }
   g.count = g.splats.size();
   return g;
 }

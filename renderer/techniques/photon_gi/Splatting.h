@@ -21,7 +21,7 @@ namespace radiant::photon_gi {
 struct GpuSplat {
   glm::vec4 positionRadius;  // xyz world position, w kernel radius h
   glm::vec4 normal;          // xyz unit normal on the side the photon arrived from, w 1 = diffuse lobe only
-  glm::vec4 wi;              // xyz unit direction towards where the photon came from
+  glm::vec4 wi;              // xyz unit direction towards where the photon came from; w 1 = a copy (buildSplatGrid)
   glm::vec4 power;           // rgb phi = flux / photons used; a > 0: coverage point of weight A / n
 };
 static_assert(sizeof(GpuSplat) == 64, "std430 GpuSplat must be 4 vec4");
@@ -54,7 +54,8 @@ struct SplatSettings {
 // The splats sorted by grid cell, and the grid (cell c holds splats cellStart[c] .. cellStart[c+1]-1).
 struct SplatGrid {
   std::vector<GpuSplat> splats;  // may be released once uploaded (count stays)
-  std::size_t count = 0;         // splats in the grid
+  std::size_t count = 0;         // entries in the grid: the splats and their copies (buildSplatGrid)
+  std::size_t originals = 0;     // the splats (entries whose wi.w is 0)
   std::vector<std::uint32_t> cellStart;
   glm::vec3 origin{0.f};
   float cellSize = 1.f;
@@ -62,8 +63,10 @@ struct SplatGrid {
   std::uint32_t maxPerCell = 0;  // the fullest cell's splats (the gather's dispatch count follows it)
   float hMin = 0.f;              // the smallest kernel radius
 };
-// Cells are at least the reach of the largest kernel, h sqrt(1 + planeTolerance^2) (a gather visits the
-// 27 cells around a pixel), and at most 128 per axis.
+// A gather visits the 27 cells around a pixel. Cells are the reach h sqrt(1 + planeTolerance^2) of the
+// largest kernel, or of a smaller percentile one when that walks fewer candidates with the wider
+// splats' copies (stored every third cell across their reach, so that a walk meets each splat once;
+// at most 3 x the splats and 2^20); at most 128 per axis.
 SplatGrid buildSplatGrid(std::vector<GpuSplat> splats);
 
 // Declares the splat buffers (capacity in powers of two), the accumulation targets and `indirect`.

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -22,6 +23,7 @@
 #include "renderer/techniques/gbuffer/GBuffer.h"
 #include "renderer/techniques/photon_gi/PhotonGi.h"
 #include "renderer/techniques/photon_gi/Splatting.h"
+#include "renderer/shading/PhotonGrid.h"
 #include "tests/support/RenderTestSupport.h"
 #include "tests/support/SceneBuilder.h"
 
@@ -295,6 +297,92 @@ TEST(PhotonGi, GatherSeesEveryPhotonWhenACellHoldsMoreThan65536) {
   for (std::size_t i = 0; i < a.pixels.size(); ++i) { sa += a.pixels[i]; sb += b.pixels[i]; }
   EXPECT_GT(sa, 0.0);
   EXPECT_NEAR(sb / sa, 1.0, 1e-3);
+}
+
+// The gather grid with kernels of very different sizes (Splatting.h buildSplatGrid): cells follow the
+// small kernels and the wide ones are copied every third cell across their reach. The CPU walk of
+// photon_gi/grid.glsl (the 27 cells around a point's own) must meet every splat that reaches the point
+// exactly once: a miss loses light, a second meeting counts it twice.
+TEST(PhotonGi, GridWalkMeetsEverySplatThatReachesAPointExactlyOnce) {
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<float> u(-1.f, 1.f), small(0.02f, 0.05f), wide(0.1f, 0.2f);
+  std::vector<GpuSplat> splats;
+  for (int i = 0; i < 4000; ++i) {
+    const float h = i % 50 == 0 ? wide(rng) : small(rng);
+    GpuSplat s = photon_gi::photonSplat(glm::vec3(u(rng), u(rng), u(rng)), h, glm::vec3(0, 1, 0), glm::vec3(0, 1, 0),
+                                        glm::vec3(float(i)));  // the power names the splat
+    splats.push_back(s);
+  }
+  const std::vector<GpuSplat> originals = splats;
+  const photon_gi::SplatGrid g = photon_gi::buildSplatGrid(splats);
+  const float reachScale = std::sqrt(1.f + kPhotonPlaneTolerance * kPhotonPlaneTolerance);
+  EXPECT_EQ(g.originals, originals.size());
+  EXPECT_GT(g.count, g.originals);                          // the wide kernels were copied
+  EXPECT_LE(g.count, 4 * g.originals);                      // copies at most 3x the splats
+  EXPECT_LT(g.cellSize, 0.1f * reachScale);                 // cells follow the small kernels
+  std::size_t flaggedCopies = 0;
+  for (const GpuSplat& s : g.splats) flaggedCopies += s.wi.w > 0.5f;
+  EXPECT_EQ(flaggedCopies, g.count - g.originals);          // the splat method draws each once
+  int checked = 0, reached = 0, reachedWide = 0;
+  for (int q = 0; q < 3000; ++q) {
+    // Half the points anywhere (and beyond the splats' bounds), half near a splat, at up to 1.1 reaches.
+    glm::vec3 x(1.1f * u(rng), 1.1f * u(rng), 1.1f * u(rng));
+    if (q % 2 == 1) {
+      const GpuSplat& s = originals[std::size_t(0.5f * (u(rng) + 1.f) * float(originals.size() - 1))];
+      x = glm::vec3(s.positionRadius) + 0.64f * s.positionRadius.w * reachScale * glm::vec3(u(rng), u(rng), u(rng));
+    }
+    std::map<int, int> met;  // splat -> meetings within its reach
+    const glm::ivec3 c = glm::ivec3(glm::floor((x - g.origin) / g.cellSize));
+    for (int k = 0; k < 27; ++k) {
+      const glm::ivec3 cell = c + glm::ivec3(k % 3, (k / 3) % 3, k / 9) - 1;
+      if (glm::any(glm::lessThan(cell, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(cell, g.dims))) continue;
+      const std::size_t index = (std::size_t(cell.z) * g.dims.y + cell.y) * g.dims.x + cell.x;
+      for (std::uint32_t e = g.cellStart[index]; e < g.cellStart[index + 1]; ++e) {
+        const GpuSplat& s = g.splats[e];
+        if (glm::length(x - glm::vec3(s.positionRadius)) < s.positionRadius.w * reachScale) ++met[int(s.power.r)];
+      }
+    }
+    for (std::size_t i = 0; i < originals.size(); ++i) {
+      const GpuSplat& s = originals[i];
+      const bool reaches = glm::length(x - glm::vec3(s.positionRadius)) < s.positionRadius.w * reachScale;
+      const auto it = met.find(int(i));
+      const int meetings = it == met.end() ? 0 : it->second;
+      ++checked;
+      reached += reaches;
+      reachedWide += reaches && s.positionRadius.w >= 0.1f;
+      if (meetings != (reaches ? 1 : 0)) {
+        ADD_FAILURE() << "splat " << i << " (h " << s.positionRadius.w << ") met " << meetings << " times at a point it "
+                      << (reaches ? "reaches" : "does not reach");
+        return;
+      }
+    }
+  }
+  EXPECT_GT(reached, 1500);  // the walk was asked about many splats, wide (copied) and small
+  EXPECT_GT(reachedWide, 300);
+  std::printf("grid: cell %.4f, %zu entries for %zu splats; %d of %d (point, splat) pairs within reach, %d of a wide one\n",
+              g.cellSize, g.count, g.originals, reached, checked, reachedWide);
+}
+
+// The same on the GPU: splatting (originals only) and gathering (copies met once) agree when a few
+// wide kernels are copied across the grid.
+TEST(PhotonGi, SplatAndGatherAgreeWithCopiedWideKernels) {
+  SplatHarness h(plane(), 64);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-kHalf, kHalf);
+  std::vector<GpuSplat> splats;
+  for (int i = 0; i < 6000; ++i)
+    splats.push_back(photon_gi::photonSplat(glm::vec3(u(rng), 0.f, u(rng)), i % 40 == 0 ? 0.2f : 0.06f,
+                                            glm::vec3(0, 1, 0), glm::vec3(0, 1, 0), glm::vec3(1.f)));
+  ASSERT_GT(photon_gi::buildSplatGrid(splats).count, splats.size());  // copies were made
+  const Image a = h.run(splats, settings(photon_gi::Method::Splat, false));
+  const Image b = h.run(splats, settings(photon_gi::Method::Gather, false));
+  double maxRel = 0.0, sum = 0.0;
+  for (std::size_t i = 0; i < a.pixels.size(); ++i) {
+    maxRel = std::max(maxRel, std::abs(double(a.pixels[i]) - b.pixels[i]) / (std::abs(double(b.pixels[i])) + 1e-3));
+    sum += b.pixels[i];
+  }
+  EXPECT_GT(sum, 0.0);
+  EXPECT_LT(maxRel, 1e-3);  // float summation order only
 }
 
 // ---- The technique on whole scenes --------------------------------------------------------------
