@@ -142,25 +142,24 @@ GpuScene::GpuScene(const Scene& scene, const rt::Cancel& cancel) : sceneKey(next
     g.tangents = makeBuffer(label + " tangents", tangents);
     g.indices = makeBuffer(label + " indices", mi.indices);
     g.indexCount = static_cast<GLsizei>(mi.indices.size());
-    g.vao = gl::VertexArray(label);
-    g.vao.attribute(0, 0, g.positions, 3, sizeof(glm::vec3));
-    g.vao.attribute(1, 1, g.normals, 3, sizeof(glm::vec3));
-    g.vao.attribute(2, 2, g.uv0, 2, sizeof(glm::vec2));
-    g.vao.attribute(3, 3, g.uv1, 2, sizeof(glm::vec2));
-    g.vao.attribute(4, 4, g.tangents, 4, sizeof(glm::vec4));
-    g.vao.elements(g.indices);
+    // One vertex layout for the mesh and its levels of detail (the same vertices, other indices).
+    auto vertexArray = [&g](const std::string& name, const gl::Buffer& indices) {
+      gl::VertexArray vao(name);
+      vao.attribute(0, 0, g.positions, 3, sizeof(glm::vec3));
+      vao.attribute(1, 1, g.normals, 3, sizeof(glm::vec3));
+      vao.attribute(2, 2, g.uv0, 2, sizeof(glm::vec2));
+      vao.attribute(3, 3, g.uv1, 2, sizeof(glm::vec2));
+      vao.attribute(4, 4, g.tangents, 4, sizeof(glm::vec4));
+      vao.elements(indices);
+      return vao;
+    };
+    g.vao = vertexArray(label, g.indices);
     for (MeshLodLevel& level : buildMeshLods(mi, lodBaseError)) {
       GpuMesh::Lod lod;
       lod.indices = makeBuffer(label + " lod indices", level.indices);
       lod.indexCount = static_cast<GLsizei>(level.indices.size());
       lod.error = level.error;
-      lod.vao = gl::VertexArray(label + " lod");
-      lod.vao.attribute(0, 0, g.positions, 3, sizeof(glm::vec3));
-      lod.vao.attribute(1, 1, g.normals, 3, sizeof(glm::vec3));
-      lod.vao.attribute(2, 2, g.uv0, 2, sizeof(glm::vec2));
-      lod.vao.attribute(3, 3, g.uv1, 2, sizeof(glm::vec2));
-      lod.vao.attribute(4, 4, g.tangents, 4, sizeof(glm::vec4));
-      lod.vao.elements(lod.indices);
+      lod.vao = vertexArray(label + " lod", lod.indices);
       g.lods.push_back(std::move(lod));
     }
     g.material = mi.material >= 0 && mi.material < defaultMaterial ? mi.material : defaultMaterial;

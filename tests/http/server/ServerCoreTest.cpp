@@ -74,6 +74,17 @@ httplib::Result post(httplib::Client& c, const std::string& path, const json& bo
 
 json body(const httplib::Result& r) { return json::parse(r->body); }
 
+// GET /v1/renders/{id} until its state is `state` (at most 5 s); the last description.
+json waitForState(httplib::Client& c, const std::string& id, const std::string& state) {
+  json st;
+  for (int i = 0; i < 500; ++i) {
+    st = body(c.Get(("/v1/renders/" + id).c_str()));
+    if (st["state"] == state) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return st;
+}
+
 // Every error response: problem+json with the given status, type slug and pointer.
 void expectProblem(const httplib::Result& r, int status, const std::string& type, const std::string& pointer) {
   ASSERT_TRUE(r) << "no response";
@@ -439,12 +450,7 @@ TEST(ServerCore, CancelQueuedRemovesItAndCancelRunningStopsIt) {
   del = c.Delete(("/v1/renders/" + running).c_str());
   ASSERT_EQ(del->status, 202);
   EXPECT_EQ(body(del)["cancel_requested"], true);
-  json st;
-  for (int i = 0; i < 500; ++i) {
-    st = body(c.Get(("/v1/renders/" + running).c_str()));
-    if (st["state"] == "canceled") break;
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
+  const json st = waitForState(c, running, "canceled");
   EXPECT_EQ(st["state"], "canceled") << st.dump();
   EXPECT_EQ(s.control.started, 1) << "the canceled queued job never reached the renderer";
   s.control.open();
@@ -804,12 +810,7 @@ TEST(ServerCore, QueuedRendersHoldTheirScenesInTheDecodeMemory) {
   EXPECT_EQ(reserved(), double(48u << 20));
   s.control.open();
   for (const auto& id : {body(running)["id"].get<std::string>(), body(admitted)["id"].get<std::string>()}) {
-    json st;
-    for (int i = 0; i < 1000; ++i) {
-      st = body(c.Get(("/v1/renders/" + id).c_str()));
-      if (st["state"] == "done") break;
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
+    const json st = waitForState(c, id, "done");
     EXPECT_EQ(st["state"], "done") << st.dump();
   }
   // Finished jobs (kept for their frames) hold no scene: only the cache's two remain charged.
