@@ -60,23 +60,31 @@ void main() {
   if (nv < 1e-3) ns = normalize(ns + wo * (1e-3 - nv));
   // glTF emission leaves the front face only unless the material is double-sided (as the reference).
   bool emits = gl_FrontFacing || materialDoubleSided(m);
-  if (u_objectCode > 0 && specularInMaps(p.surface.x, p.surface.z)) {
-    o_material = specularTexel(p.baseColor.rgb, p.surface.x, p.surface.z, p.surface.w);
-    if (o_material.a < 0.0) {
+  bool specular = u_objectCode > 0 && specularInMaps(p.surface.x, p.surface.z);
+  vec4 texel = specular ? specularTexel(p.baseColor.rgb, p.surface.x, p.surface.z, p.surface.w) : vec4(0.0);
+  bool mirror = specular && texel.a < 0.0;
+  // One light loop for the two kinds of lit texel (llvmpipe runs both branches of an `if` with a loop in
+  // each: two loops per fragment; docs/PERFORMANCE.md): a diffuse texel with every lobe, a mirror's
+  // diffuse lobe with Dirac specular and coat lobes (lightsWithoutSpecular 0).
+  vec3 lit = vec3(0.0);
+  if (!specular || mirror)
+    lit = (emits ? p.emission.rgb : vec3(0.0)) + directLighting(v_position, ns, ns, ng, wo, p, u_lightCount,
+                                                                mirror ? 0 : u_lightCount);
+  if (specular) {
+    o_material = texel;
+    if (mirror) {
       // A mirror keeps its F0 in the albedo map (a = 0: not a lit diffuse texel) and the radiance of
-      // its diffuse lobe in the material map: its emission and the lights' direct light with Dirac
-      // specular and coat lobes (lightsWithoutSpecular 0), which the trace adds to what the mirror
-      // reflects, as `direct` lights the diffuse lobe of the mirror pixels on screen. Without it a
-      // metallic 0.67 sphere seen in another mirror reflected only the dark ground where the
-      // reference saw its sunlit dielectric third (MetalRoughSpheres' worst pixel).
-      o_albedo = vec4(o_material.rgb, 0.0);
-      vec3 L = (emits ? p.emission.rgb : vec3(0.0)) + directLighting(v_position, ns, ns, ng, wo, p, u_lightCount, 0);
-      o_material = vec4(L, -1.0);
+      // its diffuse lobe in the material map: its emission and the lights' direct light, which the
+      // trace adds to what the mirror reflects, as `direct` lights the diffuse lobe of the mirror
+      // pixels on screen. Without it a metallic 0.67 sphere seen in another mirror reflected only the
+      // dark ground where the reference saw its sunlit dielectric third (MetalRoughSpheres' worst pixel).
+      o_albedo = vec4(texel.rgb, 0.0);
+      o_material = vec4(lit, -1.0);
     }
   } else {
     // The Lambertian part of the glTF BRDF (what the caustics pass lights at the maps' texels).
     if (!materialUnlit(m)) o_albedo = vec4(p.baseColor.rgb * (1.0 - p.surface.x) * (1.0 - p.surface.z), 1.0);
-    vec3 L = (emits ? p.emission.rgb : vec3(0.0)) + directLighting(v_position, ns, ng, wo, p);
+    vec3 L = lit;
     // The environment's glossy lobe (its diffuse lobe is photon_gi's photons, gathered into the maps
     // with the Lambertian term): without it a rough metal seen in a mirror was black but for its sun
     // glints (MetalRoughSpheres' mirror spheres reflecting their rough neighbours). Times the
