@@ -38,9 +38,13 @@ struct FidelityOptions {
   std::string models = "../shared/testdata/gltf-samples";   // one folder per model (Khronos layout)
   std::string environments = "../shared/testdata/environments";
   std::vector<std::string> onlyModels, onlyEnvironments;    // empty = all (folder names, map file stems)
-  int size = 128, spp = 1024;
+  int size = 128;
+  // The reference: renders of `spp` samples per pixel at seeds 0, 1, ..., averaged, until the mean of
+  // the even seeds scores at most `convergedDb` against the mean of the odd ones, or `maxSpp` samples
+  // are reached (maxSpp == spp: one seed, no convergence check).
+  int spp = 1024, maxSpp = 16384;
+  double convergedDb = -23;
   double thetaDeg = 30, phiDeg = 75;                        // camera.orbit; radius: the automatic framing's
-  bool convergence = false;                                 // also a seed-1 reference, scored against seed 0
   bool quiet = false;
   std::vector<std::string> servers;                         // the first is used (default the global one)
 };

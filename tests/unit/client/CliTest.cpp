@@ -126,6 +126,10 @@ TEST(Cli, BadCommandLinesAreUsageErrors) {
   EXPECT_EQ(f.code, 2);
   EXPECT_NE(f.err.find("/nonexistent/models"), std::string::npos) << f.err;
   EXPECT_EQ(radiant("bench --fidelity --spp 0").code, 2);
+  const ProcessRun m = radiant("bench --fidelity --spp 1024 --max-spp 512");
+  EXPECT_EQ(m.code, 2);
+  EXPECT_NE(m.err.find("--max-spp"), std::string::npos) << m.err;
+  EXPECT_EQ(radiant("bench --fidelity --converged-db 3").code, 2);
 }
 
 TEST(Cli, BashCompletionListsEveryCommandAndEachCommandsFlags) {
