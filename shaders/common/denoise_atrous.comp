@@ -52,11 +52,16 @@ void main() {
       if (xq.w <= 0.0) continue;
       vec3 cq = valueAt(q);
       if (!finite3(cq)) continue;
-      float wn = pow(max(dot(np, texelFetch(t_normal, q, 0).xyz), 0.0), u_sigmaNormal);
-      float wx = exp(-abs(dot(np, xq.xyz - xp.xyz)) * planeScale);
+      // The three edge-stopping weights as one exponential: normal max(0, cos)^sigma_normal =
+      // exp(sigma_normal ln cos), plane, luminance (one exp and one log per tap instead of pow and two
+      // exp: 240 -> 225 ms of llvmpipe's filter at 256 px, k = 2; a lattice-tiled version with the
+      // taps in shared memory ran 2.5x slower there).
+      float cosN = dot(np, texelFetch(t_normal, q, 0).xyz);
+      if (cosN <= 0.0) continue;  // weight 0
       float lq = lum(cq);
-      float wl = exp(-abs(lp - lq) / (u_sigmaLuminance * 0.5 * (abs(lp) + abs(lq)) + 1e-20));
-      float w = kernel[abs(dx)] * kernel[abs(dy)] * wn * wx * wl;
+      float e = abs(dot(np, xq.xyz - xp.xyz)) * planeScale +
+                abs(lp - lq) / (u_sigmaLuminance * 0.5 * (abs(lp) + abs(lq)) + 1e-20) - u_sigmaNormal * log(cosN);
+      float w = kernel[abs(dx)] * kernel[abs(dy)] * exp(-e);
       sum += w * cq;
       weights += w;
     }
