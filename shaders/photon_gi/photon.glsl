@@ -1,6 +1,8 @@
 // Photon splatting (Stürzlinger & Bastos 1997, §2.2, optimised mode §2.2.1), shared by the splat
 // fragment shader and the per-pixel gather baseline so both compute exactly the same estimate:
 //   L_o(x, wo) = sum_j phi_j f_r(x, wi_j, wo) k((x - x_j) / h_j) / h_j^2            (eq. 2 with 1/h^2)
+// times |n_s . wi_j| / |n_j . wi_j| (the pixel's shading normal over the photon's geometric normal; 1 on
+// a flat surface: photonContribution)
 // with a kernel k of unit integral over the unit disk, evaluated in photon j's tangent plane. A photon
 // contributes only to pixels whose G-buffer surface lies in its plane and faces the same way (the
 // paper's per-surface stencil, here a surface test), so splats do not bleed across creases or onto
@@ -62,20 +64,25 @@ vec3 photonContribution(GpuPhoton p, SplatSurface s) {
   float k = photonKernel(p, s.x, s.ng);
   if (k <= 0.0) return vec3(0.0);
   vec3 wi = p.wi.xyz;
-  float NdotL = dot(s.n, wi);
-  if (NdotL <= 0.0) return vec3(0.0);
+  // The photon's flux per area is irradiance on its own (geometric) plane, E = int L_i |n_j . wi| dw,
+  // so each photon stands for L_i dw = (phi / A) / |n_j . wi|, and the receiver reflects
+  // f |n_s . wi| L_i dw (the reference's integrand, with the pixel's shading normal):
+  // phi f |n_s . wi| / |n_j . wi| k / h^2. Dividing by the receiver's own cosine instead (as until
+  // 2026-12-05) is the same on a flat surface, not where the kernel spans a curve or a normal map
+  // (MetalRoughSpheres' spheres are smaller than their kernels: -19.5 -> -19.7 dB under qwantani).
+  float cosJ = dot(p.normal.xyz, wi);
+  if (cosJ <= 0.0 || dot(s.n, wi) <= 0.0) return vec3(0.0);
   // The layered glTF BSDF (common/brdf.glsl gltfBsdfCos, the reference's rt::GltfBsdf): the base under
-  // the sheen and the clear coat. gltfBsdfCos is f cos(theta_i); density estimation needs f alone (the
-  // photon flux per area already carries the cosine). A lobe too sharp to estimate from photons, or a
-  // glossy reflection another technique owns (normal.w), is left out by making it a Dirac lobe, which
-  // carries nothing towards a photon's direction: the base's specular (roughness 0 leaves the diffuse
-  // lobe with its Fresnel weight) and the coat's lobe (its (1 - Fc) attenuation of the base stays).
+  // the sheen and the clear coat; gltfBsdfCos is f |n_s . wi|, divided by the photon's cosine. A lobe
+  // too sharp to estimate from photons, or a glossy reflection another technique owns (normal.w), is
+  // left out by making it a Dirac lobe, which carries nothing towards a photon's direction: the base's
+  // specular (roughness 0 leaves the diffuse lobe with its Fresnel weight) and the coat's lobe (its
+  // (1 - Fc) attenuation of the base stays).
   MaterialParams m = s.p;
   bool diffuseOnly = p.normal.w > 0.5;
   if (diffuseOnly || m.surface.y < u_minGlossyRoughness) m.surface.y = 0.0;
   if (diffuseOnly || m.clearcoat.y < u_minGlossyRoughness) m.clearcoat.y = 0.0;
-  vec3 f = gltfBsdfCos(s.n, s.nc, s.wo, wi, m, m.surface.w) / NdotL;
-  return p.power.rgb * f * k;
+  return p.power.rgb * (gltfBsdfCos(s.n, s.nc, s.wo, wi, m, m.surface.w) / cosJ) * k;
 }
 
 // A coverage point (uniform by area over its surface, weight A / n, its normal the front of its
