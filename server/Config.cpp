@@ -21,6 +21,10 @@ std::string usage() {
   --token-file FILE         require "Authorization: Bearer <contents of FILE>"
   --config FILE             JSON file with any of these options (keys use '_': "max_queue")
   --max-body-bytes N        largest request body (default 67108864)
+  --body-memory-bytes N     bytes the request bodies being read or handled may hold together (at least
+                            --max-body-bytes): a body is charged as it arrives (its Content-Length at
+                            once) until its request is answered; one that does not fit waits up to 1 s,
+                            then gets 503 body-busy (default 268435456)
   --max-width N, --max-height N   largest image (default 4096, never above the schema's 4096)
   --max-samples N           largest per-pixel sample count (x-cost "samples": spp, samples, light paths
                             per pixel, compare.spp) (default 65536)
@@ -143,6 +147,7 @@ void apply(ServerConfig& c, const std::string& name, const std::string& v, std::
   else if (name == "gl-debug") c.glDebug = v != "false" && v != "0";
   else if (name == "max-json-depth") c.limits.maxJsonDepth = static_cast<std::size_t>(toInt(flag, v, 8, 1000));
   else if (name == "max-decode-bytes") c.maxDecodeBytes = static_cast<std::size_t>(toInt(flag, v, 1 << 20, 1ll << 40));
+  else if (name == "body-memory-bytes") c.bodyMemoryBytes = static_cast<std::size_t>(toInt(flag, v, 1 << 20, 1ll << 40));
   else if (name == "decode-memory-bytes") c.decodeMemoryBytes = static_cast<std::size_t>(toInt(flag, v, 1 << 20, 1ll << 40));
   else if (name == "gpu-scenes") c.gpuScenes = static_cast<int>(toInt(flag, v, 1, 256));
   else if (name == "derived-cache-bytes") c.derivedCacheBytes = static_cast<std::size_t>(toInt(flag, v, 1 << 20, 1ll << 40));

@@ -18,6 +18,9 @@ struct ServerConfig {
   std::string assetRoot;               // scene.asset paths resolve here ("" = scene.asset refused)
   std::string token;                   // bearer token ("" = no auth), read from token_file
   std::size_t maxBodyBytes = 64u << 20;
+  // Bytes the request bodies being read or handled may hold together, at least maxBodyBytes
+  // (HttpServer.cpp readBody): bounds what many connections can make the daemon hold.
+  std::size_t bodyMemoryBytes = 256u << 20;
   api::RequestLimits limits{.defaultFrameBudgetMs = 10000};  // --default-frame-budget-ms: on in the daemon
   int maxQueue = 16;                   // jobs waiting (the running one not counted)
   double requestTimeoutS = 300;        // submit -> frames encoded; a timed-out job frees its slot

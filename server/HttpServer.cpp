@@ -339,6 +339,7 @@ struct HttpServer::Impl {
   ContentStore scenes;
   ContentStore images;  // comparison targets (compare.against = their digest)
   DecodeMemory decodeMemory;  // before the caches: what they hold releases its charge here when dropped
+  DecodeMemory bodyMemory;    // request bodies being read or handled (--body-memory-bytes; readBody)
   DecodedScenes decoded;
   DecodedImages decodedImages;
   RenderService service;
@@ -361,6 +362,7 @@ struct HttpServer::Impl {
         scenes(config.cacheDir, config.maxSceneBytes, "scenes"),
         images(config.cacheDir, config.maxSceneBytes, "images"),
         decodeMemory(std::max(config.decodeMemoryBytes, config.maxDecodeBytes)),
+        bodyMemory(std::max(config.bodyMemoryBytes, config.maxBodyBytes)),
         decoded(config.sceneCacheEntries, config.sceneCacheBytes),
         decodedImages(std::min<std::size_t>(4, config.sceneCacheEntries), config.sceneCacheBytes / 2),
         service(config, hooks, frames, metrics) {
@@ -533,18 +535,49 @@ struct HttpServer::Impl {
 
   // ---- helpers --------------------------------------------------------------------------------
   // The body of a POST/PUT, counted while it is read: chunked and gzip/deflate bodies (which httplib
-  // inflates on the way) stop at --max-body-bytes instead of being read whole first.
-  std::string readBody(const httplib::Request& req, httplib::Response& res, const httplib::ContentReader& reader) {
+  // inflates on the way) stop at --max-body-bytes instead of being read whole first. Its bytes are
+  // charged to `charge` (bodyMemory, --body-memory-bytes) before they are held: the Content-Length at
+  // once when the request gives one (so a body that cannot fit is refused before it is read), else in
+  // steps of 64 KiB as it arrives; wrapBody keeps the charge until the request is answered. Without it
+  // every HTTP thread could hold a body of --max-body-bytes (24 threads x 64 MiB by default).
+  std::string readBody(const httplib::Request& req, httplib::Response& res, const httplib::ContentReader& reader,
+                       DecodeMemory::Reservation& charge) {
     std::string body;
-    bool tooLarge = false;
-    const bool ok = reader([&](const char* data, std::size_t n) {
+    bool tooLarge = false, busy = false;
+    std::size_t charged = 0;
+    auto chargeUpTo = [&](std::size_t bytes) {
+      if (bytes <= charged) return true;
+      const std::size_t more = std::min(std::max<std::size_t>(bytes - charged, std::size_t(64) << 10), config.maxBodyBytes - charged);
+      try {
+        charge.grow(more);
+      } catch (const api::ApiError&) {
+        busy = true;
+        return false;
+      }
+      charged += more;
+      return true;
+    };
+    if (req.has_header("Content-Length")) {
+      const std::uint64_t declared = req.get_header_value<std::uint64_t>("Content-Length");
+      if (declared <= config.maxBodyBytes) chargeUpTo(static_cast<std::size_t>(declared));
+    }
+    const bool ok = !busy && reader([&](const char* data, std::size_t n) {
       if (n > config.maxBodyBytes - body.size()) {
         tooLarge = true;
         return false;
       }
+      if (!chargeUpTo(body.size() + n)) return false;
       body.append(data, n);
       return true;
     });
+    if (busy) {
+      markCloseConnection();  // the body (or its rest) is still on the wire
+      res.set_header("Connection", "close");
+      throw api::ApiError(503, "body-busy", "Busy reading bodies",
+                          "the request bodies being read or handled hold " + std::to_string(bodyMemory.reserved()) +
+                              " of the " + std::to_string(bodyMemory.total()) +
+                              " bytes they may take together (--body-memory-bytes): retry after the Retry-After seconds");
+    }
     // httplib refuses a Content-Length over the limit itself (status 413) without reading the body.
     if (!ok && res.status == 413) tooLarge = true;
     if (tooLarge || !ok) {
@@ -567,10 +600,11 @@ struct HttpServer::Impl {
   httplib::Server::HandlerWithContentReader wrapBody(F f) {
     return [this, f](const httplib::Request& req, httplib::Response& res, const httplib::ContentReader& reader) {
       try {
-        const std::string body = readBody(req, res, reader);
+        DecodeMemory::Reservation charge(bodyMemory);  // held until the answer: the body lives that long
+        const std::string body = readBody(req, res, reader, charge);
         f(req, body, res);
       } catch (const api::ApiError& e) {
-        if (e.type == "decode-busy") res.set_header("Retry-After", "1");
+        if (e.type == "decode-busy" || e.type == "body-busy") res.set_header("Retry-After", "1");
         sendProblem(res, e, tRequest.renderId);
       } catch (const std::exception& e) {
         sendProblem(res, 500, "internal-error", "Internal error", e.what(), "", tRequest.renderId);
@@ -609,6 +643,8 @@ struct HttpServer::Impl {
                 {"max_decode_bytes", config.maxDecodeBytes},
                 {"decode_memory_bytes", config.decodeMemoryBytes},
                 {"decode_memory_effective_bytes", decodeMemory.total()},
+                {"body_memory_bytes", config.bodyMemoryBytes},
+                {"body_memory_effective_bytes", bodyMemory.total()},
                 {"max_frame_bytes", config.maxFrameBytes},
                 {"scene_cache_bytes", config.sceneCacheBytes},
                 {"gpu_scenes", config.gpuScenes},
@@ -786,7 +822,9 @@ struct HttpServer::Impl {
           {"radiant_image_cache_bytes", {"Bytes of decoded images kept in memory (half of --scene-cache-bytes).", double(decodedImages.totalBytes())}},
           {"radiant_frame_store_bytes", {"Bytes of encoded frames stored.", double(frames.totalBytes())}},
           {"radiant_decode_bytes_reserved", {"Bytes of --decode-memory-bytes taken: decodes in flight, and the decoded scenes and images cached or held by renders.", double(decodeMemory.reserved())}},
-          {"radiant_decodes_refused", {"Decodes refused with 503 decode-busy since start (--decode-memory-bytes).", double(decodeMemory.refused())}}};
+          {"radiant_decodes_refused", {"Decodes refused with 503 decode-busy since start (--decode-memory-bytes).", double(decodeMemory.refused())}},
+          {"radiant_body_bytes_reserved", {"Bytes of --body-memory-bytes taken by request bodies being read or handled.", double(bodyMemory.reserved())}},
+          {"radiant_bodies_refused", {"Requests refused with 503 body-busy since start (--body-memory-bytes).", double(bodyMemory.refused())}}};
       res.status = 200;
       res.set_content(metrics.text(gauges), "text/plain; version=0.0.4; charset=utf-8");
     }));

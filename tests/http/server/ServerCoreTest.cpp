@@ -757,6 +757,66 @@ TEST(ServerCore, DecodesShareTheDecodeMemoryByBytes) {
   EXPECT_EQ(ok->status, 201) << ok->body;
 }
 
+// Issue 30, request bodies bounded by bytes: the bodies being read or handled share --body-memory-bytes
+// (1 MiB here, with --max-body-bytes 1 MiB). An upload of 600 KiB held in its decode keeps its body
+// charged until it is answered; a second of 600 KiB waits a second and gets 503 body-busy with
+// Retry-After, its connection closed (refused on its Content-Length, before its body is read); a small
+// one fits beside; once the first is answered the second succeeds. Before, each HTTP thread could hold a
+// body of --max-body-bytes (24 threads x 64 MiB by default).
+TEST(ServerCore, RequestBodiesShareTheBodyMemoryByBytes) {
+  ServerConfig config;
+  config.maxBodyBytes = 1u << 20;
+  config.bodyMemoryBytes = 1u << 20;
+  TestServer s(config);
+  s.waitReady();
+  auto info = body(s.client().Get("/v1/info"));
+  EXPECT_EQ(info["limits"]["body_memory_effective_bytes"], 1u << 20);
+  auto padded = [](int n, bool hold) {
+    return R"({"asset":{"version":"2.0"},"extras":{"n":)" + std::to_string(n) + (hold ? R"(,"hold-decode":1)" : "") +
+           R"(,"pad":")" + std::string(600 << 10, 'x') + "\"}}";
+  };
+  const std::string held = padded(1, true);
+  s.control.holdDecode = true;
+  std::thread first([&] {
+    auto c = s.client();
+    auto r = c.Put("/v1/scenes", held, "model/gltf+json");
+    ASSERT_TRUE(r);
+    EXPECT_EQ(r->status, 201) << r->body;
+  });
+  for (int i = 0; i < 2000 && s.control.decoding.load() == 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  ASSERT_EQ(s.control.decoding.load(), 1);
+  auto c = s.client();
+  auto metrics = c.Get("/metrics");
+  ASSERT_TRUE(metrics);
+  EXPECT_NE(metrics->body.find("radiant_body_bytes_reserved " + std::to_string(held.size()) + "\n"), std::string::npos)
+      << metrics->body.substr(0, 200);
+  // A small body fits beside the held one.
+  const std::string small = R"({"asset":{"version":"2.0"},"extras":{"n":2}})";
+  auto fits = c.Put("/v1/scenes", small, "model/gltf+json");
+  ASSERT_TRUE(fits);
+  EXPECT_EQ(fits->status, 201) << fits->body;
+  // A second large one does not: it waits, then is refused.
+  const std::string other = padded(3, false);
+  auto c2 = s.client();
+  const auto t0 = std::chrono::steady_clock::now();
+  auto busy = c2.Put("/v1/scenes", other, "model/gltf+json");
+  const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  expectProblem(busy, 503, "body-busy", "");
+  EXPECT_EQ(busy->get_header_value("Retry-After"), "1");
+  EXPECT_EQ(busy->get_header_value("Connection"), "close");
+  EXPECT_GE(waited, 0.9);
+  metrics = c.Get("/metrics");
+  ASSERT_TRUE(metrics);
+  EXPECT_NE(metrics->body.find("radiant_bodies_refused 1\n"), std::string::npos);
+  s.control.holdDecode = false;
+  first.join();
+  metrics = c.Get("/metrics");
+  EXPECT_NE(metrics->body.find("radiant_body_bytes_reserved 0\n"), std::string::npos);
+  auto ok = s.client().Put("/v1/scenes", other, "model/gltf+json");
+  ASSERT_TRUE(ok);
+  EXPECT_EQ(ok->status, 201) << ok->body;
+}
+
 // Issue 30, queued jobs bounded by bytes: a decoded scene stays charged to the decode memory (64 MiB
 // here) while the cache or a job holds it. Two renders holding 24 MiB scenes each (one running at the
 // gate, one queued) leave no room for a third scene: its decode drops what only the cache holds, waits a
