@@ -236,6 +236,8 @@ using DecodedImages = DecodedCache<Image, imageBytes>;
 // second for jobs to end, then the decode is refused with 503 decode-busy and Retry-After: concurrent
 // uploads cannot add up to more than the budget (3 meshopt uploads decoding 256 MiB each took the daemon
 // to 1.8 GB), nor can renders queued behind a long one, each holding a scene of its own.
+// A second instance budgets the request bodies being read or handled (bodyMemory, --body-memory-bytes,
+// readBody), whose callers turn its 503 decode-busy into body-busy.
 class DecodeMemory {
 public:
   explicit DecodeMemory(std::size_t bytes) : total_(std::max<std::size_t>(1, bytes)) {}

@@ -255,7 +255,8 @@ int fidelityBench(const GlobalOptions& g, const FidelityOptions& o) {
         };
         addSeed();
         // Seeds come in pairs (even against odd) once there is more than one.
-        const int maxSeeds = std::max(1, o.maxSpp / o.spp) < 2 ? 1 : std::max(1, o.maxSpp / o.spp) / 2 * 2;
+        const int seedBudget = o.maxSpp / o.spp;  // >= 1: runBench refuses --max-spp below --spp
+        const int maxSeeds = seedBudget < 2 ? 1 : seedBudget / 2 * 2;
         std::optional<double> halvesDb;
         bool converged = false;
         for (int want = 2; maxSeeds > 1;) {
