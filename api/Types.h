@@ -154,6 +154,9 @@ struct PassStats {
   double gpuMs = 0.0;
   double cpuMs = 0.0;
   std::map<std::string, double> counters;  // beams, photons, samples, ...
+  // What the pass chose differently from what the request implies (the Renderer moves each into
+  // stats.warnings, prefixed with the pass's name).
+  std::vector<std::string> warnings;
 };
 
 struct CacheEvent {

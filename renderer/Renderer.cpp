@@ -738,6 +738,8 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
                                "', which its TechniqueInfo does not declare");
       im.resources.endPass();
       gl::checkError(("execute " + t->info().name).c_str());
+      for (auto& w : stats.passes[i].warnings) stats.warnings.push_back(t->info().name + ": " + std::move(w));
+      stats.passes[i].warnings.clear();
     }
 
     // Readback of every AOV the outputs name (beauty always).

@@ -8,6 +8,9 @@
 //   (ordered dithering; the stochastic-transparency shadow of Enderton et al. 2010 with a fixed
 //   pattern), and the PCF kernel of the lookup averages the kept texels back into a transmittance
 //   1 - alpha (exact over every 4x4 block; a 3x3 kernel sees it within +-1/9 per pixel).
+// OPAQUE (the variant the pass draws opaque materials with): no material read and no discard, so
+// that the depth test may run before the shader (a shader that can discard tests depth after it, and
+// llvmpipe then shades every layer of layered geometry).
 #include "common/material.glsl"
 
 in vec3 v_position;
@@ -26,6 +29,7 @@ float bayerThreshold(ivec2 texel) {
 }
 
 void main() {
+#ifndef OPAQUE
   SurfaceUv uv = SURFACE_UV_FRAGMENT(v_uv0, v_uv1);  // before any discard (common/material.glsl)
   Material m = materials[u_material];
   int mode = materialAlphaMode(m);
@@ -34,6 +38,7 @@ void main() {
     if (materialMasked(m, alpha)) discard;
     if (mode == 2 && alpha <= bayerThreshold(ivec2(gl_FragCoord.xy))) discard;
   }
+#endif
   o_distance = u_orthographic != 0 ? dot(v_position - u_lightPosition, u_lightDirection)
                                    : length(v_position - u_lightPosition);
 }

@@ -9,6 +9,7 @@
 #include "renderer/frame/FrameView.h"
 #include "renderer/frame/PassContext.h"
 #include "renderer/shading/CubeFaces.h"
+#include "renderer/shading/Stretches.h"
 
 namespace radiant {
 namespace {
@@ -18,7 +19,58 @@ glm::vec3 anyPerpendicular(const glm::vec3& d) {
   return std::abs(d.y) < 0.99f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
 }
 
+// A spot light's map: its cone plus a margin, at most 170 degrees.
+float spotFov(const Light& l) { return std::min(2.f * l.outerConeAngle + glm::radians(4.f), glm::radians(170.f)); }
+
 }  // namespace
+
+std::vector<double> ShadowMapsPass::mapCoverage(const Scene& scene, const std::vector<Light>& lights,
+                                                const std::set<int>& excluded, const rt::Cancel& cancel) {
+  constexpr double kPi = 3.14159265358979323846;
+  const double radius = std::max<double>(scene.features.bounds.radius(), 1e-6);
+  // Per light: the factor from a triangle's projected area (directional) or solid angle (spot, point)
+  // to map areas.
+  std::vector<double> factor(lights.size());
+  for (std::size_t li = 0; li < lights.size(); ++li) {
+    const Light& l = lights[li];
+    if (l.type == LightType::Directional) factor[li] = 1.0 / (4.0 * radius * radius);  // the map spans 2r x 2r
+    else if (l.type == LightType::Spot) {
+      const double t = std::tan(0.5 * spotFov(l));  // the map spans 2t x 2t of the plane at distance 1
+      factor[li] = 1.0 / (4.0 * t * t);
+    } else factor[li] = 6.0 / (4.0 * kPi);  // six face maps cover the sphere's 4 pi
+  }
+  std::vector<double> coverage(lights.size(), 0.0);
+  for (std::size_t m = 0; m < scene.meshes.size(); ++m) {
+    if (excluded.count(static_cast<int>(m))) continue;
+    cancel.check("shadow_maps' overdraw estimate, mesh " + std::to_string(m));
+    const MeshInstance& mesh = scene.meshes[m];
+    for (std::size_t i = 0; i + 2 < mesh.indices.size(); i += 3) {
+      const glm::dvec3 p0 = mesh.positions[mesh.indices[i]], p1 = mesh.positions[mesh.indices[i + 1]],
+                       p2 = mesh.positions[mesh.indices[i + 2]];
+      const glm::dvec3 area = 0.5 * glm::cross(p1 - p0, p2 - p0);  // normal times area
+      const glm::dvec3 centre = (p0 + p1 + p2) / 3.0;
+      for (std::size_t li = 0; li < lights.size(); ++li) {
+        const Light& l = lights[li];
+        double a;
+        if (l.type == LightType::Directional) {
+          a = std::abs(glm::dot(area, glm::dvec3(glm::normalize(l.direction))));
+        } else {
+          const glm::dvec3 v = centre - glm::dvec3(l.position);
+          if (l.type == LightType::Spot && !(glm::dot(v, glm::dvec3(l.direction)) > 0.0)) continue;  // behind it
+          const double d = glm::length(v);
+          a = d > 0.0 ? std::min(std::abs(glm::dot(area, v)) / (d * d * d), 2.0 * kPi) : 2.0 * kPi;
+        }
+        if (std::isfinite(a)) coverage[li] += a * factor[li];
+      }
+    }
+  }
+  return coverage;
+}
+
+int ShadowMapsPass::sizeWithinBudget(int size, double coverage) {
+  while (size / 2 >= kMinAutoSize && coverage * double(size) * size > kFragmentBudget) size /= 2;
+  return size;
+}
 
 const TechniqueInfo& ShadowMapsPass::info() const {
   static const TechniqueInfo i{"shadow_maps",
@@ -43,6 +95,39 @@ Requirements ShadowMapsPass::requirements(const Scene& scene, const api::RenderR
 void ShadowMapsPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
   const std::vector<Light>& lights = res.view().lights;  // the scene's, then the environment's
   size_ = params.get<int>("shadow_map_size", 1024);
+  // The maps depend on geometry, lights, size and the meshes left out (Technique::shadowMapExclusions);
+  // their overdraw on all but the size.
+  excluded_ = res.shadowMapExclusions();
+  std::string inputs = res.sceneKey();
+  if (lights.size() > scene.lights.size()) inputs += "|" + res.view().lightingEnvironmentKey();
+  for (int m : excluded_) inputs += "|-" + std::to_string(m);
+  if (inputs != coverageKey_) {
+    coverageKey_.clear();  // until the estimate is whole (it may be cancelled)
+    coverage_ = 0.0;
+    for (double c : mapCoverage(scene, lights, excluded_, res.cancel())) coverage_ += c;
+    coverageKey_ = inputs;
+  }
+  warning_.clear();
+  const double fragments = coverage_ * double(size_) * size_;
+  if (params.given("shadow_map_size")) {
+    if (fragments > kFragmentLimit)
+      throw api::ApiError(
+          422, "limit-exceeded", "Server limit exceeded",
+          "/passes/shadow_maps/shadow_map_size: maps of " + std::to_string(size_) + "^2 would rasterise an estimated " +
+              std::to_string(static_cast<long long>(fragments / 1e6)) + " million fragments (the scene's triangles " +
+              "cover each map about " + std::to_string(static_cast<long long>(coverage_ / std::max<std::size_t>(1, lights.size()))) +
+              " times over), above the limit of " + std::to_string(static_cast<long long>(kFragmentLimit / 1e6)) +
+              " million: lower shadow_map_size, or leave it out to let the server choose",
+          "/passes/shadow_maps/shadow_map_size");
+  } else if (const int lowered = sizeWithinBudget(size_, coverage_); lowered < size_) {
+    warning_ = "the default " + std::to_string(size_) + "^2 maps would rasterise an estimated " +
+               std::to_string(static_cast<long long>(fragments / 1e6)) + " million fragments (overdraw: the " +
+               "scene's triangles cover each map about " +
+               std::to_string(static_cast<long long>(coverage_ / std::max<std::size_t>(1, lights.size()))) +
+               " times over), above the budget of " + std::to_string(static_cast<long long>(kFragmentBudget / 1e6)) +
+               " million: drawn at " + std::to_string(lowered) + "^2 (set shadow_maps.shadow_map_size to choose)";
+    size_ = lowered;
+  }
   const float bias = params.get<float>("shadow_bias", 1.0f);
   const float normalOffset = params.get<float>("normal_offset", 1.5f);
   const Bounds& b = scene.features.bounds;
@@ -64,7 +149,7 @@ void ShadowMapsPass::prepare(const Scene& scene, const Params& params, FrameReso
       for (int f = 0; f < 6; ++f) draws_.push_back({static_cast<int>(li), cubes * 6 + f, true, cubeFaceViewProj(l.position, f, znear)});
       ++cubes;
     } else if (l.type == LightType::Spot) {
-      const float fov = std::min(2.f * l.outerConeAngle + glm::radians(4.f), glm::radians(170.f));
+      const float fov = spotFov(l);
       si.viewProj = reversedZPerspective(fov, 1.f, znear) * glm::lookAt(l.position, l.position + dir, anyPerpendicular(dir));
       si.params = glm::vec4(gpu::kShadow2D, static_cast<float>(maps2d), 2.f * std::tan(0.5f * fov) / size_, normalOffset);
       si.params2 = glm::vec4(0.f, bias, 0.f, 0.f);
@@ -103,11 +188,7 @@ void ShadowMapsPass::prepare(const Scene& scene, const Params& params, FrameReso
   res.framebuffer("shadow");
   res.buffer("shadow_info", infos_.size() * sizeof(gpu::ShadowInfo));
 
-  // The maps depend on geometry, lights, size and the meshes left out (Technique::shadowMapExclusions).
-  excluded_ = res.shadowMapExclusions();
-  std::string digest = res.sceneKey() + "|" + std::to_string(size_);
-  if (lights.size() > scene.lights.size()) digest += "|" + res.view().lightingEnvironmentKey();
-  for (int m : excluded_) digest += "|-" + std::to_string(m);
+  std::string digest = inputs + "|" + std::to_string(size_);
   // The maps live in the shared shadow textures: valid only when they hold this digest's maps (another
   // scene may have rendered into them since; FrameResources::holds).
   mapsValid_ = res.holds("shadow_cube", digest, "shadow_maps");
@@ -120,6 +201,10 @@ void ShadowMapsPass::execute(PassContext& ctx) {
   res.markWritten("shadow_maps");
   ctx.stats.counters["maps_rendered"] = mapsValid_ ? 0.0 : static_cast<double>(draws_.size());
   ctx.stats.counters["meshes_excluded"] = static_cast<double>(excluded_.size());
+  ctx.stats.counters["map_size"] = size_;
+  // The overdraw estimate the size was chosen by (kFragmentBudget), in fragments of every map.
+  ctx.stats.counters["fragments_estimated"] = coverage_ * double(size_) * size_;
+  if (!warning_.empty()) ctx.stats.warnings.push_back(warning_);
   if (mapsValid_) return;
 
   gl::Framebuffer& fb = res.framebuffer("shadow");
@@ -128,8 +213,15 @@ void ShadowMapsPass::execute(PassContext& ctx) {
   gl::Texture& depth = res.texture("shadow_depth");
   fb.attach(GL_DEPTH_ATTACHMENT, depth);
   fb.setDrawBuffers({GL_COLOR_ATTACHMENT0});
-  const gl::Program& prog = ctx.shaders.program({"shadow_maps/shadow.vert", "shadow_maps/shadow.frag"});
-  prog.use();
+  // Opaque materials through a variant without the material read and discard (shadow.frag, OPAQUE),
+  // whose depth test may run before the shader; MASK and BLEND ones through the full program.
+  const gl::Program& opaqueProg =
+      ctx.shaders.program({"shadow_maps/shadow.vert", "shadow_maps/shadow.frag"}, {{"OPAQUE", "1"}});
+  const gl::Program& alphaProg = ctx.shaders.program({"shadow_maps/shadow.vert", "shadow_maps/shadow.frag"});
+  auto opaque = [&](std::size_t m) {
+    const int mat = ctx.scene.meshes[m].material;
+    return mat < 0 || mat >= int(ctx.scene.materials.size()) || ctx.scene.materials[mat].alphaMode == AlphaMode::Opaque;
+  };
   glViewport(0, 0, size_, size_);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_GREATER);
@@ -139,7 +231,9 @@ void ShadowMapsPass::execute(PassContext& ctx) {
   const float far[4] = {1e30f, 0.f, 0.f, 0.f};
   const float depthClear = 0.f;
   std::size_t drawnTriangles = 0, fullTriangles = 0;
+  StretchGate gate(ctx.cancel);  // one map (a cube face) is a stretch of GPU work
   for (const Draw& d : draws_) {
+    gate.check("shadow_maps, map " + std::to_string(&d - draws_.data() + 1) + " of " + std::to_string(draws_.size()));
     const Light& l = ctx.view.lights[d.light];
     fb.attach(GL_COLOR_ATTACHMENT0, d.cube ? cube : flat, 0, d.layer);
     fb.checkComplete("ShadowMapsPass::execute");
@@ -149,29 +243,33 @@ void ShadowMapsPass::execute(PassContext& ctx) {
     const bool ortho = l.type == LightType::Directional;
     const glm::vec3 origin = ortho ? glm::vec3(0.f) : l.position;
     const glm::vec3 dir = glm::normalize(l.direction);
-    prog.setMat4("u_viewProj", &d.viewProj[0][0]);
-    prog.set("u_lightPosition", &origin[0], 3);
-    prog.set("u_lightDirection", &dir[0], 3);
-    prog.set("u_orthographic", ortho ? 1 : 0);
-    // With textures: MASK and BLEND materials' coverage comes from the base colour's alpha (shadow.frag).
+    // MASK and BLEND materials' coverage comes from the base colour's alpha (shadow.frag), with textures.
     // A point light's cube face draws only the meshes in its 90-degree frustum (sphereInCubeFace).
     // Each mesh at the coarsest level of detail within a quarter of the map's texel where the mesh is
     // nearest the light (GpuScene::drawMeshes; the normal offset and bias are a texel or more).
     const float texel = infos_[d.light].params.z;  // world units (orthographic) or per unit distance
-    drawnTriangles += ctx.gpu.drawMeshes(prog, true, [&](std::size_t m) {
-      if (excluded_.count(static_cast<int>(m))) return false;
-      const Bounds& b = ctx.scene.meshes[m].bounds;
-      if (d.cube && !sphereInCubeFace(l.position, d.layer % 6, b.center(), b.radius())) return false;
-      fullTriangles += ctx.scene.meshes[m].triangleCount();
-      return true;
-    }, [&](std::size_t m) {
-      if (ortho) return 0.25f * texel;
-      const Bounds& b = ctx.scene.meshes[m].bounds;
-      return 0.25f * texel * std::max(glm::length(b.center() - l.position) - b.radius(), 0.f);
-    });
+    for (const bool opaquePass : {true, false}) {
+      const gl::Program& prog = opaquePass ? opaqueProg : alphaProg;
+      prog.use();
+      prog.setMat4("u_viewProj", &d.viewProj[0][0]);
+      prog.set("u_lightPosition", &origin[0], 3);
+      prog.set("u_lightDirection", &dir[0], 3);
+      prog.set("u_orthographic", ortho ? 1 : 0);
+      drawnTriangles += ctx.gpu.drawMeshes(prog, !opaquePass, [&](std::size_t m) {
+        if (excluded_.count(static_cast<int>(m)) || opaque(m) != opaquePass) return false;
+        const Bounds& b = ctx.scene.meshes[m].bounds;
+        if (d.cube && !sphereInCubeFace(l.position, d.layer % 6, b.center(), b.radius())) return false;
+        fullTriangles += ctx.scene.meshes[m].triangleCount();
+        return true;
+      }, [&](std::size_t m) {
+        if (ortho) return 0.25f * texel;
+        const Bounds& b = ctx.scene.meshes[m].bounds;
+        return 0.25f * texel * std::max(glm::length(b.center() - l.position) - b.radius(), 0.f);
+      });
+    }
+    gate.issued();
   }
   res.setHolds("shadow_cube", digest_);  // after writing: a frame that fails before leaves them invalid
-  ctx.stats.counters["map_size"] = size_;
   // The levels of detail drawn (GpuScene::drawMeshes): triangles over all maps, against the full meshes'.
   ctx.stats.counters["triangles_drawn"] = static_cast<double>(drawnTriangles);
   ctx.stats.counters["triangles_full"] = static_cast<double>(fullTriangles);

@@ -694,6 +694,7 @@ TEST(Environment, ShadowMapsBeyondTheMemoryLimitAreRefused) {
   req.environment = "sha256:" + std::string(64, 'e');
   req.passes["direct"] = {{"sky_lights", 64}};
   req.passes["shadow_maps"] = {{"shadow_map_size", 4096}};
+  req.explicitParams["shadow_maps"] = {"shadow_map_size"};  // as the request's JSON names it (a default would be lowered)
   try {
     renderer().render(scene, req, nullptr, FrameInputs{nullptr, &env});
     FAIL() << "65 maps of 4096^2 rendered";

@@ -13,6 +13,8 @@
 
 #include <gtest/gtest.h>
 
+#include "renderer/techniques/shadow_maps/ShadowMaps.h"
+
 #include "api/Aovs.h"
 #include "renderer/Renderer.h"
 #include "renderer/scene/BuiltinScenes.h"
@@ -241,6 +243,59 @@ TEST(RenderCore, StatsTimeEveryPassAndSkipWithReasons) {
   ASSERT_TRUE(d.stats.skipped.count("shadow_maps"));
   EXPECT_EQ(d.stats.skipped.at("shadow_maps"), "the scene has no punctual lights and the frame no environment map");
   for (float v : aov(d, "beauty").pixels) EXPECT_EQ(v, 0.f);
+}
+
+// Layered geometry makes the shadow maps' cost unbounded (fragments = map area x overdraw: 16,667
+// stacked triangles: 2.7 billion in a default frame's 17 maps). 3000 stacked 2 x 2 quads 1e-4 apart cover a
+// directional light's map 1483 times over: the default 1024^2 would rasterise 1.5 billion fragments, so
+// the maps are drawn at 256^2 (97 Mi, within ShadowMapsPass::kFragmentBudget) with a warning, and the
+// top layer is still lit as the light's irradiance says and not shadowed by the layers under it. A
+// size the request names is not lowered: above kFragmentLimit it is a 422 naming the field.
+TEST(RenderCore, ShadowMapOverdrawIsBoundedByTheFragmentBudget) {
+  SceneBuilder b;
+  const int white = b.material(lambertian());
+  Scene scene = b.directionalLight({0, -1, 0}, 2.f).topDownOrtho(5.f, 0.9f).build("stack");
+  MeshInstance stack;
+  stack.material = white;
+  for (int i = 0; i < 3000; ++i) {
+    const float y = -1e-4f * i;
+    const std::uint32_t v = static_cast<std::uint32_t>(stack.positions.size());
+    for (const glm::vec3 p : {glm::vec3(-1, y, 1), glm::vec3(1, y, 1), glm::vec3(1, y, -1), glm::vec3(-1, y, -1)}) {
+      stack.positions.push_back(p);
+      stack.normals.push_back({0, 1, 0});
+      stack.bounds.extend(p);
+    }
+    stack.indices.insert(stack.indices.end(), {v, v + 1, v + 2, v, v + 2, v + 3});
+  }
+  scene.meshes.push_back(std::move(stack));
+  scene.features = computeFeatures(scene);
+  api::RenderRequest req = request(32);
+  req.disabledPasses = {"photon_gi"};
+  const RenderOutput out = renderer().render(scene, req);
+  expectAllFinite(out);
+  const api::PassStats* maps = testing::pass(out, "shadow_maps");
+  ASSERT_NE(maps, nullptr);
+  EXPECT_EQ(maps->counters.at("map_size"), 256.0);
+  EXPECT_LE(maps->counters.at("fragments_estimated"), ShadowMapsPass::kFragmentBudget);
+  EXPECT_NEAR(maps->counters.at("fragments_estimated"), 3000 * 4.0 / (8.0 + 0.2999 * 0.2999) * 256 * 256,
+              0.01 * maps->counters.at("fragments_estimated"));
+  bool warned = false;
+  for (const auto& w : out.stats.warnings) warned = warned || w.rfind("shadow_maps: the default 1024^2 maps", 0) == 0;
+  EXPECT_TRUE(warned);
+  const float expected = 2.f / glm::pi<float>();
+  const Image& direct = aov(out, "direct");
+  for (int y = 2; y < 30; ++y)
+    for (int x = 2; x < 30; ++x) EXPECT_NEAR(direct.at(x, y)[1], expected, 0.01f * expected) << x << "," << y;
+
+  req.explicitParams["shadow_maps"] = {"shadow_map_size"};
+  req.passes["shadow_maps"] = {{"shadow_map_size", 2048}};  // 1483 x 2048^2 = 6.2 billion
+  try {
+    renderer().render(scene, req);
+    FAIL() << "maps of 6 billion fragments rendered";
+  } catch (const api::ApiError& e) {
+    EXPECT_EQ(e.status, 422);
+    EXPECT_EQ(e.pointer, "/passes/shadow_maps/shadow_map_size");
+  }
 }
 
 TEST(RenderCore, DerivedDataIsCachedAcrossFrames) {

@@ -4,7 +4,7 @@
 
 TEST(Types, FrameStatsJson) {
   radiant::api::FrameStats s;
-  s.passes.push_back({"direct", 1.5, 0.25, {{"lights", 2}}});
+  s.passes.push_back({"direct", 1.5, 0.25, {{"lights", 2}}, {}});
   s.skipped["shadow_maps"] = "the scene has no punctual lights";
   s.cache.push_back({"shadow_map:light0", true});
   s.renderMs = 12;
