@@ -7,6 +7,7 @@
 #include <limits>
 #include <string>
 
+#include "api/Types.h"
 #include "renderer/frame/GpuTypes.h"
 #include "renderer/frame/PassContext.h"
 #include "renderer/shading/CubeFaces.h"
@@ -131,8 +132,34 @@ void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResour
     if (!causticsKeepMaps_) resolution_ = mapResolution(largestObjectPixels_, texelsPerPixel, maxResolution);
   }
 
+  // The maps' memory (kMaxBytes), checked before anything is allocated.
+  warning_.clear();
+  const int objectCount = static_cast<int>(objects_.size());
+  if (mapBytes(objectCount, layers_, resolution_) > kMaxBytes) {
+    const auto mib = [](double b) { return std::to_string(static_cast<long long>(b / (1 << 20))); };
+    int lowered = resolution_;
+    while (lowered > 16 && mapBytes(objectCount, layers_, lowered) > kMaxBytes) lowered /= 2;
+    const std::string need = std::to_string(objectCount) + " specular objects x " + std::to_string(layers_) +
+                             " layers of 6 faces at " + std::to_string(resolution_) + "^2 texels need " +
+                             mib(mapBytes(objectCount, layers_, resolution_)) + " MiB of maps, above the limit of " +
+                             mib(kMaxBytes) + " MiB";
+    if (!adaptive)
+      throw api::ApiError(422, "limit-exceeded", "Server limit exceeded",
+                          "/passes/specular/cube_resolution: " + need + ": lower cube_resolution or layers",
+                          "/passes/specular/cube_resolution");
+    if (mapBytes(objectCount, layers_, lowered) > kMaxBytes)
+      throw api::ApiError(422, "limit-exceeded", "Server limit exceeded",
+                          "/passes/specular: " + need + ", and " + mib(mapBytes(objectCount, layers_, lowered)) +
+                              " MiB even at 16 texels: turn the pass off (passes.specular = false) or give the "
+                              "scene fewer mirror-like and transmissive meshes",
+                          "/passes/specular");
+    warning_ = need + ": drawn at " + std::to_string(lowered) + "^2" +
+               (causticsKeepMaps_ ? " (the caustics' photons see coarser maps)" : "");
+    resolution_ = lowered;
+  }
+
   const int w = res.view().width, h = res.view().height;
-  const int cubes = std::max<int>(1, static_cast<int>(objects_.size()) * layers_);
+  const int cubes = std::max<int>(1, objectCount * layers_);
   gl::Texture& material = res.texture("specular_ldm_material", GL_TEXTURE_CUBE_MAP_ARRAY, GL_RGBA16F, resolution_,
                                       resolution_, 6 * cubes);
   gl::Texture& geometry = res.texture("specular_ldm_geometry", GL_TEXTURE_CUBE_MAP_ARRAY, GL_RGBA32F, resolution_,
@@ -395,6 +422,8 @@ void SpecularPass::execute(PassContext& ctx) {
   }
   res.markWritten("specular_maps");
   ctx.stats.counters["cube_resolution"] = resolution_;
+  ctx.stats.counters["map_bytes"] = mapBytes(static_cast<int>(objects_.size()), layers_, resolution_);
+  if (!warning_.empty()) ctx.stats.warnings.push_back(warning_);
   ctx.stats.counters["largest_object_pixels"] = std::isfinite(largestObjectPixels_) ? largestObjectPixels_ : -1.0;
   ctx.stats.counters["maps_kept_for_caustics"] = causticsKeepMaps_ ? 1 : 0;
   ctx.stats.counters["layers"] = layers_;

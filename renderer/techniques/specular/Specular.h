@@ -51,6 +51,18 @@ public:
   static glm::vec3 referencePoint(const MeshInstance& mesh) { return specularReferencePoint(mesh); }
   static std::vector<std::size_t> specularMeshes(const Scene& scene) { return radiant::specularMeshes(scene); }
 
+  // The maps' memory (every object, layer and face of the four cube-map arrays: RGBA16F material,
+  // RGBA32F geometry, R32F distance, RGBA8 albedo) is bounded whatever the scene: 36 mirror spheres at
+  // 256 texels held 1.4 GB. A resolution the pass chooses (from the objects' size on screen, or
+  // cube_resolution kept for caustics) is halved until the maps fit, with a warning; one the request
+  // gives (cube_resolution without map_texels_per_pixel) is a 422 above it, as is a scene whose
+  // specular objects do not fit even at 16 texels.
+  static constexpr double kMaxBytes = 512.0 * 1024.0 * 1024.0;
+  static constexpr double kBytesPerTexel = 8.0 + 16.0 + 4.0 + 4.0;
+  static double mapBytes(int objects, int layers, int resolution) {
+    return double(std::max(1, objects * layers)) * 6.0 * double(resolution) * resolution * kBytesPerTexel;
+  }
+
 private:
   struct Object {
     std::size_t mesh;
@@ -69,6 +81,7 @@ private:
   bool minmax_ = true;
   bool mapsValid_ = false;
   bool mapsIbl_ = false;  // the maps carry the sky's glossy lobe (direct owns L(sky)GE and there is a sky)
+  std::string warning_;   // for stats.warnings when kMaxBytes lowered the maps' resolution
   std::string digest_;  // the maps' key without the photon set (execute() appends it; FrameResources::holds)
 };
 

@@ -840,5 +840,36 @@ TEST(Specular, MapsFollowTheObjectsSizeOnScreen) {
   EXPECT_EQ(specularCounter(lit, "cube_resolution"), 256.0);
 }
 
+// The maps' memory is bounded (SpecularPass::kMaxBytes, 512 MiB: 32 bytes a texel over the four
+// cube-map arrays; 36 mirror spheres at 256 texels held 1.27 GiB). A resolution the pass chooses is
+// halved until the maps fit, with a warning; one the request gives is a 422 naming the field, before
+// anything is allocated, and the next frame renders.
+TEST(Specular, MapsStayWithinTheirMemoryLimit) {
+  EXPECT_EQ(SpecularPass::mapBytes(36, 3, 256), 36.0 * 3 * 6 * 256 * 256 * 32);
+  EXPECT_GT(SpecularPass::mapBytes(36, 3, 256), SpecularPass::kMaxBytes);
+  EXPECT_LT(SpecularPass::mapBytes(36, 3, 128), SpecularPass::kMaxBytes);
+  const Scene painted = testing::radiancePaintedCornell("cornell_glass");
+  const int n = 32;
+  try {
+    renderer().render(painted, request(n, n, {{"cube_resolution", 2048}}));  // 2.25 GiB for one object
+    FAIL() << "maps of 2.25 GiB rendered";
+  } catch (const api::ApiError& e) {
+    EXPECT_EQ(e.status, 422);
+    EXPECT_EQ(e.pointer, "/passes/specular/cube_resolution");
+    EXPECT_NE(std::string(e.what()).find("2304 MiB"), std::string::npos) << e.what();
+  }
+  // 64 texels per pixel of the sphere's 14.7 px want 1024 (576 MiB): drawn at 512 (144 MiB).
+  RenderOutput out = renderer().render(painted, request(n, n, {{"cube_resolution", 2048}, {"map_texels_per_pixel", 64}}));
+  const api::PassStats* specular = passStats(out, "specular");
+  ASSERT_NE(specular, nullptr);
+  EXPECT_EQ(specular->counters.at("cube_resolution"), 512.0);
+  EXPECT_LE(specular->counters.at("map_bytes"), SpecularPass::kMaxBytes);
+  bool warned = false;
+  for (const auto& w : out.stats.warnings) warned = warned || (w.rfind("specular: 1 specular objects", 0) == 0 &&
+                                                               w.find("drawn at 512^2") != std::string::npos);
+  EXPECT_TRUE(warned);
+  expectFiniteNonNegative(findAov(out, "specular"));
+}
+
 }  // namespace
 }  // namespace radiant
