@@ -71,6 +71,7 @@ private:
   std::set<int> excluded_;  // meshes left out of the maps this frame
   std::string coverageKey_;  // what coverage_ was estimated for: geometry, lights and exclusions
   double coverage_ = 0.0;    // every map's coverage summed (mapCoverage)
+  double estimateMs_ = 0.0;  // what this frame's prepare() spent on mapCoverage
   std::string warning_;      // for stats.warnings when the budget lowered the default size
 };
 
