@@ -24,12 +24,16 @@ layout(location = 7) out vec4 o_specular;  // rgb specular colour, a specular we
 void main() {
   SurfaceUv uv = SURFACE_UV_FRAGMENT(v_uv0, v_uv1);  // before any discard (common/material.glsl)
   Material m = materials[u_material];
+#ifndef OPAQUE
   if (materialMasked(m, decodeBaseColor(m, uv).a)) discard;
   // alphaMode BLEND: composited over the lit opaque frame by the transparency pass; the passes that
   // read the G-buffer light what lies behind it.
   if (materialAlphaMode(m) == 2) discard;
   // glTF: back faces of single-sided materials are not rendered.
   if (!gl_FrontFacing && !materialDoubleSided(m)) discard;
+#endif
+  // OPAQUE (GBufferPass draws its opaque materials with it): no discard, so that the depth test runs
+  // before the shader and hidden layers are not shaded; single-sided back faces are culled instead.
   MaterialParams p = decodeMaterial(m, uv);
 
   vec3 faceNormal = materialSafeNormalize(cross(dFdx(v_position), dFdy(v_position)), vec3(0, 1, 0));

@@ -62,16 +62,39 @@ void GBufferPass::execute(PassContext& ctx) {
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_GREATER);
   glDepthMask(GL_TRUE);
-  glDisable(GL_CULL_FACE);  // single-sided back faces are discarded in the shader (glTF semantics)
   glDisable(GL_BLEND);
 
-  const gl::Program& prog = ctx.shaders.program({"gbuffer/gbuffer.vert", "gbuffer/gbuffer.frag"});
-  prog.use();
-  prog.setMat4("u_viewProj", &view.viewProj[0][0]);
-  prog.set("u_eye", &view.eye[0], 3);
+  // Three groups: opaque single-sided materials through the shader variant that cannot discard, with
+  // back faces culled (glTF: they are not rendered; culling and gl_FrontFacing decide facing alike);
+  // opaque double-sided ones through the same variant; MASK and BLEND ones through the full shader,
+  // which discards their cut-out texels, BLEND surfaces (the transparency pass's) and single-sided back
+  // faces. A shader that can discard loses the early depth test, and llvmpipe then shades every layer.
+  const gl::Program& opaqueProg =
+      ctx.shaders.program({"gbuffer/gbuffer.vert", "gbuffer/gbuffer.frag"}, {{"OPAQUE", "1"}});
+  const gl::Program& fullProg = ctx.shaders.program({"gbuffer/gbuffer.vert", "gbuffer/gbuffer.frag"});
   const glm::vec3 forward = -glm::normalize(glm::vec3(view.camera.world[2]));
-  prog.set("u_viewForward", &forward[0], 3);
-  ctx.gpu.draw(prog, true);
+  auto material = [&](std::size_t m) -> const Material& { return ctx.scene.material(ctx.scene.meshes[m].material); };
+  enum Group { kSingleSided, kDoubleSided, kAlpha };
+  auto groupOf = [&](std::size_t m) {
+    const Material& mat = material(m);
+    if (mat.alphaMode != AlphaMode::Opaque) return kAlpha;
+    return mat.doubleSided ? kDoubleSided : kSingleSided;
+  };
+  for (const Group g : {kSingleSided, kDoubleSided, kAlpha}) {
+    const gl::Program& prog = g == kAlpha ? fullProg : opaqueProg;
+    prog.use();
+    prog.setMat4("u_viewProj", &view.viewProj[0][0]);
+    prog.set("u_eye", &view.eye[0], 3);
+    prog.set("u_viewForward", &forward[0], 3);
+    if (g == kSingleSided) {
+      glEnable(GL_CULL_FACE);
+      glCullFace(GL_BACK);
+    } else {
+      glDisable(GL_CULL_FACE);
+    }
+    ctx.gpu.drawMeshes(prog, true, [&](std::size_t m) { return groupOf(m) == g; });
+  }
+  glDisable(GL_CULL_FACE);
   ctx.stats.counters["triangles"] = static_cast<double>(ctx.gpu.triangles);
   for (const auto& out : info().outputs) ctx.resources.markWritten(out);
 }
