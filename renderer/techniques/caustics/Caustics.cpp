@@ -7,6 +7,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "api/Types.h"
 #include "renderer/frame/GpuTypes.h"
 #include "renderer/frame/PassContext.h"
 #include "renderer/shading/DirectLighting.h"
@@ -188,8 +189,29 @@ void CausticsPass::prepare(const Scene& scene, const Params& params, FrameResour
   const int groups = ((P + kGroup - 1) / kGroup) * ((P + kGroup - 1) / kGroup);
   res.buffer("caustics_power_sums", static_cast<std::size_t>(groups) * 2 * sizeof(glm::vec4));
 
-  const int C = cubeResolution_;
+  // The caustic cubes' memory (kMaxBytes), before anything is allocated.
   const int cubes = std::max<int>(1, static_cast<int>(generators_.size()));
+  warning_.clear();
+  if (cubeBytes(cubes, cubeResolution_) > kMaxBytes) {
+    const auto mib = [](double b) { return std::to_string(static_cast<long long>(b / (1 << 20))); };
+    int lowered = cubeResolution_;
+    while (lowered > 16 && cubeBytes(cubes, lowered) > kMaxBytes) lowered /= 2;
+    const std::string need = std::to_string(generators_.size()) + " generators' caustic cubes at " +
+                             std::to_string(cubeResolution_) + "^2 texels need " + mib(cubeBytes(cubes, cubeResolution_)) +
+                             " MiB, above the limit of " + mib(kMaxBytes) + " MiB";
+    if (params.given("cube_resolution"))
+      throw api::ApiError(422, "limit-exceeded", "Server limit exceeded",
+                          "/passes/caustics/cube_resolution: " + need + ": lower cube_resolution",
+                          "/passes/caustics/cube_resolution");
+    if (cubeBytes(cubes, lowered) > kMaxBytes)
+      throw api::ApiError(422, "limit-exceeded", "Server limit exceeded",
+                          "/passes/caustics: " + need + ", and " + mib(cubeBytes(cubes, lowered)) +
+                              " MiB even at 16 texels: turn the pass off (passes.caustics = false)",
+                          "/passes/caustics");
+    warning_ = need + ": drawn at " + std::to_string(lowered) + "^2";
+    cubeResolution_ = lowered;
+  }
+  const int C = cubeResolution_;
   int levels = 1;
   while ((C >> levels) > 0) ++levels;  // down to 1 x 1
   gl::Texture& cube = res.texture("caustics_cube", GL_TEXTURE_CUBE_MAP_ARRAY, GL_RGBA32F, C, C, 6 * cubes, levels);
@@ -482,6 +504,8 @@ void CausticsPass::execute(PassContext& ctx) {
   counters["pairs_light_inside_generator"] = skippedPairs_;
   counters["photon_resolution"] = P;
   counters["cube_resolution"] = C;
+  counters["cube_bytes"] = cubeBytes(G, C);
+  if (!warning_.empty()) ctx.stats.warnings.push_back(warning_);
   counters["triangles"] = method_ == Method::Triangles ? 2.0 * (P - 1) * (P - 1) * pairs_.size() : 0.0;
   counters["splats"] = method_ == Method::Splat ? double(P) * P * pairs_.size() : 0.0;
   counters["area_weight"] = areaWeight_;

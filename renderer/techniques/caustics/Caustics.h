@@ -50,6 +50,17 @@ public:
   // to skip (also used by the tests).
   static std::string skipReason(const Scene& scene);
 
+  // The caustic cubes' memory (RGBA32F with its mip chain, six faces per generator: 8 MiB a generator
+  // at the default 256 texels, 128 MiB at 1024) is bounded whatever the scene. A cube_resolution the
+  // request leaves to the default is halved until the cubes fit, with a warning; one it gives is a 422
+  // above the limit, as is a scene whose generators do not fit even at 16 texels.
+  static constexpr double kMaxBytes = 512.0 * 1024.0 * 1024.0;
+  static double cubeBytes(int generators, int resolution) {
+    double texels = 0.0;
+    for (int r = resolution; r > 0; r >>= 1) texels += double(r) * r;  // the mip chain down to 1 x 1
+    return double(std::max(1, generators)) * 6.0 * texels * 16.0;
+  }
+
 private:
   struct Pair {
     int light;
@@ -66,6 +77,7 @@ private:
   std::vector<std::size_t> generators_;  // mesh index per generator (= specular object index)
   std::vector<Pair> pairs_;
   int skippedPairs_ = 0;  // lights inside (or too close to) a generator's bounds
+  std::string warning_;   // for stats.warnings when kMaxBytes lowered cube_resolution
 };
 
 }  // namespace radiant

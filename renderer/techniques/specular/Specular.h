@@ -52,8 +52,8 @@ public:
   static std::vector<std::size_t> specularMeshes(const Scene& scene) { return radiant::specularMeshes(scene); }
 
   // The maps' memory (every object, layer and face of the four cube-map arrays: RGBA16F material,
-  // RGBA32F geometry, R32F distance, RGBA8 albedo) is bounded whatever the scene: 36 mirror spheres at
-  // 256 texels held 1.4 GB. A resolution the pass chooses (from the objects' size on screen, or
+  // RGBA32F geometry, R32F distance, RGBA8 albedo) is bounded whatever the scene: 36 glass and metal spheres
+  // at 256 texels held 1.27 GiB. A resolution the pass chooses (from the objects' size on screen, or
   // cube_resolution kept for caustics) is halved until the maps fit, with a warning; one the request
   // gives (cube_resolution without map_texels_per_pixel) is a 422 above it, as is a scene whose
   // specular objects do not fit even at 16 texels.

@@ -367,6 +367,46 @@ TEST(Caustics, FlatMirrorCausticIsTheLightsImage) {
   EXPECT_EQ(maxOutside, 0.0);
 }
 
+// The caustic cubes' memory is bounded (CausticsPass::kMaxBytes, 512 MiB: six RGBA32F faces with their
+// mip chain per generator, 8 MiB at 256 texels). The flat-mirror scene with 64 more mirrors beyond the
+// light's range (generators without a pair still get a cube): 65 x 8 MiB at the default 256 is over the
+// limit, so the cubes are drawn at 128 with a warning; a cube_resolution the request gives is a 422
+// naming it, before anything is allocated.
+TEST(Caustics, CubesStayWithinTheirMemoryLimit) {
+  EXPECT_EQ(CausticsPass::cubeBytes(1, 256), 6.0 * 87381 * 16);  // 256^2 + 128^2 + ... + 1 texels
+  EXPECT_GT(CausticsPass::cubeBytes(65, 256), CausticsPass::kMaxBytes);
+  EXPECT_LT(CausticsPass::cubeBytes(64, 256), CausticsPass::kMaxBytes);
+  testing::SceneBuilder b;
+  const int mirror = b.material(testing::mirror(glm::vec3(0.8f)));
+  b.quad({0, 1, 0}, {0, 0, 0.5f}, {0.5f, 0, 0}, mirror, "mirror");
+  b.quad({0, 3, 0}, {2.5f, 0, 0}, {0, 0, 2.5f}, b.material(testing::lambertian()), "ceiling");
+  for (int i = 0; i < 64; ++i) b.quad({40.f + 0.5f * (i % 8), 1, 0.5f * (i / 8)}, {0, 0, 0.1f}, {0.1f, 0, 0}, mirror, "far");
+  b.pointLight({0, 2, 0}, 5.f);
+  b.scene().lights[0].range = 10.f;
+  b.scene().camera = testing::orthoCamera({0, 2.5f, 0}, {0, 1, 0}, {0, 0, 1}, 2.f, 2.f);
+  Scene scene = b.build("caustics-cube-memory");
+  RenderOutput out = renderer().render(scene, request(16));
+  EXPECT_EQ(counter(out, "caustics", "generators"), 65.0);
+  EXPECT_EQ(counter(out, "caustics", "pairs"), 1.0);
+  EXPECT_EQ(counter(out, "caustics", "cube_resolution"), 128.0);
+  EXPECT_LE(counter(out, "caustics", "cube_bytes"), CausticsPass::kMaxBytes);
+  bool warned = false;
+  for (const auto& w : out.stats.warnings) warned = warned || (w.rfind("caustics: 65 generators", 0) == 0 &&
+                                                               w.find("drawn at 128^2") != std::string::npos);
+  EXPECT_TRUE(warned);
+  expectFinite(findAov(out, "caustics"));
+
+  api::RenderRequest given = request(16, {{"cube_resolution", 256}});
+  given.explicitParams["caustics"] = {"cube_resolution"};  // as the request's JSON names it
+  try {
+    renderer().render(scene, given);
+    FAIL() << "65 caustic cubes of 256^2 rendered";
+  } catch (const api::ApiError& e) {
+    EXPECT_EQ(e.status, 422);
+    EXPECT_EQ(e.pointer, "/passes/caustics/cube_resolution");
+  }
+}
+
 // Degenerate input (oracle 6), each with finite output and an exact zero where no light can arrive.
 // (a) All-invalid hit image: a mirror facing up under a light and nothing above it, so every photon
 // leaves the scene.
