@@ -668,9 +668,9 @@ TEST(HostileService, TheDecodedSceneCacheIsBoundedInBytes) {
     ASSERT_EQ(up->status, 201) << up->body;
     digests[k] = json::parse(up->body)["digest"];
   }
-  // The scene cache is what is tested, not the light: the default frame's photon_gi on 16,667 stacked
-  // unit triangles 1e-4 apart took 20-40 s per render on 2 loaded cores (a client timeout failed this
-  // test in CI), so the renders are direct light only.
+  // The scene cache is what is tested, not the light, so the renders are direct light only. (The
+  // default frame of 16,667 stacked unit triangles 1e-4 apart once took 20-40 s a render, a client
+  // timeout in CI: its 17 shadow maps' overdraw, now bounded by ShadowMapsPass's fragment budget.)
   auto loadMs = [&](int k) {
     auto r = c.Post("/v1/renders",
                     json{{"scene", {{"digest", digests[k]}}},
