@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -44,9 +45,9 @@ void tracePhoton(const RayScene& rays, const SceneLights& lights, const PhotonOp
       PhotonRecord r;
       r.position = hit.p;
       r.mesh = hit.mesh;
-      r.normal = sh.ngFacing;
+      r.normalOct = octEncode(sh.ngFacing);
       r.photon = static_cast<std::uint32_t>(index);
-      r.wi = wo;
+      r.wiOct = octEncode(wo);
       r.bounce = static_cast<std::uint16_t>(bounce);
       r.flags = static_cast<std::uint16_t>((bounce >= 1 && specularChain ? kPhotonSpecularChain : 0) |
                                            (bounce >= 1 && narrowLobePath ? kPhotonNarrowLobePath : 0));
@@ -78,6 +79,33 @@ void tracePhoton(const RayScene& rays, const SceneLights& lights, const PhotonOp
 }
 
 }  // namespace
+
+std::uint32_t octEncode(const glm::vec3& v) {
+  const float l1 = std::abs(v.x) + std::abs(v.y) + std::abs(v.z);
+  if (!(l1 > 0.f) || !std::isfinite(l1)) return octEncode(glm::vec3(0.f, 0.f, 1.f));
+  glm::vec2 p = glm::vec2(v.x, v.y) / l1;
+  if (v.z < 0.f) {  // the lower hemisphere folds over the diagonals
+    const glm::vec2 folded = (1.f - glm::abs(glm::vec2(p.y, p.x)));
+    p = glm::vec2(p.x >= 0.f ? folded.x : -folded.x, p.y >= 0.f ? folded.y : -folded.y);
+  }
+  auto snorm16 = [](float x) {
+    return static_cast<std::uint32_t>(static_cast<std::uint16_t>(
+        static_cast<std::int16_t>(std::lround(std::clamp(x, -1.f, 1.f) * 32767.f))));
+  };
+  return snorm16(p.x) | (snorm16(p.y) << 16);
+}
+
+glm::vec3 octDecode(std::uint32_t packed) {
+  const glm::vec2 p(static_cast<float>(static_cast<std::int16_t>(packed & 0xFFFFu)) / 32767.f,
+                    static_cast<float>(static_cast<std::int16_t>(packed >> 16)) / 32767.f);
+  glm::vec3 v(p.x, p.y, 1.f - std::abs(p.x) - std::abs(p.y));
+  if (v.z < 0.f) {
+    const glm::vec2 unfolded = 1.f - glm::abs(glm::vec2(v.y, v.x));
+    v.x = p.x >= 0.f ? unfolded.x : -unfolded.x;
+    v.y = p.y >= 0.f ? unfolded.y : -unfolded.y;
+  }
+  return glm::normalize(v);
+}
 
 std::size_t PhotonSet::recordsOfFirst(std::uint64_t n) const {
   if (n >= emitted) return records.size();

@@ -272,16 +272,17 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
     for (std::size_t i = 0; i < records_; ++i) {
       const rt::PhotonRecord& r = cache.set.records[i];
       if (!splatted(r) || !(h[r.mesh] > 0.f)) continue;
+      const glm::vec3 wi = r.wi();
       const bool diffuseOnly = r.bounce == 0 && !ownsSkyGlossy &&
                                lights.emitters()[r.light].kind == rt::SceneLights::Kind::Environment;
       // The sky's first hits carry only the residual's light: the environment's lights are `direct`'s,
       // with shadow maps (renderer/shading/EnvironmentLights.h); later bounces carry the whole map.
       const float share = r.bounce == 0 && view.environmentLights && view.environment &&
                                   lights.emitters()[r.light].kind == rt::SceneLights::Kind::Environment
-                              ? view.environmentLights->residualShare(*view.environment, r.wi)
+                              ? view.environmentLights->residualShare(*view.environment, wi)
                               : 1.f;
       if (!(share > 0.f)) continue;
-      out.push_back(photon_gi::photonSplat(r.position, h[r.mesh], r.normal, r.wi, r.flux * (invPhotons * share), diffuseOnly));
+      out.push_back(photon_gi::photonSplat(r.position, h[r.mesh], r.normal(), wi, r.flux * (invPhotons * share), diffuseOnly));
     }
     c->photonSplats = out.size();
     if (splat_.renormalize)
@@ -314,7 +315,8 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   coveragePoints_ = splats.coveragePoints;
   hMin_ = splats.hMin;
   hMax_ = splats.hMax;
-  photon_gi::declareSplatResources(res, *grid_, splat_);
+  photon_gi::declareSplatResources(res, *grid_, splat_, upload_);
+  splatBufferBytes_ = res.buffer("photon_gi_splats").size();
   splatDigest_ = splatDigest;
   // Uploaded here, not in execute(), and published: specular, earlier in the frame, shades its distance
   // maps' diffuse texels from the same splats (the path L D+ D S+ E, docs/TECHNIQUES.md).
@@ -371,6 +373,7 @@ void PhotonGiPass::execute(PassContext& ctx) {
   c["bytes_per_photon"] =
       settings_.photons ? double(records_ * sizeof(rt::PhotonRecord)) / double(settings_.photons) : 0.0;
   c["splat_bytes"] = static_cast<double>(grid_->count * sizeof(photon_gi::GpuSplat));
+  c["splat_buffer_bytes"] = static_cast<double>(splatBufferBytes_);
   // The gather grid (Splatting.h buildSplatGrid): its cell, and the wide kernels' copies in other cells.
   c["grid_cell_size"] = grid_->cellSize;
   c["grid_copies"] = static_cast<double>(grid_->count - grid_->originals);

@@ -50,13 +50,14 @@ private:
   // (FrameResources::holds), so a cached set of another scene or setting is uploaded again (and rebuilt:
   // the CPU copy is released after upload).
   std::string splatDigest_;
-  bool rebuilt_ = false;
-  float lightPhotonWeight_ = 1.f;  // the environment lights' weight in the sky photons' emission  // this frame rebuilt a cached set that was not resident
+  bool rebuilt_ = false;            // this frame rebuilt a cached set that was not resident
+  float lightPhotonWeight_ = 1.f;  // the environment lights' weight in the sky photons' emission
   std::size_t records_ = 0, photonSplats_ = 0, coveragePoints_ = 0;
+  std::size_t splatBufferBytes_ = 0;  // the splat buffer's size (at most 12.5% over the grid's)
   std::uint64_t traced_ = 0;  // photons traced by this frame (0 when the set was cached)
-  std::uint64_t capped_ = 0;
+  std::uint64_t capped_ = 0;  // photons of the cached set ended by max_bounces (PhotonSet::capped)
   bool denoise_ = true;
-  denoise::Settings denoiseSettings_;  // photons of the cached set ended by max_bounces (PhotonSet::capped)
+  denoise::Settings denoiseSettings_;
   double traceMs_ = 0.0, buildMs_ = 0.0;
   float hMin_ = 0.f, hMax_ = 0.f;
 };

@@ -1,6 +1,7 @@
 #include "renderer/techniques/photon_gi/Splatting.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <stdexcept>
 
@@ -26,10 +27,22 @@ constexpr float kPlaneTolerance = kPhotonPlaneTolerance;
 constexpr float kNormalCosine = kPhotonNormalCosine;
 constexpr float kMinKernelMass = kPhotonMinKernelMass;
 
+// A buffer's size for `bytes`: rounded up to an eighth of the power of two at or below it (at least 4 KiB),
+// so at most 12.5% is unused. Powers of two left up to half of it unused, and llvmpipe writes every byte
+// of a new buffer: the 4M-photon Cornell box's 325 MB of splats took a 512 MiB buffer, 187 MiB of its
+// peak resident set (issue 30).
 std::size_t capacity(std::size_t bytes) {
-  std::size_t c = 4096;
-  while (c < bytes) c *= 2;
-  return c;
+  const std::size_t granule = std::max<std::size_t>(4096, std::bit_floor(std::max<std::size_t>(bytes, 1)) / 8);
+  return (std::max<std::size_t>(bytes, 1) + granule - 1) / granule * granule;
+}
+
+// Declares `name` with room for `bytes`: a larger buffer is kept, unless the grid is being replaced
+// (its upload follows) and the buffer is over twice what it needs, so that one large photon set does
+// not hold its buffer for every later scene.
+void declareBuffer(FrameResources& res, const char* name, std::size_t bytes, bool replacing) {
+  const bool have = res.hasBuffer(name);
+  const std::size_t size = have ? res.buffer(name).size() : 0;
+  if (!have || size < bytes || (replacing && size > 2 * capacity(bytes))) res.buffer(name, capacity(bytes));
 }
 
 }  // namespace
@@ -173,13 +186,10 @@ SplatGrid buildSplatGrid(std::vector<GpuSplat> splats) {
   return g;
 }
 
-void declareSplatResources(FrameResources& res, const SplatGrid& grid, const SplatSettings& settings) {
-  const std::size_t splatBytes = std::max<std::size_t>(grid.count, 1) * sizeof(GpuSplat);
-  if (!res.hasBuffer("photon_gi_splats") || res.buffer("photon_gi_splats").size() < splatBytes)
-    res.buffer("photon_gi_splats", capacity(splatBytes));
-  const std::size_t cellBytes = grid.cellStart.size() * sizeof(std::uint32_t);
-  if (!res.hasBuffer("photon_gi_cells") || res.buffer("photon_gi_cells").size() < cellBytes)
-    res.buffer("photon_gi_cells", capacity(cellBytes));
+void declareSplatResources(FrameResources& res, const SplatGrid& grid, const SplatSettings& settings,
+                           bool replacing) {
+  declareBuffer(res, "photon_gi_splats", std::max<std::size_t>(grid.count, 1) * sizeof(GpuSplat), replacing);
+  declareBuffer(res, "photon_gi_cells", grid.cellStart.size() * sizeof(std::uint32_t), replacing);
   const int w = res.view().width, h = res.view().height;
   gl::Texture& accum = res.texture("photon_gi_accum", GL_TEXTURE_2D, GL_RGBA32F, w, h);
   accum.setFilter(GL_NEAREST, GL_NEAREST);
@@ -190,8 +200,7 @@ void declareSplatResources(FrameResources& res, const SplatGrid& grid, const Spl
     res.texture("photon_gi_fixup", GL_TEXTURE_2D, GL_R32F, w, h).setFilter(GL_NEAREST, GL_NEAREST);
     // The fix-up list (fixup_list.comp): a 16-byte header and one packed point per pixel at most.
     const std::size_t listBytes = 16 + 4 * static_cast<std::size_t>(w) * h;
-    if (!res.hasBuffer("photon_gi_fixup_list") || res.buffer("photon_gi_fixup_list").size() < listBytes)
-      res.buffer("photon_gi_fixup_list", capacity(listBytes));
+    declareBuffer(res, "photon_gi_fixup_list", listBytes, true);  // rewritten every frame
     // The fix-up cascade's block samples (steps step / 2, step / 4, ... down to 2), one texture sized
     // for the finest of them.
     if (step >= 4)

@@ -69,8 +69,10 @@ struct SplatGrid {
 // at most 3 x the splats and 2^20); at most 128 per axis.
 SplatGrid buildSplatGrid(std::vector<GpuSplat> splats);
 
-// Declares the splat buffers (capacity in powers of two), the accumulation targets and `indirect`.
-void declareSplatResources(FrameResources& res, const SplatGrid& grid, const SplatSettings& settings);
+// Declares the splat buffers (at most 12.5% over the grid's size; over twice it, a buffer is reallocated
+// only when `replacing`, i.e. the grid is uploaded next), the accumulation targets and `indirect`.
+void declareSplatResources(FrameResources& res, const SplatGrid& grid, const SplatSettings& settings,
+                           bool replacing);
 // Uploads `grid` into the splat buffers (its CPU splats must still be there).
 void uploadSplatGrid(FrameResources& res, const SplatGrid& grid);
 // Uploads `grid` when `upload` (else the buffers hold it already), accumulates into the target and

@@ -58,7 +58,7 @@ public:
   // The `indirect` image (RGB, row 0 = top) for these splats.
   Image run(std::vector<GpuSplat> splats, const SplatSettings& settings) {
     const photon_gi::SplatGrid grid = photon_gi::buildSplatGrid(std::move(splats));
-    photon_gi::declareSplatResources(res_, grid, settings);
+    photon_gi::declareSplatResources(res_, grid, settings, true);
     photon_gi::splatAndResolve(res_, shaders_, view_, settings, grid, true, false);
     std::vector<float> rgba(static_cast<std::size_t>(view_.width) * view_.height * 4);
     res_.texture("indirect").download(0, GL_RGBA, GL_FLOAT, rgba.data(), rgba.size() * sizeof(float));

@@ -382,6 +382,34 @@ TEST(RenderCore, PhotonSetsAreKeptWithinTheDerivedCacheBytes) {
   r.setDerivedCacheBytes(std::size_t(1) << 40);
 }
 
+// Issue 30: the splat buffer is at most 12.5% over its grid (it was the next power of two: 512 MiB for
+// the 4M-photon Cornell box's 325 MB, all of it resident on llvmpipe), and a large set's buffer is not
+// kept for a smaller one uploaded after it (over twice its size, it is reallocated).
+TEST(RenderCore, TheSplatBufferFollowsItsGrid) {
+  auto counters = [](const RenderOutput& o) {
+    for (const auto& p : o.stats.passes)
+      if (p.name == "photon_gi") return p.counters;
+    ADD_FAILURE() << "no photon_gi pass";
+    return std::map<std::string, double>{};
+  };
+  Renderer& r = renderer();
+  const Scene a = umbraScene(1.f, "splat-buffer");
+  std::vector<double> sizes;
+  for (int photons : {10000, 300000, 10000}) {
+    api::RenderRequest req = request(8);
+    req.passes["photon_gi"] = {{"photons", photons}};
+    const auto c = counters(r.render(a, req));
+    ASSERT_GT(c.at("splat_bytes"), 0.0);
+    EXPECT_GE(c.at("splat_buffer_bytes"), c.at("splat_bytes"));
+    // 12.5%, or the 4 KiB granule of a small buffer
+    EXPECT_LE(c.at("splat_buffer_bytes"), std::max(c.at("splat_bytes") + 4096.0, 1.125 * c.at("splat_bytes")))
+        << photons << " photons";
+    sizes.push_back(c.at("splat_buffer_bytes"));
+  }
+  EXPECT_GT(sizes[1], 10.0 * sizes[0]);
+  EXPECT_EQ(sizes[2], sizes[0]) << "the 300k-photon buffer was kept for the 10k-photon grid";
+}
+
 TEST(RenderCore, SharedDerivedResourcesHoldTheSceneRenderedLast) {
   // Two scenes whose shadows differ (the occluder left or right of the light), rendered A, B, A with
   // both kept uploaded: the third frame must equal the first. The shadow maps live in one texture that
