@@ -59,6 +59,7 @@ void to_json(nlohmann::json& j, const FrameStats& s) {
   }
   if (!s.budget.is_null()) j["budget"] = s.budget;
   if (!s.refinement.is_null()) j["refinement"] = s.refinement;
+  if (!s.memory.is_null()) j["memory"] = s.memory;
 }
 
 int defaultSupersampling(int width, int height) {

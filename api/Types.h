@@ -201,6 +201,10 @@ struct FrameStats {
   // ms, predicted error (api/Presets.h, chooseConfiguration); null otherwise. With refine: also "refinement".
   nlohmann::json budget;
   nlohmann::json refinement;
+  // The memory accountant after the frame (FrameResources::makeRoom): resident_bytes, resource_bytes
+  // (textures and buffers), derived_bytes (sized derived data), target_bytes, released_bytes (what
+  // this frame's passes and its end released to stay under the target).
+  nlohmann::json memory;
 };
 
 void to_json(nlohmann::json& j, const PassStats& s);

@@ -423,6 +423,13 @@ struct Renderer::Impl {
 
 Renderer::Renderer(const DeviceOptions& options) : impl_(std::make_unique<Impl>()) {
   impl_->device = EglDevice::create(options);
+  // What the memory accountant may drop beyond the frame's own resources: the GPU copies of the scenes
+  // not being rendered (the current one is the most recently used, last) and their environment splits.
+  impl_->resources.setTrimHook([im = impl_.get()] {
+    if (im->gpuScenes.size() > 1) im->gpuScenes.erase(im->gpuScenes.begin(), im->gpuScenes.end() - 1);
+    if (im->environmentSplits.size() > 1)
+      im->environmentSplits.erase(im->environmentSplits.begin(), im->environmentSplits.end() - 1);
+  });
   // Per-pass times (GpuProfiler.h): timer queries on a hardware device, glFinish brackets on a software one.
   impl_->profiler = GpuProfiler(impl_->device->info().software ? GpuProfiler::Method::Finish : GpuProfiler::Method::TimerQuery);
   // Reversed-Z needs the [0,1] clip-space depth range (FrameView.h).
@@ -462,6 +469,8 @@ void Renderer::calibrateSpeed() {
 }
 
 void Renderer::setDerivedCacheBytes(std::size_t bytes) { impl_->resources.setDerivedBytes(bytes); }
+
+void Renderer::setMemoryTarget(std::size_t bytes) { impl_->resources.setMemoryTarget(bytes); }
 
 void Renderer::setGpuSceneCapacity(std::size_t scenes) {
   impl_->gpuSceneCapacity = std::max<std::size_t>(1, scenes);
@@ -809,6 +818,13 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
       if (alpha) out.aovs.push_back(std::move(*alpha));
     }
     stats.renderMs = msSince(frameStart);
+    // The memory accountant: what this frame has not used goes when the resident set is over the target.
+    im.resources.makeRoom(0);
+    stats.memory = {{"resident_bytes", FrameResources::residentBytes()},
+                    {"resource_bytes", im.resources.resourceBytes()},
+                    {"derived_bytes", im.resources.derivedBytes()},
+                    {"target_bytes", im.resources.memoryTarget()},
+                    {"released_bytes", im.resources.releasedThisFrame()}};
     report(1.0);
     if (nonFinite) stats.passes.back().counters["non_finite_pixels_zeroed"] = static_cast<double>(nonFinite);
     reportOutputRange(out, zeroed, request);  // after compare: its error and reference AOVs are outputs too

@@ -91,6 +91,10 @@ public:
   // dropped first (FrameResources::setDerivedBytes). Default 1 TiB (unbounded); radiantd
   // --derived-cache-bytes.
   void setDerivedCacheBytes(std::size_t bytes);
+  // The resident set the memory accountant keeps the process under (FrameResources::makeRoom): passes
+  // about to allocate much, and every frame's end, release what the frame does not use when over it.
+  // Default 1 TiB (off); radiantd --memory-target-bytes.
+  void setMemoryTarget(std::size_t bytes);
   // The budget chooser's speed factor (api::MachineSpeed): > 0 pins it (radiantd --speed-factor),
   // 0 measures it: a calibration frame before the first frame with a time budget, then the ratio of
   // measured to predicted time of recent frames comparable with the preset table. Default 0.

@@ -60,6 +60,10 @@ std::string usage() {
                             photon maps), least recently used evicted (default 4, at most 256)
   --derived-cache-bytes N   photon sets and splat grids kept across renders, in bytes, least recently
                             used dropped first (default 1073741824; the frame in use keeps its own)
+  --memory-target-bytes N   the resident set the renderer keeps the daemon under: a pass about to
+                            allocate much (photon records and splats, specular and caustic maps) and
+                            every frame's end release what the frame does not use (other scenes' GPU
+                            copies, maps and derived data) when over it (default 1342177280)
   --speed-factor F|auto      this machine's frame time over the preset table's prediction, which time
                             budgets scale every predicted cost by; auto (the default) measures it: a
                             calibration frame before the first budgeted frame, then recent frames
@@ -151,6 +155,7 @@ void apply(ServerConfig& c, const std::string& name, const std::string& v, std::
   else if (name == "decode-memory-bytes") c.decodeMemoryBytes = static_cast<std::size_t>(toInt(flag, v, 1 << 20, 1ll << 40));
   else if (name == "gpu-scenes") c.gpuScenes = static_cast<int>(toInt(flag, v, 1, 256));
   else if (name == "derived-cache-bytes") c.derivedCacheBytes = static_cast<std::size_t>(toInt(flag, v, 1 << 20, 1ll << 40));
+  else if (name == "memory-target-bytes") c.memoryTargetBytes = static_cast<std::size_t>(toInt(flag, v, 1 << 20, 1ll << 40));
   else if (name == "speed-factor") {
     c.speedFactor = v == "auto" ? 0.0 : toDouble(flag, v);
     if (c.speedFactor > 64.0 || (c.speedFactor > 0 && c.speedFactor < 1.0 / 64.0))

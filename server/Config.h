@@ -42,6 +42,9 @@ struct ServerConfig {
   double speedFactor = 0.0;            // time budgets' speed factor: 0 measures it, > 0 pins it (--speed-factor)
   int gpuScenes = 4;                   // scenes kept uploaded to the GPU (with their derived data), LRU
   std::size_t derivedCacheBytes = std::size_t(1024) << 20;  // photon sets and splat grids kept, LRU (--derived-cache-bytes)
+  // The resident set the renderer's memory accountant keeps the daemon under (--memory-target-bytes):
+  // over it, what the frame does not use (other scenes' GPU copies, maps, derived data) is released.
+  std::size_t memoryTargetBytes = std::size_t(1280) << 20;
   double readTimeoutS = 30;            // receiving one request (headers and body), in total
   double keepAliveTimeoutS = 2;        // an idle keep-alive connection is closed after this
   // After SIGTERM, frame and job GETs are served this long (ending early once every frame was

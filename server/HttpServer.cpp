@@ -651,6 +651,7 @@ struct HttpServer::Impl {
                 {"scene_cache_bytes", config.sceneCacheBytes},
                 {"gpu_scenes", config.gpuScenes},
                 {"derived_cache_bytes", config.derivedCacheBytes},
+                {"memory_target_bytes", config.memoryTargetBytes},
                 {"speed_factor", config.speedFactor > 0 ? json(config.speedFactor) : json("auto")},
                 {"default_frame_budget_ms", config.limits.defaultFrameBudgetMs},
                 {"read_timeout_s", config.readTimeoutS},

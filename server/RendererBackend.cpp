@@ -23,10 +23,12 @@ constexpr float kMaxImageRadiance = 1e18f;
 
 class RendererBackend final : public RenderBackend {
 public:
-  RendererBackend(const DeviceOptions& options, int gpuScenes, double speedFactor, std::size_t derivedBytes)
+  RendererBackend(const DeviceOptions& options, int gpuScenes, double speedFactor, std::size_t derivedBytes,
+                  std::size_t memoryTarget)
       : renderer_(options) {
     renderer_.setGpuSceneCapacity(static_cast<std::size_t>(gpuScenes));
     renderer_.setDerivedCacheBytes(derivedBytes);
+    renderer_.setMemoryTarget(memoryTarget);
     renderer_.setSpeedFactor(speedFactor);
   }
   DeviceInfo device() const override { return renderer_.device(); }
@@ -52,8 +54,9 @@ BackendHooks rendererHooks(const ServerConfig& config) {
   const int gpuScenes = config.gpuScenes;
   const double speedFactor = config.speedFactor;
   const std::size_t derivedBytes = config.derivedCacheBytes;
-  h.createBackend = [device, gpuScenes, speedFactor, derivedBytes] {
-    return std::make_unique<RendererBackend>(device, gpuScenes, speedFactor, derivedBytes);
+  const std::size_t memoryTarget = config.memoryTargetBytes;
+  h.createBackend = [device, gpuScenes, speedFactor, derivedBytes, memoryTarget] {
+    return std::make_unique<RendererBackend>(device, gpuScenes, speedFactor, derivedBytes, memoryTarget);
   };
   const std::size_t maxBytes = config.maxBodyBytes;
   const std::size_t maxDecoded = config.maxDecodeBytes;

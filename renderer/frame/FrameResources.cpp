@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cstdio>
+
+#include <malloc.h>
+#include <unistd.h>
 #include <stdexcept>
 
 #include "api/Aovs.h"
@@ -67,6 +70,8 @@ void FrameResources::beginFrame(const GpuScene& gpu, const FrameView& view, std:
   endPass();  // a pass that threw last frame left its scope open
   written_.clear();
   declaredThisFrame_.clear();
+  usedThisFrame_.clear();
+  releasedThisFrame_ = 0;
 }
 
 const std::string& FrameResources::sceneKey() const { return gpu_->sceneKey; }
@@ -101,6 +106,7 @@ gl::Texture& FrameResources::texture(const std::string& name, GLenum target, GLe
                                      int height, int depth, int levels) {
   const TextureSpec spec{target, internalFormat, width, height, depth, levels};
   checkAccess(name, false);
+  used(name);
   for (const api::AovInfo& a : api::aovTable()) {
     if (a.resource != name) continue;
     const GLenum declared = a.format == api::AovFormat::R32F      ? GL_R32F
@@ -129,12 +135,14 @@ gl::Texture& FrameResources::texture(const std::string& name, GLenum target, GLe
 
 gl::Texture& FrameResources::texture(const std::string& name) {
   checkAccess(name, false);
+  used(name);
   auto it = textures_.find(name);
   if (it == textures_.end()) throw std::logic_error("FrameResources: texture '" + name + "' was never declared");
   return it->second.second;
 }
 
 gl::Framebuffer& FrameResources::framebuffer(const std::string& name) {
+  used(name);
   auto it = framebuffers_.find(name);
   if (it == framebuffers_.end()) {
     checkNoAllocation("framebuffer", name);
@@ -144,6 +152,7 @@ gl::Framebuffer& FrameResources::framebuffer(const std::string& name) {
 }
 
 gl::Buffer& FrameResources::buffer(const std::string& name, std::size_t bytes, GLbitfield flags) {
+  used(name);
   auto it = buffers_.find(name);
   if (it != buffers_.end() && it->second.size() == bytes) return it->second;
   checkNoAllocation("buffer", name);
@@ -152,6 +161,7 @@ gl::Buffer& FrameResources::buffer(const std::string& name, std::size_t bytes, G
 }
 
 gl::Buffer& FrameResources::buffer(const std::string& name) {
+  used(name);
   auto it = buffers_.find(name);
   if (it == buffers_.end()) throw std::logic_error("FrameResources: buffer '" + name + "' was never declared");
   return it->second;
@@ -172,6 +182,62 @@ void FrameResources::clear() {
   holds_.clear();
   written_.clear();
   declaredThisFrame_.clear();
+  usedThisFrame_.clear();
+}
+
+std::size_t FrameResources::resourceBytes() const {
+  std::size_t total = 0;
+  for (const auto& [name, entry] : textures_) total += gl::textureBytes(entry.second);
+  for (const auto& [name, buffer] : buffers_) total += buffer.size();
+  return total;
+}
+
+std::size_t FrameResources::residentBytes() {
+  std::FILE* f = std::fopen("/proc/self/statm", "r");
+  if (!f) return 0;
+  unsigned long long size = 0, resident = 0;
+  const int n = std::fscanf(f, "%llu %llu", &size, &resident);
+  std::fclose(f);
+  const long page = sysconf(_SC_PAGESIZE);
+  return n == 2 && page > 0 ? static_cast<std::size_t>(resident) * static_cast<std::size_t>(page) : 0;
+}
+
+void FrameResources::releaseIdle() {
+  auto idle = [&](const std::string& name) { return usedThisFrame_.count(name) == 0; };
+  for (auto it = framebuffers_.begin(); it != framebuffers_.end();)
+    it = idle(it->first) ? framebuffers_.erase(it) : std::next(it);
+  for (auto it = textures_.begin(); it != textures_.end();) {
+    if (!idle(it->first)) { ++it; continue; }
+    holds_.erase(it->first);
+    it = textures_.erase(it);
+  }
+  for (auto it = buffers_.begin(); it != buffers_.end();) {
+    if (!idle(it->first)) { ++it; continue; }
+    holds_.erase(it->first);
+    it = buffers_.erase(it);
+  }
+  for (auto& [key, entries] : cache_)
+    entries.remove_if([&](const Entry& e) { return e.frame != frame_; });
+  if (trimHook_) trimHook_();
+  malloc_trim(0);
+}
+
+std::size_t FrameResources::textureAllocation(const std::string& name, GLenum target, GLenum internalFormat,
+                                              int width, int height, int depth, int levels) const {
+  auto it = textures_.find(name);
+  if (it != textures_.end() && it->second.first == TextureSpec{target, internalFormat, width, height, depth, levels})
+    return 0;
+  return gl::textureBytes(target, internalFormat, width, height, depth, levels);
+}
+
+std::size_t FrameResources::makeRoom(std::size_t bytes) {
+  const std::size_t before = residentBytes();
+  if (before == 0 || before + bytes <= memoryTarget_) return 0;
+  releaseIdle();
+  const std::size_t after = residentBytes();
+  const std::size_t released = before > after ? before - after : 0;
+  releasedThisFrame_ += released;
+  return released;
 }
 
 }  // namespace radiant

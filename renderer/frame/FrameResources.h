@@ -69,11 +69,17 @@ public:
                        int height, int depth = 1, int levels = 1);
   // An already declared texture; throws std::logic_error naming it otherwise.
   gl::Texture& texture(const std::string& name);
-  bool hasTexture(const std::string& name) const { return textures_.count(name) != 0; }
+  bool hasTexture(const std::string& name) const {
+    used(name);
+    return textures_.count(name) != 0;
+  }
   gl::Framebuffer& framebuffer(const std::string& name);
   gl::Buffer& buffer(const std::string& name, std::size_t bytes, GLbitfield flags = GL_DYNAMIC_STORAGE_BIT);
   gl::Buffer& buffer(const std::string& name);
-  bool hasBuffer(const std::string& name) const { return buffers_.count(name) != 0; }
+  bool hasBuffer(const std::string& name) const {
+    used(name);
+    return buffers_.count(name) != 0;
+  }
 
   // Derived data that lives in a frame resource shared by every scene (the shadow maps, the specular
   // and env_diffuse cube maps, the environment map and its prefiltered levels, uploaded beams): the
@@ -171,6 +177,30 @@ public:
   // Drops every cached entry and resource (after a GL failure the objects may be invalid).
   void clear();
 
+  // One memory accountant (issue 30): the process's resident set is kept under a target (radiantd
+  // --memory-target-bytes). A pass about to allocate much (photon records, splat grids) calls
+  // makeRoom() with its estimate first: when the resident set plus the estimate exceed the target, what
+  // this frame has not used goes (release below), and the Renderer's hook (the GPU scenes of other
+  // scenes). The Renderer calls it with 0 after each frame, so the resident set at rest stays under the
+  // target too. Returns the bytes the resident set shrank by (0 when nothing was needed).
+  std::size_t makeRoom(std::size_t bytes);
+  // What declaring this texture would allocate: 0 when it exists with this spec, else its bytes.
+  std::size_t textureAllocation(const std::string& name, GLenum target, GLenum internalFormat, int width, int height,
+                                int depth = 1, int levels = 1) const;
+  std::size_t releasedThisFrame() const { return releasedThisFrame_; }
+  void setMemoryTarget(std::size_t bytes) { memoryTarget_ = bytes; }
+  std::size_t memoryTarget() const { return memoryTarget_; }
+  void setTrimHook(std::function<void()> hook) { trimHook_ = std::move(hook); }
+  // Releases every texture, buffer and framebuffer this frame has not used and every cached entry of an
+  // earlier frame (what they held is forgotten: the next frame that needs them rebuilds them), then
+  // gives the freed heap back to the system.
+  void releaseIdle();
+  // Bytes of the textures and buffers (estimated from their formats and sizes; on a GPU they are
+  // device memory, on llvmpipe host memory).
+  std::size_t resourceBytes() const;
+  // The process's resident set (Linux /proc/self/statm; 0 where unavailable).
+  static std::size_t residentBytes();
+
 private:
   rt::Cancel cancel_;
   struct TextureSpec {
@@ -202,6 +232,12 @@ private:
   std::map<std::string, std::string> lightPaths_;
   std::set<int> shadowMapExclusions_;
   std::set<std::string> declaredThisFrame_;
+  // Textures, buffers and framebuffers looked up or declared this frame (releaseIdle keeps them).
+  mutable std::set<std::string> usedThisFrame_;
+  void used(const std::string& name) const { usedThisFrame_.insert(name); }
+  std::size_t memoryTarget_ = std::size_t(1) << 40;
+  std::size_t releasedThisFrame_ = 0;
+  std::function<void()> trimHook_;
   std::set<std::string> passWrites_;
   // The current pass scope (beginPass / endPass).
   void checkAccess(const std::string& name, bool write) const;

@@ -172,6 +172,31 @@ void Buffer::bindBase(GLenum target, GLuint index) const { glBindBufferBase(targ
 
 // --- Texture -----------------------------------------------------------------------------------
 
+std::size_t textureBytes(GLenum target, GLenum internalFormat, int width, int height, int depth, int levels) {
+  std::size_t texel = 16;
+  switch (internalFormat) {
+    case GL_R8: texel = 1; break;
+    case GL_R16F: case GL_RG8: case GL_DEPTH_COMPONENT16: texel = 2; break;
+    case GL_RGBA8: case GL_SRGB8_ALPHA8: case GL_R32F: case GL_R32UI: case GL_R32I: case GL_RG16F:
+    case GL_R11F_G11F_B10F: case GL_RGB10_A2: case GL_DEPTH_COMPONENT24: case GL_DEPTH_COMPONENT32F:
+    case GL_DEPTH24_STENCIL8: texel = 4; break;
+    case GL_RGBA16F: case GL_RG32F: case GL_RG32UI: texel = 8; break;
+    case GL_RGB32F: texel = 12; break;
+    default: texel = 16; break;
+  }
+  const std::size_t faces = target == GL_TEXTURE_CUBE_MAP ? 6 : 1;
+  const bool layered = target != GL_TEXTURE_3D;  // arrays keep their layers at every level
+  std::size_t total = 0;
+  int w = std::max(width, 0), h = std::max(height, 0), d = std::max(depth, 0);
+  for (int level = 0; level < levels; ++level) {
+    total += std::size_t(w) * std::size_t(h) * std::size_t(d) * faces * texel;
+    w = std::max(1, w / 2);
+    h = std::max(1, h / 2);
+    if (!layered) d = std::max(1, d / 2);
+  }
+  return total;
+}
+
 Texture::Texture(std::string_view labelText, GLenum target, GLenum internalFormat, int width,
                  int height, int depth, int levels)
     : target_(target),

@@ -88,6 +88,13 @@ private:
   int width_ = 0, height_ = 0, depth_ = 0, levels_ = 0;
 };
 
+// Bytes of a texture's storage, all levels and faces (its internal format's texel size; 16 bytes for a
+// format this does not know, which over-counts rather than under-counts).
+std::size_t textureBytes(GLenum target, GLenum internalFormat, int width, int height, int depth, int levels);
+inline std::size_t textureBytes(const Texture& t) {
+  return textureBytes(t.target(), t.format(), t.width(), t.height(), t.depth(), t.levels());
+}
+
 class Framebuffer : public Object {
 public:
   Framebuffer() = default;

@@ -193,6 +193,15 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   const rt::SceneLights lights(rays, view.environment, view.ambient, emission);
   traced_ = 0;
   traceMs_ = 0.0;
+  // The memory accountant (FrameResources::makeRoom) before tracing: the new records, held twice while
+  // the threads' blocks are joined, and the splat grid on the CPU and in its buffer (records per photon
+  // from this set so far, else 2; the Cornell box leaves 1.9).
+  const double recordsPerPhoton =
+      cache.set.emitted > 0 ? std::max(1.0, double(cache.set.records.size()) / double(cache.set.emitted)) : 2.0;
+  if (cache.set.emitted < s.photons)
+    res.makeRoom(static_cast<std::size_t>(recordsPerPhoton * double(s.photons - cache.set.emitted) * 2.0 *
+                                              sizeof(rt::PhotonRecord) +
+                                          recordsPerPhoton * double(s.photons) * 2.0 * sizeof(photon_gi::GpuSplat)));
   if (cache.set.emitted < s.photons) {
     const auto t0 = Clock::now();
     rt::PhotonOptions o;
@@ -238,6 +247,7 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   buildMs_ = 0.0;
   auto buildSplats = [&] {
     upload_ = true;
+    res.makeRoom(records_ * 2 * sizeof(photon_gi::GpuSplat));  // the grid on the CPU and in its buffer
     const auto t0 = Clock::now();
     auto c = std::make_unique<SplatCache>();
     // Splatted: photons with at least one earlier reflection (the paper's optimised mode: direct light

@@ -410,6 +410,52 @@ TEST(RenderCore, TheSplatBufferFollowsItsGrid) {
   EXPECT_EQ(sizes[2], sizes[0]) << "the 300k-photon buffer was kept for the 10k-photon grid";
 }
 
+// Issue 30, the memory accountant (FrameResources::makeRoom): under a target the process is over,
+// what a frame does not use goes — other scenes' GPU copies, their photon sets and every resource the
+// frame did not touch — and what a later frame rebuilds from that is the same image. Under a target it
+// is under, nothing goes.
+TEST(RenderCore, TheMemoryTargetReleasesWhatTheFrameDoesNotUse) {
+  auto counter = [](const RenderOutput& o, const char* name) {
+    for (const auto& p : o.stats.passes)
+      if (p.name == "photon_gi") return p.counters.at(name);
+    ADD_FAILURE() << "no photon_gi pass";
+    return -1.0;
+  };
+  auto hit = [](const RenderOutput& o, const char* what) {
+    for (const auto& c : o.stats.cache)
+      if (c.what == what) return c.hit;
+    ADD_FAILURE() << "no " << what << " cache entry";
+    return false;
+  };
+  Renderer& r = renderer();
+  r.setGpuSceneCapacity(4);
+  r.setMemoryTarget(std::size_t(1) << 40);
+  api::RenderRequest req = request(16, {"beauty"});
+  req.passes["photon_gi"] = {{"photons", 20000}};
+  const Scene a = umbraScene(1.f, "memory-a"), b = umbraScene(1.f, "memory-b");
+  r.render(a, req);
+  const RenderOutput first = r.render(b, req);
+  const RenderOutput kept = r.render(a, req);
+  EXPECT_TRUE(hit(kept, "gpu_scene"));
+  EXPECT_EQ(counter(kept, "photons_traced"), 0.0) << "under the target every scene keeps its photons";
+  EXPECT_EQ(kept.stats.memory.at("released_bytes").get<double>(), 0.0);
+  EXPECT_GT(kept.stats.memory.at("resident_bytes").get<double>(), 0.0);
+  EXPECT_GT(kept.stats.memory.at("resource_bytes").get<double>(), 0.0);
+
+  r.setMemoryTarget(1);  // always over: every frame's end releases what that frame did not use
+  const RenderOutput released = r.render(a, req);
+  EXPECT_EQ(released.stats.memory.at("target_bytes").get<double>(), 1.0);
+  const RenderOutput rebuilt = r.render(b, req);
+  EXPECT_FALSE(hit(rebuilt, "gpu_scene")) << "b's GPU copy went with a's frame";
+  EXPECT_EQ(counter(rebuilt, "photons_traced"), 20000.0) << "b's photon set went with a's frame";
+  EXPECT_LT(testing::maxAbsDifference(aov(first, "beauty"), aov(rebuilt, "beauty")), 1e-5f)
+      << "b rebuilt after the release renders as before";
+  const RenderOutput again = r.render(b, req);
+  EXPECT_TRUE(hit(again, "gpu_scene")) << "the frame's own scene stays";
+  EXPECT_EQ(counter(again, "photons_traced"), 0.0) << "the frame's own photons stay";
+  r.setMemoryTarget(std::size_t(1) << 40);
+}
+
 TEST(RenderCore, SharedDerivedResourcesHoldTheSceneRenderedLast) {
   // Two scenes whose shadows differ (the occluder left or right of the light), rendered A, B, A with
   // both kept uploaded: the third frame must equal the first. The shadow maps live in one texture that
