@@ -80,24 +80,30 @@ void tracePhoton(const RayScene& rays, const SceneLights& lights, const PhotonOp
 
 }  // namespace
 
-std::uint32_t octEncode(const glm::vec3& v) {
+std::uint32_t octEncode(const glm::vec3& v, int bits) {
   const float l1 = std::abs(v.x) + std::abs(v.y) + std::abs(v.z);
-  if (!(l1 > 0.f) || !std::isfinite(l1)) return octEncode(glm::vec3(0.f, 0.f, 1.f));
+  if (!(l1 > 0.f) || !std::isfinite(l1)) return octEncode(glm::vec3(0.f, 0.f, 1.f), bits);
   glm::vec2 p = glm::vec2(v.x, v.y) / l1;
   if (v.z < 0.f) {  // the lower hemisphere folds over the diagonals
     const glm::vec2 folded = (1.f - glm::abs(glm::vec2(p.y, p.x)));
     p = glm::vec2(p.x >= 0.f ? folded.x : -folded.x, p.y >= 0.f ? folded.y : -folded.y);
   }
-  auto snorm16 = [](float x) {
-    return static_cast<std::uint32_t>(static_cast<std::uint16_t>(
-        static_cast<std::int16_t>(std::lround(std::clamp(x, -1.f, 1.f) * 32767.f))));
+  const float scale = static_cast<float>((1 << (bits - 1)) - 1);
+  const std::uint32_t mask = (1u << bits) - 1u;
+  auto snorm = [&](float x) {
+    return static_cast<std::uint32_t>(static_cast<std::int32_t>(std::lround(std::clamp(x, -1.f, 1.f) * scale))) & mask;
   };
-  return snorm16(p.x) | (snorm16(p.y) << 16);
+  return snorm(p.x) | (snorm(p.y) << bits);
 }
 
-glm::vec3 octDecode(std::uint32_t packed) {
-  const glm::vec2 p(static_cast<float>(static_cast<std::int16_t>(packed & 0xFFFFu)) / 32767.f,
-                    static_cast<float>(static_cast<std::int16_t>(packed >> 16)) / 32767.f);
+glm::vec3 octDecode(std::uint32_t packed, int bits) {
+  const float scale = static_cast<float>((1 << (bits - 1)) - 1);
+  auto coordinate = [&](std::uint32_t field) {  // sign-extended from `bits` bits (two's complement, C++20)
+    const int v = static_cast<std::int32_t>(field << (32 - bits)) >> (32 - bits);
+    return std::clamp(static_cast<float>(v) / scale, -1.f, 1.f);
+  };
+  const std::uint32_t mask = (1u << bits) - 1u;
+  const glm::vec2 p(coordinate(packed & mask), coordinate((packed >> bits) & mask));
   glm::vec3 v(p.x, p.y, 1.f - std::abs(p.x) - std::abs(p.y));
   if (v.z < 0.f) {
     const glm::vec2 unfolded = 1.f - glm::abs(glm::vec2(v.y, v.x));

@@ -26,13 +26,14 @@
 
 namespace radiant::rt {
 
-// Unit vectors in 32 bits: the octahedral map (Meyer et al. 2010, "On floating-point normal vectors")
-// with 16-bit signed-normalised coordinates; the decoded vector is within 1e-4 radians (0.006 degrees)
-// of the encoded one (6.4e-5 measured, tested), far below what a photon's direction or its surface's
-// normal is used for (the kernel's plane and normal tests, a BRDF of roughness >= 0.2). Zero or
-// non-finite input encodes +z.
-std::uint32_t octEncode(const glm::vec3& unit);
-glm::vec3 octDecode(std::uint32_t packed);
+// Unit vectors in 2 x `bits` bits (at most 16): the octahedral map (Meyer et al. 2010, "On
+// floating-point normal vectors") with signed-normalised coordinates, x in the low `bits`, y above
+// (the convention of shaders/common/octahedral.glsl). At 16 bits the decoded vector is within 1e-4
+// radians (0.006 degrees) of the encoded one (6.4e-5 measured, tested), far below what a photon's
+// direction or its surface's normal is used for (the kernel's plane and normal tests, a BRDF of
+// roughness >= 0.2); photon_gi's splats use 15. Zero or non-finite input encodes +z.
+std::uint32_t octEncode(const glm::vec3& unit, int bits = 16);
+glm::vec3 octDecode(std::uint32_t packed, int bits = 16);
 
 // 48 bytes: the normal and the direction are octahedral-encoded (4M photons leave about 7.7M records on
 // the Cornell box: 368 MB, not the 490 MB of three-float vectors; issue 30's memory goal).

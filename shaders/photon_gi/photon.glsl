@@ -11,14 +11,22 @@
 #ifndef RADIANT_PHOTON_GI_PHOTON
 #define RADIANT_PHOTON_GI_PHOTON
 #include "common/brdf.glsl"
+#include "common/octahedral.glsl"
 
 // std430 mirror of photon_gi::GpuSplat (renderer/techniques/photon_gi/Splatting.h).
 struct GpuPhoton {
   vec4 positionRadius;  // xyz world position, w kernel radius h
-  vec4 normal;          // xyz unit normal on the side the photon arrived from; w = 1: diffuse lobe only
-  vec4 wi;              // xyz unit direction towards where it came from; w = 1: a copy (the grid's, splat.vert)
+  vec3 normal;          // unit normal on the side the photon arrived from
+  uint wiFlags;         // photonWi (bits 0-29), bit 30: diffuse lobe only, bit 31: a copy (the grid's, splat.vert)
   vec4 power;           // rgb phi_j = flux / photons used; a > 0: a coverage point of weight A / n
 };
+// The unit direction towards where the photon came from: two 15-bit signed octahedral coordinates.
+vec3 photonWi(GpuPhoton p) {
+  int x = bitfieldExtract(int(p.wiFlags), 0, 15), y = bitfieldExtract(int(p.wiFlags), 15, 15);
+  return octDecode(clamp(vec2(x, y) / 16383.0, -1.0, 1.0));
+}
+bool photonDiffuseOnly(GpuPhoton p) { return (p.wiFlags & 0x40000000u) != 0u; }
+bool photonIsCopy(GpuPhoton p) { return (p.wiFlags & 0x80000000u) != 0u; }
 
 layout(std430, binding = 5) readonly buffer Photons { GpuPhoton photons[]; };
 
@@ -52,10 +60,10 @@ struct SplatSurface {
 float photonKernel(GpuPhoton p, vec3 x, vec3 ng) {
   float h = p.positionRadius.w;
   vec3 d = x - p.positionRadius.xyz;
-  float planeDistance = dot(d, p.normal.xyz);
+  float planeDistance = dot(d, p.normal);
   if (abs(planeDistance) > u_planeTolerance * h) return 0.0;
-  if (dot(ng, p.normal.xyz) < u_normalCosine) return 0.0;
-  vec3 inPlane = d - planeDistance * p.normal.xyz;
+  if (dot(ng, p.normal) < u_normalCosine) return 0.0;
+  vec3 inPlane = d - planeDistance * p.normal;
   return kernel2d(dot(inPlane, inPlane) / (h * h)) / (h * h);
 }
 
@@ -63,23 +71,23 @@ float photonKernel(GpuPhoton p, vec3 x, vec3 ng) {
 vec3 photonContribution(GpuPhoton p, SplatSurface s) {
   float k = photonKernel(p, s.x, s.ng);
   if (k <= 0.0) return vec3(0.0);
-  vec3 wi = p.wi.xyz;
+  vec3 wi = photonWi(p);
   // The photon's flux per area is irradiance on its own (geometric) plane, E = int L_i |n_j . wi| dw,
   // so each photon stands for L_i dw = (phi / A) / |n_j . wi|, and the receiver reflects
   // f |n_s . wi| L_i dw (the reference's integrand, with the pixel's shading normal):
   // phi f |n_s . wi| / |n_j . wi| k / h^2. Dividing by the receiver's own cosine instead (as until
   // 2026-12-05) is the same on a flat surface, not where the kernel spans a curve or a normal map
   // (MetalRoughSpheres' spheres are smaller than their kernels: -19.5 -> -19.7 dB under qwantani).
-  float cosJ = dot(p.normal.xyz, wi);
+  float cosJ = dot(p.normal, wi);
   if (cosJ <= 0.0 || dot(s.n, wi) <= 0.0) return vec3(0.0);
   // The layered glTF BSDF (common/brdf.glsl gltfBsdfCos, the reference's rt::GltfBsdf): the base under
   // the sheen and the clear coat; gltfBsdfCos is f |n_s . wi|, divided by the photon's cosine. A lobe
-  // too sharp to estimate from photons, or a glossy reflection another technique owns (normal.w), is
+  // too sharp to estimate from photons, or a glossy reflection another technique owns (photonDiffuseOnly), is
   // left out by making it a Dirac lobe, which carries nothing towards a photon's direction: the base's
   // specular (roughness 0 leaves the diffuse lobe with its Fresnel weight) and the coat's lobe (its
   // (1 - Fc) attenuation of the base stays).
   MaterialParams m = s.p;
-  bool diffuseOnly = p.normal.w > 0.5;
+  bool diffuseOnly = photonDiffuseOnly(p);
   if (diffuseOnly || m.surface.y < u_minGlossyRoughness) m.surface.y = 0.0;
   if (diffuseOnly || m.clearcoat.y < u_minGlossyRoughness) m.clearcoat.y = 0.0;
   return p.power.rgb * (gltfBsdfCos(s.n, s.nc, s.wo, wi, m, m.surface.w) / cosJ) * k;
@@ -96,10 +104,10 @@ vec3 photonContribution(GpuPhoton p, SplatSurface s) {
 float coverageKernel(GpuPhoton p, vec3 x, vec3 nw) {
   float h = p.positionRadius.w;
   vec3 d = x - p.positionRadius.xyz;
-  float planeDistance = dot(d, p.normal.xyz);
+  float planeDistance = dot(d, p.normal);
   if (abs(planeDistance) > u_planeTolerance * h) return 0.0;
-  if (dot(nw, p.normal.xyz) < u_normalCosine) return 0.0;
-  vec3 inPlane = d - planeDistance * p.normal.xyz;
+  if (dot(nw, p.normal) < u_normalCosine) return 0.0;
+  vec3 inPlane = d - planeDistance * p.normal;
   return p.power.a * kernel2d(dot(inPlane, inPlane) / (h * h)) / (h * h);
 }
 float coverageContribution(GpuPhoton p, SplatSurface s) { return coverageKernel(p, s.x, s.nw); }

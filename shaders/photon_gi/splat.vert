@@ -10,12 +10,12 @@ void main() {
   int photon = u_firstInstance + gl_InstanceID;
   vec2 c = vec2((gl_VertexID & 1) != 0 ? 1.0 : -1.0, (gl_VertexID & 2) != 0 ? 1.0 : -1.0);
   GpuPhoton p = photons[photon];
-  if (p.wi.w > 0.5) {  // a copy in another cell of the grid (Splatting.cpp buildSplatGrid): its original draws it
+  if (photonIsCopy(p)) {  // a copy in another cell of the grid (Splatting.cpp buildSplatGrid): its original draws it
     gl_Position = vec4(2.0, 2.0, 2.0, 1.0);
     v_photon = photon;
     return;
   }
-  vec3 n = p.normal.xyz;
+  vec3 n = p.normal;
   // Duff et al. 2017 orthonormal basis.
   float sgn = n.z >= 0.0 ? 1.0 : -1.0;
   float a = -1.0 / (sgn + n.z);

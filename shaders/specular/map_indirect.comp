@@ -61,8 +61,9 @@ vec4 gatherAt(ivec2 px, vec4 acc) {
       GpuPhoton p = photons[i];
       if (p.power.a > 0.0) {
         acc.a += coverageKernel(p, x, nw);
-      } else if (dot(n, p.wi.xyz) > 0.0) {
-        acc.rgb += p.power.rgb * photonKernel(p, x, n);
+      } else {
+        float k = photonKernel(p, x, n);
+        if (k > 0.0 && dot(n, photonWi(p)) > 0.0) acc.rgb += p.power.rgb * k;
       }
     }
   }

@@ -9,6 +9,7 @@
 
 #include "renderer/frame/GpuTypes.h"
 #include "renderer/raytracing/Bsdf.h"
+#include "renderer/raytracing/PhotonTracer.h"
 #include "renderer/shading/PhotonGrid.h"
 #include "renderer/shading/Stretches.h"
 
@@ -47,6 +48,10 @@ void declareBuffer(FrameResources& res, const char* name, std::size_t bytes, boo
 
 }  // namespace
 
+std::uint32_t splatDirectionBits(const glm::vec3& wi) { return rt::octEncode(wi, 15); }
+
+glm::vec3 splatDirection(const GpuSplat& s) { return rt::octDecode(s.wiFlags & ((1u << 30) - 1u), 15); }
+
 double meshArea(const MeshInstance& m) {
   double a = 0.0;
   for (std::size_t t = 0; t + 2 < m.indices.size(); t += 3) {
@@ -78,7 +83,7 @@ void appendCoveragePoints(const MeshInstance& m, std::size_t n, float h, std::ve
                     &v2 = m.positions[m.indices[3 * t + 2]];
     const glm::vec3 p = b.x * v0 + b.y * v1 + (1.f - b.x - b.y) * v2;
     const glm::vec3 ng = glm::normalize(glm::cross(v1 - v0, v2 - v0));
-    out.push_back({glm::vec4(p, h), glm::vec4(ng, 0.f), glm::vec4(0.f), glm::vec4(0.f, 0.f, 0.f, weight)});
+    out.push_back({glm::vec4(p, h), ng, 0u, glm::vec4(0.f, 0.f, 0.f, weight)});
   }
 }
 
@@ -105,7 +110,7 @@ SplatGrid buildSplatGrid(std::vector<GpuSplat> splats) {
   // A splat whose reach spans m cells beyond its own (m = ceil(reach / cell)) is stored in its cell c
   // and, per axis, in c + 3k for |k| <= K = floor((m + 1) / 3): a point m or fewer cells away walks the
   // 3 x 3 x 3 cells around its own, and exactly one of them per axis is c + 3k (one of any three
-  // consecutive cells is), so the walk meets the splat once, never twice. Copies carry wi.w = 1: the
+  // consecutive cells is), so the walk meets the splat once, never twice. Copies carry kSplatCopy: the
   // splat method (one quad per splat) draws originals only.
   auto copiesPerAxis = [&](float h, float cell) {
     const int m = static_cast<int>(std::ceil(h * reachScale / cell));
@@ -180,7 +185,7 @@ SplatGrid buildSplatGrid(std::vector<GpuSplat> splats) {
   for (std::size_t e = 0; e < entries.size(); ++e) {
     GpuSplat& out = g.splats[next[entries[e].second]++];
     out = splats[entries[e].first];
-    out.wi.w = isCopy[e] ? 1.f : 0.f;
+    out.wiFlags = isCopy[e] ? (out.wiFlags | kSplatCopy) : (out.wiFlags & ~kSplatCopy);
   }
   g.count = g.splats.size();
   return g;

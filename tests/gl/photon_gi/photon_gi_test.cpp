@@ -321,7 +321,7 @@ TEST(PhotonGi, GridWalkMeetsEverySplatThatReachesAPointExactlyOnce) {
   EXPECT_LE(g.count, 4 * g.originals);                      // copies at most 3x the splats
   EXPECT_LT(g.cellSize, 0.1f * reachScale);                 // cells follow the small kernels
   std::size_t flaggedCopies = 0;
-  for (const GpuSplat& s : g.splats) flaggedCopies += s.wi.w > 0.5f;
+  for (const GpuSplat& s : g.splats) flaggedCopies += (s.wiFlags & photon_gi::kSplatCopy) != 0;
   EXPECT_EQ(flaggedCopies, g.count - g.originals);          // the splat method draws each once
   int checked = 0, reached = 0, reachedWide = 0;
   for (int q = 0; q < 3000; ++q) {
