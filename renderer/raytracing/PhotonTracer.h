@@ -67,7 +67,7 @@ struct PhotonOptions {
   std::uint64_t seed = 0;
   int threads = 0;  // 0 = TBB default
   // Polled every kCancelPollPhotons photons: tracePhotons() then throws Cancelled and leaves `set` as it
-  // was (the new records are appended only once every photon is traced), so a cached set stays whole.
+  // was (the records appended by the waves before it are removed again), so a cached set stays whole.
   Cancel cancel;
 };
 

@@ -30,6 +30,8 @@ struct PhotonCache {
 };
 struct SplatCache {
   photon_gi::SplatGrid grid;
+  std::size_t records = 0;      // the photon records it was built from
+  std::uint64_t capped = 0;     // photons of that set ended by max_bounces
   std::size_t photonSplats = 0, coveragePoints = 0;
   float hMin = 0.f, hMax = 0.f;
   std::size_t bytes() const {
@@ -193,27 +195,31 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   const rt::SceneLights lights(rays, view.environment, view.ambient, emission);
   traced_ = 0;
   traceMs_ = 0.0;
-  // The memory accountant (FrameResources::makeRoom) before tracing: the new records, held twice while
-  // the threads' blocks are joined, and the splat grid on the CPU and in its buffer (records per photon
-  // from this set so far, else 2; the Cornell box leaves 1.9).
-  const double recordsPerPhoton =
-      cache.set.emitted > 0 ? std::max(1.0, double(cache.set.records.size()) / double(cache.set.emitted)) : 2.0;
-  if (cache.set.emitted < s.photons)
-    res.makeRoom(static_cast<std::size_t>(recordsPerPhoton * double(s.photons - cache.set.emitted) * 2.0 *
-                                              sizeof(rt::PhotonRecord) +
-                                          recordsPerPhoton * double(s.photons) * 2.0 * sizeof(photon_gi::GpuSplat)));
-  if (cache.set.emitted < s.photons) {
-    const auto t0 = Clock::now();
-    rt::PhotonOptions o;
-    o.maxBounces = s.maxBounces;
-    o.seed = view.seed;
-    o.cancel = res.cancel();  // a cancelled trace throws and leaves cache.set as it was (PhotonTracer.h)
-    traced_ = s.photons - cache.set.emitted;
-    rt::tracePhotons(rays, lights, o, s.photons, cache.set);
-    traceMs_ = msSince(t0);
-  }
-  records_ = cache.set.recordsOfFirst(s.photons);
-  capped_ = cache.set.capped;
+  recordsReleased_ = false;
+  // The records of the first s.photons photons, traced when a splat grid is built from them (not when
+  // the grid is cached and resident: the records may have been released to keep memory under its
+  // target, below). The memory accountant (FrameResources::makeRoom) comes first: the new records,
+  // held twice while the threads' blocks are joined, and the splat grid on the CPU and in its buffer
+  // (records per photon from this set so far, else 2; the Cornell box leaves 1.9).
+  auto traceRecords = [&] {
+    if (cache.set.emitted < s.photons) {
+      const double recordsPerPhoton =
+          cache.set.emitted > 0 ? std::max(1.0, double(cache.set.records.size()) / double(cache.set.emitted)) : 2.0;
+      res.makeRoom(static_cast<std::size_t>(
+          recordsPerPhoton * double(s.photons - cache.set.emitted) * 2.0 * sizeof(rt::PhotonRecord) +
+          recordsPerPhoton * double(s.photons) * 2.0 * sizeof(photon_gi::GpuSplat)));
+      const auto t0 = Clock::now();
+      rt::PhotonOptions o;
+      o.maxBounces = s.maxBounces;
+      o.seed = view.seed;
+      o.cancel = res.cancel();  // a cancelled trace throws and leaves cache.set as it was (PhotonTracer.h)
+      traced_ = s.photons - cache.set.emitted;
+      rt::tracePhotons(rays, lights, o, s.photons, cache.set);
+      traceMs_ = msSince(t0);
+    }
+    records_ = cache.set.recordsOfFirst(s.photons);
+    capped_ = cache.set.capped;
+  };
 
   // --- The splats: which records, their kernel radius per surface (eq. 3), coverage points.
   const bool ownsSky = res.ownsLightPath("photon_gi", "L(sky)DE");
@@ -247,9 +253,11 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   buildMs_ = 0.0;
   auto buildSplats = [&] {
     upload_ = true;
-    res.makeRoom(records_ * 2 * sizeof(photon_gi::GpuSplat));  // the grid on the CPU and in its buffer
+    traceRecords();
     const auto t0 = Clock::now();
     auto c = std::make_unique<SplatCache>();
+    c->records = records_;
+    c->capped = capped_;
     // Splatted: photons with at least one earlier reflection (the paper's optimised mode: direct light
     // from punctual lights is the raster pass's), direct light from emissive triangles, which no raster
     // pass computes, and the sky's direct light when this pass owns it (the planner gives it to
@@ -306,6 +314,18 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
             h[m], out);
       }
     c->coveragePoints = out.size() - c->photonSplats;
+    // The records are not needed again this frame. Resident beside the grid being built and its buffer,
+    // they made the peak (4M photons on the Cornell box: 351 MiB of records beside twice 232 MiB of
+    // splats): when those two would take the process over its memory target, they go first, and a
+    // later frame that must rebuild the grid (another C, the buffer taken by another scene) traces
+    // them again.
+    const std::size_t gridBytes = 2 * out.size() * sizeof(photon_gi::GpuSplat);
+    res.makeRoom(gridBytes);
+    const std::size_t resident = FrameResources::residentBytes();
+    if (resident > 0 && resident + gridBytes > res.memoryTarget()) {
+      cache.set = rt::PhotonSet{};
+      recordsReleased_ = true;
+    }
     c->grid = photon_gi::buildSplatGrid(std::move(out));
     buildMs_ = msSince(t0);
     return c;
@@ -321,6 +341,8 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
     rebuilt_ = true;
   }
   grid_ = &splats.grid;
+  records_ = splats.records;
+  capped_ = splats.capped;
   photonSplats_ = splats.photonSplats;
   coveragePoints_ = splats.coveragePoints;
   hMin_ = splats.hMin;
@@ -373,6 +395,8 @@ void PhotonGiPass::execute(PassContext& ctx) {
   c["photons"] = static_cast<double>(settings_.photons);
   c["photons_traced"] = static_cast<double>(traced_);
   c["photons_cached"] = traced_ == 0 ? 1.0 : 0.0;
+  // The records were released after the grid was built, to stay under --memory-target-bytes.
+  c["records_released"] = recordsReleased_ ? 1.0 : 0.0;
   c["trace_ms"] = traceMs_;
   c["splat_build_ms"] = buildMs_;
   c["records"] = static_cast<double>(records_);

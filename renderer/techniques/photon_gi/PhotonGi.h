@@ -51,6 +51,7 @@ private:
   // the CPU copy is released after upload).
   std::string splatDigest_;
   bool rebuilt_ = false;            // this frame rebuilt a cached set that was not resident
+  bool recordsReleased_ = false;    // this frame released the records after building the grid (memory)
   float lightPhotonWeight_ = 1.f;  // the environment lights' weight in the sky photons' emission
   std::size_t records_ = 0, photonSplats_ = 0, coveragePoints_ = 0;
   std::size_t splatBufferBytes_ = 0;  // the splat buffer's size (at most 12.5% over the grid's)
