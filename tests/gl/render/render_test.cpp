@@ -456,6 +456,37 @@ TEST(RenderCore, TheMemoryTargetReleasesWhatTheFrameDoesNotUse) {
   r.setMemoryTarget(std::size_t(1) << 40);
 }
 
+// Issue 30: over the memory target, photon_gi lets its records go once the splat grid is built. The
+// grid stays resident, so the next frame traces nothing and renders the same image; a frame that needs
+// another grid (another C) traces the photons again.
+TEST(RenderCore, PhotonRecordsReleasedUnderTheMemoryTargetAreTracedAgainWhenNeeded) {
+  auto counter = [](const RenderOutput& o, const char* name) {
+    for (const auto& p : o.stats.passes)
+      if (p.name == "photon_gi") return p.counters.at(name);
+    ADD_FAILURE() << "no photon_gi pass";
+    return -1.0;
+  };
+  Renderer& r = renderer();
+  const Scene a = umbraScene(1.f, "records-released");
+  api::RenderRequest req = request(16, {"beauty"});
+  req.passes["photon_gi"] = {{"photons", 20000}};
+  r.setMemoryTarget(1);
+  const RenderOutput first = r.render(a, req);
+  EXPECT_EQ(counter(first, "photons_traced"), 20000.0);
+  EXPECT_EQ(counter(first, "records_released"), 1.0);
+  EXPECT_GT(counter(first, "records"), 0.0);
+  const RenderOutput second = r.render(a, req);
+  EXPECT_EQ(counter(second, "photons_traced"), 0.0) << "the grid was resident: nothing to trace";
+  EXPECT_EQ(counter(second, "records"), counter(first, "records")) << "the grid's own count";
+  EXPECT_LT(testing::maxAbsDifference(aov(first, "beauty"), aov(second, "beauty")), 1e-6f);
+  req.passes["photon_gi"] = {{"photons", 20000}, {"C", 12.0}};
+  EXPECT_EQ(counter(r.render(a, req), "photons_traced"), 20000.0) << "another grid needs the records again";
+  r.setMemoryTarget(std::size_t(1) << 40);
+  req.passes["photon_gi"] = {{"photons", 20000}};
+  const RenderOutput kept = r.render(a, req);
+  EXPECT_EQ(counter(kept, "records_released"), 0.0) << "under the target the records stay";
+}
+
 TEST(RenderCore, SharedDerivedResourcesHoldTheSceneRenderedLast) {
   // Two scenes whose shadows differ (the occluder left or right of the light), rendered A, B, A with
   // both kept uploaded: the third frame must equal the first. The shadow maps live in one texture that
