@@ -472,6 +472,8 @@ void Renderer::setDerivedCacheBytes(std::size_t bytes) { impl_->resources.setDer
 
 void Renderer::setMemoryTarget(std::size_t bytes) { impl_->resources.setMemoryTarget(bytes); }
 
+void Renderer::setMemoryLimit(std::size_t bytes) { impl_->resources.setMemoryLimit(bytes); }
+
 void Renderer::setGpuSceneCapacity(std::size_t scenes) {
   impl_->gpuSceneCapacity = std::max<std::size_t>(1, scenes);
   impl_->resources.setDerivedCapacity(impl_->gpuSceneCapacity);
@@ -824,6 +826,7 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
                     {"resource_bytes", im.resources.resourceBytes()},
                     {"derived_bytes", im.resources.derivedBytes()},
                     {"target_bytes", im.resources.memoryTarget()},
+                    {"limit_bytes", im.resources.memoryLimit()},
                     {"released_bytes", im.resources.releasedThisFrame()}};
     report(1.0);
     if (nonFinite) stats.passes.back().counters["non_finite_pixels_zeroed"] = static_cast<double>(nonFinite);

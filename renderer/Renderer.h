@@ -95,6 +95,9 @@ public:
   // about to allocate much, and every frame's end, release what the frame does not use when over it.
   // Default 1 TiB (off); radiantd --memory-target-bytes.
   void setMemoryTarget(std::size_t bytes);
+  // The resident set beyond which a pass's large allocation is refused (503 memory-busy) when the
+  // release does not make room for it; 0 = none (the default); radiantd --memory-limit-bytes.
+  void setMemoryLimit(std::size_t bytes);
   // The budget chooser's speed factor (api::MachineSpeed): > 0 pins it (radiantd --speed-factor),
   // 0 measures it: a calibration frame before the first frame with a time budget, then the ratio of
   // measured to predicted time of recent frames comparable with the preset table. Default 0.

@@ -64,6 +64,10 @@ std::string usage() {
                             allocate much (photon records and splats, specular and caustic maps) and
                             every frame's end release what the frame does not use (other scenes' GPU
                             copies, maps and derived data) when over it (default 1342177280)
+  --memory-limit-bytes N    a frame whose large allocation (photon records and splats, specular and
+                            caustic maps) would take the daemon's resident set over N even after that
+                            release gets 503 memory-busy with Retry-After, before allocating; 0 = no
+                            limit (default 1500000000)
   --speed-factor F|auto      this machine's frame time over the preset table's prediction, which time
                             budgets scale every predicted cost by; auto (the default) measures it: a
                             calibration frame before the first budgeted frame, then recent frames
@@ -156,6 +160,7 @@ void apply(ServerConfig& c, const std::string& name, const std::string& v, std::
   else if (name == "gpu-scenes") c.gpuScenes = static_cast<int>(toInt(flag, v, 1, 256));
   else if (name == "derived-cache-bytes") c.derivedCacheBytes = static_cast<std::size_t>(toInt(flag, v, 1 << 20, 1ll << 40));
   else if (name == "memory-target-bytes") c.memoryTargetBytes = static_cast<std::size_t>(toInt(flag, v, 1 << 20, 1ll << 40));
+  else if (name == "memory-limit-bytes") c.memoryLimitBytes = static_cast<std::size_t>(toInt(flag, v, 0, 1ll << 40));
   else if (name == "speed-factor") {
     c.speedFactor = v == "auto" ? 0.0 : toDouble(flag, v);
     if (c.speedFactor > 64.0 || (c.speedFactor > 0 && c.speedFactor < 1.0 / 64.0))

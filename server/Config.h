@@ -45,6 +45,9 @@ struct ServerConfig {
   // The resident set the renderer's memory accountant keeps the daemon under (--memory-target-bytes):
   // over it, what the frame does not use (other scenes' GPU copies, maps, derived data) is released.
   std::size_t memoryTargetBytes = std::size_t(1280) << 20;
+  // Beyond it a frame's large allocation that the release cannot make room for is a 503 memory-busy
+  // (--memory-limit-bytes; 0 = none).
+  std::size_t memoryLimitBytes = 1500000000;
   double readTimeoutS = 30;            // receiving one request (headers and body), in total
   double keepAliveTimeoutS = 2;        // an idle keep-alive connection is closed after this
   // After SIGTERM, frame and job GETs are served this long (ending early once every frame was

@@ -606,7 +606,7 @@ struct HttpServer::Impl {
         const std::string body = readBody(req, res, reader, charge);
         f(req, body, res);
       } catch (const api::ApiError& e) {
-        if (e.type == "decode-busy" || e.type == "body-busy") res.set_header("Retry-After", "1");
+        if (e.type == "decode-busy" || e.type == "body-busy" || e.type == "memory-busy") res.set_header("Retry-After", "1");
         sendProblem(res, e, tRequest.renderId);
       } catch (const std::exception& e) {
         sendProblem(res, 500, "internal-error", "Internal error", e.what(), "", tRequest.renderId);
@@ -620,7 +620,7 @@ struct HttpServer::Impl {
       try {
         f(req, res);
       } catch (const api::ApiError& e) {
-        if (e.type == "decode-busy") res.set_header("Retry-After", "1");
+        if (e.type == "decode-busy" || e.type == "memory-busy") res.set_header("Retry-After", "1");
         sendProblem(res, e, tRequest.renderId);
       } catch (const std::exception& e) {
         sendProblem(res, 500, "internal-error", "Internal error", e.what(), "", tRequest.renderId);
@@ -652,6 +652,7 @@ struct HttpServer::Impl {
                 {"gpu_scenes", config.gpuScenes},
                 {"derived_cache_bytes", config.derivedCacheBytes},
                 {"memory_target_bytes", config.memoryTargetBytes},
+                {"memory_limit_bytes", config.memoryLimitBytes},
                 {"speed_factor", config.speedFactor > 0 ? json(config.speedFactor) : json("auto")},
                 {"default_frame_budget_ms", config.limits.defaultFrameBudgetMs},
                 {"read_timeout_s", config.readTimeoutS},
@@ -981,6 +982,7 @@ struct HttpServer::Impl {
       if (body.contains("error")) {
         const json& e = body["error"];
         std::string type = e["type"].get<std::string>().substr(std::string("https://radiant.dev/problems/").size());
+        if (type == "memory-busy") res.set_header("Retry-After", "1");
         return sendProblem(res, e["status"], type, e["title"], e["detail"], e.value("pointer", ""), job->id);
       }
       sendProblem(res, 504, "timeout", "Render timed out", "render " + job->id + " did not finish in time", "", job->id);

@@ -24,11 +24,12 @@ constexpr float kMaxImageRadiance = 1e18f;
 class RendererBackend final : public RenderBackend {
 public:
   RendererBackend(const DeviceOptions& options, int gpuScenes, double speedFactor, std::size_t derivedBytes,
-                  std::size_t memoryTarget)
+                  std::size_t memoryTarget, std::size_t memoryLimit)
       : renderer_(options) {
     renderer_.setGpuSceneCapacity(static_cast<std::size_t>(gpuScenes));
     renderer_.setDerivedCacheBytes(derivedBytes);
     renderer_.setMemoryTarget(memoryTarget);
+    renderer_.setMemoryLimit(memoryLimit);
     renderer_.setSpeedFactor(speedFactor);
   }
   DeviceInfo device() const override { return renderer_.device(); }
@@ -54,9 +55,9 @@ BackendHooks rendererHooks(const ServerConfig& config) {
   const int gpuScenes = config.gpuScenes;
   const double speedFactor = config.speedFactor;
   const std::size_t derivedBytes = config.derivedCacheBytes;
-  const std::size_t memoryTarget = config.memoryTargetBytes;
-  h.createBackend = [device, gpuScenes, speedFactor, derivedBytes, memoryTarget] {
-    return std::make_unique<RendererBackend>(device, gpuScenes, speedFactor, derivedBytes, memoryTarget);
+  const std::size_t memoryTarget = config.memoryTargetBytes, memoryLimit = config.memoryLimitBytes;
+  h.createBackend = [device, gpuScenes, speedFactor, derivedBytes, memoryTarget, memoryLimit] {
+    return std::make_unique<RendererBackend>(device, gpuScenes, speedFactor, derivedBytes, memoryTarget, memoryLimit);
   };
   const std::size_t maxBytes = config.maxBodyBytes;
   const std::size_t maxDecoded = config.maxDecodeBytes;

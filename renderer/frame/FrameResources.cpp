@@ -232,12 +232,26 @@ std::size_t FrameResources::textureAllocation(const std::string& name, GLenum ta
 
 std::size_t FrameResources::makeRoom(std::size_t bytes) {
   const std::size_t before = residentBytes();
-  if (before == 0 || before + bytes <= memoryTarget_) return 0;
+  if (before == 0 || before + bytes <= std::min(memoryTarget_, memoryLimit_ ? memoryLimit_ : memoryTarget_)) return 0;
   releaseIdle();
   const std::size_t after = residentBytes();
   const std::size_t released = before > after ? before - after : 0;
   releasedThisFrame_ += released;
   return released;
+}
+
+void FrameResources::admit(std::size_t bytes, const std::string& pointer) const {
+  const std::size_t after = memoryLimit_ ? residentBytes() : 0;
+  if (memoryLimit_ && after > 0 && after + bytes > memoryLimit_) {
+    const auto mib = [](std::size_t b) { return std::to_string(b >> 20); };
+    throw api::ApiError(503, "memory-busy", "Not enough memory",
+                        (pointer.empty() ? std::string("this frame") : pointer) + " needs about " + mib(bytes) +
+                            " MiB more, and the daemon holds " + mib(after) + " MiB after releasing what the frame "
+                            "does not use (decoded scenes of queued renders among it), above its limit of " +
+                            mib(memoryLimit_) + " MiB (--memory-limit-bytes): retry after the Retry-After seconds, "
+                            "or ask for less",
+                        pointer);
+  }
 }
 
 }  // namespace radiant

@@ -184,6 +184,12 @@ public:
   // scenes). The Renderer calls it with 0 after each frame, so the resident set at rest stays under the
   // target too. Returns the bytes the resident set shrank by (0 when nothing was needed).
   std::size_t makeRoom(std::size_t bytes);
+  // Admission under the memory limit (radiantd --memory-limit-bytes, 0 = none): after makeRoom, an
+  // estimate that still does not fit under it is refused, a 503 memory-busy (Retry-After) naming
+  // `pointer`, the parameter that sized the allocation, before anything is allocated.
+  void admit(std::size_t bytes, const std::string& pointer) const;
+  void setMemoryLimit(std::size_t bytes) { memoryLimit_ = bytes; }
+  std::size_t memoryLimit() const { return memoryLimit_; }
   // What declaring this texture would allocate: 0 when it exists with this spec, else its bytes.
   std::size_t textureAllocation(const std::string& name, GLenum target, GLenum internalFormat, int width, int height,
                                 int depth = 1, int levels = 1) const;
@@ -237,6 +243,7 @@ private:
   void used(const std::string& name) const { usedThisFrame_.insert(name); }
   std::size_t memoryTarget_ = std::size_t(1) << 40;
   std::size_t releasedThisFrame_ = 0;
+  std::size_t memoryLimit_ = 0;
   std::function<void()> trimHook_;
   std::set<std::string> passWrites_;
   // The current pass scope (beginPass / endPass).

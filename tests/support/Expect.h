@@ -1,8 +1,10 @@
 #pragma once
-// Test support: the message of the exception a call must throw.
+// Test support: the exception a call must throw.
 #include <string>
 
 #include <gtest/gtest.h>
+
+#include "api/Types.h"
 
 namespace radiant::testing {
 
@@ -16,6 +18,19 @@ std::string thrownMessage(F&& f) {
   }
   ADD_FAILURE() << "expected an exception";
   return {};
+}
+
+// Runs `f`, expecting an api::ApiError (a request refused with a status and a pointer), and returns
+// it; a failure, and status 0, if none is thrown.
+template <class F>
+api::ApiError thrownApiError(F&& f) {
+  try {
+    f();
+  } catch (const api::ApiError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "expected an api::ApiError";
+  return api::ApiError(0, "", "", "", "");
 }
 
 }  // namespace radiant::testing

@@ -214,7 +214,10 @@ void CausticsPass::prepare(const Scene& scene, const Params& params, FrameResour
   const int C = cubeResolution_;
   int levels = 1;
   while ((C >> levels) > 0) ++levels;  // down to 1 x 1
-  res.makeRoom(res.textureAllocation("caustics_cube", GL_TEXTURE_CUBE_MAP_ARRAY, GL_RGBA32F, C, C, 6 * cubes, levels));
+  const std::size_t cubeAllocation =
+      res.textureAllocation("caustics_cube", GL_TEXTURE_CUBE_MAP_ARRAY, GL_RGBA32F, C, C, 6 * cubes, levels);
+  res.makeRoom(cubeAllocation);
+  res.admit(cubeAllocation, "/passes/caustics/cube_resolution");
   gl::Texture& cube = res.texture("caustics_cube", GL_TEXTURE_CUBE_MAP_ARRAY, GL_RGBA32F, C, C, 6 * cubes, levels);
   cube.setFilter(GL_LINEAR_MIPMAP_LINEAR, GL_LINEAR);
   gl::Framebuffer& cubeFb = res.framebuffer("caustics_cube");

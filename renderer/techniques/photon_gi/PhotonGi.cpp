@@ -198,16 +198,19 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   recordsReleased_ = false;
   // The records of the first s.photons photons, traced when a splat grid is built from them (not when
   // the grid is cached and resident: the records may have been released to keep memory under its
-  // target, below). The memory accountant (FrameResources::makeRoom) comes first: the new records,
-  // held twice while the threads' blocks are joined, and the splat grid on the CPU and in its buffer
-  // (records per photon from this set so far, else 2; the Cornell box leaves 1.9).
+  // target, below). The memory accountant (FrameResources::makeRoom, admit) comes first: the new
+  // records (appended in waves: held once) and the splats sorted into the grid, at most one per record
+  // (records per photon from this set so far, else 2; the Cornell box leaves 1.9, 55% of them
+  // splatted). The grid and its buffer are charged when the splats are known, below.
   auto traceRecords = [&] {
     if (cache.set.emitted < s.photons) {
       const double recordsPerPhoton =
           cache.set.emitted > 0 ? std::max(1.0, double(cache.set.records.size()) / double(cache.set.emitted)) : 2.0;
-      res.makeRoom(static_cast<std::size_t>(
-          recordsPerPhoton * double(s.photons - cache.set.emitted) * 2.0 * sizeof(rt::PhotonRecord) +
-          recordsPerPhoton * double(s.photons) * 2.0 * sizeof(photon_gi::GpuSplat)));
+      const auto bytes = static_cast<std::size_t>(
+          recordsPerPhoton * double(s.photons - cache.set.emitted) * sizeof(rt::PhotonRecord) +
+          recordsPerPhoton * double(s.photons) * sizeof(photon_gi::GpuSplat));
+      res.makeRoom(bytes);
+      res.admit(bytes, "/passes/photon_gi/photons");
       const auto t0 = Clock::now();
       rt::PhotonOptions o;
       o.maxBounces = s.maxBounces;
@@ -326,6 +329,7 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
       cache.set = rt::PhotonSet{};
       recordsReleased_ = true;
     }
+    res.admit(gridBytes, "/passes/photon_gi/photons");
     c->grid = photon_gi::buildSplatGrid(std::move(out));
     buildMs_ = msSince(t0);
     return c;

@@ -161,10 +161,13 @@ void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResour
   const int w = res.view().width, h = res.view().height;
   const int cubes = std::max<int>(1, objectCount * layers_);
   // The memory accountant (FrameResources::makeRoom) before the maps are allocated.
-  res.makeRoom(res.textureAllocation("specular_ldm_material", GL_TEXTURE_CUBE_MAP_ARRAY, GL_RGBA16F, resolution_,
-                                     resolution_, 6 * cubes) +
-               res.textureAllocation("specular_ldm_geometry", GL_TEXTURE_CUBE_MAP_ARRAY, GL_RGBA32F, resolution_,
-                                     resolution_, 6 * cubes));
+  const std::size_t mapAllocation =
+      res.textureAllocation("specular_ldm_material", GL_TEXTURE_CUBE_MAP_ARRAY, GL_RGBA16F, resolution_, resolution_,
+                            6 * cubes) +
+      res.textureAllocation("specular_ldm_geometry", GL_TEXTURE_CUBE_MAP_ARRAY, GL_RGBA32F, resolution_, resolution_,
+                            6 * cubes);
+  res.makeRoom(mapAllocation);
+  res.admit(mapAllocation, "/passes/specular/cube_resolution");
   gl::Texture& material = res.texture("specular_ldm_material", GL_TEXTURE_CUBE_MAP_ARRAY, GL_RGBA16F, resolution_,
                                       resolution_, 6 * cubes);
   gl::Texture& geometry = res.texture("specular_ldm_geometry", GL_TEXTURE_CUBE_MAP_ARRAY, GL_RGBA32F, resolution_,

@@ -14,6 +14,7 @@
 #include "renderer/scene/BuiltinScenes.h"
 #include "renderer/techniques/caustics/Caustics.h"
 #include "tests/gl/specular/SpecularTestSupport.h"
+#include "tests/support/Expect.h"
 
 namespace radiant {
 namespace {
@@ -398,13 +399,9 @@ TEST(Caustics, CubesStayWithinTheirMemoryLimit) {
 
   api::RenderRequest given = request(16, {{"cube_resolution", 256}});
   given.explicitParams["caustics"] = {"cube_resolution"};  // as the request's JSON names it
-  try {
-    renderer().render(scene, given);
-    FAIL() << "65 caustic cubes of 256^2 rendered";
-  } catch (const api::ApiError& e) {
-    EXPECT_EQ(e.status, 422);
-    EXPECT_EQ(e.pointer, "/passes/caustics/cube_resolution");
-  }
+  const api::ApiError e = testing::thrownApiError([&] { renderer().render(scene, given); });  // 65 cubes of 256^2
+  EXPECT_EQ(e.status, 422);
+  EXPECT_EQ(e.pointer, "/passes/caustics/cube_resolution");
 }
 
 // Degenerate input (oracle 6), each with finite output and an exact zero where no light can arrive.

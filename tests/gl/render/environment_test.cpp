@@ -14,6 +14,7 @@
 #include "renderer/scene/GltfLoader.h"
 #include "renderer/shading/ImageBasedLighting.h"
 #include "tests/gl/specular/SpecularTestSupport.h"  // orthoCamera, mirror
+#include "tests/support/Expect.h"
 #include "tests/support/RenderTestSupport.h"
 #include "tests/support/SceneBuilder.h"
 
@@ -695,14 +696,11 @@ TEST(Environment, ShadowMapsBeyondTheMemoryLimitAreRefused) {
   req.passes["direct"] = {{"sky_lights", 64}};
   req.passes["shadow_maps"] = {{"shadow_map_size", 4096}};
   req.explicitParams["shadow_maps"] = {"shadow_map_size"};  // as the request's JSON names it (a default would be lowered)
-  try {
-    renderer().render(scene, req, nullptr, FrameInputs{nullptr, &env});
-    FAIL() << "65 maps of 4096^2 rendered";
-  } catch (const api::ApiError& e) {
-    EXPECT_EQ(e.status, 422);
-    EXPECT_EQ(e.pointer, "/passes/shadow_maps/shadow_map_size");
-    EXPECT_NE(std::string(e.what()).find("sky_lights"), std::string::npos) << e.what();
-  }
+  const api::ApiError e =  // 65 maps of 4096^2
+      testing::thrownApiError([&] { renderer().render(scene, req, nullptr, FrameInputs{nullptr, &env}); });
+  EXPECT_EQ(e.status, 422);
+  EXPECT_EQ(e.pointer, "/passes/shadow_maps/shadow_map_size");
+  EXPECT_NE(std::string(e.what()).find("sky_lights"), std::string::npos) << e.what();
   req.passes["shadow_maps"] = {{"shadow_map_size", 1024}};  // 65 MiB x 4 = 260 MiB: within the limit
   const RenderOutput out = renderer().render(scene, req, nullptr, FrameInputs{nullptr, &env});
   ASSERT_NE(testing::pass(out, "direct"), nullptr);

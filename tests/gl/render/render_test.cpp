@@ -289,13 +289,9 @@ TEST(RenderCore, ShadowMapOverdrawIsBoundedByTheFragmentBudget) {
 
   req.explicitParams["shadow_maps"] = {"shadow_map_size"};
   req.passes["shadow_maps"] = {{"shadow_map_size", 2048}};  // 1483 x 2048^2 = 6.2 billion
-  try {
-    renderer().render(scene, req);
-    FAIL() << "maps of 6 billion fragments rendered";
-  } catch (const api::ApiError& e) {
-    EXPECT_EQ(e.status, 422);
-    EXPECT_EQ(e.pointer, "/passes/shadow_maps/shadow_map_size");
-  }
+  const api::ApiError e = testing::thrownApiError([&] { renderer().render(scene, req); });  // 6 billion fragments
+  EXPECT_EQ(e.status, 422);
+  EXPECT_EQ(e.pointer, "/passes/shadow_maps/shadow_map_size");
 }
 
 TEST(RenderCore, DerivedDataIsCachedAcrossFrames) {
@@ -485,6 +481,27 @@ TEST(RenderCore, PhotonRecordsReleasedUnderTheMemoryTargetAreTracedAgainWhenNeed
   req.passes["photon_gi"] = {{"photons", 20000}};
   const RenderOutput kept = r.render(a, req);
   EXPECT_EQ(counter(kept, "records_released"), 0.0) << "under the target the records stay";
+}
+
+// Issue 30, admission: a frame whose photon records would take the process over the memory limit
+// even after the release is refused before tracing — a 503 memory-busy naming the photon count — and
+// the renderer goes on rendering; without a limit the same frame renders.
+TEST(RenderCore, AFrameOverTheMemoryLimitIsRefusedBeforeItAllocates) {
+  Renderer& r = renderer();
+  const Scene a = umbraScene(1.f, "memory-limit");
+  api::RenderRequest req = request(8, {"beauty"});
+  req.passes["photon_gi"] = {{"photons", 20000}};
+  r.render(a, req);  // compiles the shaders, allocates the frame's targets and traces 20k photons
+  req.passes["photon_gi"] = {{"photons", 2000000}};  // about 380 MB of records and splats estimated
+  r.setMemoryLimit(FrameResources::residentBytes() + (std::size_t(32) << 20));
+  const api::ApiError e = testing::thrownApiError([&] { r.render(a, req); });  // 2M photons 32 MiB below the limit
+  EXPECT_EQ(e.status, 503);
+  EXPECT_EQ(e.type, "memory-busy");
+  EXPECT_EQ(e.pointer, "/passes/photon_gi/photons");
+  EXPECT_NE(std::string(e.what()).find("--memory-limit-bytes"), std::string::npos) << e.what();
+  req.passes["photon_gi"] = {{"photons", 20000}};  // traced before the limit: renders
+  EXPECT_NO_THROW(r.render(a, req));
+  r.setMemoryLimit(0);
 }
 
 TEST(RenderCore, SharedDerivedResourcesHoldTheSceneRenderedLast) {

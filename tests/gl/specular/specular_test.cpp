@@ -11,6 +11,7 @@
 #include "renderer/reference/PathTracer.h"
 #include "renderer/techniques/specular/Specular.h"
 #include "tests/gl/specular/SpecularTestSupport.h"
+#include "tests/support/Expect.h"
 
 namespace radiant {
 namespace {
@@ -850,14 +851,11 @@ TEST(Specular, MapsStayWithinTheirMemoryLimit) {
   EXPECT_LT(SpecularPass::mapBytes(36, 3, 128), SpecularPass::kMaxBytes);
   const Scene painted = testing::radiancePaintedCornell("cornell_glass");
   const int n = 32;
-  try {
-    renderer().render(painted, request(n, n, {{"cube_resolution", 2048}}));  // 2.25 GiB for one object
-    FAIL() << "maps of 2.25 GiB rendered";
-  } catch (const api::ApiError& e) {
-    EXPECT_EQ(e.status, 422);
-    EXPECT_EQ(e.pointer, "/passes/specular/cube_resolution");
-    EXPECT_NE(std::string(e.what()).find("2304 MiB"), std::string::npos) << e.what();
-  }
+  const api::ApiError e =  // 2.25 GiB for one object
+      testing::thrownApiError([&] { renderer().render(painted, request(n, n, {{"cube_resolution", 2048}})); });
+  EXPECT_EQ(e.status, 422);
+  EXPECT_EQ(e.pointer, "/passes/specular/cube_resolution");
+  EXPECT_NE(std::string(e.what()).find("2304 MiB"), std::string::npos) << e.what();
   // 64 texels per pixel of the sphere's 14.7 px want 1024 (576 MiB): drawn at 512 (144 MiB).
   RenderOutput out = renderer().render(painted, request(n, n, {{"cube_resolution", 2048}, {"map_texels_per_pixel", 64}}));
   const api::PassStats* specular = passStats(out, "specular");

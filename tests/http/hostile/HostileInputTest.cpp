@@ -721,3 +721,28 @@ TEST(HostileService, InvalidUtf8BeforeAuthenticationIsA401AndTheDaemonLives) {
   EXPECT_GE(lines, 3);
   fs::remove_all(dir);
 }
+
+// Issue 30, admission: over --memory-limit-bytes a frame's photon records are refused before they are
+// traced — 503 memory-busy with Retry-After, naming the photon count — and the daemon serves on: the
+// same scene without photon_gi renders.
+TEST(HostileService, AFrameOverTheMemoryLimitIsA503WithRetryAfter) {
+  const auto dir = radiant::testing::scratch("memorylimit");
+  Daemon d(RADIANTD_PATH, {"--port", "0", "--memory-limit-bytes", "1048576"}, {}, dir / "stderr.log");
+  ASSERT_TRUE(d.waitReady(std::chrono::seconds(60)));
+  auto c = d.client();
+  auto r = c.Post("/v1/renders", R"({"scene":{"builtin":"cornell_box"},"width":16,"height":16})", "application/json");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 503) << r->body;
+  EXPECT_EQ(r->get_header_value("Retry-After"), "1");
+  const json problem = json::parse(r->body);
+  EXPECT_EQ(problem["type"], "https://radiant.dev/problems/memory-busy");
+  EXPECT_EQ(problem["pointer"], "/passes/photon_gi/photons");
+  auto ok = c.Post("/v1/renders", R"({"scene":{"builtin":"cornell_box"},"width":16,"height":16,"passes":{"photon_gi":false}})",
+                   "application/json");
+  ASSERT_TRUE(ok);
+  EXPECT_EQ(ok->status, 200) << ok->body;
+  auto info = c.Get("/v1/info");
+  ASSERT_TRUE(info);
+  EXPECT_EQ(json::parse(info->body)["limits"]["memory_limit_bytes"], 1048576);
+  fs::remove_all(dir);
+}
