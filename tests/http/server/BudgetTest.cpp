@@ -556,8 +556,9 @@ TEST(Budgets, TheChooserMeasuresTheMachineAndScalesItsPredictions) {
       << "the window holds the observed frames before this one";
   // The same seed and point again: its photons are reused, so the frame is not observed.
   const json again = d.render(budgeted(15));
-  if (again["stats"]["budget"]["techniques"]["photon_gi"]["params"] == r["stats"]["budget"]["techniques"]["photon_gi"]["params"])
+  if (again["stats"]["budget"]["techniques"]["photon_gi"]["params"] == r["stats"]["budget"]["techniques"]["photon_gi"]["params"]) {
     EXPECT_FALSE(again["stats"]["budget"]["speed"]["observed"].get<bool>()) << again["stats"]["cache"].dump();
+  }
 
   // Pinned: exactly 4x the table, no calibration.
   RealDaemon pinned("speed-pinned", {"--speed-factor", "4"});
