@@ -172,6 +172,14 @@ Scene umbraScene(float scale, const std::string& digest) {
   return b.build(digest);
 }
 
+// A counter of photon_gi in a frame's stats (a failure, and -1, when the pass did not run).
+double photonGiCounter(const RenderOutput& o, const std::string& name) {
+  for (const auto& p : o.stats.passes)
+    if (p.name == "photon_gi") return p.counters.at(name);
+  ADD_FAILURE() << "no photon_gi pass";
+  return -1.0;
+}
+
 TEST(RenderCore, UmbraIsBlackAndLitPlaneHasNoAcne) {
   const int size = 96;
   const float half = 1.5f;
@@ -411,12 +419,6 @@ TEST(RenderCore, TheSplatBufferFollowsItsGrid) {
 // frame did not touch — and what a later frame rebuilds from that is the same image. Under a target it
 // is under, nothing goes.
 TEST(RenderCore, TheMemoryTargetReleasesWhatTheFrameDoesNotUse) {
-  auto counter = [](const RenderOutput& o, const char* name) {
-    for (const auto& p : o.stats.passes)
-      if (p.name == "photon_gi") return p.counters.at(name);
-    ADD_FAILURE() << "no photon_gi pass";
-    return -1.0;
-  };
   auto hit = [](const RenderOutput& o, const char* what) {
     for (const auto& c : o.stats.cache)
       if (c.what == what) return c.hit;
@@ -433,7 +435,7 @@ TEST(RenderCore, TheMemoryTargetReleasesWhatTheFrameDoesNotUse) {
   const RenderOutput first = r.render(b, req);
   const RenderOutput kept = r.render(a, req);
   EXPECT_TRUE(hit(kept, "gpu_scene"));
-  EXPECT_EQ(counter(kept, "photons_traced"), 0.0) << "under the target every scene keeps its photons";
+  EXPECT_EQ(photonGiCounter(kept, "photons_traced"), 0.0) << "under the target every scene keeps its photons";
   EXPECT_EQ(kept.stats.memory.at("released_bytes").get<double>(), 0.0);
   EXPECT_GT(kept.stats.memory.at("resident_bytes").get<double>(), 0.0);
   EXPECT_GT(kept.stats.memory.at("resource_bytes").get<double>(), 0.0);
@@ -443,12 +445,12 @@ TEST(RenderCore, TheMemoryTargetReleasesWhatTheFrameDoesNotUse) {
   EXPECT_EQ(released.stats.memory.at("target_bytes").get<double>(), 1.0);
   const RenderOutput rebuilt = r.render(b, req);
   EXPECT_FALSE(hit(rebuilt, "gpu_scene")) << "b's GPU copy went with a's frame";
-  EXPECT_EQ(counter(rebuilt, "photons_traced"), 20000.0) << "b's photon set went with a's frame";
+  EXPECT_EQ(photonGiCounter(rebuilt, "photons_traced"), 20000.0) << "b's photon set went with a's frame";
   EXPECT_LT(testing::maxAbsDifference(aov(first, "beauty"), aov(rebuilt, "beauty")), 1e-5f)
       << "b rebuilt after the release renders as before";
   const RenderOutput again = r.render(b, req);
   EXPECT_TRUE(hit(again, "gpu_scene")) << "the frame's own scene stays";
-  EXPECT_EQ(counter(again, "photons_traced"), 0.0) << "the frame's own photons stay";
+  EXPECT_EQ(photonGiCounter(again, "photons_traced"), 0.0) << "the frame's own photons stay";
   r.setMemoryTarget(std::size_t(1) << 40);
 }
 
@@ -456,31 +458,25 @@ TEST(RenderCore, TheMemoryTargetReleasesWhatTheFrameDoesNotUse) {
 // grid stays resident, so the next frame traces nothing and renders the same image; a frame that needs
 // another grid (another C) traces the photons again.
 TEST(RenderCore, PhotonRecordsReleasedUnderTheMemoryTargetAreTracedAgainWhenNeeded) {
-  auto counter = [](const RenderOutput& o, const char* name) {
-    for (const auto& p : o.stats.passes)
-      if (p.name == "photon_gi") return p.counters.at(name);
-    ADD_FAILURE() << "no photon_gi pass";
-    return -1.0;
-  };
   Renderer& r = renderer();
   const Scene a = umbraScene(1.f, "records-released");
   api::RenderRequest req = request(16, {"beauty"});
   req.passes["photon_gi"] = {{"photons", 20000}};
   r.setMemoryTarget(1);
   const RenderOutput first = r.render(a, req);
-  EXPECT_EQ(counter(first, "photons_traced"), 20000.0);
-  EXPECT_EQ(counter(first, "records_released"), 1.0);
-  EXPECT_GT(counter(first, "records"), 0.0);
+  EXPECT_EQ(photonGiCounter(first, "photons_traced"), 20000.0);
+  EXPECT_EQ(photonGiCounter(first, "records_released"), 1.0);
+  EXPECT_GT(photonGiCounter(first, "records"), 0.0);
   const RenderOutput second = r.render(a, req);
-  EXPECT_EQ(counter(second, "photons_traced"), 0.0) << "the grid was resident: nothing to trace";
-  EXPECT_EQ(counter(second, "records"), counter(first, "records")) << "the grid's own count";
+  EXPECT_EQ(photonGiCounter(second, "photons_traced"), 0.0) << "the grid was resident: nothing to trace";
+  EXPECT_EQ(photonGiCounter(second, "records"), photonGiCounter(first, "records")) << "the grid's own count";
   EXPECT_LT(testing::maxAbsDifference(aov(first, "beauty"), aov(second, "beauty")), 1e-6f);
   req.passes["photon_gi"] = {{"photons", 20000}, {"C", 12.0}};
-  EXPECT_EQ(counter(r.render(a, req), "photons_traced"), 20000.0) << "another grid needs the records again";
+  EXPECT_EQ(photonGiCounter(r.render(a, req), "photons_traced"), 20000.0) << "another grid needs the records again";
   r.setMemoryTarget(std::size_t(1) << 40);
   req.passes["photon_gi"] = {{"photons", 20000}};
   const RenderOutput kept = r.render(a, req);
-  EXPECT_EQ(counter(kept, "records_released"), 0.0) << "under the target the records stay";
+  EXPECT_EQ(photonGiCounter(kept, "records_released"), 0.0) << "under the target the records stay";
 }
 
 // Issue 30, admission: a frame whose photon records would take the process over the memory limit

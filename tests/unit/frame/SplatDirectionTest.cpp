@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "renderer/techniques/photon_gi/Splatting.h"
+#include "tests/support/Directions.h"
 
 namespace radiant::photon_gi {
 namespace {
@@ -14,22 +15,7 @@ namespace {
 // within 2e-4 radians (what 15 bits per octahedral coordinate allow, after the photon record's 16),
 // and the flags beside them survive and do not disturb the direction.
 TEST(SplatDirection, IsWithinItsStatedAngleAndKeepsItsFlags) {
-  std::vector<glm::vec3> dirs;
-  const int n = 100000;
-  for (int i = 0; i < n; ++i) {
-    const double z = 1.0 - (i + 0.5) * 2.0 / n, r = std::sqrt(std::max(0.0, 1.0 - z * z));
-    const double phi = i * 2.399963229728653;
-    dirs.emplace_back(float(r * std::cos(phi)), float(r * std::sin(phi)), float(z));
-  }
-  for (int a = 0; a < 3; ++a)
-    for (float sgn : {-1.f, 1.f}) {
-      glm::vec3 v(0.f);
-      v[a] = sgn;
-      dirs.push_back(v);
-    }
-  for (float x : {-1.f, 1.f})
-    for (float y : {-1.f, 1.f})
-      for (float z : {-1.f, 0.f, 1.f}) dirs.push_back(glm::normalize(glm::vec3(x, y, z)));
+  const std::vector<glm::vec3> dirs = testing::testDirections(100000);
   double worst = 0.0;
   for (const glm::vec3& v : dirs)
     for (bool diffuseOnly : {false, true}) {

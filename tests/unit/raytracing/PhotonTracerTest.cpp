@@ -8,6 +8,7 @@
 #include <cstring>
 
 #include "renderer/raytracing/PhotonTracer.h"
+#include "tests/support/Directions.h"
 #include "tests/unit/reference/TestScenes.h"
 
 namespace radiant::rt {
@@ -355,22 +356,7 @@ namespace {
 // decode to a unit vector within 1e-4 radians of what was encoded (6.4e-5 measured); zero and non-finite input decode to
 // a unit vector (+z), never NaN.
 TEST(PhotonTracer, OctahedralRecordVectorsAreWithinTheirStatedAngle) {
-  std::vector<glm::vec3> dirs;
-  const int n = 200000;
-  for (int i = 0; i < n; ++i) {
-    const double z = 1.0 - (i + 0.5) * 2.0 / n, r = std::sqrt(std::max(0.0, 1.0 - z * z));
-    const double phi = i * 2.399963229728653;
-    dirs.emplace_back(float(r * std::cos(phi)), float(r * std::sin(phi)), float(z));
-  }
-  for (int a = 0; a < 3; ++a)
-    for (float sgn : {-1.f, 1.f}) {
-      glm::vec3 v(0.f);
-      v[a] = sgn;
-      dirs.push_back(v);
-    }
-  for (float x : {-1.f, 1.f})
-    for (float y : {-1.f, 1.f})
-      for (float z : {-1.f, 0.f, 1.f}) dirs.push_back(glm::normalize(glm::vec3(x, y, z)));
+  std::vector<glm::vec3> dirs = testing::testDirections(200000);
   for (float t = -1.f; t <= 1.f; t += 1.f / 64.f) {
     dirs.push_back(glm::normalize(glm::vec3(t, 1.f - std::abs(t), 0.f)));
     dirs.push_back(glm::normalize(glm::vec3(t, 0.f, -1.f)));
