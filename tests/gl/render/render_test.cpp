@@ -172,6 +172,14 @@ Scene umbraScene(float scale, const std::string& digest) {
   return b.build(digest);
 }
 
+// Whether the frame's lookup of `what` hit its cache (a failure, and false, when it did not look it up).
+bool cacheHit(const RenderOutput& o, const std::string& what) {
+  for (const auto& c : o.stats.cache)
+    if (c.what == what) return c.hit;
+  ADD_FAILURE() << "no " << what << " cache entry in the stats";
+  return false;
+}
+
 // A counter of photon_gi in a frame's stats (a failure, and -1, when the pass did not run).
 double photonGiCounter(const RenderOutput& o, const std::string& name) {
   for (const auto& p : o.stats.passes)
@@ -328,20 +336,14 @@ TEST(RenderCore, DerivedDataIsCachedAcrossFrames) {
 // again, and A B C A has evicted it (least recently used first). The scenes' derived data (here the
 // shadow maps) is kept alike, so alternating between scenes rebuilds nothing.
 TEST(RenderCore, GpuSceneCacheKeepsTheMostRecentlyUsedScenes) {
-  auto hitOf = [](const RenderOutput& o, const char* what) {
-    for (const auto& c : o.stats.cache)
-      if (c.what == what) return c.hit;
-    ADD_FAILURE() << "no " << what << " cache entry in the stats";
-    return false;
-  };
   // The uploaded scene is kept per scene (LRU); the shadow maps live in one shared texture, so they are
   // reused only when the frame before rendered the same scene (FrameResources::holds).
   const Scene* last = nullptr;
   auto gpuHit = [&](const Scene& s) {
     const RenderOutput o = renderer().render(s, request(8));
-    EXPECT_EQ(hitOf(o, "shadow_maps"), last == &s) << "the shadow textures hold the last scene's maps";
+    EXPECT_EQ(cacheHit(o, "shadow_maps"), last == &s) << "the shadow textures hold the last scene's maps";
     last = &s;
-    return hitOf(o, "gpu_scene");
+    return cacheHit(o, "gpu_scene");
   };
   Renderer& r = renderer();
   r.setGpuSceneCapacity(2);
@@ -419,12 +421,6 @@ TEST(RenderCore, TheSplatBufferFollowsItsGrid) {
 // frame did not touch — and what a later frame rebuilds from that is the same image. Under a target it
 // is under, nothing goes.
 TEST(RenderCore, TheMemoryTargetReleasesWhatTheFrameDoesNotUse) {
-  auto hit = [](const RenderOutput& o, const char* what) {
-    for (const auto& c : o.stats.cache)
-      if (c.what == what) return c.hit;
-    ADD_FAILURE() << "no " << what << " cache entry";
-    return false;
-  };
   Renderer& r = renderer();
   r.setGpuSceneCapacity(4);
   r.setMemoryTarget(std::size_t(1) << 40);
@@ -434,7 +430,7 @@ TEST(RenderCore, TheMemoryTargetReleasesWhatTheFrameDoesNotUse) {
   r.render(a, req);
   const RenderOutput first = r.render(b, req);
   const RenderOutput kept = r.render(a, req);
-  EXPECT_TRUE(hit(kept, "gpu_scene"));
+  EXPECT_TRUE(cacheHit(kept, "gpu_scene"));
   EXPECT_EQ(photonGiCounter(kept, "photons_traced"), 0.0) << "under the target every scene keeps its photons";
   EXPECT_EQ(kept.stats.memory.at("released_bytes").get<double>(), 0.0);
   EXPECT_GT(kept.stats.memory.at("resident_bytes").get<double>(), 0.0);
@@ -444,12 +440,12 @@ TEST(RenderCore, TheMemoryTargetReleasesWhatTheFrameDoesNotUse) {
   const RenderOutput released = r.render(a, req);
   EXPECT_EQ(released.stats.memory.at("target_bytes").get<double>(), 1.0);
   const RenderOutput rebuilt = r.render(b, req);
-  EXPECT_FALSE(hit(rebuilt, "gpu_scene")) << "b's GPU copy went with a's frame";
+  EXPECT_FALSE(cacheHit(rebuilt, "gpu_scene")) << "b's GPU copy went with a's frame";
   EXPECT_EQ(photonGiCounter(rebuilt, "photons_traced"), 20000.0) << "b's photon set went with a's frame";
   EXPECT_LT(testing::maxAbsDifference(aov(first, "beauty"), aov(rebuilt, "beauty")), 1e-5f)
       << "b rebuilt after the release renders as before";
   const RenderOutput again = r.render(b, req);
-  EXPECT_TRUE(hit(again, "gpu_scene")) << "the frame's own scene stays";
+  EXPECT_TRUE(cacheHit(again, "gpu_scene")) << "the frame's own scene stays";
   EXPECT_EQ(photonGiCounter(again, "photons_traced"), 0.0) << "the frame's own photons stay";
   r.setMemoryTarget(std::size_t(1) << 40);
 }
