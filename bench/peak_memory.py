@@ -33,6 +33,16 @@ def status_mib(pid):
     return out
 
 
+def wait_ready(server, seconds=60):
+    """Waits until the daemon at `server` answers /v1/ready (also bench/memory_budgets_full.py)."""
+    for _ in range(seconds * 10):
+        try:
+            urllib.request.urlopen(server + "/v1/ready", timeout=1)
+            return
+        except Exception:
+            time.sleep(0.1)
+
+
 def stacked_triangles(path):
     # The hostile scene-cache test's soup: 16,667 unit triangles 1e-4 apart (50,001 vertices).
     import base64
@@ -84,12 +94,7 @@ def main():
     log = open(os.path.join(tmp, "radiantd.log"), "w")
     daemon = subprocess.Popen([args.radiantd, "--port", str(args.port)] + args.flags, stdout=log, stderr=log)
     try:
-        for _ in range(600):
-            try:
-                urllib.request.urlopen(server + "/v1/ready", timeout=1)
-                break
-            except Exception:
-                time.sleep(0.1)
+        wait_ready(server)
         info = json.load(urllib.request.urlopen(server + "/v1/info"))
         renderer = info.get("device", {}).get("renderer", "?")
         m = status_mib(daemon.pid)

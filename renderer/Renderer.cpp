@@ -384,6 +384,8 @@ struct Renderer::Impl {
   // last: derived data of the map and the options only, computed once per change of either.
   std::vector<std::pair<std::string, std::shared_ptr<const EnvironmentLights>>> environmentSplits;
 
+  std::function<void()> releaseHook;  // setReleaseHook: what the renderer's owner may drop
+
   std::shared_ptr<const EnvironmentLights> environmentLights(const FrameView& view, const EnvironmentLightOptions& o,
                                                              api::FrameStats& stats, const rt::Cancel& cancel) {
     const Image& map = *view.environment;
@@ -412,6 +414,11 @@ struct Renderer::Impl {
       std::rotate(it, it + 1, gpuScenes.end());
       return *gpuScenes.back().second;
     }
+    // An upload is a large allocation like a pass's (on llvmpipe its textures and buffers are host
+    // memory): released for and admitted under the memory limit before it is made.
+    const std::size_t bytes = GpuScene::estimateBytes(scene);
+    resources.makeRoom(bytes);
+    resources.admit(bytes, "/scene");
     const auto t0 = Clock::now();
     auto g = std::make_unique<GpuScene>(scene, cancel);
     stats.uploadMs = msSince(t0);
@@ -429,6 +436,7 @@ Renderer::Renderer(const DeviceOptions& options) : impl_(std::make_unique<Impl>(
     if (im->gpuScenes.size() > 1) im->gpuScenes.erase(im->gpuScenes.begin(), im->gpuScenes.end() - 1);
     if (im->environmentSplits.size() > 1)
       im->environmentSplits.erase(im->environmentSplits.begin(), im->environmentSplits.end() - 1);
+    if (im->releaseHook) im->releaseHook();
   });
   // Per-pass times (GpuProfiler.h): timer queries on a hardware device, glFinish brackets on a software one.
   impl_->profiler = GpuProfiler(impl_->device->info().software ? GpuProfiler::Method::Finish : GpuProfiler::Method::TimerQuery);
@@ -441,6 +449,8 @@ Renderer::Renderer(const DeviceOptions& options) : impl_(std::make_unique<Impl>(
 Renderer::~Renderer() = default;
 
 void Renderer::setSpeedFactor(double factor) { impl_->speed.pin(factor); }
+
+void Renderer::setReleaseHook(std::function<void()> hook) { impl_->releaseHook = std::move(hook); }
 
 // The speed factor's calibration (api::MachineSpeed): the preset table's canonical frame, the built-in
 // Cornell box at the table's error size with photon_gi's cheapest front point, rendered twice with
@@ -557,6 +567,11 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
                               const FrameInputs& inputsIn) {
   Impl& im = *impl_;
   im.device->makeCurrent();
+  // The frame's memory claim (FrameResources::admit) ends with the frame, however it ends.
+  struct ClaimScope {
+    FrameResources& resources;
+    ~ClaimScope() { resources.releaseClaim(); }
+  } claimScope{im.resources};
   RenderOutput out;
   api::FrameStats& stats = out.stats;
   const DeviceInfo& dev = im.device->info();

@@ -98,6 +98,9 @@ public:
   // The resident set beyond which a pass's large allocation is refused (503 memory-busy) when the
   // release does not make room for it; 0 = none (the default); radiantd --memory-limit-bytes.
   void setMemoryLimit(std::size_t bytes);
+  // Called (on the render thread) when the memory accountant releases, to free what the renderer's
+  // owner holds for it and may drop: radiantd's decoded scenes and images that no job holds.
+  void setReleaseHook(std::function<void()> hook);
   // The budget chooser's speed factor (api::MachineSpeed): > 0 pins it (radiantd --speed-factor),
   // 0 measures it: a calibration frame before the first frame with a time budget, then the ratio of
   // measured to predicted time of recent frames comparable with the preset table. Default 0.

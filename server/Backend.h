@@ -32,6 +32,9 @@ public:
   // `inputs` holds the decoded images the request names by digest (compare.against, environment).
   virtual RenderOutput render(const Scene& scene, const api::RenderRequest& request,
                               const std::atomic<bool>* cancel, const FrameInputs& inputs) = 0;
+  // What the backend's memory accountant may call (on the render thread) when it releases memory:
+  // the server drops the decoded scenes and images no job holds. Default: not used.
+  virtual void setReleaseHook(std::function<void()>) {}
 };
 
 struct BackendHooks {
@@ -54,6 +57,10 @@ struct BackendHooks {
                             float exposureEV)>
       encodeFrame;
   std::vector<TechniqueDescription> techniques;  // what the backend implements (may be empty: unknown)
+  // The process's resident set in bytes, which decodes and request bodies are admitted against under
+  // --memory-limit-bytes (the renderer's own admission reads the same). Unset: radiant::residentBytes()
+  // (renderer/ResidentMemory.h); tests inject one.
+  std::function<std::size_t()> residentBytes;
 };
 
 }  // namespace radiant::server

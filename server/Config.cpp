@@ -66,8 +66,10 @@ std::string usage() {
                             copies, maps and derived data) when over it (default 1342177280)
   --memory-limit-bytes N    a frame whose large allocation (photon records and splats, specular and
                             caustic maps) would take the daemon's resident set over N even after that
-                            release gets 503 memory-busy with Retry-After, before allocating; 0 = no
-                            limit (default 1500000000)
+                            release gets 503 memory-busy with Retry-After, before allocating; so does a
+                            decode or a request body that would (after dropping unheld decoded scenes
+                            and waiting up to 1 s), whatever the budgets above sum to; 0 = no limit
+                            (default 1500000000)
   --speed-factor F|auto      this machine's frame time over the preset table's prediction, which time
                             budgets scale every predicted cost by; auto (the default) measures it: a
                             calibration frame before the first budgeted frame, then recent frames

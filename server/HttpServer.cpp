@@ -9,9 +9,12 @@
 #include <functional>
 #include <future>
 #include <iostream>
+#include <limits>
 #include <list>
+#include <malloc.h>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <random>
 #include <set>
 #include <thread>
@@ -30,6 +33,7 @@
 #include "server/Metrics.h"
 #include "server/RenderService.h"
 #include "server/ContentStore.h"
+#include "renderer/ResidentMemory.h"
 #include "renderer/scene/GltfPackage.h"
 
 namespace radiant::server {
@@ -238,9 +242,41 @@ using DecodedImages = DecodedCache<Image, imageBytes>;
 // to 1.8 GB), nor can renders queued behind a long one, each holding a scene of its own.
 // A second instance budgets the request bodies being read or handled (bodyMemory, --body-memory-bytes,
 // readBody), whose callers turn its 503 decode-busy into body-busy.
+//
+// Both budgets are also held to the process's memory limit (--memory-limit-bytes) through one
+// ResidentGate: a reservation fits only when the resident set, plus every reservation still in flight
+// (a decode's or body's bytes not yet known to be resident: counted twice once they are, which errs on
+// the safe side), plus its own bytes stays under the limit. The renderer admits its large allocations
+// against the same resident set (FrameResources::admit), so decoded scenes held by queued renders,
+// bodies being read and the frame cannot add up past the limit, whatever the three budgets sum to.
+// Refused after the same wait, with 503 memory-busy.
+class ResidentGate {
+public:
+  ResidentGate(std::function<std::size_t()> resident, std::size_t limit)
+      : resident_(resident ? std::move(resident) : std::function<std::size_t()>(radiant::residentBytes)), limit_(limit) {}
+  std::size_t limit() const { return limit_; }
+  // Claims `bytes` more (MemoryClaims, shared with the renderer's admission) when they fit; `resident`
+  // (out) is what was read. No limit, or an unknown resident set (0), always fits.
+  bool claim(std::size_t bytes, std::size_t& resident) {
+    if (limit_ == 0) return true;
+    return MemoryClaims::process().tryReplace(0, bytes, limit_, resident_, &resident);
+  }
+  void release(std::size_t bytes) {
+    if (limit_ != 0) MemoryClaims::process().release(bytes);
+  }
+  std::uint64_t refused() const { return refused_.load(); }
+  void countRefusal() { ++refused_; }
+
+private:
+  std::function<std::size_t()> resident_;
+  std::size_t limit_;
+  std::atomic<std::uint64_t> refused_{0};
+};
+
 class DecodeMemory {
 public:
-  explicit DecodeMemory(std::size_t bytes) : total_(std::max<std::size_t>(1, bytes)) {}
+  explicit DecodeMemory(std::size_t bytes, ResidentGate* gate = nullptr)
+      : total_(std::max<std::size_t>(1, bytes)), gate_(gate) {}
   std::size_t total() const { return total_; }
   std::size_t reserved() {
     std::lock_guard lock(mutex_);
@@ -255,25 +291,55 @@ public:
     explicit Reservation(DecodeMemory& m) : m_(&m) {}
     Reservation(const Reservation&) = delete;
     Reservation& operator=(const Reservation&) = delete;
-    ~Reservation() { m_->release(held_); }
-    // Adds `bytes`, waiting up to `wait` for them; throws ApiError 503 decode-busy when they do not free.
+    ~Reservation() {
+      if (m_->gate_) m_->gate_->release(claimed_);
+      m_->release(held_);
+    }
+    // Adds `bytes`, waiting up to `wait` for them; throws ApiError 503 decode-busy when they do not free
+    // (memory-busy when the budget has them but the process's memory limit does not).
     void grow(std::size_t bytes, std::chrono::milliseconds wait = std::chrono::seconds(1)) {
       const std::size_t total = m_->total_;
+      ResidentGate* gate = m_->gate_;
       // Never more than the whole budget: a decode the per-decode limit allows always fits on its own.
-      bool fits = bytes <= total - std::min(total, held_);
+      bool fits = bytes <= total - std::min(total, held_) && (!gate || gate->limit() == 0 || bytes <= gate->limit());
+      bool overLimit = false;
+      std::size_t resident = 0;
       const auto until = std::chrono::steady_clock::now() + wait;
       while (fits) {
         if (m_->evict_ && m_->reserved() + bytes > total) m_->evict_(m_->reserved() + bytes - total);
         std::unique_lock lock(m_->mutex_);
         if (m_->used_ + bytes <= total) {
-          m_->used_ += bytes;
-          held_ += bytes;
-          return;
+          // The budget has them; the process's limit next (claimed under the budget's lock, so a
+          // claim is never left without its budget bytes).
+          overLimit = gate && !gate->claim(bytes, resident);
+          if (overLimit && m_->evict_) {
+            // Over the limit: what only the caches hold goes first (the freed heap returns to the system).
+            lock.unlock();
+            m_->evict_(bytes);
+            malloc_trim(0);
+            lock.lock();
+            overLimit = m_->used_ + bytes <= total && !gate->claim(bytes, resident);
+          }
+          if (!overLimit && m_->used_ + bytes <= total) {
+            m_->used_ += bytes;
+            held_ += bytes;
+            if (gate) claimed_ += bytes;
+            return;
+          }
         }
         // A job ending releases its charges (notify); a cached result it held becomes droppable.
         const auto next = std::min(until, std::chrono::steady_clock::now() + std::chrono::milliseconds(100));
         if (std::chrono::steady_clock::now() >= until) break;
         m_->cv_.wait_until(lock, next);
+      }
+      if (overLimit) {
+        gate->countRefusal();
+        throw api::ApiError(503, "memory-busy", "Not enough memory",
+                            "reading or decoding needs " + std::to_string(bytes >> 20) + " MiB more; the daemon "
+                                "holds " + std::to_string(resident >> 20) + " MiB and decodes, bodies and the frame "
+                                "in flight claim " + std::to_string(MemoryClaims::process().claimed() >> 20) +
+                                " MiB more, over its limit of " + std::to_string(gate->limit() >> 20) +
+                                " MiB (--memory-limit-bytes): retry after the Retry-After seconds");
       }
       std::lock_guard lock(m_->mutex_);
       ++m_->refused_;
@@ -291,6 +357,7 @@ public:
   private:
     DecodeMemory* m_;
     std::size_t held_ = 0;
+    std::size_t claimed_ = 0;  // of held_, claimed under the memory limit (MemoryClaims)
   };
 
   // A decoded value charged to the budget (`bytes`, what it holds) until its last holder lets it go.
@@ -327,6 +394,7 @@ private:
   std::mutex mutex_;
   std::condition_variable cv_;
   std::size_t total_, used_ = 0;
+  ResidentGate* gate_;
   std::atomic<std::uint64_t> refused_{0};
   std::function<void(std::size_t)> evict_;
 };
@@ -340,6 +408,7 @@ struct HttpServer::Impl {
   FrameStore frames;
   ContentStore scenes;
   ContentStore images;  // comparison targets (compare.against = their digest)
+  ResidentGate residentGate;  // --memory-limit-bytes, for both budgets below
   DecodeMemory decodeMemory;  // before the caches: what they hold releases its charge here when dropped
   DecodeMemory bodyMemory;    // request bodies being read or handled (--body-memory-bytes; readBody)
   DecodedScenes decoded;
@@ -357,14 +426,31 @@ struct HttpServer::Impl {
     return c;
   }
 
+  // The backend's memory accountant may drop the decoded scenes and images no job holds (on the render
+  // thread, when it releases: FrameResources::makeRoom), so a frame is not refused memory that only
+  // these caches keep.
+  static BackendHooks withRelease(BackendHooks h, Impl* self) {
+    if (!h.createBackend) return h;
+    h.createBackend = [create = std::move(h.createBackend), self] {
+      std::unique_ptr<RenderBackend> backend = create();
+      backend->setReleaseHook([self] {
+        self->decodedImages.dropUnshared(std::numeric_limits<std::size_t>::max());
+        self->decoded.dropUnshared(std::numeric_limits<std::size_t>::max());
+      });
+      return backend;
+    };
+    return h;
+  }
+
   Impl(ServerConfig c, BackendHooks h)
       : config(derived(std::move(c))),
-        hooks(std::move(h)),
+        hooks(withRelease(std::move(h), this)),
         frames(config.maxFrameBytes, config.frameTtlS),
         scenes(config.cacheDir, config.maxSceneBytes, "scenes"),
         images(config.cacheDir, config.maxSceneBytes, "images"),
-        decodeMemory(std::max(config.decodeMemoryBytes, config.maxDecodeBytes)),
-        bodyMemory(std::max(config.bodyMemoryBytes, config.maxBodyBytes)),
+        residentGate(hooks.residentBytes, config.memoryLimitBytes),
+        decodeMemory(std::max(config.decodeMemoryBytes, config.maxDecodeBytes), &residentGate),
+        bodyMemory(std::max(config.bodyMemoryBytes, config.maxBodyBytes), &residentGate),
         decoded(config.sceneCacheEntries, config.sceneCacheBytes),
         decodedImages(std::min<std::size_t>(4, config.sceneCacheEntries), config.sceneCacheBytes / 2),
         service(config, hooks, frames, metrics) {
@@ -546,14 +632,16 @@ struct HttpServer::Impl {
                        DecodeMemory::Reservation& charge) {
     std::string body;
     bool tooLarge = false, busy = false;
+    std::optional<api::ApiError> overLimit;  // memory-busy: the process's limit, not the bodies' budget
     std::size_t charged = 0;
     auto chargeUpTo = [&](std::size_t bytes) {
       if (bytes <= charged) return true;
       const std::size_t more = std::min(std::max<std::size_t>(bytes - charged, std::size_t(64) << 10), config.maxBodyBytes - charged);
       try {
         charge.grow(more);
-      } catch (const api::ApiError&) {
+      } catch (const api::ApiError& e) {
         busy = true;
+        if (e.type == "memory-busy") overLimit = e;
         return false;
       }
       charged += more;
@@ -575,6 +663,7 @@ struct HttpServer::Impl {
     if (busy) {
       markCloseConnection();  // the body (or its rest) is still on the wire
       res.set_header("Connection", "close");
+      if (overLimit) throw *overLimit;
       throw api::ApiError(503, "body-busy", "Busy reading bodies",
                           "the request bodies being read or handled hold " + std::to_string(bodyMemory.reserved()) +
                               " of the " + std::to_string(bodyMemory.total()) +
@@ -827,6 +916,7 @@ struct HttpServer::Impl {
           {"radiant_frame_store_bytes", {"Bytes of encoded frames stored.", double(frames.totalBytes())}},
           {"radiant_decode_bytes_reserved", {"Bytes of --decode-memory-bytes taken: decodes in flight, and the decoded scenes and images cached or held by renders.", double(decodeMemory.reserved())}},
           {"radiant_decodes_refused", {"Decodes refused with 503 decode-busy since start (--decode-memory-bytes).", double(decodeMemory.refused())}},
+          {"radiant_memory_refused", {"Bodies and decodes refused with 503 memory-busy since start: the resident set was near --memory-limit-bytes.", double(residentGate.refused())}},
           {"radiant_body_bytes_reserved", {"Bytes of --body-memory-bytes taken by request bodies being read or handled.", double(bodyMemory.reserved())}},
           {"radiant_bodies_refused", {"Requests refused with 503 body-busy since start (--body-memory-bytes).", double(bodyMemory.refused())}}};
       res.status = 200;

@@ -37,6 +37,7 @@ public:
                       const FrameInputs& inputs) override {
     return renderer_.render(scene, request, cancel, inputs);
   }
+  void setReleaseHook(std::function<void()> hook) override { renderer_.setReleaseHook(std::move(hook)); }
 
 private:
   Renderer renderer_;

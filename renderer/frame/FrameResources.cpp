@@ -1,14 +1,13 @@
 #include "renderer/frame/FrameResources.h"
 
 #include <algorithm>
-#include <cstdio>
+#include <stdexcept>
 
 #include <malloc.h>
-#include <unistd.h>
-#include <stdexcept>
 
 #include "api/Aovs.h"
 #include "renderer/frame/GpuScene.h"
+#include "renderer/ResidentMemory.h"
 
 namespace radiant {
 namespace {
@@ -192,15 +191,7 @@ std::size_t FrameResources::resourceBytes() const {
   return total;
 }
 
-std::size_t FrameResources::residentBytes() {
-  std::FILE* f = std::fopen("/proc/self/statm", "r");
-  if (!f) return 0;
-  unsigned long long size = 0, resident = 0;
-  const int n = std::fscanf(f, "%llu %llu", &size, &resident);
-  std::fclose(f);
-  const long page = sysconf(_SC_PAGESIZE);
-  return n == 2 && page > 0 ? static_cast<std::size_t>(resident) * static_cast<std::size_t>(page) : 0;
-}
+std::size_t FrameResources::residentBytes() { return radiant::residentBytes(); }
 
 void FrameResources::releaseIdle() {
   auto idle = [&](const std::string& name) { return usedThisFrame_.count(name) == 0; };
@@ -240,18 +231,28 @@ std::size_t FrameResources::makeRoom(std::size_t bytes) {
   return released;
 }
 
-void FrameResources::admit(std::size_t bytes, const std::string& pointer) const {
-  const std::size_t after = memoryLimit_ ? residentBytes() : 0;
-  if (memoryLimit_ && after > 0 && after + bytes > memoryLimit_) {
-    const auto mib = [](std::size_t b) { return std::to_string(b >> 20); };
-    throw api::ApiError(503, "memory-busy", "Not enough memory",
-                        (pointer.empty() ? std::string("this frame") : pointer) + " needs about " + mib(bytes) +
-                            " MiB more, and the daemon holds " + mib(after) + " MiB after releasing what the frame "
-                            "does not use (decoded scenes of queued renders among it), above its limit of " +
-                            mib(memoryLimit_) + " MiB (--memory-limit-bytes): retry after the Retry-After seconds, "
-                            "or ask for less",
-                        pointer);
+void FrameResources::admit(std::size_t bytes, const std::string& pointer) {
+  if (!memoryLimit_) return;
+  // The frame's earlier allocations are resident now: its claim is the next one alone.
+  std::size_t after = 0;
+  if (MemoryClaims::process().tryReplace(claim_, bytes, memoryLimit_, residentBytes, &after)) {
+    claim_ = bytes;
+    return;
   }
+  const auto mib = [](std::size_t b) { return std::to_string(b >> 20); };
+  const std::size_t others = MemoryClaims::process().claimed() - claim_;
+  throw api::ApiError(503, "memory-busy", "Not enough memory",
+                      (pointer.empty() ? std::string("this frame") : pointer) + " needs about " + mib(bytes) +
+                          " MiB more; the daemon holds " + mib(after) + " MiB after releasing what the frame does "
+                          "not use (decoded scenes of queued renders among it) and decodes and request bodies in "
+                          "flight claim " + mib(others) + " MiB more, above its limit of " + mib(memoryLimit_) +
+                          " MiB (--memory-limit-bytes): retry after the Retry-After seconds, or ask for less",
+                      pointer);
+}
+
+void FrameResources::releaseClaim() {
+  if (claim_) MemoryClaims::process().release(claim_);
+  claim_ = 0;
 }
 
 }  // namespace radiant

@@ -186,8 +186,12 @@ public:
   std::size_t makeRoom(std::size_t bytes);
   // Admission under the memory limit (radiantd --memory-limit-bytes, 0 = none): after makeRoom, an
   // estimate that still does not fit under it is refused, a 503 memory-busy (Retry-After) naming
-  // `pointer`, the parameter that sized the allocation, before anything is allocated.
-  void admit(std::size_t bytes, const std::string& pointer) const;
+  // `pointer`, the parameter that sized the allocation, before anything is allocated. An admitted
+  // estimate is claimed process-wide (MemoryClaims, renderer/ResidentMemory.h) until the next admission
+  // of the frame replaces it or releaseClaim(), so concurrent decodes and request bodies see it.
+  void admit(std::size_t bytes, const std::string& pointer);
+  // Lets the frame's claim go (the Renderer, when the frame ends however it ends).
+  void releaseClaim();
   void setMemoryLimit(std::size_t bytes) { memoryLimit_ = bytes; }
   std::size_t memoryLimit() const { return memoryLimit_; }
   // What declaring this texture would allocate: 0 when it exists with this spec, else its bytes.
@@ -244,6 +248,7 @@ private:
   std::size_t memoryTarget_ = std::size_t(1) << 40;
   std::size_t releasedThisFrame_ = 0;
   std::size_t memoryLimit_ = 0;
+  std::size_t claim_ = 0;  // admit(): the frame's claim in MemoryClaims
   std::function<void()> trimHook_;
   std::set<std::string> passWrites_;
   // The current pass scope (beginPass / endPass).

@@ -88,6 +88,15 @@ std::string nextSceneKey(const Scene& scene) {
 }
 }  // namespace
 
+std::size_t GpuScene::estimateBytes(const Scene& scene) {
+  std::size_t bytes = 0;
+  for (const Texture& t : scene.textures) bytes += std::size_t(t.width) * std::size_t(t.height) * 4 * 4 / 3;
+  constexpr std::size_t kVertexBytes = 2 * sizeof(glm::vec3) + 2 * sizeof(glm::vec2) + sizeof(glm::vec4);
+  for (const MeshInstance& mi : scene.meshes)
+    bytes += mi.positions.size() * kVertexBytes + 2 * mi.indices.size() * sizeof(std::uint32_t);
+  return bytes;
+}
+
 GpuScene::GpuScene(const Scene& scene, const rt::Cancel& cancel) : sceneKey(nextSceneKey(scene)) {
   // Textures: colour textures are sampled through sRGB formats so the hardware linearises them.
   std::map<std::pair<int, bool>, int> textureIndex;

@@ -49,6 +49,10 @@ public:
   // `cancel` is polled between meshes (each uploads its buffers and first-used textures): a cancelled
   // upload throws rt::Cancelled and the half-built object is destroyed, never cached.
   explicit GpuScene(const Scene& scene, const rt::Cancel& cancel = {});
+  // What the upload will allocate, before making it (the memory accountant's admission): every
+  // texture once with its mip chain, every vertex with all five attributes, the indices and their
+  // levels of detail (at most as many again).
+  static std::size_t estimateBytes(const Scene& scene);
   // Identity of what was uploaded, for keys of derived data: "<digest>#<upload generation>". The
   // generation is unique per upload, so a key never outlives the scene it was built from (an address
   // could be reused by the next scene).

@@ -17,6 +17,7 @@
 
 #include "api/Aovs.h"
 #include "renderer/Renderer.h"
+#include "renderer/ResidentMemory.h"
 #include "renderer/scene/BuiltinScenes.h"
 #include "renderer/frame/FramePlanner.h"
 #include "renderer/frame/FrameResources.h"
@@ -491,8 +492,23 @@ TEST(RenderCore, AFrameOverTheMemoryLimitIsRefusedBeforeItAllocates) {
   EXPECT_EQ(e.type, "memory-busy");
   EXPECT_EQ(e.pointer, "/passes/photon_gi/photons");
   EXPECT_NE(std::string(e.what()).find("--memory-limit-bytes"), std::string::npos) << e.what();
+  EXPECT_EQ(MemoryClaims::process().claimed(), 0u) << "a refused frame's claim ends with it";
   req.passes["photon_gi"] = {{"photons", 20000}};  // traced before the limit: renders
   EXPECT_NO_THROW(r.render(a, req));
+  EXPECT_EQ(MemoryClaims::process().claimed(), 0u) << "a frame's claim ends with it";
+  // A scene's upload is admitted like a pass's allocation: a 4096^2 texture (85 MiB with its mips)
+  // is refused before it is uploaded, at /scene.
+  Scene big = umbraScene(1.f, "memory-limit-texture");
+  Texture t;
+  t.width = t.height = 4096;
+  t.rgba8.assign(std::size_t(4096) * 4096 * 4, 128);
+  big.textures.push_back(std::move(t));
+  r.setMemoryLimit(FrameResources::residentBytes() + (std::size_t(32) << 20));
+  const api::ApiError upload = testing::thrownApiError([&] { r.render(big, req); });
+  EXPECT_EQ(upload.status, 503);
+  EXPECT_EQ(upload.type, "memory-busy");
+  EXPECT_EQ(upload.pointer, "/scene");
+  EXPECT_EQ(MemoryClaims::process().claimed(), 0u);
   r.setMemoryLimit(0);
 }
 

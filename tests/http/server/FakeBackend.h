@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "api/Validate.h"
+#include "renderer/ResidentMemory.h"
 #include "server/Backend.h"
 #include "server/RenderService.h"
 
@@ -34,6 +35,8 @@ struct FakeControl {
   // Image decodes (uploads and the images renders name); one of bytes holding "hold-image" waits while
   // holdDecode is set (imageDecoding counts those waiting).
   std::atomic<int> imageDecodes{0}, imageDecoding{0};
+  // The resident set the server sees (--memory-limit-bytes admission); 0: the test process's own.
+  std::atomic<std::size_t> resident{0};
 
   void close() { std::lock_guard l(m); gateOpen = false; }
   void open() { { std::lock_guard l(m); gateOpen = true; } cv.notify_all(); }
@@ -159,6 +162,10 @@ inline server::BackendHooks fakeHooks(FakeControl& c) {
                      {"value", chosen[0].pixels.empty() ? 0.f : chosen[0].pixels[0]}, {"exposure", exposure}};
     for (const auto& img : chosen) j["aovs"].push_back(img.aov);
     return "FAKEFRAME " + j.dump();
+  };
+  h.residentBytes = [&c] {
+    const std::size_t r = c.resident.load();
+    return r ? r : radiant::residentBytes();
   };
   h.techniques = {{"direct", "fake direct", {"direct"}},
                   {"gbuffer", "fake gbuffer", {"albedo", "normal", "depth"}},

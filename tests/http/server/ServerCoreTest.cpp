@@ -877,6 +877,66 @@ TEST(ServerCore, QueuedRendersHoldTheirScenesInTheDecodeMemory) {
   EXPECT_EQ(reserved(), double(48u << 20));
 }
 
+// Issue 30, the budgets together: decodes and request bodies are also held to --memory-limit-bytes
+// (512 MiB here) against the process's resident set, which the test sets. Near the limit a decode that
+// would cross it first drops the decoded scenes only the cache holds, then waits a second and is refused
+// with 503 memory-busy and Retry-After (a body likewise, before it is read); one that fits beside still
+// runs; a decode that is waiting gets its room when the resident set falls.
+TEST(ServerCore, DecodesAndBodiesAreHeldToTheMemoryLimit) {
+  ServerConfig config;
+  config.memoryLimitBytes = 512u << 20;
+  TestServer s(config);
+  s.waitReady();
+  auto c = s.client();
+  auto metric = [&](const std::string& name) {
+    auto m = c.Get("/metrics");
+    const std::string key = "\n" + name + " ";
+    const auto at = m->body.find(key);
+    return at == std::string::npos ? -1.0 : std::stod(m->body.substr(at + key.size()));
+  };
+  // A decoded scene of 8 MiB that only the cache holds.
+  auto cached = c.Put("/v1/scenes", R"({"asset":{"version":"2.0"},"extras":{"scene-mib":8,"n":1}})", "model/gltf+json");
+  ASSERT_EQ(cached->status, 201) << cached->body;
+  EXPECT_EQ(metric("radiant_decode_bytes_reserved"), double(8u << 20));
+
+  s.control.resident = 500u << 20;
+  const std::string big = R"({"asset":{"version":"2.0"},"extras":{"reserve-mib":16,"n":2}})";
+  const auto t0 = std::chrono::steady_clock::now();
+  auto refused = c.Put("/v1/scenes", big, "model/gltf+json");
+  EXPECT_GE(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 0.9);
+  expectProblem(refused, 503, "memory-busy", "");
+  EXPECT_EQ(refused->get_header_value("Retry-After"), "1");
+  EXPECT_NE(json::parse(refused->body)["detail"].get<std::string>().find("--memory-limit-bytes"), std::string::npos);
+  EXPECT_EQ(metric("radiant_memory_refused"), 1.0);
+  EXPECT_EQ(metric("radiant_decode_bytes_reserved"), 0.0);  // the cached scene went first
+  EXPECT_EQ(metric("radiant_decodes_refused"), 0.0);        // the decode budget had room
+
+  // 500 + 8 MiB fits under 512.
+  auto fits = c.Put("/v1/scenes", R"({"asset":{"version":"2.0"},"extras":{"reserve-mib":8,"n":3}})", "model/gltf+json");
+  ASSERT_TRUE(fits);
+  EXPECT_EQ(fits->status, 201) << fits->body;
+
+  // A body of 600 KiB 100 KiB below the limit: refused on its Content-Length, its connection closed.
+  s.control.resident = (512u << 20) - (100u << 10);
+  const std::string padded = R"({"asset":{"version":"2.0"},"extras":{"n":4,"pad":")" + std::string(600 << 10, 'x') + "\"}}";
+  auto body = s.client().Put("/v1/scenes", padded, "model/gltf+json");
+  expectProblem(body, 503, "memory-busy", "");
+  EXPECT_EQ(body->get_header_value("Connection"), "close");
+  EXPECT_EQ(metric("radiant_memory_refused"), 2.0);
+
+  // A waiting decode gets its room when the resident set falls within its second.
+  s.control.resident = 500u << 20;
+  std::thread later([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    s.control.resident = 100u << 20;
+  });
+  auto admitted = s.client().Put("/v1/scenes", big, "model/gltf+json");
+  later.join();
+  ASSERT_TRUE(admitted);
+  EXPECT_EQ(admitted->status, 201) << admitted->body;
+  EXPECT_EQ(metric("radiant_memory_refused"), 2.0);
+}
+
 TEST(ServerCore, MetricsCountRequestsPassesAndQueue) {
   TestServer s;
   s.waitReady();
