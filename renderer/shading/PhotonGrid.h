@@ -43,6 +43,7 @@ struct PhotonGrid {
   glm::ivec3 dims{1};
   std::uint32_t maxPerCell = 0;
   int kernel = 0;            // photon.glsl KERNEL_*
+  float minRadius = 0.f;     // the smallest splat radius h (photon_gi's h_min): readers' surface tests
   bool renormalize = true;   // divide by the coverage points' kernel mass
   // Binds the splat and cell buffers (kPhotonSplatBinding, kPhotonCellBinding).
   void bind(FrameResources& res) const {

@@ -88,6 +88,8 @@ RADIANT_CONST int kBindingMaterials = 0;
 RADIANT_CONST int kBindingLights = 1;
 RADIANT_CONST int kBindingShadows = 2;
 RADIANT_CONST int kBindingSheenAlbedo = 7;  // float[kSheenAlbedoSize^2] (GpuScene::sheenAlbedo)
+// uint[3]: the photon gathers of specular's maps, per kind (specular/map_indirect.comp, stats counters).
+RADIANT_CONST int kBindingMapGatherCounts = 8;
 
 // ---------------------------------------------------------------------------------------------------
 // Lights.

@@ -17,9 +17,12 @@ layout(binding = 0, rgba32f) readonly uniform imageCubeArray i_geometry;  // oct
 layout(binding = 1, rgba8) readonly uniform imageCubeArray i_albedo;      // rgb albedo, a 1 = lit diffuse
 layout(binding = 2, rgba16f) uniform imageCubeArray i_material;           // rgb radiance of diffuse texels
 layout(binding = 3, rgba32f) uniform image2D i_accum;                     // this face's sums over slices
-layout(binding = 4, rgba32f) uniform image2D i_blocks;  // mode 1: the block samples' E (a 1) or none (a -1)
-layout(binding = 5, r32f) uniform image2D i_fixup;      // mode 2 writes 1 where no block sample fits
+// mode 1: the block samples' E, a = 1 + the sample texel's index in its block (a -1: none)
+layout(binding = 4, rgba32f) uniform image2D i_blocks;
+layout(binding = 5, r32f) uniform image2D i_fixup;  // mode 2 writes 1 where no block sample fits
 
+// The gathers made, per kind: [0] first-level block samples, [1] second-level, [2] single texels.
+layout(std430, binding = kBindingMapGatherCounts) buffer GatherCounts { uint gatherCounts[3]; };
 uniform vec3 u_reference;
 uniform int u_layerFace;  // cube * 6 + face
 uniform int u_face;
@@ -28,12 +31,17 @@ uniform int u_first;        // first slice: start the sums at 0
 uniform int u_last;         // last slice: add the estimate to the material texel
 uniform int u_renormalize;
 uniform float u_minKernelMass;
+uniform float u_hMin;  // the smallest splat radius of the photon set (PhotonGrid::minRadius)
 // u_mode 0: every texel gathers (u_fixupOnly 1: only the texels mode 2 marked); 1: one gather per
 // u_block x u_block block, at its centre texel, into i_blocks; 2: every diffuse texel takes the block
 // samples of its own and the 8 neighbouring blocks that lie on its surface (same object code, normal
 // within 25 degrees, within 0.1 of the distance between them off its plane: the gather's estimate is
 // smooth over a kernel radius, the block is 1/64 of a face), weighted by a tent over their texel
-// distance; where none fits it is marked for mode 0.
+// distance; where none fits it is marked for mode 0. With u_fixupOnly 1, modes 1 and 2 are a second,
+// finer level over what the first left marked: a block's sample is its first marked texel (none: no
+// gather), and only marked texels take samples (unmarked where one fits). On small curved objects
+// (a sphere a few texels across in the environment layers) the first level's samples rarely fit, and
+// the texels the second level leaves gather themselves.
 uniform int u_mode;
 uniform int u_block;
 uniform int u_fixupOnly;
@@ -70,6 +78,14 @@ vec4 gatherAt(ivec2 px, vec4 acc) {
   return acc;
 }
 
+// A sample within the smallest kernel radius of the texel and within the kernel's plane tolerance of its
+// plane sees the photons the texel would (photon_gi/upsample.comp's sameSurface, its neighbour fill): on
+// objects smaller than the kernel (MetalRoughSpheres' spheres, a few texels across in the environment
+// layers) the plane test above fails between neighbouring texels while the estimate cannot differ.
+bool withinKernel(vec3 d, vec3 n) {
+  return dot(d, d) <= u_hMin * u_hMin && abs(dot(d, n)) <= u_planeTolerance * u_hMin;
+}
+
 bool lit(vec4 albedo) { return albedo.a > 0.0 && any(greaterThan(albedo.rgb, vec3(0.0))); }
 
 vec3 irradiance(vec4 acc) {
@@ -89,11 +105,27 @@ void main() {
     int blocks = (u_size + u_block - 1) / u_block;
     if (id.x >= blocks || id.y >= blocks) return;
     ivec2 px = min(id * u_block + u_block / 2, ivec2(u_size - 1));
+    bool found = true;
+    if (u_fixupOnly != 0) {
+      found = false;
+      for (int i = 0; i < u_block * u_block && !found; ++i) {
+        ivec2 q = id * u_block + ivec2(i % u_block, i / u_block);
+        if (q.x < u_size && q.y < u_size && imageLoad(i_fixup, q).r == 1.0) {
+          px = q;
+          found = true;
+        }
+      }
+    }
     vec4 albedo = imageLoad(i_albedo, ivec3(px, u_layerFace));
+    bool sampled = found && lit(albedo);
     vec4 acc = u_first != 0 ? vec4(0.0) : imageLoad(i_accum, id);
-    if (lit(albedo)) acc = gatherAt(px, acc);
+    if (sampled) {
+      acc = gatherAt(px, acc);
+      if (u_first != 0) atomicAdd(gatherCounts[u_fixupOnly], 1u);
+    }
+    ivec2 at = px - id * u_block;
     if (u_last == 0) imageStore(i_accum, id, acc);
-    else imageStore(i_blocks, id, lit(albedo) ? vec4(irradiance(acc), 1.0) : vec4(0.0, 0.0, 0.0, -1.0));
+    else imageStore(i_blocks, id, sampled ? vec4(irradiance(acc), float(1 + at.y * u_block + at.x)) : vec4(0.0, 0.0, 0.0, -1.0));
     return;
   }
   ivec2 px = id;
@@ -101,6 +133,7 @@ void main() {
   ivec3 t = ivec3(px, u_layerFace);
   vec4 albedo = imageLoad(i_albedo, t);
   if (u_mode == 2) {
+    if (u_fixupOnly != 0 && imageLoad(i_fixup, px).r != 1.0) return;
     if (!lit(albedo)) { imageStore(i_fixup, px, vec4(0.0)); return; }
     vec4 g = imageLoad(i_geometry, t);
     vec3 x = texelPoint(px, g);
@@ -115,14 +148,15 @@ void main() {
         if (any(lessThan(b, ivec2(0))) || any(greaterThanEqual(b, ivec2(blocks)))) continue;
         vec4 e = imageLoad(i_blocks, b);
         if (e.a < 0.0) continue;
-        ivec2 sp = min(b * u_block + u_block / 2, ivec2(u_size - 1));
+        int at = int(e.a) - 1;
+        ivec2 sp = b * u_block + ivec2(at % u_block, at / u_block);
         vec4 gs = imageLoad(i_geometry, ivec3(sp, u_layerFace));
         if (gs.w != g.w) continue;
         vec3 xs = texelPoint(sp, gs);
         vec3 ns = texelNormal(gs, xs);
         if (dot(ns, n) < 0.9) continue;
         vec3 d = xs - x;
-        if (abs(dot(d, n)) > 0.1 * length(d) + 1e-4 * g.z) continue;
+        if (abs(dot(d, n)) > 0.1 * length(d) + 1e-4 * g.z && !withinKernel(d, n)) continue;
         vec2 o = abs(vec2(sp - px)) / float(u_block);
         float w = max(1.0 - o.x, 0.0) * max(1.0 - o.y, 0.0);
         if (sp == px) w = 1.0;
@@ -140,7 +174,10 @@ void main() {
   }
   if (u_fixupOnly != 0 && imageLoad(i_fixup, px).r != 1.0) return;
   vec4 acc = u_first != 0 ? vec4(0.0) : imageLoad(i_accum, px);
-  if (lit(albedo)) acc = gatherAt(px, acc);
+  if (lit(albedo)) {
+    acc = gatherAt(px, acc);
+    if (u_first != 0) atomicAdd(gatherCounts[2], 1u);
+  }
   if (u_last == 0) {
     imageStore(i_accum, px, acc);
     return;

@@ -371,6 +371,7 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   published.dims = grid_->dims;
   published.maxPerCell = grid_->maxPerCell;
   published.kernel = static_cast<int>(splat_.kernel);
+  published.minRadius = hMin_;
   published.renormalize = splat_.renormalize;
   publishPhotonGrid(res, published);
 }

@@ -34,6 +34,9 @@ constexpr int kMapTextureUnitPeel = gpu::kUnitPeel;
 // (docs/PERFORMANCE.md), and with 36 glass spheres the gathers at 4 x 4 blocks were 14 of the specular
 // pass's 22 s at 256 x 256 (issue 31).
 int mapIndirectBlock(int resolution, int block) { return std::clamp(block, 1, std::max(1, resolution / 8)); }
+// The second level's blocks (map_indirect.comp, u_fixupOnly in modes 1 and 2): the texels no sample of
+// the first level fits share one gather per 2 x 2 where they lie on one surface.
+constexpr int kFineBlock = 2;
 constexpr float kEmptyDistance = 3.0e38f;  // shaders/specular/ldm.glsl
 
 }  // namespace
@@ -192,8 +195,12 @@ void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResour
   const int blocks = (resolution_ + mapIndirectBlock(resolution_, indirectBlock_) - 1) / mapIndirectBlock(resolution_, indirectBlock_);
   res.texture("specular_ldm_indirect_blocks", GL_TEXTURE_2D, GL_RGBA32F, blocks, blocks)
       .setFilter(GL_NEAREST, GL_NEAREST);
+  res.texture("specular_ldm_indirect_fine", GL_TEXTURE_2D, GL_RGBA32F, (resolution_ + kFineBlock - 1) / kFineBlock,
+              (resolution_ + kFineBlock - 1) / kFineBlock)
+      .setFilter(GL_NEAREST, GL_NEAREST);
   res.texture("specular_ldm_indirect_fixup", GL_TEXTURE_2D, GL_R32F, resolution_, resolution_)
       .setFilter(GL_NEAREST, GL_NEAREST);
+  res.buffer("specular_gather_counts", 3 * sizeof(std::uint32_t));
   res.buffer("specular_objects", std::max<std::size_t>(1, objects_.size()) * sizeof(GpuObject));
   res.buffer("specular_minmax", static_cast<std::size_t>(cubes) * 2 * sizeof(std::uint32_t));
 
@@ -347,16 +354,22 @@ void SpecularPass::execute(PassContext& ctx) {
       albedo.bindImage(1, GL_READ_ONLY, 0, true, 0);
       material.bindImage(2, GL_READ_WRITE, 0, true, 0);
       res.texture("specular_ldm_indirect").bindImage(3, GL_READ_WRITE);
-      res.texture("specular_ldm_indirect_blocks").bindImage(4, GL_READ_WRITE);
+      gl::Texture& blockSamples = res.texture("specular_ldm_indirect_blocks");
+      gl::Texture& fineSamples = res.texture("specular_ldm_indirect_fine");
       res.texture("specular_ldm_indirect_fixup").bindImage(5, GL_READ_WRITE);
+      gl::Buffer& gatherCounts = res.buffer("specular_gather_counts");
+      const std::uint32_t noGathers[3] = {0, 0, 0};
+      gatherCounts.upload(noGathers, sizeof(noGathers));
+      gatherCounts.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingMapGatherCounts);
       const int block = mapIndirectBlock(resolution_, indirectBlock_);
       const int blocks = (resolution_ + block - 1) / block;
-      gather.set("u_block", block);
+      const int fineBlocks = (resolution_ + kFineBlock - 1) / kFineBlock;
       gather.set("u_kernel", photons->kernel);
       gather.set("u_planeTolerance", kPhotonPlaneTolerance);
       gather.set("u_normalCosine", kPhotonNormalCosine);
       gather.set("u_renormalize", photons->renormalize ? 1 : 0);
       gather.set("u_minKernelMass", kPhotonMinKernelMass);
+      gather.set("u_hMin", photons->minRadius);
       gather.set("u_size", resolution_);
       gather.set("u_gridOrigin", &photons->origin[0], 3);
       gather.set("u_cellSize", photons->cellSize);
@@ -388,11 +401,19 @@ void SpecularPass::execute(PassContext& ctx) {
                 ++dispatches;
               }
             };
-            if (block > 1) {
-              gatherSlices(1, 0, blocks);
+            // One level of block samples (mode 1) and their spread (mode 2); the second level (fixupOnly
+            // 1: blocks of 2) works on the texels the first left marked (map_indirect.comp).
+            auto blockLevel = [&](int size, int count, gl::Texture& samples, int fixupOnly) {
+              gather.set("u_block", size);
+              samples.bindImage(4, GL_READ_WRITE);
+              gatherSlices(1, fixupOnly, count);
               gather.set("u_mode", 2);
               glDispatchCompute((resolution_ + 7) / 8, (resolution_ + 7) / 8, 1);
               glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+            };
+            if (block > 1) {
+              blockLevel(block, blocks, blockSamples, 0);
+              if (block > kFineBlock) blockLevel(kFineBlock, fineBlocks, fineSamples, 1);
               gatherSlices(0, 1, resolution_);
             } else {
               gatherSlices(0, 0, resolution_);
@@ -402,6 +423,13 @@ void SpecularPass::execute(PassContext& ctx) {
       }
       ctx.stats.counters["maps_indirect_dispatches"] = dispatches;
       ctx.stats.counters["maps_indirect_block"] = block;
+      // The gathers per kind (read once per build of the maps: their texels are what the blocks save).
+      std::uint32_t gathers[3];
+      glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+      gatherCounts.download(gathers, sizeof(gathers));
+      ctx.stats.counters["maps_indirect_block_gathers"] = gathers[0];
+      ctx.stats.counters["maps_indirect_fine_gathers"] = gathers[1];
+      ctx.stats.counters["maps_indirect_texel_gathers"] = gathers[2];
     }
     // Min-max distance per layer (thesis Fig. 5.3).
     std::vector<std::uint32_t> init(static_cast<std::size_t>(objectCount) * layers_ * 2);
