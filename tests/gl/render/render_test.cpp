@@ -30,6 +30,16 @@
 namespace radiant {
 namespace {
 
+// A camera override looking from `position` at `target` (every other field at its default).
+api::CameraOverride lookAt(glm::vec3 position, glm::vec3 target, glm::vec3 up, float yfovDegrees) {
+  api::CameraOverride camera;
+  camera.position = position;
+  camera.target = target;
+  camera.up = up;
+  camera.yfovDegrees = yfovDegrees;
+  return camera;
+}
+
 using testing::aov;
 using testing::renderer;
 
@@ -106,7 +116,9 @@ TEST(RenderCore, PointLightRangeWindowIsTheSpecsUnsquaredWindow) {
       const float window = std::max(0.f, 1.f - d2 * d2 / 16.f);
       const float expected = std::pow(d2, -1.5f) * window;
       const float got = direct.at(x, y)[0];
-      if (glm::dot(w, w) < 0.05f * 0.05f) EXPECT_NEAR(got, 15.f / 16.f, 0.01f) << "foot point " << x << "," << y;
+      if (glm::dot(w, w) < 0.05f * 0.05f) {
+        EXPECT_NEAR(got, 15.f / 16.f, 0.01f) << "foot point " << x << "," << y;
+      }
       if (window > 0.1f) {
         EXPECT_NEAR(got / expected, 1.0f, 0.02f) << "pixel " << x << "," << y;
         ++inside;
@@ -315,7 +327,7 @@ TEST(RenderCore, DerivedDataIsCachedAcrossFrames) {
   Scene scene = umbraScene(1.f, "cache");
   renderer().render(scene, request(32));
   api::RenderRequest moved = request(48);
-  moved.camera = api::CameraOverride{{0.5f, 3.f, 2.f}, {0, 0, 0}, {0, 1, 0}, 50.f};
+  moved.camera = lookAt({0.5f, 3.f, 2.f}, {0, 0, 0}, {0, 1, 0}, 50.f);
   RenderOutput second = renderer().render(scene, moved);
   bool gpuHit = false, shadowHit = false;
   for (const auto& c : second.stats.cache) {
@@ -324,13 +336,19 @@ TEST(RenderCore, DerivedDataIsCachedAcrossFrames) {
   }
   EXPECT_TRUE(gpuHit);
   EXPECT_TRUE(shadowHit);
-  for (const auto& p : second.stats.passes)
-    if (p.name == "shadow_maps") EXPECT_EQ(p.counters.at("maps_rendered"), 0.0);
+  for (const auto& p : second.stats.passes) {
+    if (p.name == "shadow_maps") {
+      EXPECT_EQ(p.counters.at("maps_rendered"), 0.0);
+    }
+  }
   // A different map size is a different derived product: rebuilt.
   moved.passes["shadow_maps"] = {{"shadow_map_size", 512}};
   RenderOutput third = renderer().render(scene, moved);
-  for (const auto& c : third.stats.cache)
-    if (c.what == "shadow_maps") EXPECT_FALSE(c.hit);
+  for (const auto& c : third.stats.cache) {
+    if (c.what == "shadow_maps") {
+      EXPECT_FALSE(c.hit);
+    }
+  }
 }
 
 // The GPU scene cache keeps the `capacity` most recently used scenes: with capacity 2, A B A hits A
@@ -547,7 +565,7 @@ TEST(RenderCore, GrazingViewsStayFinite) {
   // A camera almost in the plane of the floor: NdotV -> 0 everywhere.
   Scene scene = planeScene().pointLight({0, 1, 0}, 3.f).build("grazing");
   api::RenderRequest req = request(64, {"beauty", "direct", "normal", "depth", "albedo"});
-  req.camera = api::CameraOverride{{0, 1e-4f, 15.f}, {0, 0, 0}, {0, 1, 0}, 60.f};
+  req.camera = lookAt({0, 1e-4f, 15.f}, {0, 0, 0}, {0, 1, 0}, 60.f);
   RenderOutput out = renderer().render(scene, req);
   expectAllFinite(out);
   for (float v : aov(out, "direct").pixels) EXPECT_GE(v, 0.f);
@@ -681,7 +699,7 @@ TEST(AovTable, MaterialAovCarriesTransmission) {
   b.quad({5, 0, 0}, {5, 0, 0}, {0, 0, -10}, b.material(opaque), "opaque");
   b.directionalLight({0, -1, 0}, 1.f);
   api::RenderRequest req = request(32, {"beauty", "material"});
-  req.camera = api::CameraOverride{{0, 10, 0}, {0, 0, 0}, {0, 0, -1}, 90.f};
+  req.camera = lookAt({0, 10, 0}, {0, 0, 0}, {0, 0, -1}, 90.f);
   const RenderOutput out = renderer().render(b.build("material-aov"), req);
   const Image& m = aov(out, "material");
   ASSERT_EQ(m.channels, 4);
@@ -941,7 +959,9 @@ TEST(RenderCore, PassTimesAreEachPassesOwnAndSayHowTheyWereMeasured) {
   double sum = 0;
   for (const api::PassStats& p : out.stats.passes) {
     EXPECT_TRUE(std::isfinite(p.gpuMs) && p.gpuMs >= 0) << p.name;
-    if (software) EXPECT_GE(p.gpuMs, p.cpuMs) << p.name << ": its time includes issuing its commands";
+    if (software) {
+      EXPECT_GE(p.gpuMs, p.cpuMs) << p.name << ": its time includes issuing its commands";
+    }
     sum += p.gpuMs;
   }
   EXPECT_LE(sum, out.stats.renderMs) << "the passes' times are disjoint parts of the render";
