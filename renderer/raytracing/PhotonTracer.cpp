@@ -1,6 +1,7 @@
 #include "renderer/raytracing/PhotonTracer.h"
 
 #include "renderer/raytracing/Particles.h"
+#include "renderer/raytracing/Threads.h"
 
 #include <algorithm>
 #include <atomic>
@@ -8,7 +9,6 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 namespace radiant::rt {
 namespace {
@@ -153,12 +153,7 @@ void tracePhotons(const RayScene& rays, const SceneLights& lights, const PhotonO
           capped += counter.capped;
         });
       };
-      if (options.threads > 0) {
-        tbb::task_arena arena(options.threads);
-        arena.execute(run);
-      } else {
-        run();
-      }
+      rt::withThreads(options.threads, run);
       std::size_t added = 0;
       for (const auto& v : perBlock) added += v.size();
       if (set.records.size() + added > set.records.capacity()) {

@@ -9,12 +9,12 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include "renderer/raytracing/CameraRays.h"
 #include "renderer/raytracing/Lights.h"
 #include "renderer/raytracing/Particles.h"
 #include "renderer/raytracing/RayScene.h"
+#include "renderer/raytracing/Threads.h"
 
 namespace radiant::reference {
 namespace {
@@ -147,12 +147,7 @@ Image LightTracer::render(const Camera& camera, int width, int height, const Lig
       if (options.progress) options.progress(static_cast<double>(first + count) / static_cast<double>(blocks));
     }
   };
-  if (options.threads > 0) {
-    tbb::task_arena arena(options.threads);
-    arena.execute(run);
-  } else {
-    run();
-  }
+  rt::withThreads(options.threads, run);
   Image image = Image::make("beauty", width, height, 3);
   const double scale = 1.0 / static_cast<double>(paths);
   for (std::size_t i = 0; i < sum.size(); ++i) image.pixels[i] = static_cast<float>(sum[i] * scale);

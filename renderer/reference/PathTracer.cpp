@@ -11,11 +11,11 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include "renderer/raytracing/CameraRays.h"
 #include "renderer/raytracing/Lights.h"
 #include "renderer/raytracing/RayScene.h"
+#include "renderer/raytracing/Threads.h"
 #include "renderer/raytracing/VolumeInterior.h"
 
 namespace radiant::reference {
@@ -319,12 +319,7 @@ Image PathTracer::render(const Camera& camera, int width, int height, const Refe
       capped += counter.capped;
     });
   };
-  if (options.threads > 0) {
-    tbb::task_arena arena(options.threads);
-    arena.execute(renderTiles);
-  } else {
-    renderTiles();
-  }
+  rt::withThreads(options.threads, renderTiles);
   impl_->lastRays = rays.load();
   impl_->lastCapped = capped.load();
   return image;

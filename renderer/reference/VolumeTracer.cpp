@@ -7,13 +7,13 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include "renderer/raytracing/CameraRays.h"
 #include "renderer/raytracing/Lights.h"
 #include "renderer/raytracing/Media.h"
 #include "renderer/raytracing/ParticleMedium.h"
 #include "renderer/raytracing/RayScene.h"
+#include "renderer/raytracing/Threads.h"
 
 namespace radiant::reference {
 
@@ -262,12 +262,7 @@ Image VolumeTracer::render(const Camera& camera, int width, int height, const Vo
         }
     });
   };
-  if (o.threads > 0) {
-    tbb::task_arena arena(o.threads);
-    arena.execute(rows);
-  } else {
-    rows();
-  }
+  rt::withThreads(o.threads, rows);
   return image;
 }
 
