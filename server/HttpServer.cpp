@@ -244,10 +244,10 @@ using DecodedImages = DecodedCache<Image, imageBytes>;
 // readBody), whose callers turn its 503 decode-busy into body-busy.
 //
 // Both budgets are also held to the process's memory limit (--memory-limit-bytes) through one
-// ResidentGate: a reservation fits only when the resident set, plus every reservation still in flight
-// (a decode's or body's bytes not yet known to be resident: counted twice once they are, which errs on
-// the safe side), plus its own bytes stays under the limit. The renderer admits its large allocations
-// against the same resident set (FrameResources::admit), so decoded scenes held by queued renders,
+// ResidentGate: a reservation fits only when the resident set, plus every claim still in flight (the
+// process-wide MemoryClaims: decodes' and bodies' reservations, and the frame's next large allocation,
+// which the renderer claims in FrameResources::admit; counted twice once resident, which errs on the
+// safe side), plus its own bytes stays under the limit. So decoded scenes held by queued renders,
 // bodies being read and the frame cannot add up past the limit, whatever the three budgets sum to.
 // Refused after the same wait, with 503 memory-busy.
 class ResidentGate {
@@ -301,13 +301,14 @@ public:
       const std::size_t total = m_->total_;
       ResidentGate* gate = m_->gate_;
       // Never more than the whole budget: a decode the per-decode limit allows always fits on its own.
-      bool fits = bytes <= total - std::min(total, held_) && (!gate || gate->limit() == 0 || bytes <= gate->limit());
-      bool overLimit = false;
+      bool overLimit = gate && gate->limit() != 0 && bytes > gate->limit();  // never fits: refused at once
+      bool fits = bytes <= total - std::min(total, held_) && !overLimit;
       std::size_t resident = 0;
       const auto until = std::chrono::steady_clock::now() + wait;
       while (fits) {
         if (m_->evict_ && m_->reserved() + bytes > total) m_->evict_(m_->reserved() + bytes - total);
         std::unique_lock lock(m_->mutex_);
+        overLimit = false;  // what the last try found decides the refusal's kind
         if (m_->used_ + bytes <= total) {
           // The budget has them; the process's limit next (claimed under the budget's lock, so a
           // claim is never left without its budget bytes).
