@@ -89,6 +89,19 @@ float skyCapCosine(float cosTheta, float sigma) {
   return max(e, 0.0) / (3.14159265358979 * sin2);
 }
 
+// The sky lights' (lights[u_diffuseOnlyFrom .. u_lightCount)) irradiance at p, shadowed: what the sky
+// loop of directLighting below gives a Lambertian lobe, times pi / albedo (specular/map_sky.comp).
+vec3 skyIrradiance(vec3 p, vec3 n, vec3 ng) {
+  vec3 E = vec3(0.0);
+  for (int i = u_diffuseOnlyFrom; i < u_lightCount; ++i) {
+    LightSample s = sampleLight(lights[i], p);
+    float k = skyCapCosine(dot(n, s.wi), max(lights[i].spotCone.z, 0.0));
+    if (k <= 0.0) continue;
+    E += k * s.intensity * shadowVisibility2D(i, p, ng, s.dist, u_pcfRadius);
+  }
+  return E;
+}
+
 // Sum over the first `count` lights of f(wi, wo) cos(theta_i) E_light V_shadow (no emission). n is the
 // shading normal (facing wo), ng the geometric normal on the same side (used for the shadow normal
 // offset). nc is the clear coat's normal (KHR_materials_clearcoat; n when there is no coat).

@@ -28,6 +28,7 @@ layout(location = 0) out vec4 o_material;
 layout(location = 1) out vec4 o_geometry;
 layout(location = 2) out float o_distance;  // cleared to kEmptyDistance
 layout(location = 3) out vec4 o_albedo;     // rgb diffuse albedo of a non-specular, lit surface (a 1), a mirror's F0 (a 0), else 0
+layout(location = 4) out vec4 o_diffuse;    // the Lambertian albedo the sky lights reach (map_sky.comp), else 0
 
 void main() {
   SurfaceUv uv = SURFACE_UV_FRAGMENT(v_uv0, v_uv1);  // before any discard (common/material.glsl)
@@ -66,10 +67,16 @@ void main() {
   // One light loop for the two kinds of lit texel (llvmpipe runs both branches of an `if` with a loop in
   // each: two loops per fragment; docs/PERFORMANCE.md): a diffuse texel with every lobe, a mirror's
   // diffuse lobe with Dirac specular and coat lobes (lightsWithoutSpecular 0).
+  // The sky lights are map_sky.comp's, per texel, on this Lambertian albedo; the others are lit here.
+  vec3 diffuseAlbedo = materialUnlit(m) ? vec3(0.0) : p.baseColor.rgb * (1.0 - p.surface.x) * (1.0 - p.surface.z);
+  int lights = min(u_lightCount, u_diffuseOnlyFrom);
   vec3 lit = vec3(0.0);
-  if (!specular || mirror)
-    lit = (emits ? p.emission.rgb : vec3(0.0)) + directLighting(v_position, ns, ns, ng, wo, p, u_lightCount,
-                                                                mirror ? 0 : u_lightCount);
+  o_diffuse = vec4(0.0);
+  if (!specular || mirror) {
+    lit = (emits ? p.emission.rgb : vec3(0.0)) + directLighting(v_position, ns, ns, ng, wo, p, lights,
+                                                                mirror ? 0 : lights);
+    o_diffuse = vec4(diffuseAlbedo, 1.0);
+  }
   if (specular) {
     o_material = texel;
     if (mirror) {
@@ -83,7 +90,7 @@ void main() {
     }
   } else {
     // The Lambertian part of the glTF BRDF (what the caustics pass lights at the maps' texels).
-    if (!materialUnlit(m)) o_albedo = vec4(p.baseColor.rgb * (1.0 - p.surface.x) * (1.0 - p.surface.z), 1.0);
+    if (!materialUnlit(m)) o_albedo = vec4(diffuseAlbedo, 1.0);
     vec3 L = lit;
     // The environment's glossy lobe (its diffuse lobe is photon_gi's photons, gathered into the maps
     // with the Lambertian term): without it a rough metal seen in a mirror was black but for its sun

@@ -186,6 +186,8 @@ void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResour
       .setFilter(GL_NEAREST, GL_NEAREST);
   distance.setFilter(GL_LINEAR, GL_LINEAR);
   res.texture("specular_ldm_depth", GL_TEXTURE_2D, GL_DEPTH_COMPONENT32F, resolution_, resolution_);
+  res.texture("specular_ldm_face_diffuse", GL_TEXTURE_2D, GL_RGBA8, resolution_, resolution_)
+      .setFilter(GL_NEAREST, GL_NEAREST);
   gl::Texture& peel = res.texture("specular_ldm_peel", GL_TEXTURE_2D, GL_RGBA32F, resolution_, resolution_);
   peel.setFilter(GL_NEAREST, GL_NEAREST);
   res.framebuffer("specular_ldm");
@@ -272,6 +274,12 @@ void SpecularPass::execute(PassContext& ctx) {
     ibl::bind(res, prog, gpu::kUnitIblDfg, gpu::kUnitIblPrefiltered);
     if (!mapsIbl_) prog.set("u_iblMode", ibl::kNone);
     peel.bindUnit(kMapTextureUnitPeel);
+    // The sky lights per texel after each face (shaders/specular/map_sky.comp), on the Lambertian albedo
+    // map.frag writes to the face's scratch target.
+    gl::Texture& faceDiffuse = res.texture("specular_ldm_face_diffuse");
+    const gl::Program& sky = ctx.shaders.program({"specular/map_sky.comp"});
+    const bool skyLights = ctx.view.skyLights() > 0;
+    if (skyLights) bindDirectLighting(sky, res, ctx.gpu, static_cast<int>(ctx.view.lights.size()), 1);
     glViewport(0, 0, resolution_, resolution_);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_GREATER);  // reversed-Z
@@ -307,13 +315,16 @@ void SpecularPass::execute(PassContext& ctx) {
           fb.attach(GL_COLOR_ATTACHMENT1, geometry, 0, layerFace);
           fb.attach(GL_COLOR_ATTACHMENT2, distance, 0, layerFace);
           fb.attach(GL_COLOR_ATTACHMENT3, albedo, 0, layerFace);
-          fb.setDrawBuffers({GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2, GL_COLOR_ATTACHMENT3});
+          fb.attach(GL_COLOR_ATTACHMENT4, faceDiffuse);
+          fb.setDrawBuffers({GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2, GL_COLOR_ATTACHMENT3,
+                             GL_COLOR_ATTACHMENT4});
           fb.checkComplete("SpecularPass::execute (maps)");
           fb.bind();
           glClearNamedFramebufferfv(fb.id(), GL_COLOR, 0, zero);
           glClearNamedFramebufferfv(fb.id(), GL_COLOR, 1, zero);
           glClearNamedFramebufferfv(fb.id(), GL_COLOR, 2, empty);
           glClearNamedFramebufferfv(fb.id(), GL_COLOR, 3, zero);
+          glClearNamedFramebufferfv(fb.id(), GL_COLOR, 4, zero);
           glClearNamedFramebufferfv(fb.id(), GL_DEPTH, 0, &depthClear);
           const glm::mat4 vp = cubeFaceViewProj(ref, f, znear);
           prog.setMat4("u_viewProj", &vp[0][0]);
@@ -338,6 +349,20 @@ void SpecularPass::execute(PassContext& ctx) {
             const Bounds& mb = ctx.scene.meshes[mesh].bounds;
             return 0.25f * (2.f / resolution_) * std::max(glm::length(mb.center() - ref) - mb.radius(), 0.f);
           });
+          if (skyLights) {
+            glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+            sky.use();
+            sky.set("u_reference", &ref[0], 3);
+            sky.set("u_layerFace", layerFace);
+            sky.set("u_face", f);
+            sky.set("u_size", resolution_);
+            geometry.bindImage(0, GL_READ_ONLY, 0, true, 0);
+            faceDiffuse.bindImage(1, GL_READ_ONLY);
+            material.bindImage(2, GL_READ_WRITE, 0, true, 0);
+            glDispatchCompute((resolution_ + 7) / 8, (resolution_ + 7) / 8, 1);
+            glMemoryBarrier(GL_FRAMEBUFFER_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+            prog.use();
+          }
           gate.issued();
           ++draws;
         }
