@@ -7,10 +7,9 @@
 // The surface point is the reference point plus the texel's centre direction times its stored
 // distance; its normal faces the reference point (the map's viewer, as map.frag shades it). One gather
 // per block of texels, spread over the block's texels on the same surface (u_mode below).
-#include "common/cube_texels.glsl"  // faceDirection
-#include "common/octahedral.glsl"
 #include "photon_gi/grid.glsl"
 #include "photon_gi/photon.glsl"
+#include "specular/map_texel.glsl"  // texelPoint, texelNormal; u_reference, u_face, u_size
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0, rgba32f) readonly uniform imageCubeArray i_geometry;  // oct normal, distance, object
@@ -23,10 +22,7 @@ layout(binding = 5, r32f) uniform image2D i_fixup;  // mode 2 writes 1 where no 
 
 // The gathers made, per kind: [0] first-level block samples, [1] second-level, [2] single texels.
 layout(std430, binding = kBindingMapGatherCounts) buffer GatherCounts { uint gatherCounts[3]; };
-uniform vec3 u_reference;
 uniform int u_layerFace;  // cube * 6 + face
-uniform int u_face;
-uniform int u_size;
 uniform int u_first;        // first slice: start the sums at 0
 uniform int u_last;         // last slice: add the estimate to the material texel
 uniform int u_renormalize;
@@ -45,14 +41,6 @@ uniform float u_hMin;  // the smallest splat radius of the photon set (PhotonGri
 uniform int u_mode;
 uniform int u_block;
 uniform int u_fixupOnly;
-
-vec3 texelPoint(ivec2 px, vec4 g) {
-  return u_reference + normalize(faceDirection(u_face, (vec2(px) + 0.5) / float(u_size) * 2.0 - 1.0)) * g.z;
-}
-vec3 texelNormal(vec4 g, vec3 x) {
-  vec3 n = normalize(octDecode(g.xy));
-  return dot(n, x - u_reference) > 0.0 ? -n : n;  // facing the reference point, the map's viewer
-}
 
 // The photon sums at texel px (rgb sum phi k / h^2 of this slice, a the coverage points' kernel mass).
 vec4 gatherAt(ivec2 px, vec4 acc) {
