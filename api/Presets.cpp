@@ -444,29 +444,60 @@ void MachineSpeed::calibrate(double measuredMs, double predictedMs) {
   if (const double r = ratio(measuredMs, predictedMs); r > 0) calibration_ = r;
 }
 
-void MachineSpeed::observe(double measuredMs, double predictedMs) {
-  const double r = ratio(measuredMs, predictedMs);
-  if (!(r > 0)) return;
-  recent_.push_back(r);
-  if (recent_.size() > kWindow) recent_.erase(recent_.begin());
-}
-
-double MachineSpeed::factor() const {
-  if (pinned()) return pinned_;
-  std::vector<double> v = recent_;
-  if (calibration_ > 0) v.push_back(calibration_);
-  if (v.empty()) return 1.0;
+namespace {
+double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const std::size_t n = v.size();
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
+}  // namespace
 
-json MachineSpeed::toJson() const {
+void MachineSpeed::observe(double measuredMs, double predictedMs, const std::string& scene) {
+  const double r = ratio(measuredMs, predictedMs);
+  if (!(r > 0)) return;
+  recent_.push_back(r);
+  if (recent_.size() > kWindow) recent_.erase(recent_.begin());
+  const std::size_t index = observed_++;
+  if (scene.empty() || pinned()) return;  // a pinned factor learns no scene's
+  auto it = std::find_if(scenes_.begin(), scenes_.end(), [&](const SceneFrames& e) { return e.first == scene; });
+  if (it == scenes_.end()) it = scenes_.insert(scenes_.end(), {scene, {}});
+  it->second.push_back({r, index});
+  if (it->second.size() > kSceneWindow) it->second.erase(it->second.begin());
+  // A scene none of whose frames is among the last kWindow is not used again (ownRecent).
+  std::erase_if(scenes_, [&](const SceneFrames& e) { return e.second.back().index + kWindow < observed_; });
+}
+
+double MachineSpeed::machine() const {
+  if (pinned()) return pinned_;
+  std::vector<double> v = recent_;
+  if (calibration_ > 0) v.push_back(calibration_);
+  return v.empty() ? 1.0 : median(std::move(v));
+}
+
+std::vector<double> MachineSpeed::ownRecent(const std::string& scene) const {
+  std::vector<double> own;
+  if (pinned() || scene.empty()) return own;
+  auto it = std::find_if(scenes_.begin(), scenes_.end(), [&](const SceneFrames& e) { return e.first == scene; });
+  if (it != scenes_.end())
+    for (const Frame& f : it->second)
+      if (f.index + kWindow >= observed_) own.push_back(f.ratio);
+  return own;
+}
+
+double MachineSpeed::factor(const std::string& scene) const {
+  std::vector<double> own = ownRecent(scene);
+  return own.empty() ? machine() : median(std::move(own));
+}
+
+json MachineSpeed::toJson(const std::string& scene) const {
   const bool measured = calibration_ > 0 || !recent_.empty();
-  return {{"factor", factor()},
+  const std::vector<double> own = ownRecent(scene);
+  return {{"factor", factor(scene)},
           {"source", pinned() ? "pinned" : measured ? "measured" : "table"},
+          {"machine", machine()},
           {"calibration", calibration_ > 0 ? json(calibration_) : json(nullptr)},
-          {"recent", recent_}};
+          {"recent", recent_},
+          {"scene", {{"basis", own.empty() ? "machine" : "own"}, {"recent", own}}}};
 }
 
 void recordMeasured(json& budget, const FrameStats& stats, double frameMs) {

@@ -153,18 +153,30 @@ double costPixels(const std::string& technique, double rasterPixels, int supersa
 
 // How fast this machine runs the preset table's frames: measured frame ms over the table's prediction
 // for the same frame (both without a compare block's reference). The budget chooser multiplies every
-// prediction by factor(), so that a budget holds on a machine that is loaded, slower or faster than the
-// one the table was measured on (the table's own load is in its "runs").
+// prediction by factor(scene), so that a budget holds on a machine that is loaded, slower or faster than
+// the one the table was measured on (the table's own load is in its "runs"), and on a scene whose frames
+// the table's models get wrong (a scene is a scene and the passes it runs).
 //
-// Sources, in order: a pinned factor (radiantd --speed-factor); else the median of the calibration's
-// ratio and the ratios of the last kWindow observed frames; else 1 (nothing measured yet). The median
-// keeps one stray frame (a page-in, a burst of load) from moving the chooser; the window lets the
-// factor follow the machine's load within a few frames. The Renderer decides which frames are
-// comparable with the table (a frame compiling shaders or uploading its scene is not, nor one reusing
-// seed-keyed derived data the table's cost sweeps traced cold): see Renderer.cpp, comparableWithPresetTable.
+// The machine's factor: a pinned one (radiantd --speed-factor); else the median of the calibration's
+// ratio and the ratios of the last kWindow observed frames, whatever their scene; else 1 (nothing
+// measured yet). The median keeps one stray frame (a page-in, a burst of load) from moving the chooser;
+// the window lets the factor follow the machine's load within a few frames.
+//
+// A scene's factor (measured, not pinned): when one of the scene's last kSceneWindow observed frames is
+// among the last kWindow observed, the median of those of its frames ("own": they measure this machine's
+// load and the models' error on this scene at once); else the machine's ("machine"). Where frames of a
+// well and a badly modelled scene alternate (cornell_box and cornell_glass in bench/budget_ladder.py),
+// the machine's window mixes both and its median jumps between them; each scene's own frames do not.
+// A scene's frames that are older are not used: they say nothing about today's load, and carrying the
+// models' error on the scene over to today's machine factor would need that factor free of other
+// scenes' errors, which a window of mixed frames is not, so they are dropped (at most kWindow scenes
+// are kept).
+// The Renderer decides which frames are comparable with the table (a frame compiling shaders or
+// uploading its scene is not, nor one reusing seed-keyed derived data the table's cost sweeps traced
+// cold): see Renderer.cpp, comparableWithPresetTable.
 class MachineSpeed {
 public:
-  static constexpr std::size_t kWindow = 9;
+  static constexpr std::size_t kWindow = 9, kSceneWindow = 5;
   // Ratios outside [kMinRatio, kMaxRatio] are clamped: a frame that took 100x its prediction says the
   // frame was unusual, not that the machine is 100x slower.
   static constexpr double kMinRatio = 1.0 / 64.0, kMaxRatio = 64.0;
@@ -175,18 +187,30 @@ public:
   // The calibration frame's ratio (measured / predicted ms); needsCalibration() until one is recorded.
   void calibrate(double measuredMs, double predictedMs);
   bool needsCalibration() const { return !pinned() && calibration_ <= 0; }
-  // A frame comparable with the table: its ratio joins the window (the oldest leaves). Ignored when
-  // either time is not a positive finite number.
-  void observe(double measuredMs, double predictedMs);
-  double factor() const;
-  // {"factor", "source": "pinned" | "measured" | "table", "calibration": ratio or null,
-  //  "recent": [ratios, oldest first]}
-  nlohmann::json toJson() const;
+  // A frame of `scene` ("": none) comparable with the table: its ratio joins the machine's window and
+  // the scene's (the oldest leaves each). Ignored when either time is not a positive finite number.
+  void observe(double measuredMs, double predictedMs, const std::string& scene = "");
+  // The factor for a frame of `scene` (pinned, or "": the machine's).
+  double factor(const std::string& scene = "") const;
+  // {"factor": factor(scene), "source": "pinned" | "measured" | "table", "machine": the machine's factor,
+  //  "calibration": ratio or null, "recent": [the machine's window, oldest first],
+  //  "scene": {"basis": "own" | "machine", "recent": [the scene's ratios it used, oldest first]}}
+  nlohmann::json toJson(const std::string& scene = "") const;
 
 private:
+  struct Frame {
+    double ratio;       // measured / predicted
+    std::size_t index;  // its place among every observed frame
+  };
+  using SceneFrames = std::pair<std::string, std::vector<Frame>>;
   static double ratio(double measuredMs, double predictedMs);
+  double machine() const;
+  // The scene's frames among the last kWindow observed (empty: none, or pinned).
+  std::vector<double> ownRecent(const std::string& scene) const;
   double pinned_ = 0.0, calibration_ = 0.0;
   std::vector<double> recent_;
+  std::size_t observed_ = 0;
+  std::vector<SceneFrames> scenes_;  // those with a frame among the last kWindow observed
 };
 
 // Adds measured_ms per technique (passCostMs) and for the frame (`frameMs`: the render up to readback,

@@ -643,9 +643,13 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     for (Technique* t : plan.passes) planned.push_back(t->info().name);
     // The cost models' scene variables (particles of the scene and the request's media, light_volumes' beams).
     const api::SceneCounts counts = sceneCostCounts(scene, request.media);
+    // The speed factor's scene (api::MachineSpeed): the scene and the passes it runs, whose models'
+    // error on it the factor's scene correction learns.
+    std::string speedScene = (scene.digest.empty() ? "name:" + scene.name : scene.digest) + "|";
+    for (const std::string& p : planned) speedScene += p + ",";
     // The server's default frame budget lowers a default supersampling first (api/Presets.h).
     if (const int within = api::supersamplingWithinDefaultBudget(api::PresetTable::builtin(), planned, request, k,
-                                                                 inputs.limits, counts, im.speed.factor());
+                                                                 inputs.limits, counts, im.speed.factor(speedScene));
         within < k) {
       stats.warnings.push_back("supersampling " + std::to_string(within) + " instead of the default " + std::to_string(k) +
                                ": at " + std::to_string(k) + " the default frame is predicted above this server's default "
@@ -709,9 +713,9 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     // The supersampled request: the cost models' `pixels` are the raster's (the table was measured at
     // k = 1, so a request that keeps its own supersampling under a budget is charged k^2 the pixels),
     // except photon_gi's, whose gather follows the output pixels (api::costPixels).
-    const nlohmann::json speedState = im.speed.toJson();  // what this frame's choice used
+    const nlohmann::json speedState = im.speed.toJson(speedScene);  // what this frame's choice used
     api::BudgetChoice choice = api::chooseConfiguration(api::PresetTable::builtin(), planned, supersampled,
-                                                        inputs.limits, counts, im.speed.factor());
+                                                        inputs.limits, counts, im.speed.factor(speedScene));
     for (auto& w : choice.warnings) stats.warnings.push_back(std::move(w));
     std::set<int> shadowMapExclusions;  // meshes whose shadows a pass supplies itself (light_volumes)
     for (std::size_t i = 0; i < plan.passes.size(); ++i) {
@@ -824,7 +828,7 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     }
     const bool observed = !im.calibrating && !im.speed.pinned() && im.lastFrame.predictedMs > 0 &&
                           comparableWithPresetTable(stats, programsBefore != im.shaders.cachedPrograms());
-    if (observed) im.speed.observe(im.lastFrame.measuredMs, im.lastFrame.predictedMs);
+    if (observed) im.speed.observe(im.lastFrame.measuredMs, im.lastFrame.predictedMs, speedScene);
     if (choice.active) stats.budget["speed"]["observed"] = observed;  // this frame joined the window
     if (request.compare)
       compare(im.resources, scene, outView, request, inputs.compareTarget, im.techniques, plan.passes, out);

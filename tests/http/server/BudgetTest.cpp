@@ -535,7 +535,8 @@ TEST(Budgets, TheChooserMeasuresTheMachineAndScalesItsPredictions) {
               speed["factor"].get<double>() * table.predictMs("direct", json::object(), px), 1e-9);
 
   // Fresh seeds: comparable frames join the window (the first budgeted frame may have compiled its
-  // point's shaders, so count from the second), and the factor is the median of window and calibration.
+  // point's shaders, so count from the second): the machine's factor is the median of window and
+  // calibration; the frame's is its scene's own (api::MachineSpeed).
   int observed = r["stats"]["budget"]["speed"]["observed"].get<bool>();
   for (std::uint64_t seed = 12; seed < 16; ++seed) {
     body = budgeted(seed);
@@ -545,7 +546,15 @@ TEST(Budgets, TheChooserMeasuresTheMachineAndScalesItsPredictions) {
     speed = r["stats"]["budget"]["speed"];
     std::vector<double> all = speed["recent"].get<std::vector<double>>();
     all.push_back(speed["calibration"].get<double>());
-    EXPECT_DOUBLE_EQ(speed["factor"].get<double>(), median(all)) << speed.dump();
+    EXPECT_DOUBLE_EQ(speed["machine"].get<double>(), median(all)) << speed.dump();
+    // Every observed frame is this scene's and recent: its factor is the median of its own ratios.
+    if (!speed["scene"]["recent"].empty()) {
+      EXPECT_EQ(speed["scene"]["basis"], "own") << speed.dump();
+      EXPECT_DOUBLE_EQ(speed["factor"].get<double>(), median(speed["scene"]["recent"].get<std::vector<double>>()))
+          << speed.dump();
+    } else {
+      EXPECT_DOUBLE_EQ(speed["factor"].get<double>(), speed["machine"].get<double>()) << speed.dump();
+    }
     observed += speed["observed"].get<bool>();
     std::printf("seed %llu: speed %s, predicted %.1f ms, measured %.1f ms\n", static_cast<unsigned long long>(seed),
                 speed.dump().c_str(), r["stats"]["budget"]["predicted_ms"].get<double>(),

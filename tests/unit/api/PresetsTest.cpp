@@ -651,3 +651,42 @@ TEST(Presets, MachineSpeedIsTheMedianOfTheCalibrationAndRecentFrames) {
   p.pin(0);  // back to measuring
   EXPECT_DOUBLE_EQ(p.factor(), 5.0);
 }
+
+// A scene whose frames the table's models get wrong (cornell_glass ran 1.4-3.2x its predictions where
+// the Cornell box ran 1x: docs/performance/presets-and-budgets.md) is predicted from its own recent
+// frames, and does not move the other scenes' budgets; once its frames are old, the machine's factor.
+TEST(Presets, MachineSpeedPredictsAScenesFramesFromItsOwnRecentFrames) {
+  MachineSpeed m;
+  m.calibrate(100, 100);
+  for (int i = 0; i < 3; ++i) m.observe(100, 100, "box");
+  EXPECT_DOUBLE_EQ(m.factor("box"), 1.0);
+  EXPECT_DOUBLE_EQ(m.factor("glass"), 1.0);  // not seen yet: the machine's
+  EXPECT_EQ(m.toJson("glass")["scene"]["basis"], "machine");
+  // The glass scene runs 3x its prediction, frame after frame; the box's frames are still recent.
+  for (std::size_t i = 0; i < MachineSpeed::kSceneWindow; ++i) m.observe(300, 100, "glass");
+  EXPECT_DOUBLE_EQ(m.factor("glass"), 3.0);
+  EXPECT_DOUBLE_EQ(m.factor("box"), 1.0);
+  EXPECT_EQ(m.toJson("glass")["scene"]["basis"], "own");
+  EXPECT_DOUBLE_EQ(m.factor(), 3.0) << "the machine's window: 5 of 3x, 3 of 1x and the calibration";
+  // Alternating, each keeps its own while the machine's median jumps between them.
+  for (int i = 0; i < 4; ++i) {
+    m.observe(100, 100, "box");
+    EXPECT_DOUBLE_EQ(m.factor("box"), 1.0);
+    m.observe(300, 100, "glass");
+    EXPECT_DOUBLE_EQ(m.factor("glass"), 3.0);
+  }
+  // The machine gets 2x slower: the box's frames say so. The glass scene's frames are now older than
+  // the window: the machine's factor.
+  for (std::size_t i = 0; i < MachineSpeed::kWindow; ++i) m.observe(200, 100, "box");
+  EXPECT_DOUBLE_EQ(m.factor("box"), 2.0);
+  EXPECT_DOUBLE_EQ(m.factor("glass"), 2.0);
+  EXPECT_EQ(m.toJson("glass")["scene"]["basis"], "machine");
+  EXPECT_EQ(m.toJson("box")["scene"]["recent"].size(), MachineSpeed::kSceneWindow);
+  // Pinned: the pinned factor for every scene, none learned.
+  MachineSpeed p;
+  p.pin(2.0);
+  p.observe(300, 100, "glass");
+  EXPECT_DOUBLE_EQ(p.factor("glass"), 2.0);
+  p.pin(0);
+  EXPECT_EQ(p.toJson("glass")["scene"]["basis"], "machine");
+}
