@@ -123,7 +123,9 @@ def main():
                         rec = {"mode": m, "scene": s, "round": rnd, "budget_ms": budget, "seed": seed,
                                "predicted_ms": b["predicted_ms"], "measured_ms": b["measured_ms"],
                                "speed": b.get("speed"), "fits": b["measured_ms"] <= budget,
-                               "params": {t: v.get("params") for t, v in b["techniques"].items() if v.get("params")}}
+                               "params": {t: v.get("params") for t, v in b["techniques"].items() if v.get("params")},
+                               "techniques": {t: {k: v.get(k) for k in ("predicted_ms", "measured_ms")}
+                                              for t, v in b["techniques"].items()}}
                         records.append(rec)
                         print(f"{m:>5} {s:14} budget {budget:8.1f} ms  predicted {b['predicted_ms']:8.1f}  "
                               f"measured {b['measured_ms']:8.1f}  factor {b.get('speed', {}).get('factor', 1):.2f}  "
