@@ -467,11 +467,35 @@ void MachineSpeed::observe(double measuredMs, double predictedMs, const std::str
   std::erase_if(scenes_, [&](const SceneFrames& e) { return e.second.back().index + kWindow < observed_; });
 }
 
-double MachineSpeed::machine() const {
-  if (pinned()) return pinned_;
+std::vector<double> MachineSpeed::machineRatios() const {
   std::vector<double> v = recent_;
   if (calibration_ > 0) v.push_back(calibration_);
+  return v;
+}
+
+double MachineSpeed::machine() const {
+  if (pinned()) return pinned_;
+  std::vector<double> v = machineRatios();
   return v.empty() ? 1.0 : median(std::move(v));
+}
+
+double MachineSpeed::headroom(const std::string& scene) const {
+  if (pinned()) return 1.0;
+  std::vector<double> v = ownRecent(scene);
+  if (v.size() < 3) v = machineRatios();
+  const std::size_t n = v.size();
+  if (n < 3) return 1.0;
+  double mean = 0, var = 0;
+  for (double r : v) mean += std::log(r) / double(n);
+  for (double r : v) var += (std::log(r) - mean) * (std::log(r) - mean) / double(n - 1);
+  // One-sided 90% quantiles of Student's t with n - 1 = 2 .. 10 degrees of freedom (then 11+: 1.36).
+  static constexpr double kT90[] = {1.886, 1.638, 1.533, 1.476, 1.440, 1.415, 1.397, 1.383, 1.372};
+  const double t = n - 1 <= 10 ? kT90[n - 3] : 1.36;
+  return std::clamp(std::exp(t * std::sqrt(var) * std::sqrt(1.0 + 1.0 / double(n))), 1.0, kMaxHeadroom);
+}
+
+double MachineSpeed::planningFactor(const std::string& scene) const {
+  return std::clamp(factor(scene) * headroom(scene), kMinRatio, kMaxRatio);
 }
 
 std::vector<double> MachineSpeed::ownRecent(const std::string& scene) const {
@@ -492,7 +516,9 @@ double MachineSpeed::factor(const std::string& scene) const {
 json MachineSpeed::toJson(const std::string& scene) const {
   const bool measured = calibration_ > 0 || !recent_.empty();
   const std::vector<double> own = ownRecent(scene);
-  return {{"factor", factor(scene)},
+  return {{"factor", planningFactor(scene)},
+          {"median", factor(scene)},
+          {"headroom", headroom(scene)},
           {"source", pinned() ? "pinned" : measured ? "measured" : "table"},
           {"machine", machine()},
           {"calibration", calibration_ > 0 ? json(calibration_) : json(nullptr)},

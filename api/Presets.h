@@ -121,7 +121,8 @@ struct BudgetChoice {
 // stats.default_frame_budget {budget_ms, predicted_default_ms, flag} and a first warning saying so. A
 // frame with an unmodelled technique (no prediction) or that names its passes runs as asked.
 //
-// `speed`: this machine's measured time over the table's prediction (MachineSpeed::factor): every
+// `speed`: this machine's measured time over the table's prediction (MachineSpeed::planningFactor: the
+// frame's scene's median ratio times its headroom): every
 // predicted ms (the techniques', the overhead's, the frame's) is the table's times `speed`, so that a
 // budget is met on a machine slower or faster than the one the table was measured on. Budget B at
 // speed s chooses what budget B / s chooses at speed 1. stats.speed_factor echoes it.
@@ -190,9 +191,18 @@ public:
   // A frame of `scene` ("": none) comparable with the table: its ratio joins the machine's window and
   // the scene's (the oldest leaves each). Ignored when either time is not a positive finite number.
   void observe(double measuredMs, double predictedMs, const std::string& scene = "");
-  // The factor for a frame of `scene` (pinned, or "": the machine's).
+  // The factor for a frame of `scene` (pinned, or "": the machine's): the median of its ratios.
   double factor(const std::string& scene = "") const;
-  // {"factor": factor(scene), "source": "pinned" | "measured" | "table", "machine": the machine's factor,
+  // What a budget plans with: factor(scene) times the headroom that makes a frame fit its budget with
+  // 90% probability when its ratio varies as the ratios factor() took its median of have: log-ratios
+  // taken as normal, the one-sided 90% Student-t prediction bound exp(t(0.9, n-1) s sqrt(1 + 1/n)) over
+  // their median (s their sample deviation, n >= 3 of them; fewer: the machine's window's, else 1),
+  // within [1, kMaxHeadroom]. A configuration predicted at the budget over this fits it 9 times in 10
+  // (bench/budget_ladder.py); pinned: the pinned factor, no headroom.
+  double planningFactor(const std::string& scene = "") const;
+  static constexpr double kMaxHeadroom = 2.0;
+  // {"factor": planningFactor(scene), "median": factor(scene), "headroom": their ratio,
+  //  "source": "pinned" | "measured" | "table", "machine": the machine's factor,
   //  "calibration": ratio or null, "recent": [the machine's window, oldest first],
   //  "scene": {"basis": "own" | "machine", "recent": [the scene's ratios it used, oldest first]}}
   nlohmann::json toJson(const std::string& scene = "") const;
@@ -207,6 +217,8 @@ private:
   double machine() const;
   // The scene's frames among the last kWindow observed (empty: none, or pinned).
   std::vector<double> ownRecent(const std::string& scene) const;
+  std::vector<double> machineRatios() const;  // the window and the calibration
+  double headroom(const std::string& scene) const;
   double pinned_ = 0.0, calibration_ = 0.0;
   std::vector<double> recent_;
   std::size_t observed_ = 0;

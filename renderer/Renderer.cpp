@@ -649,7 +649,7 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     for (const std::string& p : planned) speedScene += p + ",";
     // The server's default frame budget lowers a default supersampling first (api/Presets.h).
     if (const int within = api::supersamplingWithinDefaultBudget(api::PresetTable::builtin(), planned, request, k,
-                                                                 inputs.limits, counts, im.speed.factor(speedScene));
+                                                                 inputs.limits, counts, im.speed.planningFactor(speedScene));
         within < k) {
       stats.warnings.push_back("supersampling " + std::to_string(within) + " instead of the default " + std::to_string(k) +
                                ": at " + std::to_string(k) + " the default frame is predicted above this server's default "
@@ -715,7 +715,7 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     // except photon_gi's, whose gather follows the output pixels (api::costPixels).
     const nlohmann::json speedState = im.speed.toJson(speedScene);  // what this frame's choice used
     api::BudgetChoice choice = api::chooseConfiguration(api::PresetTable::builtin(), planned, supersampled,
-                                                        inputs.limits, counts, im.speed.factor(speedScene));
+                                                        inputs.limits, counts, im.speed.planningFactor(speedScene));
     for (auto& w : choice.warnings) stats.warnings.push_back(std::move(w));
     std::set<int> shadowMapExclusions;  // meshes whose shadows a pass supplies itself (light_volumes)
     for (std::size_t i = 0; i < plan.passes.size(); ++i) {

@@ -550,11 +550,17 @@ TEST(Budgets, TheChooserMeasuresTheMachineAndScalesItsPredictions) {
     // Every observed frame is this scene's and recent: its factor is the median of its own ratios.
     if (!speed["scene"]["recent"].empty()) {
       EXPECT_EQ(speed["scene"]["basis"], "own") << speed.dump();
-      EXPECT_DOUBLE_EQ(speed["factor"].get<double>(), median(speed["scene"]["recent"].get<std::vector<double>>()))
+      EXPECT_DOUBLE_EQ(speed["median"].get<double>(), median(speed["scene"]["recent"].get<std::vector<double>>()))
           << speed.dump();
     } else {
-      EXPECT_DOUBLE_EQ(speed["factor"].get<double>(), speed["machine"].get<double>()) << speed.dump();
+      EXPECT_DOUBLE_EQ(speed["median"].get<double>(), speed["machine"].get<double>()) << speed.dump();
     }
+    // The budget plans with the median times its headroom (api::MachineSpeed::planningFactor).
+    EXPECT_GE(speed["headroom"].get<double>(), 1.0);
+    EXPECT_LE(speed["headroom"].get<double>(), api::MachineSpeed::kMaxHeadroom);
+    EXPECT_NEAR(speed["factor"].get<double>(), speed["median"].get<double>() * speed["headroom"].get<double>(),
+                1e-12 * speed["factor"].get<double>())
+        << speed.dump();
     observed += speed["observed"].get<bool>();
     std::printf("seed %llu: speed %s, predicted %.1f ms, measured %.1f ms\n", static_cast<unsigned long long>(seed),
                 speed.dump().c_str(), r["stats"]["budget"]["predicted_ms"].get<double>(),
