@@ -154,6 +154,12 @@ bool PresetTable::hasModel(const std::string& technique) const {
 double PresetTable::predictMs(const std::string& technique, const json& params, double pixels,
                               const SceneCounts& counts) const {
   if (!hasModel(technique)) return -1.0;
+  if (technique == "specular" && counts.specularMapTexels > 0 && params.contains("cube_resolution") &&
+      params["cube_resolution"].is_number()) {
+    json run = params;
+    run["cube_resolution"] = std::min(params["cube_resolution"].get<double>(), counts.specularMapTexels);
+    return std::max(0.0, evalTerms(table_["techniques"][technique]["model"]["terms"], run, pixels, counts));
+  }
   return std::max(0.0, evalTerms(table_["techniques"][technique]["model"]["terms"], params, pixels, counts));
 }
 

@@ -49,8 +49,15 @@ struct SceneCounts {
   // The specular pass's objects (renderer/shading/SpecularObjects.h specularMeshes: every mesh with a
   // mirror-like or transmissive material): it renders layered distance maps per object.
   double specularObjects = 0;
+  // The specular maps' face resolution the frame runs at, when the pass chooses it from the view
+  // (renderer/techniques/specular/Specular.h chooseMapResolution); 0: the parameter's. Specular's model
+  // is charged the smaller of it and cube_resolution (predictMs): a default frame's maps follow the
+  // objects' size on screen (MetalRoughSpheres' 12 spheres at 64 texels, not the default 256).
+  double specularMapTexels = 0;
   nlohmann::json toJson() const {
-    return {{"particles", particles}, {"beams", beams}, {"specular_objects", specularObjects}};
+    nlohmann::json j{{"particles", particles}, {"beams", beams}, {"specular_objects", specularObjects}};
+    if (specularMapTexels > 0) j["specular_map_texels"] = specularMapTexels;
+    return j;
   }
   // toJson's inverse (stats.scene.counts, stats.budget.scene_counts); a missing key counts 0.
   static SceneCounts fromJson(const nlohmann::json& j) {
@@ -58,6 +65,7 @@ struct SceneCounts {
     c.particles = j.value("particles", 0.0);
     c.beams = j.value("beams", 0.0);
     c.specularObjects = j.value("specular_objects", 0.0);
+    c.specularMapTexels = j.value("specular_map_texels", 0.0);
     return c;
   }
 };

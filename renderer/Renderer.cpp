@@ -28,6 +28,7 @@
 #include "renderer/shading/DirectLighting.h"
 #include "renderer/shading/EnvironmentLights.h"
 #include "renderer/techniques/reference/ReferencePass.h"
+#include "renderer/techniques/specular/Specular.h"
 #include "renderer/techniques/Registry.h"
 
 namespace radiant {
@@ -642,7 +643,25 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     std::vector<std::string> planned;
     for (Technique* t : plan.passes) planned.push_back(t->info().name);
     // The cost models' scene variables (particles of the scene and the request's media, light_volumes' beams).
-    const api::SceneCounts counts = sceneCostCounts(scene, request.media);
+    api::SceneCounts counts = sceneCostCounts(scene, request.media);
+    // specular's maps follow the view: its model is charged the resolution the pass will choose.
+    if (std::find(planned.begin(), planned.end(), "specular") != planned.end()) {
+      const auto given = request.passes.find("specular");
+      const auto named = request.explicitParams.find("specular");
+      const Params sp(api::techniqueParams("specular", given != request.passes.end() && given->second.is_object()
+                                                           ? given->second
+                                                           : nlohmann::json(nullptr)),
+                      named == request.explicitParams.end() ? std::set<std::string>{} : named->second);
+      api::RenderRequest atK = request;
+      atK.width *= k;
+      atK.height *= k;
+      atK.supersampling = k;
+      const auto owner = plan.lightPaths.find("LS+DE");
+      counts.specularMapTexels =
+          chooseMapResolution(scene, makeFrameView(scene, atK, inputs.environment), sp,
+                              owner != plan.lightPaths.end() && owner->second == "caustics")
+              .texels;
+    }
     // The speed factor's scene (api::MachineSpeed): the scene and the passes it runs, whose models'
     // error on it the factor's scene correction learns.
     std::string speedScene = (scene.digest.empty() ? "name:" + scene.name : scene.digest) + "|";

@@ -59,6 +59,24 @@ int mapResolution(double objectPixels, double texelsPerPixel, int maxResolution)
   return std::min(r, maxResolution);
 }
 
+MapResolution chooseMapResolution(const Scene& scene, const FrameView& view, const Params& params, bool causticsOwnsLSDE) {
+  MapResolution r;
+  r.texels = std::clamp(params.get<int>("cube_resolution", 256), 16, 2048);
+  // A cube_resolution the request gives is run as asked, unless it gives map_texels_per_pixel too.
+  const bool adaptive = !params.given("cube_resolution") || params.given("map_texels_per_pixel");
+  const double texelsPerPixel = adaptive ? std::clamp(params.get<double>("map_texels_per_pixel", 1.0), 0.0, 64.0) : 0.0;
+  if (texelsPerPixel <= 0.0) return r;
+  for (std::size_t i : specularMeshes(scene))
+    r.largestObjectPixels = std::max(r.largestObjectPixels, projectedDiameterPixels(view, scene.meshes[i].bounds));
+  // The caustics pass traces its photons from the lights through these maps: what they need does
+  // not depend on the camera (a generator a few pixels wide on screen can focus a caustic across the
+  // floor; at 128 texels a glass slab lost 4% of its caustic photons at its edges against 256), so
+  // with caustics in the frame the maps stay at cube_resolution.
+  r.keptForCaustics = causticsOwnsLSDE;
+  if (!r.keptForCaustics) r.texels = mapResolution(r.largestObjectPixels, texelsPerPixel, r.texels);
+  return r;
+}
+
 const TechniqueInfo& SpecularPass::info() const {
   static const TechniqueInfo i{
       "specular",
@@ -86,10 +104,6 @@ void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResour
   maxDepth_ = std::clamp(params.get<int>("max_depth", 4), 1, 8);
   linearSteps_ = std::clamp(params.get<int>("linear_steps", 32), 1, 256);
   secantSteps_ = std::clamp(params.get<int>("secant_steps", 4), 0, 32);
-  const int maxResolution = std::clamp(params.get<int>("cube_resolution", 256), 16, 2048);
-  // A cube_resolution the request gives is run as asked, unless it gives map_texels_per_pixel too.
-  const bool adaptive = !params.given("cube_resolution") || params.given("map_texels_per_pixel");
-  const double texelsPerPixel = adaptive ? std::clamp(params.get<double>("map_texels_per_pixel", 1.0), 0.0, 64.0) : 0.0;
   layers_ = std::clamp(params.get<int>("layers", 3), 3, 6);
   indirectBlock_ = std::clamp(params.get<int>("map_indirect_block", 8), 1, 64);
   minmax_ = params.get<bool>("minmax", true);
@@ -120,20 +134,14 @@ void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResour
 
   // The maps' resolution follows what the camera sees of the specular objects (issue 31): a map's face
   // needs about as many texels across as the largest object covers pixels (mapResolution), not a fixed
-  // 256 whatever its size on screen; at most cube_resolution.
-  resolution_ = maxResolution;
-  largestObjectPixels_ = 0.0;
-  causticsKeepMaps_ = false;
-  if (texelsPerPixel > 0.0) {
-    for (const Object& o : objects_)
-      largestObjectPixels_ = std::max(largestObjectPixels_, projectedDiameterPixels(res.view(), scene.meshes[o.mesh].bounds));
-    // The caustics pass traces its photons from the lights through these maps: what they need does
-    // not depend on the camera (a generator a few pixels wide on screen can focus a caustic across the
-    // floor; at 128 texels a glass slab lost 4% of its caustic photons at its edges against 256), so
-    // with caustics in the frame the maps stay at cube_resolution.
-    causticsKeepMaps_ = res.lightPathOwner("LS+DE") == "caustics";
-    if (!causticsKeepMaps_) resolution_ = mapResolution(largestObjectPixels_, texelsPerPixel, maxResolution);
-  }
+  // 256 whatever its size on screen; at most cube_resolution (chooseMapResolution).
+  const MapResolution chosen = chooseMapResolution(scene, res.view(), params, res.lightPathOwner("LS+DE") == "caustics");
+  resolution_ = chosen.texels;
+  largestObjectPixels_ = chosen.largestObjectPixels;
+  causticsKeepMaps_ = chosen.keptForCaustics;
+  // A cube_resolution the request gives is run as asked (a 422 above the memory bound below), unless it
+  // gives map_texels_per_pixel too.
+  const bool adaptive = !params.given("cube_resolution") || params.given("map_texels_per_pixel");
 
   // The maps' memory (kMaxBytes), checked before anything is allocated.
   warning_.clear();

@@ -29,6 +29,17 @@ double projectedDiameterPixels(const FrameView& view, const Bounds& bounds);
 // The layered distance maps' face resolution for the largest specular object's projected diameter:
 // texelsPerPixel times it, rounded up to a power of two, within [16, maxResolution].
 int mapResolution(double objectPixels, double texelsPerPixel, int maxResolution);
+// The maps' face resolution a frame runs at (before the memory bound's halving, SpecularPass::kMaxBytes):
+// a cube_resolution the request gives (without map_texels_per_pixel) as given; cube_resolution when
+// caustics owns L S+ D E (it traces its photons through these maps: keptForCaustics); else
+// mapResolution of the largest specular object's projected diameter. One place for the pass and for
+// the budget chooser, which charges specular's cost model this resolution (api::SceneCounts).
+struct MapResolution {
+  int texels = 0;
+  double largestObjectPixels = 0.0;
+  bool keptForCaustics = false;
+};
+MapResolution chooseMapResolution(const Scene& scene, const FrameView& view, const Params& params, bool causticsOwnsLSDE);
 
 class SpecularPass final : public Technique {
 public:

@@ -799,6 +799,8 @@ TEST(Specular, MapsFollowTheObjectsSizeOnScreen) {
     EXPECT_NEAR(specularCounter(out, "largest_object_pixels"), d, 0.02 * d);
     EXPECT_EQ(specularCounter(out, "cube_resolution"), mapResolution(d, 1.0, 256));
     EXPECT_EQ(specularCounter(out, "maps_kept_for_caustics"), 0.0);
+    // The budget chooser charges specular's model the resolution the pass runs (api::SceneCounts).
+    EXPECT_EQ(out.stats.scene["counts"]["specular_map_texels"].get<double>(), specularCounter(out, "cube_resolution"));
   }
   EXPECT_EQ(mapResolution(14.6, 1.0, 256), 16);
   EXPECT_EQ(mapResolution(58.4, 1.0, 256), 64);
@@ -835,10 +837,13 @@ TEST(Specular, MapsFollowTheObjectsSizeOnScreen) {
   EXPECT_EQ(specularCounter(asked, "cube_resolution"), 128.0);
   RenderOutput both = renderer().render(painted, request(n, n, {{"cube_resolution", 128}, {"map_texels_per_pixel", 0.5}}));
   EXPECT_EQ(specularCounter(both, "cube_resolution"), 16.0);  // 0.5 x 29 px
+  for (const RenderOutput* o : {&asked, &both})
+    EXPECT_EQ(o->stats.scene["counts"]["specular_map_texels"].get<double>(), specularCounter(*o, "cube_resolution"));
   // With the point light the caustics pass runs and the maps stay at cube_resolution.
   RenderOutput lit = renderer().render(loadBuiltinScene("cornell_glass"), request(n, n));
   EXPECT_EQ(specularCounter(lit, "maps_kept_for_caustics"), 1.0);
   EXPECT_EQ(specularCounter(lit, "cube_resolution"), 256.0);
+  EXPECT_EQ(lit.stats.scene["counts"]["specular_map_texels"].get<double>(), 256.0);
 }
 
 // The maps' memory is bounded (SpecularPass::kMaxBytes, 512 MiB: 32 bytes a texel over the four

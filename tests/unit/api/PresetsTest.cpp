@@ -692,6 +692,23 @@ TEST(Presets, MachineSpeedPredictsAScenesFramesFromItsOwnRecentFrames) {
   EXPECT_EQ(p.toJson("glass")["scene"]["basis"], "machine");
 }
 
+// specular's maps follow the view (renderer/techniques/specular/Specular.h chooseMapResolution): its
+// model is charged the resolution the frame runs at, never more than the cube_resolution it is given.
+TEST(Presets, SpecularIsChargedTheMapResolutionTheFrameRuns) {
+  const PresetTable& t = PresetTable::builtin();
+  SceneCounts twelve{0, 0, 12}, at64 = twelve;
+  at64.specularMapTexels = 64;
+  const double px = 512.0 * 512.0;
+  EXPECT_DOUBLE_EQ(t.predictMs("specular", {{"cube_resolution", 256}, {"layers", 3}}, px, at64),
+                   t.predictMs("specular", {{"cube_resolution", 64}, {"layers", 3}}, px, twelve));
+  EXPECT_LT(t.predictMs("specular", {{"cube_resolution", 256}, {"layers", 3}}, px, at64),
+            t.predictMs("specular", {{"cube_resolution", 256}, {"layers", 3}}, px, twelve));
+  EXPECT_DOUBLE_EQ(t.predictMs("specular", {{"cube_resolution", 32}, {"layers", 3}}, px, at64),
+                   t.predictMs("specular", {{"cube_resolution", 32}, {"layers", 3}}, px, twelve));
+  EXPECT_EQ(SceneCounts::fromJson(at64.toJson()).specularMapTexels, 64.0);
+  EXPECT_FALSE(twelve.toJson().contains("specular_map_texels"));
+}
+
 // The headroom a budget plans with: a frame whose ratio varies as the scene's recent ratios do fits its
 // budget 9 times in 10. Closed form on three ratios e^-a, 1, e^a (median 1, sample deviation a of the
 // logs): exp(t(0.9, 2) a sqrt(4/3)); and by simulation, log-normal ratios (sigma 0.1) in windows of
