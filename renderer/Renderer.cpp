@@ -662,8 +662,8 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
                               owner != plan.lightPaths.end() && owner->second == "caustics")
               .texels;
     }
-    // The speed factor's scene (api::MachineSpeed): the scene and the passes it runs, whose models'
-    // error on it the factor's scene correction learns.
+    // The speed factor's scene (api::MachineSpeed): the scene and the passes it runs, whose own recent
+    // frames measure the load and the models' error on it at once.
     std::string speedScene = (scene.digest.empty() ? "name:" + scene.name : scene.digest) + "|";
     for (const std::string& p : planned) speedScene += p + ",";
     // The server's default frame budget lowers a default supersampling first (api/Presets.h).

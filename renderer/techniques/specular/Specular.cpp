@@ -63,8 +63,8 @@ MapResolution chooseMapResolution(const Scene& scene, const FrameView& view, con
   MapResolution r;
   r.texels = std::clamp(params.get<int>("cube_resolution", 256), 16, 2048);
   // A cube_resolution the request gives is run as asked, unless it gives map_texels_per_pixel too.
-  const bool adaptive = !params.given("cube_resolution") || params.given("map_texels_per_pixel");
-  const double texelsPerPixel = adaptive ? std::clamp(params.get<double>("map_texels_per_pixel", 1.0), 0.0, 64.0) : 0.0;
+  r.adaptive = !params.given("cube_resolution") || params.given("map_texels_per_pixel");
+  const double texelsPerPixel = r.adaptive ? std::clamp(params.get<double>("map_texels_per_pixel", 1.0), 0.0, 64.0) : 0.0;
   if (texelsPerPixel <= 0.0) return r;
   for (std::size_t i : specularMeshes(scene))
     r.largestObjectPixels = std::max(r.largestObjectPixels, projectedDiameterPixels(view, scene.meshes[i].bounds));
@@ -139,9 +139,7 @@ void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResour
   resolution_ = chosen.texels;
   largestObjectPixels_ = chosen.largestObjectPixels;
   causticsKeepMaps_ = chosen.keptForCaustics;
-  // A cube_resolution the request gives is run as asked (a 422 above the memory bound below), unless it
-  // gives map_texels_per_pixel too.
-  const bool adaptive = !params.given("cube_resolution") || params.given("map_texels_per_pixel");
+  const bool adaptive = chosen.adaptive;  // else a 422 above the memory bound below
 
   // The maps' memory (kMaxBytes), checked before anything is allocated.
   warning_.clear();

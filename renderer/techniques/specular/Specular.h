@@ -38,6 +38,7 @@ struct MapResolution {
   int texels = 0;
   double largestObjectPixels = 0.0;
   bool keptForCaustics = false;
+  bool adaptive = true;  // false: a cube_resolution the request gave, run as given
 };
 MapResolution chooseMapResolution(const Scene& scene, const FrameView& view, const Params& params, bool causticsOwnsLSDE);
 
