@@ -12,8 +12,8 @@ budgets 1, 1.5, 2.5, 4 and 8 times the cheapest configuration's predicted ms *at
 same budgets in both modes), each frame with a fresh seed (photons, networks traced cold, as the table's
 cost sweeps were). A frame fits when stats.budget.measured_ms <= its budget. A budget is feasible when it
 is at least the median time of the scene's 1x frames (which run the cheapest configuration): below that
-no choice fits, and on a machine slower than the table's (a loaded one) the 1x budgets are not. The modes run interleaved
-by round so that both see the same load. --load N starts N busy-loop processes for the whole run.
+no choice fits, and on a machine slower than the table's (a loaded one) the 1x budgets are not. The
+modes run interleaved by round so that both see the same load. --load N starts N busy-loop processes for the whole run.
 Prints one line per frame and a table per mode; -o writes every record as JSON.
 """
 import argparse
