@@ -40,6 +40,7 @@ struct PhotonGrid {
   std::size_t count = 0;  // splats (photons and coverage points) in the buffers
   glm::vec3 origin{0.f};
   float cellSize = 1.f;
+  float walkReach = 1e30f;  // neighbour cells farther than this from the point are skipped (grid.glsl)
   glm::ivec3 dims{1};
   std::uint32_t maxPerCell = 0;
   int kernel = 0;            // photon.glsl KERNEL_*

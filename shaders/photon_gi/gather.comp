@@ -39,7 +39,7 @@ void main() {
     ivec3 c = photonCellOf(s.x);
     for (int k = 0; k < 27; ++k) {
       uint begin, end;
-      if (!photonCellSlice(c, k, begin, end)) continue;
+      if (!photonCellSlice(s.x, c, k, begin, end)) continue;
       for (uint i = begin; i < end; ++i) {
         GpuPhoton p = photons[i];
         if (p.power.a > 0.0) acc.a += coverageContribution(p, s);

@@ -14,16 +14,24 @@ uniform float u_cellSize;
 uniform ivec3 u_gridDims;
 uniform uint u_sliceBegin;
 uniform uint u_sliceLength;
+// The farthest any splat stored in a cell reaches outside it (h sqrt(1 + tolerance^2) of the widest
+// kernel), or more than a cell when the grid holds copies (Splatting.cpp buildSplatGrid): a neighbour
+// cell farther than this from the point holds nothing that reaches it, and the walk skips it (0, a
+// program that does not set it: no cell is skipped).
+uniform float u_walkReach;
 
 // The cell holding x (may lie outside the grid: photonCellSlice skips what does).
 ivec3 photonCellOf(vec3 x) { return ivec3(floor((x - u_gridOrigin) / u_cellSize)); }
 
-// Neighbour k (0..26) of cell c: false when it is outside the grid, else this slice's entries of it,
-// [begin, end) of the photon buffer.
-bool photonCellSlice(ivec3 c, int k, out uint begin, out uint end) {
+// Neighbour k (0..26) of cell c, the cell of point x: false when it is outside the grid or farther from
+// x than u_walkReach, else this slice's entries of it, [begin, end) of the photon buffer.
+bool photonCellSlice(vec3 x, ivec3 c, int k, out uint begin, out uint end) {
   ivec3 q = c + ivec3(k % 3, (k / 3) % 3, k / 9) - 1;
   begin = end = 0u;
   if (any(lessThan(q, ivec3(0))) || any(greaterThanEqual(q, u_gridDims))) return false;
+  vec3 lo = u_gridOrigin + vec3(q) * u_cellSize;
+  vec3 gap = max(max(lo - x, x - (lo + u_cellSize)), vec3(0.0));
+  if (u_walkReach > 0.0 && dot(gap, gap) > u_walkReach * u_walkReach) return false;
   int cell = (q.z * u_gridDims.y + q.y) * u_gridDims.x + q.x;
   begin = cellStart[cell] + u_sliceBegin;
   end = min(cellStart[cell + 1], begin + u_sliceLength);

@@ -52,7 +52,7 @@ vec4 gatherAt(ivec2 px, vec4 acc) {
   ivec3 c = photonCellOf(x);
   for (int k = 0; k < 27; ++k) {
     uint begin, end;
-    if (!photonCellSlice(c, k, begin, end)) continue;
+    if (!photonCellSlice(x, c, k, begin, end)) continue;
     for (uint i = begin; i < end; ++i) {
       GpuPhoton p = photons[i];
       if (p.power.a > 0.0) {

@@ -368,6 +368,7 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   published.count = grid_->count;
   published.origin = grid_->origin;
   published.cellSize = grid_->cellSize;
+  published.walkReach = grid_->walkReach;
   published.dims = grid_->dims;
   published.maxPerCell = grid_->maxPerCell;
   published.kernel = static_cast<int>(splat_.kernel);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include <glm/gtc/type_ptr.hpp>
@@ -188,6 +189,18 @@ SplatGrid buildSplatGrid(std::vector<GpuSplat> splats) {
     out.wiFlags = isCopy[e] ? (out.wiFlags | kSplatCopy) : (out.wiFlags & ~kSplatCopy);
   }
   g.count = g.splats.size();
+  g.walkReach = 0.f;
+  if (g.count != g.originals) {
+    g.walkReach = std::numeric_limits<float>::infinity();
+  } else {
+    for (const GpuSplat& s : g.splats) {
+      const glm::vec3 p(s.positionRadius);
+      const glm::vec3 lo = g.origin + glm::vec3(glm::clamp(glm::ivec3(glm::floor((p - g.origin) / g.cellSize)),
+                                                           glm::ivec3(0), g.dims - 1)) * g.cellSize;
+      const glm::vec3 gap = glm::max(glm::max(lo - p, p - (lo + g.cellSize)), glm::vec3(0.f));
+      g.walkReach = std::max(g.walkReach, glm::length(gap) + s.positionRadius.w * reachScale);
+    }
+  }
   return g;
 }
 
@@ -279,6 +292,7 @@ void splatAndResolve(FrameResources& res, gl::ShaderLibrary& shaders, const Fram
     common(prog);
     prog.set("u_gridOrigin", glm::value_ptr(grid.origin), 3);
     prog.set("u_cellSize", grid.cellSize);
+    prog.set("u_walkReach", std::min(grid.walkReach, 1e30f));
     const int dims[3] = {grid.dims.x, grid.dims.y, grid.dims.z};
     glUniform3iv(glGetUniformLocation(prog.id(), "u_gridDims"), 1, dims);
     const int size[2] = {view.width, view.height};

@@ -72,6 +72,10 @@ struct SplatGrid {
   glm::ivec3 dims{1};
   std::uint32_t maxPerCell = 0;  // the fullest cell's splats (the gather's dispatch count follows it)
   float hMin = 0.f;              // the smallest kernel radius
+  // How far outside its cell any splat stored in a cell reaches (its distance to the cell's box plus h
+  // sqrt(1 + tolerance^2)): the walk skips neighbour cells farther than this from the point (grid.glsl).
+  // Infinite when the grid holds copies, whose cell is not their splat's.
+  float walkReach = 0.f;
 };
 // A gather visits the 27 cells around a pixel. Cells are the reach h sqrt(1 + planeTolerance^2) of the
 // largest kernel, or of a smaller percentile one when that walks fewer candidates with the wider

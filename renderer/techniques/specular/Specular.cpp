@@ -404,6 +404,7 @@ void SpecularPass::execute(PassContext& ctx) {
       gather.set("u_size", resolution_);
       gather.set("u_gridOrigin", &photons->origin[0], 3);
       gather.set("u_cellSize", photons->cellSize);
+      gather.set("u_walkReach", std::min(photons->walkReach, 1e30f));
       const int dims[3] = {photons->dims.x, photons->dims.y, photons->dims.z};
       glProgramUniform3iv(gather.id(), gather.uniformLocation("u_gridDims"), 1, dims);
       glProgramUniform1ui(gather.id(), gather.uniformLocation("u_sliceLength"), kPhotonGatherSlice);
