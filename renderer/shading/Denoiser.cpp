@@ -39,7 +39,7 @@ gl::Texture& run(FrameResources& res, gl::ShaderLibrary& shaders, const FrameVie
   for (int i = 0; i < iterations; ++i) {
     src->bindUnit(0);
     ping->bindImage(0, GL_WRITE_ONLY);
-    prog.set("u_step", 1 << i);
+    prog.set("u_step", std::max(1, s.baseStep) << i);
     prog.set("u_first", i == 0 ? 1 : 0);
     prog.set("u_last", i + 1 == iterations ? 1 : 0);
     glDispatchCompute((view.width + 7) / 8, (view.height + 7) / 8, 1);

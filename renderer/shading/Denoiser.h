@@ -23,6 +23,12 @@ namespace radiant::denoise {
 
 struct Settings {
   int iterations = 3;
+  // The first pass's step in the frame's samples (then 2x, 4x, ...): the supersampling factor k, so
+  // that the steps count output pixels. photon_gi's estimate of a supersampled frame is smooth over k
+  // samples (its gather block is k gather_step samples wide), and a first pass at step 1 filtered
+  // almost nothing: at k = 2 two passes of steps 2, 4 give three passes' (1, 2, 4) error within 0.5%
+  // for two thirds of the cost (docs/PERFORMANCE.md, "Denoiser").
+  int baseStep = 1;
   float relativeNoise = 0.1f;    // per-pixel relative standard deviation of the input
   float sigmaLuminance = 1.5f;   // in noise widths (docs/PERFORMANCE.md, "Denoiser": 0.5-4 measured)
   float sigmaNormal = 64.f;     // cosine power

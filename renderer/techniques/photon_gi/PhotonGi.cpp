@@ -174,7 +174,12 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   // / C' with C' the photons per kernel over pi, i.e. C, or C (photons / ppm_base)^(alpha / 2) on the
   // ppm schedule (docs/TECHNIQUES.md).
   denoise_ = params.get<bool>("denoise", true);
+  // The filter's steps count output pixels (k, 2k, ...: Denoiser.h baseStep); left out of the request,
+  // a supersampled frame filters with 2 passes (reach 6 output pixels on each side), one at k = 1 with
+  // 3 (7): the same error on the Cornell boxes at 64-256 px, k = 2 (docs/PERFORMANCE.md, "Denoiser").
+  denoiseSettings_.baseStep = k;
   denoiseSettings_.iterations = params.get<int>("denoise_iterations", 3);
+  if (!params.given("denoise_iterations") && k >= 2) denoiseSettings_.iterations = 2;
   const double kernelNoise = splat_.kernel == photon_gi::Kernel::Epanechnikov ? 0.651 : 0.757;
   double effectiveC = s.C;
   if (s.ppm) effectiveC *= std::pow(static_cast<double>(s.photons) / s.ppmBase, 0.5 * s.ppmAlpha);
@@ -423,6 +428,7 @@ void PhotonGiPass::execute(PassContext& ctx) {
   c["h_max"] = hMax_;
   c["C"] = settings_.C;
   c["denoise_iterations"] = denoise_ ? denoiseSettings_.iterations : 0;
+  c["denoise_base_step"] = denoise_ ? denoiseSettings_.baseStep : 0;  // the first pass's step, in the frame's samples
   c["denoise_relative_noise"] = denoiseSettings_.relativeNoise;
   c["environment_light_photons"] = lightPhotonWeight_;  // 1: sky photons drawn by the map itself
   c["gather"] = splat_.method == photon_gi::Method::Gather ? 1.0 : 0.0;

@@ -88,6 +88,39 @@ TEST(Denoise, LowersTheCornellBoxErrorKeepsTheMeanAndTheCorners) {
   EXPECT_EQ(pass(raw, "photon_gi")->counters.at("denoise_iterations"), 0.0);
 }
 
+// Supersampled (k = 2, the HTTP default): the filter's steps count output pixels (2, 4 samples) and
+// its default is 2 passes. The same properties as at k = 1, against the same truth.
+TEST(Denoise, SupersampledFramesFilterInOutputPixels) {
+  const Scene scene = loadBuiltinScene("cornell_box");
+  api::RenderRequest r;
+  r.width = r.height = 64;
+  r.supersampling = 2;
+  r.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"indirect", "normal"}, false}};
+  r.compare = api::CompareSpec{"reference", "indirect", 2048};
+  r.passes["photon_gi"] = {{"denoise", false}};
+  const RenderOutput raw = renderer().render(scene, r);
+  r.passes["photon_gi"] = {{"denoise", true}};
+  const RenderOutput clean = renderer().render(scene, r);
+  r.passes["photon_gi"] = {{"denoise", true}, {"denoise_iterations", 3}};
+  r.explicitParams["photon_gi"] = {"denoise", "denoise_iterations"};  // what the HTTP route records
+  const RenderOutput three = renderer().render(scene, r);
+  const Image& truth = aov(clean, "reference");
+  const double rawErr = rmse(aov(raw, "indirect"), truth), cleanErr = rmse(aov(clean, "indirect"), truth),
+               threeErr = rmse(aov(three, "indirect"), truth);
+  const std::vector<bool> edges = geometricEdges(aov(clean, "normal"));
+  const double rawEdge = rmse(aov(raw, "indirect"), truth, &edges), cleanEdge = rmse(aov(clean, "indirect"), truth, &edges);
+  const double meanRatio = mean(aov(clean, "indirect")) / mean(aov(raw, "indirect"));
+  std::printf("Cornell box 64 px, k = 2, indirect vs 2048 spp: rmse raw %.4f, denoised %.4f (x%.2f), 3 passes %.4f; "
+              "on edges %.4f -> %.4f; mean ratio %.4f\n",
+              rawErr, cleanErr, cleanErr / rawErr, threeErr, rawEdge, cleanEdge, meanRatio);
+  EXPECT_EQ(pass(clean, "photon_gi")->counters.at("denoise_iterations"), 2.0);
+  EXPECT_EQ(pass(clean, "photon_gi")->counters.at("denoise_base_step"), 2.0);
+  EXPECT_EQ(pass(three, "photon_gi")->counters.at("denoise_iterations"), 3.0);  // as given
+  EXPECT_LT(cleanErr, 0.95 * rawErr);
+  EXPECT_NEAR(meanRatio, 1.0, 0.005);
+  EXPECT_LT(cleanEdge, rawEdge);
+}
+
 // A closed room [-2, 2] x [-0.01, 2] x [-2, 2] of a double-sided Lambertian of albedo rho, a point light
 // under its ceiling and an orthographic camera looking down at its floor.
 testing::SceneBuilder room(float rho, float intensity) {
