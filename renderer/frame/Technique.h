@@ -4,6 +4,7 @@
 // declares its parameters in api/schema/techniques/<name>.json and its method in docs/TECHNIQUES.md.
 
 #include <set>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -59,10 +60,17 @@ public:
   explicit Params(nlohmann::json j, std::set<std::string> given = {})
       : json_(j.is_object() ? std::move(j) : nlohmann::json::object()), given_(std::move(given)) {}
   bool given(const char* key) const { return given_.count(key) != 0; }
+  // The value of `key`: the schema gives every parameter a default (api/schema/techniques/*.json,
+  // test Schema.EveryTechniqueParameterHasADefault), which is the one place it is written; a key that
+  // is not there is a programmer error.
   template <class T>
-  T get(const char* key, T fallback) const {
+  T get(const char* key) const {
     auto it = json_.find(key);
-    return it == json_.end() || it->is_null() ? fallback : it->get<T>();
+    if (it == json_.end() || it->is_null())
+      throw std::logic_error(std::string("Params::get(\"") + key +
+                             "\"): no value (a key the technique's schema does not declare, or Params not from "
+                             "api::techniqueParams)");
+    return it->get<T>();
   }
   const nlohmann::json& json() const { return json_; }
   // Digest of a subset of the parameters: what a cache entry depends on.

@@ -243,17 +243,17 @@ Requirements AmbientOcclusionPass::requirements(const Scene&, const api::RenderR
 }
 
 void AmbientOcclusionPass::prepare(const Scene&, const Params& params, FrameResources& res) {
-  method_ = ao::parseMethod(params.get<std::string>("method", "volumetric"));
-  falloff_ = ao::parseFalloff(params.get<std::string>("falloff", "step"));
-  samples_ = std::clamp(params.get<int>("samples", 16), 1, ao::kMaxSamples);
-  radius_ = params.get<float>("radius", 0.5f);
+  method_ = ao::parseMethod(params.get<std::string>("method"));
+  falloff_ = ao::parseFalloff(params.get<std::string>("falloff"));
+  samples_ = std::clamp(params.get<int>("samples"), 1, ao::kMaxSamples);
+  radius_ = params.get<float>("radius");
   if (!(radius_ > 0.f) || !std::isfinite(radius_))
     throw api::ApiError(422, "out-of-range", "Value out of range",
                         "/passes/ambient_occlusion/radius: must be a finite number above 0",
                         "/passes/ambient_occlusion/radius");
-  interleave_ = params.get<bool>("interleave", true);
-  blur_ = params.get<bool>("blur", true);
-  scale_ = params.get<std::string>("resolution_scale", "full") == "half" ? 2 : 1;
+  interleave_ = params.get<bool>("interleave");
+  blur_ = params.get<bool>("blur");
+  scale_ = params.get<std::string>("resolution_scale") == "half" ? 2 : 1;
 
   // The kernel depends on the method, the falloff and the sample count only: a radius sweep reuses it.
   const std::string digest = std::string(methodName(method_)) + "/" + (falloff_ == ao::Falloff::Step ? "step" : "cubic") +
@@ -380,8 +380,8 @@ void AmbientOcclusionPass::execute(PassContext& ctx) {
 GroundTruth AmbientOcclusionPass::groundTruth(const Params& params, const std::string& aov) const {
   if (aov != "ao") return GroundTruth::fromAovTable(aov);
   return {nlohmann::json{{"aov", "ao"},
-                         {"ao_radius", params.get<double>("radius", 0.5)},
-                         {"ao_definition", params.get<std::string>("method", "volumetric") == "volumetric" ? "volumetric"
+                         {"ao_radius", params.get<double>("radius")},
+                         {"ao_definition", params.get<std::string>("method") == "volumetric" ? "volumetric"
                                                                                                            : "cosine"}}};
 }
 

@@ -139,20 +139,20 @@ Requirements CausticsPass::requirements(const Scene& scene, const api::RenderReq
 
 void CausticsPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
   // Fallbacks are the schema defaults (api/schema/techniques/caustics.json).
-  method_ = params.get<std::string>("method", "triangles") == "splat" ? Method::Splat : Method::Triangles;
-  photonResolution_ = std::clamp(params.get<int>("photon_resolution", 128), 32, 256);
-  cubeResolution_ = std::clamp(params.get<int>("cube_resolution", 256), 16, 1024);
-  areaWeight_ = std::clamp(params.get<float>("area_weight", 1.f / 3.f), 0.1f, 1.f);
-  visibilityTolerance_ = std::clamp(params.get<float>("visibility_tolerance", 2.f), 0.f, 64.f);
-  maxDepth_ = std::clamp(params.get<int>("max_depth", 4), 1, 8);
-  secondaryMaxDepth_ = std::clamp(params.get<int>("secondary_max_depth", 2), 1, 8);
-  linearSteps_ = std::clamp(params.get<int>("linear_steps", 32), 1, 256);
-  secantSteps_ = std::clamp(params.get<int>("secant_steps", 4), 0, 32);
-  splatRadius_ = std::clamp(params.get<float>("splat_radius", 0.02f), 1e-4f, 10.f);
-  energyCheck_ = params.get<bool>("energy_check", false);
-  fresnelReflection_ = params.get<bool>("fresnel_reflection", true);
-  footprintFilter_ = params.get<bool>("footprint_filter", true);
-  specularLookup_ = params.get<bool>("specular_lookup", true);
+  method_ = params.get<std::string>("method") == "splat" ? Method::Splat : Method::Triangles;
+  photonResolution_ = std::clamp(params.get<int>("photon_resolution"), 32, 256);
+  cubeResolution_ = std::clamp(params.get<int>("cube_resolution"), 16, 1024);
+  areaWeight_ = std::clamp(params.get<float>("area_weight"), 0.1f, 1.f);
+  visibilityTolerance_ = std::clamp(params.get<float>("visibility_tolerance"), 0.f, 64.f);
+  maxDepth_ = std::clamp(params.get<int>("max_depth"), 1, 8);
+  secondaryMaxDepth_ = std::clamp(params.get<int>("secondary_max_depth"), 1, 8);
+  linearSteps_ = std::clamp(params.get<int>("linear_steps"), 1, 256);
+  secantSteps_ = std::clamp(params.get<int>("secant_steps"), 0, 32);
+  splatRadius_ = std::clamp(params.get<float>("splat_radius"), 1e-4f, 10.f);
+  energyCheck_ = params.get<bool>("energy_check");
+  fresnelReflection_ = params.get<bool>("fresnel_reflection");
+  footprintFilter_ = params.get<bool>("footprint_filter");
+  specularLookup_ = params.get<bool>("specular_lookup");
 
   generators_ = specularMeshes(scene);
   pairs_.clear();

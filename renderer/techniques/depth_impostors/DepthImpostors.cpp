@@ -40,13 +40,13 @@ GroundTruth DepthImpostorsPass::groundTruth(const Params&, const std::string& ao
 
 void DepthImpostorsPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
   const FrameView& view = res.view();
-  particlesPerBlock_ = params.get<int>("particles_per_block", 64);
-  requestedRes_ = params.get<int>("impostor_resolution", 32);
-  const int K = params.get<int>("slices", 8);
-  const int sliceRes = params.get<int>("slice_resolution", 128);
-  clipScaling_ = params.get<std::string>("clip_scaling", "exponential") == "linear" ? 0 : 1;
-  forwardScatter_ = params.get<bool>("forward_scatter", false) ? 1 : 0;
-  fourierTerms_ = params.get<std::string>("light_transmittance", "slices") == "fourier" ? params.get<int>("fourier_terms", 3) : 0;
+  particlesPerBlock_ = params.get<int>("particles_per_block");
+  requestedRes_ = params.get<int>("impostor_resolution");
+  const int K = params.get<int>("slices");
+  const int sliceRes = params.get<int>("slice_resolution");
+  clipScaling_ = params.get<std::string>("clip_scaling") == "linear" ? 0 : 1;
+  forwardScatter_ = params.get<bool>("forward_scatter") ? 1 : 0;
+  fourierTerms_ = params.get<std::string>("light_transmittance") == "fourier" ? params.get<int>("fourier_terms") : 0;
   const glm::vec3 forward = -glm::normalize(glm::vec3(view.camera.world[2]));
   const bool ortho = view.camera.projection == ProjectionType::Orthographic;
 

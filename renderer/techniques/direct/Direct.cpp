@@ -33,8 +33,8 @@ Requirements DirectPass::requirements(const Scene&, const api::RenderRequest&) c
 }
 
 void DirectPass::prepare(const Scene&, const Params& params, FrameResources& res) {
-  pcfRadius_ = params.get<int>("pcf_radius", 1);
-  imageBasedLighting_ = params.get<bool>("image_based_lighting", true);
+  pcfRadius_ = params.get<int>("pcf_radius");
+  imageBasedLighting_ = params.get<bool>("image_based_lighting");
   gl::Framebuffer& fb = res.framebuffer("direct");
   fb.attach(GL_COLOR_ATTACHMENT0, res.texture("direct"));  // declared outputs: allocated by the Renderer
   fb.attach(GL_COLOR_ATTACHMENT1, res.texture("beauty"));

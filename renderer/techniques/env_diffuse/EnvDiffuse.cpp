@@ -70,16 +70,16 @@ Requirements EnvDiffusePass::requirements(const Scene& scene, const api::RenderR
 }
 
 void EnvDiffusePass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
-  cubeResolution_ = params.get<int>("cube_resolution", 128);
-  downsample_ = params.get<int>("downsample", 4);
-  bounces_ = params.get<int>("bounces", 1);
-  horizonClip_ = params.get<bool>("horizon_clip", true);
+  cubeResolution_ = params.get<int>("cube_resolution");
+  downsample_ = params.get<int>("downsample");
+  bounces_ = params.get<int>("bounces");
+  horizonClip_ = params.get<bool>("horizon_clip");
   // The sky seen by a receiver is direct light from the environment (one scattering event), which
   // ambient_occlusion adds, with occlusion, whenever there is ambient light. The cube maps therefore
   // hold only what surfaces send, so indirect_diffuse is exactly the reference's "indirect" (two or
   // more events) and nothing is counted twice; include_sky puts the sky back for use without AO.
-  skyRadiance_ = params.get<bool>("include_sky", false) ? res.view().ambient : glm::vec3(0.f);
-  const std::string method = params.get<std::string>("form_factor", "polygon");
+  skyRadiance_ = params.get<bool>("include_sky") ? res.view().ambient : glm::vec3(0.f);
+  const std::string method = params.get<std::string>("form_factor");
   if (!isPowerOfTwoIn(cubeResolution_, 16, 1024)) badParam("cube_resolution", "must be a power of two in [16, 1024]");
   if (!isPowerOfTwoIn(downsample_, 1, 16) || downsample_ > cubeResolution_)
     badParam("downsample", "must be 1, 2, 4, 8 or 16 and at most cube_resolution");
@@ -90,8 +90,8 @@ void EnvDiffusePass::prepare(const Scene& scene, const Params& params, FrameReso
   else badParam("form_factor", "must be polygon, point or classic, got '" + method + "'");
 
   const std::vector<env_diffuse::Receiver> selected =
-      env_diffuse::selectReceivers(scene, params.get<std::string>("receivers", ""),
-                                   params.get<std::string>("reference_points", ""));
+      env_diffuse::selectReceivers(scene, params.get<std::string>("receivers"),
+                                   params.get<std::string>("reference_points"));
 
   const int R = cubeResolution_, M = downsample_, S = std::min(kConvolutionSourceSize, R);
   res.texture("env_diffuse_radiance_hi", GL_TEXTURE_CUBE_MAP, GL_RGBA32F, R, R).setFilter(GL_NEAREST, GL_NEAREST);
@@ -290,7 +290,7 @@ void EnvDiffusePass::execute(PassContext& ctx) {
 
 GroundTruth EnvDiffusePass::groundTruth(const Params& params, const std::string& aov) const {
   GroundTruth truth = GroundTruth::fromAovTable(aov);
-  if (aov == "indirect_diffuse" && truth.exists()) truth.reference["max_bounces"] = 1 + params.get<int>("bounces", 1);
+  if (aov == "indirect_diffuse" && truth.exists()) truth.reference["max_bounces"] = 1 + params.get<int>("bounces");
   return truth;
 }
 

@@ -92,8 +92,8 @@ int IlluminationNetworkPass::autoWindow(int nodes) {
 
 void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
   const FrameView& view = res.view();
-  const int N = params.get<int>("nodes", 1024), D = params.get<int>("directions", 128);
-  int M = params.get<int>("window", 0);
+  const int N = params.get<int>("nodes"), D = params.get<int>("directions");
+  int M = params.get<int>("window");
   if (M == 0) M = autoWindow(N);
   if (std::size_t(N) * std::size_t(D) > kMaxLinks)
     throw api::ApiError(422, "invalid-value", "Network too large",
@@ -105,13 +105,13 @@ void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, 
                         "directions x window^2 = " + std::to_string(std::size_t(D) * M * M) + " exceeds " +
                             std::to_string(kMaxBins) + " bins",
                         "/passes/illumination_network/window");
-  const auto seed = params.get<std::uint64_t>("seed", 0);
-  const bool fibonacci = params.get<std::string>("sampling", "fibonacci") == "fibonacci";
-  const float splatScale = params.get<float>("splat_radius", 1.f);
-  march_ = params.get<std::string>("final_render", "march") == "march";
+  const auto seed = params.get<std::uint64_t>("seed");
+  const bool fibonacci = params.get<std::string>("sampling") == "fibonacci";
+  const float splatScale = params.get<float>("splat_radius");
+  march_ = params.get<std::string>("final_render") == "march";
   marchFallback_ = false;
-  marchSteps_ = params.get<int>("march_steps", 64);
-  const float kernelScale = params.get<float>("march_kernel", 0.35f);
+  marchSteps_ = params.get<int>("march_steps");
+  const float kernelScale = params.get<float>("march_kernel");
   const std::string digest = view.mediaKey + "|" + std::to_string(N) + "|" + std::to_string(D) + "|" +
                              std::to_string(M) + "|" + params.subsetKey({"seed", "sampling", "link_opacity"});
   fresh_ = false;
@@ -125,9 +125,9 @@ void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, 
     fresh_ = true;
     return n;
   });
-  iterations_ = params.get<int>("iterations", 32);
-  linearSource_ = params.get<std::string>("link_source", "linear") == "linear";
-  exactLinks_ = params.get<std::string>("link_opacity", "medium") == "medium";
+  iterations_ = params.get<int>("iterations");
+  linearSource_ = params.get<std::string>("link_source") == "linear";
+  exactLinks_ = params.get<std::string>("link_opacity") == "medium";
 
   // Directional lights (the network's lights) and their transmittance to every node, recomputed per
   // frame since lights move: exact through the medium, or from the network's chains along each light.
@@ -141,7 +141,7 @@ void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, 
     }
     lights_.push_back({glm::normalize(l.direction), l.color * l.intensity});
   }
-  const bool networkTransmittance = params.get<std::string>("light_transmittance", "exact") == "network";
+  const bool networkTransmittance = params.get<std::string>("light_transmittance") == "network";
   transmittance_ = networkTransmittance ? network::lightTransmittance(net_->nodes, lights_, M)
                                        : network::lightTransmittance(net_->nodes, lights_, *net_->medium);
   // Warm start (a render service returns the same frame for the same request): resume only from a
@@ -149,7 +149,7 @@ void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, 
   // most `iterations` iterations, and run the rest. The result is then bitwise the cold start's (the
   // iteration is deterministic); moved lights or a changed sky start from 0.
   stateKey_ = sourcesKey(lights_, networkTransmittance, view.ambient, linearSource_);
-  warm_ = params.get<bool>("warm_start", true) && net_->stateIterations >= 0 && net_->stateKey == stateKey_ &&
+  warm_ = params.get<bool>("warm_start") && net_->stateIterations >= 0 && net_->stateKey == stateKey_ &&
           net_->stateIterations <= iterations_;
   resumedFrom_ = warm_ ? net_->stateIterations : 0;
 
@@ -183,7 +183,7 @@ void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, 
   // The sky scattered once exactly costs D x particles chords per step of the march: "auto" affords it
   // up to kSkyExactBudget of them (a few big particles, the thesis' homogeneous cloud) and leaves it to
   // the network beyond.
-  const std::string sky = params.get<std::string>("sky_single_scatter", "auto");
+  const std::string sky = params.get<std::string>("sky_single_scatter");
   if (march_ && sky == "exact" && particles_.size() * std::size_t(D) > kSkyExactMax)
     throw api::ApiError(422, "invalid-value", "Exact sky single scattering too costly",
                         "sky_single_scatter exact sums particles x directions = " +
@@ -203,7 +203,7 @@ void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, 
     // when one piece alone exceeds it (llvmpipe: e.g. > 30000 particles), the splats stand in.
     const long long P = static_cast<long long>(particles_.size()), L = static_cast<long long>(lights_.size());
     piecesLoops_ = network::marchPieceLoops(P, N, L, D, skyExact_);
-    const int asked = params.get<int>("march_stretch", 0);
+    const int asked = params.get<int>("march_stretch");
     marchStretch_ = static_cast<int>(std::min<long long>(marchSteps_, (loopBudget_ - P - 64) / piecesLoops_));
     if (asked > 0) marchStretch_ = std::min(marchStretch_, asked);
     if (marchStretch_ < 1) march_ = false, skyExact_ = false, marchFallback_ = true;  // too big for one piece

@@ -68,7 +68,7 @@ std::vector<int> LightVolumesPass::shadowMapExclusions(const Scene& scene, const
   // Negative beams are the scatterers' first-order shadows: the shadow maps must not add theirs too
   // (notes A7).
   std::vector<int> out;
-  if (params.get<std::string>("shadows", "shadow_map") != "negative_beams") return out;
+  if (params.get<std::string>("shadows") != "negative_beams") return out;
   for (std::size_t m = 0; m < scene.meshes.size(); ++m)
     if (scene.material(scene.meshes[m].material).scattersNarrowLobe()) out.push_back(static_cast<int>(m));
   return out;
@@ -76,16 +76,16 @@ std::vector<int> LightVolumesPass::shadowMapExclusions(const Scene& scene, const
 
 void LightVolumesPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
   light_volumes::BeamOptions o;
-  o.sigmaScale = params.get<float>("sigma_scale", light_volumes::kSigmaScaleFit);
-  o.negativeBeams = params.get<std::string>("shadows", "shadow_map") == "negative_beams";
-  o.maxConcentration = params.get<float>("max_concentration", 1e4f);
-  o.maxTriangleSigma = params.get<float>("max_triangle_sigma", 0.5f);
-  o.specularFallback = params.get<std::string>("tessellation_fallback", "specular") == "specular";
-  o.cullSigmas = params.get<float>("cull_sigmas", 4.f);
-  o.maxSubdivisionBeams = static_cast<std::size_t>(std::max(0, params.get<int>("max_subdivision_beams", 65536)));
+  o.sigmaScale = params.get<float>("sigma_scale");
+  o.negativeBeams = params.get<std::string>("shadows") == "negative_beams";
+  o.maxConcentration = params.get<float>("max_concentration");
+  o.maxTriangleSigma = params.get<float>("max_triangle_sigma");
+  o.specularFallback = params.get<std::string>("tessellation_fallback") == "specular";
+  o.cullSigmas = params.get<float>("cull_sigmas");
+  o.maxSubdivisionBeams = static_cast<std::size_t>(std::max(0, params.get<int>("max_subdivision_beams")));
   o.cancel = res.cancel();
-  split_ = params.get<std::string>("split", "2d") == "paper" ? light_volumes::Split::Paper : light_volumes::Split::TwoD;
-  bvh_ = params.get<std::string>("traversal", "bvh") == "bvh";
+  split_ = params.get<std::string>("split") == "paper" ? light_volumes::Split::Paper : light_volumes::Split::TwoD;
+  bvh_ = params.get<std::string>("traversal") == "bvh";
   // Every light path is counted once: without LS+DE and LG+DE (another technique owns them) the pass
   // gathers nothing and adds nothing to beauty.
   owns_ = res.ownsLightPath("light_volumes", "LS+DE") || res.ownsLightPath("light_volumes", "LG+DE");

@@ -21,8 +21,6 @@ double msSince(Clock::time_point t) { return std::chrono::duration<double, std::
 // they estimate is within about 1% at this density.
 constexpr double kCoveragePerKernel = 64.0;
 constexpr std::size_t kMaxCoveragePerSurface = 1u << 18;
-// The environment lights' weight in the emission of sky photons (photonEnvironmentDistribution).
-constexpr float kDefaultEnvironmentLightPhotons = 0.5f;
 
 struct PhotonCache {
   rt::PhotonSet set;
@@ -136,23 +134,23 @@ Requirements PhotonGiPass::requirements(const Scene& scene, const api::RenderReq
 
 void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
   Settings s;
-  s.photons = static_cast<std::uint64_t>(params.get<std::int64_t>("photons", 250000));
-  s.C = params.get<float>("C", 10.f);
-  s.ppm = params.get<std::string>("h_schedule", "paper") == "ppm";
-  s.ppmAlpha = params.get<double>("ppm_alpha", 2.0 / 3.0);
-  s.ppmBase = params.get<double>("ppm_base_photons", 250000.0);
-  s.maxBounces = params.get<int>("max_bounces", rt::kDefaultMaxBounces);
-  s.environmentLightPhotons = params.get<float>("environment_light_photons", kDefaultEnvironmentLightPhotons);
+  s.photons = static_cast<std::uint64_t>(params.get<std::int64_t>("photons"));
+  s.C = params.get<float>("C");
+  s.ppm = params.get<std::string>("h_schedule") == "ppm";
+  s.ppmAlpha = params.get<double>("ppm_alpha");
+  s.ppmBase = params.get<double>("ppm_base_photons");
+  s.maxBounces = params.get<int>("max_bounces");
+  s.environmentLightPhotons = params.get<float>("environment_light_photons");
   if (!(s.environmentLightPhotons >= 0.01f) || s.environmentLightPhotons > 1.f)
     badParam("environment_light_photons", "environment_light_photons must be in [0.01, 1]");
   if (!(s.C > 0.f) || !std::isfinite(s.C)) badParam("C", "C must be a positive number");
   settings_ = s;
-  splat_.method = params.get<std::string>("method", "gather") == "gather" ? photon_gi::Method::Gather
+  splat_.method = params.get<std::string>("method") == "gather" ? photon_gi::Method::Gather
                                                                        : photon_gi::Method::Splat;
-  splat_.kernel = params.get<std::string>("kernel", "biweight") == "epanechnikov" ? photon_gi::Kernel::Epanechnikov
+  splat_.kernel = params.get<std::string>("kernel") == "epanechnikov" ? photon_gi::Kernel::Epanechnikov
                                                                                   : photon_gi::Kernel::Biweight;
-  splat_.renormalize = params.get<bool>("renormalize", true);
-  splat_.minGlossyRoughness = params.get<float>("min_glossy_roughness", 0.2f);
+  splat_.renormalize = params.get<bool>("renormalize");
+  splat_.minGlossyRoughness = params.get<float>("min_glossy_roughness");
   const FrameView& view = res.view();
   // gather_step is in output pixels: on a k-times supersampled frame the block is k gather_step
   // samples wide, so the gather costs what it costs at k = 1 and the block's light is still spread over
@@ -164,7 +162,7 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   // would lose 1.8% of the light (docs/TECHNIQUES.md, photon_gi, gather_step). k = 1 keeps 2, where
   // the preset table was measured.
   const int k = std::max(1, view.supersampling);
-  int gatherStep = params.get<int>("gather_step", 2);
+  int gatherStep = params.get<int>("gather_step");
   if (!params.given("gather_step") && k >= 2) {
     const double size = std::sqrt(double(view.width / k) * double(view.height / k));
     gatherStep = std::clamp(static_cast<int>(std::lround(size / 64.0)), 2, 4);
@@ -173,12 +171,12 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   // The denoiser (renderer/shading/Denoiser.h), guided by the estimator's relative noise: sqrt(int K^2)
   // / C' with C' the photons per kernel over pi, i.e. C, or C (photons / ppm_base)^(alpha / 2) on the
   // ppm schedule (docs/TECHNIQUES.md).
-  denoise_ = params.get<bool>("denoise", true);
+  denoise_ = params.get<bool>("denoise");
   // The filter's steps count output pixels (k, 2k, ...: Denoiser.h baseStep); left out of the request,
   // a supersampled frame filters with 2 passes (reach 6 output pixels on each side), one at k = 1 with
   // 3 (7): the same error on the Cornell boxes at 64-256 px, k = 2 (docs/PERFORMANCE.md, "Denoiser").
   denoiseSettings_.baseStep = k;
-  denoiseSettings_.iterations = params.get<int>("denoise_iterations", 3);
+  denoiseSettings_.iterations = params.get<int>("denoise_iterations");
   if (!params.given("denoise_iterations") && k >= 2) denoiseSettings_.iterations = 2;
   const double kernelNoise = splat_.kernel == photon_gi::Kernel::Epanechnikov ? 0.651 : 0.757;
   double effectiveC = s.C;

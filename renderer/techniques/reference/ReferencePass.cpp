@@ -174,15 +174,15 @@ Requirements ReferencePass::requirements(const Scene& scene, const api::RenderRe
 
 ReferenceRequest referenceRequestFrom(const Params& params) {
   ReferenceRequest r;
-  r.aov = params.get<std::string>("aov", "beauty");
-  r.spp = params.get<int>("spp", 64);
-  r.lightPathsPerPixel = params.get<int>("light_paths_per_pixel", 0);
-  r.caustics = params.get<bool>("caustics", true);
-  r.maxBounces = params.get<int>("max_bounces", rt::kDefaultMaxBounces);
-  r.russianRoulette = params.get<bool>("russian_roulette", true);
-  r.aoRadius = params.get<float>("ao_radius", 0.5f);
-  r.aoDefinition = params.get<std::string>("ao_definition", "cosine");
-  r.mediaMode = params.get<std::string>("media_mode", "single_scatter_unshadowed");
+  r.aov = params.get<std::string>("aov");
+  r.spp = params.get<int>("spp");
+  r.lightPathsPerPixel = params.get<int>("light_paths_per_pixel");
+  r.caustics = params.get<bool>("caustics");
+  r.maxBounces = params.get<int>("max_bounces");
+  r.russianRoulette = params.get<bool>("russian_roulette");
+  r.aoRadius = params.get<float>("ao_radius");
+  r.aoDefinition = params.get<std::string>("ao_definition");
+  r.mediaMode = params.get<std::string>("media_mode");
   return r;
 }
 

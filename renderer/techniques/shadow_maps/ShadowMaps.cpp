@@ -98,7 +98,7 @@ Requirements ShadowMapsPass::requirements(const Scene& scene, const api::RenderR
 
 void ShadowMapsPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
   const std::vector<Light>& lights = res.view().lights;  // the scene's, then the environment's
-  size_ = params.get<int>("shadow_map_size", 1024);
+  size_ = params.get<int>("shadow_map_size");
   // The maps depend on geometry, lights, size and the meshes left out (Technique::shadowMapExclusions);
   // their overdraw on all but the size.
   excluded_ = res.shadowMapExclusions();
@@ -135,8 +135,8 @@ void ShadowMapsPass::prepare(const Scene& scene, const Params& params, FrameReso
                " million: drawn at " + std::to_string(lowered) + "^2 (set shadow_maps.shadow_map_size to choose)";
     size_ = lowered;
   }
-  const float bias = params.get<float>("shadow_bias", 1.0f);
-  const float normalOffset = params.get<float>("normal_offset", 1.5f);
+  const float bias = params.get<float>("shadow_bias");
+  const float normalOffset = params.get<float>("normal_offset");
   const Bounds& b = scene.features.bounds;
   const float radius = std::max(b.radius(), 1e-6f);
   const glm::vec3 center = b.center();

@@ -61,10 +61,10 @@ int mapResolution(double objectPixels, double texelsPerPixel, int maxResolution)
 
 MapResolution chooseMapResolution(const Scene& scene, const FrameView& view, const Params& params, bool causticsOwnsLSDE) {
   MapResolution r;
-  r.texels = std::clamp(params.get<int>("cube_resolution", 256), 16, 2048);
+  r.texels = std::clamp(params.get<int>("cube_resolution"), 16, 2048);
   // A cube_resolution the request gives is run as asked, unless it gives map_texels_per_pixel too.
   r.adaptive = !params.given("cube_resolution") || params.given("map_texels_per_pixel");
-  const double texelsPerPixel = r.adaptive ? std::clamp(params.get<double>("map_texels_per_pixel", 1.0), 0.0, 64.0) : 0.0;
+  const double texelsPerPixel = r.adaptive ? std::clamp(params.get<double>("map_texels_per_pixel"), 0.0, 64.0) : 0.0;
   if (texelsPerPixel <= 0.0) return r;
   for (std::size_t i : specularMeshes(scene))
     r.largestObjectPixels = std::max(r.largestObjectPixels, projectedDiameterPixels(view, scene.meshes[i].bounds));
@@ -101,12 +101,12 @@ Requirements SpecularPass::requirements(const Scene& scene, const api::RenderReq
 
 void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
   // Fallbacks are the schema defaults (api/schema/techniques/specular.json).
-  maxDepth_ = std::clamp(params.get<int>("max_depth", 4), 1, 8);
-  linearSteps_ = std::clamp(params.get<int>("linear_steps", 32), 1, 256);
-  secantSteps_ = std::clamp(params.get<int>("secant_steps", 4), 0, 32);
-  layers_ = std::clamp(params.get<int>("layers", 3), 3, 6);
-  indirectBlock_ = std::clamp(params.get<int>("map_indirect_block", 8), 1, 64);
-  minmax_ = params.get<bool>("minmax", true);
+  maxDepth_ = std::clamp(params.get<int>("max_depth"), 1, 8);
+  linearSteps_ = std::clamp(params.get<int>("linear_steps"), 1, 256);
+  secantSteps_ = std::clamp(params.get<int>("secant_steps"), 0, 32);
+  layers_ = std::clamp(params.get<int>("layers"), 3, 6);
+  indirectBlock_ = std::clamp(params.get<int>("map_indirect_block"), 1, 64);
+  minmax_ = params.get<bool>("minmax");
 
   const Bounds& sb = scene.features.bounds;
   objects_.clear();

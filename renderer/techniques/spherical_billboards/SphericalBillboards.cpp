@@ -35,15 +35,15 @@ Requirements SphericalBillboardsPass::requirements(const Scene& scene, const api
 
 void SphericalBillboardsPass::prepare(const Scene&, const Params& params, FrameResources& res) {
   const FrameView& view = res.view();
-  const std::string method = params.get<std::string>("method", "spherical");
+  const std::string method = params.get<std::string>("method");
   method_ = method == "planar" ? 1 : method == "soft" ? 2 : 0;
-  chord_ = params.get<std::string>("chord", "exact") == "screen_parallel" ? 1 : 0;
-  ratio_ = params.get<float>("resolution_ratio", 1.f);
-  softScale_ = params.get<float>("soft_scale", 1.f);
-  depthAware_ = params.get<std::string>("upsampling", "depth_aware") == "depth_aware";
+  chord_ = params.get<std::string>("chord") == "screen_parallel" ? 1 : 0;
+  ratio_ = params.get<float>("resolution_ratio");
+  softScale_ = params.get<float>("soft_scale");
+  depthAware_ = params.get<std::string>("upsampling") == "depth_aware";
   const glm::vec3 forward = -glm::normalize(glm::vec3(view.camera.world[2]));
   const bool ortho = view.camera.projection == ProjectionType::Orthographic;
-  particles_ = mediaParticles(view.media, view.ambient, view.eye, forward, ortho, params.get<bool>("sort", true));
+  particles_ = mediaParticles(view.media, view.ambient, view.eye, forward, ortho, params.get<bool>("sort"));
 
   // Overdraw estimate: covered pixels of every particle's disc over the image (the cost driver, 7.3).
   const float pixelsPerUnit = ortho ? 0.5f * view.height / view.camera.ymag

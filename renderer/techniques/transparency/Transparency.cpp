@@ -29,7 +29,7 @@ Requirements TransparencyPass::requirements(const Scene& scene, const api::Rende
 }
 
 void TransparencyPass::prepare(const Scene&, const Params& params, FrameResources& res) {
-  pcfRadius_ = params.get<int>("pcf_radius", 1);
+  pcfRadius_ = params.get<int>("pcf_radius");
   const int w = res.view().width, h = res.view().height;
   gl::Framebuffer& fb = res.framebuffer("transparency");
   fb.attach(GL_COLOR_ATTACHMENT0, res.texture("beauty"));
