@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "api/Validate.h"
 #include "renderer/raytracing/Bsdf.h"
 #include "renderer/raytracing/RayScene.h"
 #include "renderer/reference/LightTracer.h"
@@ -111,6 +112,8 @@ TEST(LightVolumesCalibration, SigmaFitIsTheL1BestGaussianOfTheReferenceLobe) {
               "best sigma per case %.4f; best scales %.3f..%.3f\n",
               fit, kSigmaScaleFit, meanL1(fit), meanL1(1.1), worstExcess, lo, hi);
   EXPECT_NEAR(fit, kSigmaScaleFit, 0.02) << "the documented constant is the fit";
+  // The pass reads the schema's default (Params has no fallback): it is the fit too.
+  EXPECT_FLOAT_EQ(api::techniqueParams("light_volumes").at("sigma_scale").get<float>(), kSigmaScaleFit);
   // sqrt(cos theta_i) carries the incidence dependence: one constant is within 0.03 of L1 of the best
   // Gaussian for every roughness and angle (measured 0.019, at roughness 0.5 and 60 degrees).
   EXPECT_LT(worstExcess, 0.03);
