@@ -7,7 +7,7 @@
 // Input: radiance (RGBA32F, the frame's size) and the G-buffer of the same frame. The radiance is
 // demodulated by the base colour (floored at kMinAlbedo) before filtering and re-modulated after, so
 // texture detail is never blurred, only the illumination. `iterations` passes of a 5x5 B3-spline kernel
-// with holes (step 1, 2, 4, ...: the default 3 passes reach 15 pixels across) weight each tap by
+// with holes (step 1, 2, 4, ...: a pass of step s reaches 2 s pixels, so 3 passes reach 29 across) weight each tap by
 //   plane:     exp(-|n_p . (x_q - x_p)| / (sigma_plane step pixel_p))   (pixel_p: the world size of a
 //              pixel at p's depth; coplanar taps pass at any distance and viewing angle)
 //   normal:    max(0, n_p . n_q)^sigma_normal
@@ -26,8 +26,9 @@ struct Settings {
   // The first pass's step in the frame's samples (then 2x, 4x, ...): the supersampling factor k, so
   // that the steps count output pixels. photon_gi's estimate of a supersampled frame is smooth over k
   // samples (its gather block is k gather_step samples wide), and a first pass at step 1 filtered
-  // almost nothing: at k = 2 two passes of steps 2, 4 give three passes' (1, 2, 4) error within 0.5%
-  // for two thirds of the cost (docs/PERFORMANCE.md, "Denoiser").
+  // almost nothing: two passes of steps k, 2k give three passes' (1, 2, 4) error within 0.6%, or less,
+  // for two thirds of the cost (the Cornell boxes at 64-256 px, k = 4, 4, 2: docs/PERFORMANCE.md,
+  // "Denoiser").
   int baseStep = 1;
   float relativeNoise = 0.1f;    // per-pixel relative standard deviation of the input
   float sigmaLuminance = 1.5f;   // in noise widths (docs/PERFORMANCE.md, "Denoiser": 0.5-4 measured)

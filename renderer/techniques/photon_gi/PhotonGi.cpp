@@ -174,7 +174,8 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   denoise_ = params.get<bool>("denoise");
   // The filter's steps count output pixels (k, 2k, ...: Denoiser.h baseStep); left out of the request,
   // a supersampled frame filters with 2 passes (reach 6 output pixels on each side), one at k = 1 with
-  // 3 (7): the same error on the Cornell boxes at 64-256 px, k = 2 (docs/PERFORMANCE.md, "Denoiser").
+  // 3 (14): within 0.6% of the former 3 passes of 1, 2, 4 samples, or below, on the Cornell boxes at
+  // 64-256 px (docs/PERFORMANCE.md, "Denoiser").
   denoiseSettings_.baseStep = k;
   denoiseSettings_.iterations = params.get<int>("denoise_iterations");
   if (!params.given("denoise_iterations") && k >= 2) denoiseSettings_.iterations = 2;
