@@ -60,9 +60,9 @@ public:
   explicit Params(nlohmann::json j, std::set<std::string> given = {})
       : json_(j.is_object() ? std::move(j) : nlohmann::json::object()), given_(std::move(given)) {}
   bool given(const char* key) const { return given_.count(key) != 0; }
-  // The value of `key`: the schema gives every parameter a default (api/schema/techniques/*.json,
-  // test Schema.EveryTechniqueParameterHasADefault), which is the one place it is written; a key that
-  // is not there is a programmer error.
+  // The value of `key`: the schema gives every parameter a default (api/schema/techniques/*.json; tests
+  // Schema.EveryTechniqueFileIsMergedWithDocumentedParams, Params.*), the one place it is written; a key
+  // that is not there is a programmer error.
   template <class T>
   T get(const char* key) const {
     auto it = json_.find(key);
