@@ -162,9 +162,10 @@ double costPixels(const std::string& technique, double rasterPixels, int supersa
 
 // How fast this machine runs the preset table's frames: measured frame ms over the table's prediction
 // for the same frame (both without a compare block's reference). The budget chooser multiplies every
-// prediction by planningFactor(scene) (factor(scene) with a headroom), so that a budget holds on a machine that is loaded, slower or faster than
-// the one the table was measured on (the table's own load is in its "runs"), and on a scene whose frames
-// the table's models get wrong (a scene is a scene and the passes it runs).
+// prediction by planningFactor(scene) (factor(scene) with a headroom), so that a budget holds on a
+// machine that is loaded, slower or faster than the one the table was measured on (the table's own load
+// is in its "runs"), and on a scene whose frames the table's models get wrong (a scene is a scene and the
+// passes it runs).
 //
 // The machine's factor: a pinned one (radiantd --speed-factor); else the median of the calibration's
 // ratio and the ratios of the last kWindow observed frames, whatever their scene; else 1 (nothing
