@@ -20,9 +20,18 @@ const json& emptyArray() {
   return a;
 }
 
-// sum of coef * product of vars; a var is "pixels", a scene count ("particles", "beams", "specular_objects") or a numeric
-// parameter (a boolean counts as 0/1).
-double evalTerms(const json& terms, const json& params, double pixels, const SceneCounts& counts = {}) {
+// A numeric parameter's value (a boolean counts as 0/1).
+double paramValue(const json& params, const std::string& n) {
+  if (params.contains(n) && params[n].is_number()) return params[n].get<double>();
+  if (params.contains(n) && params[n].is_boolean()) return params[n].get<bool>() ? 1.0 : 0.0;
+  throw std::logic_error("preset table: cost term names '" + n + "', which is no numeric parameter");
+}
+
+// sum of coef * product of vars; a var is "pixels", a scene count ("particles", "beams", "specular_objects"), a
+// numeric parameter, or another technique's parameter ("photon_gi.C": its value in `frame`, 0 when that
+// technique is not in the frame).
+double evalTerms(const json& terms, const json& params, double pixels, const SceneCounts& counts = {},
+                 const FrameParams& frame = {}) {
   double ms = 0.0;
   for (const auto& t : terms) {
     double v = t.value("coef", 0.0);
@@ -32,9 +41,10 @@ double evalTerms(const json& terms, const json& params, double pixels, const Sce
       else if (n == "particles") v *= counts.particles;
       else if (n == "beams") v *= counts.beams;
       else if (n == "specular_objects") v *= counts.specularObjects;
-      else if (params.contains(n) && params[n].is_number()) v *= params[n].get<double>();
-      else if (params.contains(n) && params[n].is_boolean()) v *= params[n].get<bool>() ? 1.0 : 0.0;
-      else throw std::logic_error("preset table: cost term names '" + n + "', which is no numeric parameter");
+      else if (const auto dot = n.find('.'); dot != std::string::npos) {
+        auto other = frame.find(n.substr(0, dot));
+        v *= other == frame.end() ? 0.0 : paramValue(other->second, n.substr(dot + 1));
+      } else v *= paramValue(params, n);
     }
     ms += v;
   }
@@ -152,15 +162,16 @@ bool PresetTable::hasModel(const std::string& technique) const {
 }
 
 double PresetTable::predictMs(const std::string& technique, const json& params, double pixels,
-                              const SceneCounts& counts) const {
+                              const SceneCounts& counts, const FrameParams& frame) const {
   if (!hasModel(technique)) return -1.0;
+  const json& terms = table_["techniques"][technique]["model"]["terms"];
   if (technique == "specular" && counts.specularMapTexels > 0 && params.contains("cube_resolution") &&
       params["cube_resolution"].is_number()) {
     json run = params;
     run["cube_resolution"] = std::min(params["cube_resolution"].get<double>(), counts.specularMapTexels);
-    return std::max(0.0, evalTerms(table_["techniques"][technique]["model"]["terms"], run, pixels, counts));
+    return std::max(0.0, evalTerms(terms, run, pixels, counts, frame));
   }
-  return std::max(0.0, evalTerms(table_["techniques"][technique]["model"]["terms"], params, pixels, counts));
+  return std::max(0.0, evalTerms(terms, params, pixels, counts, frame));
 }
 
 double PresetTable::predictOverheadMs(double pixels) const {
@@ -253,10 +264,27 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
   if (!request.quality.empty()) c.stats["quality"] = request.quality;
   else c.stats["time_budget_ms"] = request.timeBudgetMs;
 
-  // This machine's ms: the table's prediction times the speed factor (MachineSpeed).
-  auto predict = [&](const std::string& t, const json& p) {
-    const double ms = table.predictMs(t, p, costPixels(t, pixels, request.supersampling), counts);
+  // This machine's ms: the table's prediction times the speed factor (MachineSpeed), with the frame's
+  // other techniques' parameters (`frame`, c.params unless given) for a model that names them.
+  auto predictIn = [&](const std::string& t, const json& p, const FrameParams& frame) {
+    const double ms = table.predictMs(t, p, costPixels(t, pixels, request.supersampling), counts, frame);
     return ms < 0 ? ms : ms * speed;
+  };
+  auto predict = [&](const std::string& t, const json& p) { return predictIn(t, p, c.params); };
+  // What a candidate point `p` of technique t adds to the other planned techniques' cost against t's
+  // request parameters (c.params[t]), for models that name t's parameters (specular's maps gather photon_gi's
+  // photons with its kernel C). The other techniques are charged at their request parameters: exact for
+  // those without a front (specular), which the budget does not change.
+  auto coupledMs = [&](const std::string& t, const json& p) {
+    FrameParams with = c.params;
+    with[t] = p;
+    double ms = 0.0;
+    for (const auto& u : planned) {
+      if (u == t) continue;
+      const double a = predictIn(u, c.params[u], with), b = predictIn(u, c.params[u], c.params);
+      if (a >= 0 && b >= 0) ms += a - b;
+    }
+    return ms;
   };
   const double overheadMs = table.predictOverheadMs(pixels) * speed;
   c.stats["speed_factor"] = speed;
@@ -274,7 +302,8 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
 
   json techniques = json::object();
   double fixedMs = overheadMs;
-  // One candidate list per modelled technique with a front: (params, predicted ms, error, point index).
+  // One candidate list per modelled technique with a front: (params, predicted ms with what the point adds
+  // to the other techniques' cost (coupledMs), error, point index).
   struct Candidate {
     json params;
     double ms, error;
@@ -322,7 +351,7 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
           continue;
         }
         json p = techniqueParams(t, merged(c.params[t], front[i]["params"], given));
-        const double ms = predict(t, p);
+        const double ms = predict(t, p) + coupledMs(t, p);
         all.push_back({std::move(p), ms, front[i]["error"].get<double>(), int(i)});
       }
       if (!excluded.empty()) {
@@ -333,7 +362,7 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
       if (all.empty()) {
         const json lowered = clampedToCaps(t, front[0]["params"], capsExceeded(t, front[0]["params"], given, limits));
         json p = techniqueParams(t, merged(c.params[t], lowered, given));
-        const double ms = predict(t, p);
+        const double ms = predict(t, p) + coupledMs(t, p);
         all.push_back({std::move(p), ms, std::numeric_limits<double>::quiet_NaN(), -1});
       }
       // The front at this frame's pixel count: by predicted cost, then only points that lower the error.
@@ -346,7 +375,6 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
       continue;
     }
     const double ms = predict(t, c.params[t]);
-    entry["predicted_ms"] = ms >= 0 ? json(ms) : json(nullptr);
     if (ms >= 0) fixedMs += ms;
     techniques[t] = entry;
   }
@@ -387,19 +415,18 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
       json& entry = techniques[t];
       entry["params"] = chosenSubset(k.params, point["params"]);
       entry["point"] = std::max(k.point, 0);
-      entry["predicted_ms"] = k.ms;
       entry["predicted_error"] =
           k.point < 0 ? json(nullptr) : errorBlock(t, point, overridden(point["params"], explicitOf(t)));
     }
   }
   lowerDefaultsToCaps();
+  // Each technique's own prediction with the frame's final parameters (a model naming another technique's
+  // parameter sees the value chosen for it).
   double total = overheadMs;
   for (const auto& t : planned) {
-    if (!techniques[t].contains("predicted_ms")) {
-      const double ms = predict(t, c.params[t]);
-      techniques[t]["predicted_ms"] = ms >= 0 ? json(ms) : json(nullptr);
-    }
-    if (techniques[t]["predicted_ms"].is_number()) total += techniques[t]["predicted_ms"].get<double>();
+    const double ms = predict(t, c.params[t]);
+    techniques[t]["predicted_ms"] = ms >= 0 ? json(ms) : json(nullptr);
+    if (ms >= 0) total += ms;
   }
   c.stats["techniques"] = techniques;
   c.stats["scene_counts"] = counts.toJson();
@@ -430,7 +457,8 @@ double predictFrameMs(const PresetTable& table, const std::vector<std::string>& 
   double ms = table.predictOverheadMs(pixels);
   for (const auto& t : planned) {
     auto it = params.find(t);
-    const double m = it == params.end() ? -1.0 : table.predictMs(t, it->second, costPixels(t, pixels, supersampling), counts);
+    const double m =
+        it == params.end() ? -1.0 : table.predictMs(t, it->second, costPixels(t, pixels, supersampling), counts, params);
     if (m < 0) return -1.0;
     ms += m;
   }

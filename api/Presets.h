@@ -35,6 +35,9 @@ namespace radiant::api {
 // CPU work; GPU work left unsynchronised shows in the frame overhead (readback waits for it).
 double passCostMs(const PassStats& pass);
 
+// Technique -> its complete parameters, for the techniques a frame plans (BudgetChoice::params).
+using FrameParams = std::map<std::string, nlohmann::json>;
+
 // What the frame's scene holds that the cost models scale with (the models' scene variables). The
 // renderer computes them once per frame (renderer/scene/CostCounts.h, sceneCostCounts) and reports them
 // in stats.scene.counts, which is where bench/presets.py reads them from for the fit.
@@ -80,9 +83,11 @@ public:
   bool hasFront(const std::string& technique) const;  // configurations to choose from
   bool hasModel(const std::string& technique) const;  // a cost model
   // Predicted ms of `technique` with `params` (complete, defaults filled) at `pixels` on a scene with
-  // `counts`; < 0 without a model.
+  // `counts`; < 0 without a model. `frame`: the frame's planned techniques and their parameters, for a
+  // model that names another technique's parameter (specular's "photon_gi.C": its maps gather photon_gi's
+  // photons with photon_gi's kernel); such a variable counts 0 when its technique is not in `frame`.
   double predictMs(const std::string& technique, const nlohmann::json& params, double pixels,
-                   const SceneCounts& counts = {}) const;
+                   const SceneCounts& counts = {}, const FrameParams& frame = {}) const;
   double predictOverheadMs(double pixels) const;
   // The front's configurations (params, error, ...), cheapest first at the bench size.
   const nlohmann::json& front(const std::string& technique) const;

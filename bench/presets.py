@@ -132,20 +132,26 @@ TECHNIQUES = {
     },
     "specular": {
         "scene": "cornell_glass",
-        # photon_gi on (its defaults), as in a default frame: the maps gather its photons (the maps'
-        # indirect light, maps_indirect), which is most of the pass's cost on cornell_glass (at 64 px, 2.2 s
-        # of specular against the 0.2 s the table fitted without them predicted).
-        "passes": {"caustics": False},
+        # photon_gi on, as in a default frame: the maps gather its photons (the maps' indirect light,
+        # maps_indirect), which is most of the pass's cost on cornell_glass (at 64 px, 2.2 s of specular
+        # against the 0.2 s the table fitted without them predicted), with photon_gi's kernel: at C = 20
+        # the pass took 1.5x its time at C = 10 (2026-12-06 budget ladder), so photon_gi's C (the values
+        # of its front, 10 and 20) is a variable of the model ("photon_gi.C": another technique's parameter,
+        # 0 when photon_gi is not planned; api::PresetTable::predictMs).
+        "passes": {"caustics": False, "photon_gi": {}},
         # Not linear_steps: the layered maps are cached by scene, cube_resolution and layers (not the seed), so
         # a point that changes only the search steps reuses the previous point's maps and is not a cold cost.
-        "configs": [{"cube_resolution": c, "layers": n} for c in (64, 128, 256, 512) for n in (3, 6)],
+        "configs": [{"cube_resolution": c, "layers": n, "photon_gi.C": k}
+                    for c in (64, 128, 256, 512) for n in (3, 6) for k in (10, 20)],
         # layered distance maps per specular object (6 C^2 texels per layer, each face drawing what it
-        # sees), a per-object set-up, then the per-pixel search. The objects (api::SceneCounts) are varied by
-        # bench/glass_metal_field.py's fields of 4 and 12 spheres (uploaded by `spec`; cornell_glass has 1);
-        # cube_resolution up to 256 and 3 layers there (12 objects x 6 layers of 512^2 cube maps is 3 GB).
-        "terms": [[], ["pixels"], ["specular_objects"], ["specular_objects", "cube_resolution", "cube_resolution", "layers"]],
+        # sees, and gathering photon_gi's photons at its diffuse texels), a per-object set-up, then the
+        # per-pixel search. The objects (api::SceneCounts) are varied by bench/glass_metal_field.py's fields
+        # of 4 and 12 spheres (uploaded by `spec`; cornell_glass has 1); cube_resolution up to 256 and 3
+        # layers there (12 objects x 6 layers of 512^2 cube maps is 3 GB).
+        "terms": [[], ["pixels"], ["specular_objects"], ["specular_objects", "cube_resolution", "cube_resolution", "layers"],
+                  ["specular_objects", "cube_resolution", "cube_resolution", "layers", "photon_gi.C", "photon_gi.C"]],
         "variants": [{"field": 4}, {"field": 12}],
-        "variant_configs": [{"cube_resolution": c, "layers": 3} for c in (64, 128, 256)],
+        "variant_configs": [{"cube_resolution": c, "layers": 3, "photon_gi.C": 10} for c in (64, 128, 256)],
         "variant_seed": 7000,  # after every other technique's variant seeds, which stay as they were
         "compare": None,
         "no_front": "the reference has no ground truth for the specular AOV (docs/API.md, compare: no path-class "
@@ -282,7 +288,8 @@ def zip_group(name, points, technique_seed=False):
     group = {}
     for config, size, seed in points:
         for k, v in config.items():
-            group.setdefault(f"passes.{name}.{k}", []).append(v)
+            # "photon_gi.C": another technique's parameter (passes.photon_gi.C), a variable of this one's model
+            group.setdefault(f"passes.{k}" if "." in k else f"passes.{name}.{k}", []).append(v)
         if technique_seed:
             group.setdefault(f"passes.{name}.seed", []).append(seed)
         group.setdefault("width", []).append(size)
@@ -387,11 +394,22 @@ def term_value(vars_, params, pixels):
     return v
 
 
-def with_counts(params, record):
+def with_counts(params, record, terms=()):
     """A record's parameters plus its scene counts (api::SceneCounts, stats.scene.counts), the models' scene
-    variables."""
+    variables, plus the other techniques' parameters the terms name ("photon_gi.C": the request's
+    passes.photon_gi.C; 0 when the request turns that pass off)."""
     p = dict(params)
     p.update(record.get("scene_counts") or {})
+    passes = record["request"]["passes"]
+    for n in {n for term in terms for n in term if "." in n}:
+        other, key = n.split(".", 1)
+        if passes.get(other) is False:
+            p[n] = 0.0
+        elif isinstance(passes.get(other), dict) and key in passes[other]:
+            p[n] = passes[other][key]
+        else:
+            raise SystemExit(f"fit: a cost term names {n!r}, which the record's request does not set (the sweep "
+                             "must set another technique's parameter that a model names)")
     return p
 
 
@@ -510,7 +528,7 @@ def fit(records, command, runs=()):
             p = next((q for q in r["passes"] if q["name"] == name), None)
             if p is None:
                 continue
-            params = with_counts(r["request"]["passes"][name], r)
+            params = with_counts(r["request"]["passes"][name], r, t["terms"])
             rows.append((params, r["request"]["width"] * r["request"]["height"], pass_cost(p)))
         if not rows:
             continue

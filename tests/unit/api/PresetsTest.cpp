@@ -112,7 +112,17 @@ TEST(Presets, TheEmbeddedModelsScaleWithTheSceneCountsAsMeasured) {
       (var == "particles" ? counts.particles : var == "beams" ? counts.beams : counts.specularObjects) =
           c["counts"][var].get<double>();
       double sum = 0;
-      for (const json& p : c["params"]) sum += t.predictMs(name, techniqueParams(name, p), c["pixels"], counts);
+      for (const json& p : c["params"]) {
+        // "photon_gi.C": another technique's parameter, which the model reads from the frame's
+        json own = json::object();
+        FrameParams frame;
+        for (const auto& [k, v] : p.items()) {
+          const auto dot = k.find('.');
+          if (dot == std::string::npos) own[k] = v;
+          else frame[k.substr(0, dot)][k.substr(dot + 1)] = v;
+        }
+        sum += t.predictMs(name, techniqueParams(name, own), c["pixels"], counts, frame);
+      }
       EXPECT_NEAR(sum, c["predicted_ms"].get<double>(), 1e-6 * sum + 1e-9) << name;
       predicted.push_back(sum);
       std::printf("%s: %s %g: measured %.1f ms, predicted %.1f ms (%d configurations at %g pixels)\n", name.c_str(),
@@ -707,6 +717,40 @@ TEST(Presets, SpecularIsChargedTheMapResolutionTheFrameRuns) {
                    t.predictMs("specular", {{"cube_resolution", 32}, {"layers", 3}}, px, twelve));
   EXPECT_EQ(SceneCounts::fromJson(at64.toJson()).specularMapTexels, 64.0);
   EXPECT_FALSE(twelve.toJson().contains("specular_map_texels"));
+}
+
+// Issue 31: specular's maps gather photon_gi's photons with photon_gi's kernel, so specular's cost grows with
+// photon_gi's C (the budget ladder's one feasible miss: cornell_glass at 4x ran 4.9-5.2 s for 4.6 s when
+// the chooser took C = 20 and charged specular at C = 10). A model term may name another technique's
+// parameter ("photon_gi.C"): it reads the frame's value, 0 when that technique is not planned, and the
+// budget charges a photon_gi point with what it adds to specular. Synthetic: specular = 1 + 0.1 C^2
+// (11 ms at C = 10, 41 at C = 20); the photon_gi points of syntheticTable at 100 x 100 cost 14, 22, 67
+// and 142 ms; overhead 3 and direct 0.6.
+TEST(Presets, AModelThatNamesAnotherTechniquesParameterIsChargedItsChosenValue) {
+  json table = syntheticTable();
+  table["techniques"]["specular"]["model"]["terms"] =
+      json::parse(R"([{"coef": 1, "vars": []}, {"coef": 0.1, "vars": ["photon_gi.C", "photon_gi.C"]}])");
+  const PresetTable t(table);
+  const json spec = techniqueParams("specular", json::object());
+  EXPECT_DOUBLE_EQ(t.predictMs("specular", spec, 1e4, {}, {{"photon_gi", {{"C", 20}}}}), 41.0);
+  EXPECT_DOUBLE_EQ(t.predictMs("specular", spec, 1e4, {}, {{"photon_gi", {{"C", 10}}}}), 11.0);
+  EXPECT_DOUBLE_EQ(t.predictMs("specular", spec, 1e4, {}, {}), 1.0);  // photon_gi not planned: no gathers
+  EXPECT_THROW(t.predictMs("specular", spec, 1e4, {}, {{"photon_gi", json::object()}}), std::logic_error);
+
+  const std::vector<std::string> planned{"gbuffer", "direct", "specular", "photon_gi"};
+  // Budget 90: photon_gi's third point (67 ms) fits beside specular at C = 10 (3 + 0.6 + 11 + 67 = 81.6)
+  // but takes specular to C = 20 (111.6): the chooser stays at the second point (3 + 0.6 + 11 + 22).
+  const BudgetChoice tight = chooseConfiguration(t, planned, request({{"time_budget_ms", 90}}));
+  EXPECT_EQ(tight.params.at("photon_gi")["C"], 10);
+  EXPECT_EQ(tight.params.at("photon_gi")["photons"], 100000);
+  EXPECT_DOUBLE_EQ(tight.stats["predicted_ms"].get<double>(), 3 + 0.6 + 11 + 22);
+  // Budget 120: the third point with specular charged at C = 20, in its own entry and in the total.
+  const BudgetChoice wide = chooseConfiguration(t, planned, request({{"time_budget_ms", 120}}));
+  EXPECT_EQ(wide.params.at("photon_gi")["C"], 20);
+  EXPECT_DOUBLE_EQ(wide.stats["techniques"]["specular"]["predicted_ms"].get<double>(), 41.0);
+  EXPECT_DOUBLE_EQ(wide.stats["techniques"]["photon_gi"]["predicted_ms"].get<double>(), 67.0);
+  EXPECT_DOUBLE_EQ(wide.stats["predicted_ms"].get<double>(), 3 + 0.6 + 41 + 67);
+  EXPECT_DOUBLE_EQ(predictFrameMs(t, {"direct", "specular", "photon_gi"}, wide.params, 1e4, {}), 3 + 0.6 + 41 + 67);
 }
 
 // The headroom a budget plans with: a frame whose ratio varies as the scene's recent ratios do fits its
