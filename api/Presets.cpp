@@ -27,8 +27,8 @@ double paramValue(const json& params, const std::string& n) {
   throw std::logic_error("preset table: cost term names '" + n + "', which is no numeric parameter");
 }
 
-// sum of coef * product of vars; a var is "pixels", a scene count ("particles", "beams", "specular_objects"), a
-// numeric parameter, or another technique's parameter ("photon_gi.C": its value in `frame`, 0 when that
+// sum of coef * product of vars; a var is "pixels" (the raster's), a scene count ("particles", "beams",
+// "specular_objects"), photon_gi's "gather_samples" (its gather's block samples), a numeric parameter, or another technique's parameter ("photon_gi.C": its value in `frame`, 0 when that
 // technique is not in the frame).
 double evalTerms(const json& terms, const json& params, double pixels, const SceneCounts& counts = {},
                  const FrameParams& frame = {}) {
@@ -41,7 +41,10 @@ double evalTerms(const json& terms, const json& params, double pixels, const Sce
       else if (n == "particles") v *= counts.particles;
       else if (n == "beams") v *= counts.beams;
       else if (n == "specular_objects") v *= counts.specularObjects;
-      else if (const auto dot = n.find('.'); dot != std::string::npos) {
+      else if (n == "gather_samples") {  // photon_gi's block samples (SceneCounts::photonGatherBlock)
+        const double block = counts.photonGatherBlock > 0 ? counts.photonGatherBlock : paramValue(params, "gather_step");
+        v *= pixels / std::max(1.0, block * block);
+      } else if (const auto dot = n.find('.'); dot != std::string::npos) {
         auto other = frame.find(n.substr(0, dot));
         v *= other == frame.end() ? 0.0 : paramValue(other->second, n.substr(dot + 1));
       } else v *= paramValue(params, n);
@@ -201,14 +204,6 @@ double defaultFrameBudget(const RenderRequest& request, const RequestLimits* lim
 }
 }  // namespace
 
-double costPixels(const std::string& technique, double rasterPixels, int supersampling) {
-  // photon_gi's gather runs once per gather_step x gather_step block of output pixels (PhotonGi.cpp
-  // scales the step by k), its fix-ups mostly borrow a neighbour's estimate: measured on cornell_box at
-  // 256 x 256, k = 2 cost 1.14x of k = 1, where the raster's pixels would predict 4x.
-  const double k = std::max(1, supersampling);
-  return technique == "photon_gi" ? rasterPixels / (k * k) : rasterPixels;
-}
-
 BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std::string>& planned,
                                  const RenderRequest& request, const RequestLimits* limits,
                                  const SceneCounts& counts, double speed) {
@@ -235,7 +230,7 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
     // only when every planned technique has a model (else the frame's cost is not known).
     if (const double defaultBudget = defaultFrameBudget(request, limits); defaultBudget > 0) {
       const double predicted =
-          predictFrameMs(table, planned, c.params, double(request.width) * request.height, counts, request.supersampling) *
+          predictFrameMs(table, planned, c.params, double(request.width) * request.height, counts) *
           speed;
       if (predicted > defaultBudget) {
         RenderRequest budgeted = request;
@@ -267,7 +262,7 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
   // This machine's ms: the table's prediction times the speed factor (MachineSpeed), with the frame's
   // other techniques' parameters (`frame`, c.params unless given) for a model that names them.
   auto predictIn = [&](const std::string& t, const json& p, const FrameParams& frame) {
-    const double ms = table.predictMs(t, p, costPixels(t, pixels, request.supersampling), counts, frame);
+    const double ms = table.predictMs(t, p, pixels, counts, frame);
     return ms < 0 ? ms : ms * speed;
   };
   auto predict = [&](const std::string& t, const json& p) { return predictIn(t, p, c.params); };
@@ -443,22 +438,32 @@ int supersamplingWithinDefaultBudget(const PresetTable& table, const std::vector
   if (!(speed > 0.0) || !std::isfinite(speed)) speed = 1.0;
   const BudgetChoice defaults = chooseConfiguration(table, planned, request, nullptr, counts, speed);
   const double outputPixels = double(request.width) * request.height;
+  const bool photons = std::find(planned.begin(), planned.end(), "photon_gi") != planned.end();
   for (; k > 1; --k) {
-    const double ms = predictFrameMs(table, planned, defaults.params, outputPixels * k * k, counts, k);
+    SceneCounts atK = counts;
+    atK.photonGatherBlock = photons ? photonGatherBlock(request, k) : 0.0;
+    const double ms = predictFrameMs(table, planned, defaults.params, outputPixels * k * k, atK);
     if (ms < 0) return k;  // a pass the table does not model: no prediction, as asked
     if (ms * speed <= budget) return k;
   }
   return 1;
 }
 
+double photonGatherBlock(const RenderRequest& request, int k) {
+  k = std::max(1, k);
+  const json params = paramsOf(request, "photon_gi");
+  auto named = request.explicitParams.find("photon_gi");
+  const bool given = named != request.explicitParams.end() && named->second.count("gather_step") > 0;
+  return double(k) * photonGatherStep(params["gather_step"].get<int>(), given, request.width, request.height, k);
+}
+
 double predictFrameMs(const PresetTable& table, const std::vector<std::string>& planned,
-                      const std::map<std::string, json>& params, double pixels, const SceneCounts& counts,
-                      int supersampling) {
+                      const std::map<std::string, json>& params, double pixels, const SceneCounts& counts) {
   double ms = table.predictOverheadMs(pixels);
   for (const auto& t : planned) {
     auto it = params.find(t);
     const double m =
-        it == params.end() ? -1.0 : table.predictMs(t, it->second, costPixels(t, pixels, supersampling), counts, params);
+        it == params.end() ? -1.0 : table.predictMs(t, it->second, pixels, counts, params);
     if (m < 0) return -1.0;
     ms += m;
   }

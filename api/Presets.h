@@ -57,9 +57,15 @@ struct SceneCounts {
   // is charged the smaller of it and cube_resolution (predictMs): a default frame's maps follow the
   // objects' size on screen (MetalRoughSpheres' 12 spheres at 64 texels, not the default 256).
   double specularMapTexels = 0;
+  // Raster samples per side of photon_gi's gather block this frame (k x api::photonGatherStep); 0: the
+  // parameters' gather_step (k = 1, as the table was measured). photon_gi's model variable
+  // "gather_samples" is the raster's pixels over its square: the block samples, each a gather over the
+  // kernel's photons (at 256 x 256 px, k = 2 and step 4, a quarter of the samples at k = 1 and step 2).
+  double photonGatherBlock = 0;
   nlohmann::json toJson() const {
     nlohmann::json j{{"particles", particles}, {"beams", beams}, {"specular_objects", specularObjects}};
     if (specularMapTexels > 0) j["specular_map_texels"] = specularMapTexels;
+    if (photonGatherBlock > 0) j["photon_gather_block"] = photonGatherBlock;
     return j;
   }
   // toJson's inverse (stats.scene.counts, stats.budget.scene_counts); a missing key counts 0.
@@ -69,6 +75,7 @@ struct SceneCounts {
     c.beams = j.value("beams", 0.0);
     c.specularObjects = j.value("specular_objects", 0.0);
     c.specularMapTexels = j.value("specular_map_texels", 0.0);
+    c.photonGatherBlock = j.value("photon_gather_block", 0.0);
     return c;
   }
 };
@@ -125,7 +132,7 @@ struct BudgetChoice {
 // `counts`: the frame's scene counts (the models' "particles" and "beams"); stats.scene_counts echoes them.
 //
 // Pixels: `request` is the supersampled one (width and height times its `supersampling` k): every model
-// is charged the raster's pixels but photon_gi's, charged the output's (costPixels).
+// is charged the raster's pixels, photon_gi's gather its block samples (counts.photonGatherBlock).
 //
 // The server's default frame budget (limits->defaultFrameBudgetMs > 0, radiantd
 // --default-frame-budget-ms): a request with neither quality nor time_budget_ms that names no passes
@@ -155,15 +162,13 @@ int supersamplingWithinDefaultBudget(const PresetTable& table, const std::vector
 
 // Predicted ms of a whole frame in the table's units (speed 1): the overhead plus every planned
 // technique's model with `params` (technique -> complete parameters); < 0 when a planned technique has
-// no model (the frame cannot be compared with the table). `pixels`: the raster's, at `supersampling`.
+// no model (the frame cannot be compared with the table). `pixels`: the raster's.
 double predictFrameMs(const PresetTable& table, const std::vector<std::string>& planned,
-                      const std::map<std::string, nlohmann::json>& params, double pixels, const SceneCounts& counts,
-                      int supersampling = 1);
+                      const std::map<std::string, nlohmann::json>& params, double pixels, const SceneCounts& counts);
 
-// The `pixels` a technique's cost model is evaluated at, for a frame whose raster has `rasterPixels`
-// at supersampling k: the raster's for every pass but photon_gi, whose gather follows the output
-// pixels (its gather_step is in output pixels), so rasterPixels / k^2 there.
-double costPixels(const std::string& technique, double rasterPixels, int supersampling);
+// photon_gi's gather block in raster samples at supersampling k (SceneCounts::photonGatherBlock): k x
+// api::photonGatherStep for `request` (the output-size one) with its photon_gi parameters.
+double photonGatherBlock(const RenderRequest& request, int k);
 
 // How fast this machine runs the preset table's frames: measured frame ms over the table's prediction
 // for the same frame (both without a compare block's reference). The budget chooser multiplies every

@@ -95,7 +95,15 @@ TECHNIQUES = {
         "scene": "cornell_box",
         "passes": {},
         "configs": [{"photons": n, "C": c} for n in (20000, 50000, 100000, 250000, 500000) for c in (10, 20)],
-        "terms": [[], ["photons"], ["pixels"], ["pixels", "C", "C"]],
+        # gather_samples: the gather's block samples (the raster's pixels over the square of the block,
+        # stats.scene.counts.photon_gather_block): a supersampled default frame gathers once per k x k
+        # samples times 3 x 3 or 4 x 4 output pixels (api::photonGatherStep), where these sweeps (k = 1)
+        # gather per 2 x 2; the cost-only points (extra_cost_configs: gather_step 4, supersampling 2) tell
+        # that term from the raster's pixels (the upsampling, fix-ups and denoiser run per sample).
+        "terms": [[], ["photons"], ["pixels"], ["pixels", "C", "C"], ["gather_samples", "C", "C"]],
+        "extra_cost_configs": [{"photons": n, "C": c, "gather_step": s, "supersampling": k}
+                               for n in (20000, 250000) for c in (10, 20) for k, s in ((1, 4), (2, 2), (2, 4))],
+        "extra_cost_seed": 8000,
         "compare": {"aov": "indirect", "spp": 1024},
         "output_aov": "indirect",
     },
@@ -289,7 +297,9 @@ def zip_group(name, points, technique_seed=False):
     for config, size, seed in points:
         for k, v in config.items():
             # "photon_gi.C": another technique's parameter (passes.photon_gi.C), a variable of this one's model
-            group.setdefault(f"passes.{k}" if "." in k else f"passes.{name}.{k}", []).append(v)
+            # "supersampling": the request's own (the raster's pixels are k^2 the output's: raster_pixels)
+            path = k if k == "supersampling" else f"passes.{k}" if "." in k else f"passes.{name}.{k}"
+            group.setdefault(path, []).append(v)
         if technique_seed:
             group.setdefault(f"passes.{name}.seed", []).append(seed)
         group.setdefault("width", []).append(size)
@@ -325,6 +335,16 @@ def make_spec(server, out_dir, names):
         sweeps.append({"name": f"presets-cost-{name}", "technique": name, "base": base_request(name, t, 32, 0),
                        "zip": [zip_group(name, points, t.get("technique_seed", False))], "repeats": 1,
                        "warmup": t.get("warmup", 0)})
+        if t.get("extra_cost_configs"):  # cost-only points (no error sweep: not front candidates), own seeds
+            eseed, extra = t["extra_cost_seed"], []
+            for size in SIZES:
+                for config in t["extra_cost_configs"]:
+                    extra.append((config, size, eseed))
+                    eseed += 1
+            sweeps.append({"name": f"presets-cost-{name}~extra", "technique": name,
+                           "base": base_request(name, t, 32, 0),
+                           "zip": [zip_group(name, extra, t.get("technique_seed", False))], "repeats": 1,
+                           "warmup": t.get("warmup", 0)})
     # The scene-count variants: seeds from 5000 on, so that the canonical points keep the seeds of earlier runs.
     vseed = 5000
     for name, t in TECHNIQUES.items():
@@ -394,12 +414,25 @@ def term_value(vars_, params, pixels):
     return v
 
 
+def raster_pixels(record):
+    """The models' "pixels": the raster's, width x height x k^2 at the request's supersampling k (1 in
+    every sweep but photon_gi's cost-only points)."""
+    k = record["request"].get("supersampling", 1)
+    return record["request"]["width"] * record["request"]["height"] * k * k
+
+
 def with_counts(params, record, terms=()):
     """A record's parameters plus its scene counts (api::SceneCounts, stats.scene.counts), the models' scene
     variables, plus the other techniques' parameters the terms name ("photon_gi.C": the request's
     passes.photon_gi.C; 0 when the request turns that pass off)."""
     p = dict(params)
     p.update(record.get("scene_counts") or {})
+    if any("gather_samples" in term for term in terms):  # photon_gi's block samples (api::SceneCounts)
+        block = p.get("photon_gather_block")
+        if not block:
+            raise SystemExit("fit: a photon_gi record without scene_counts.photon_gather_block (a radiantd older "
+                             "than the gather-block count?)")
+        p["gather_samples"] = raster_pixels(record) / float(block) ** 2
     passes = record["request"]["passes"]
     for n in {n for term in terms for n in term if "." in n}:
         other, key = n.split(".", 1)
@@ -512,7 +545,7 @@ def fit(records, command, runs=()):
     cost = [r for r in ok if r["sweep"].startswith("presets-cost-")]
     other_rows, overhead_rows = {}, []
     for r in cost:
-        px = r["request"]["width"] * r["request"]["height"]
+        px = raster_pixels(r)
         total = 0.0
         for p in r["passes"]:
             c = pass_cost(p)
@@ -529,7 +562,7 @@ def fit(records, command, runs=()):
             if p is None:
                 continue
             params = with_counts(r["request"]["passes"][name], r, t["terms"])
-            rows.append((params, r["request"]["width"] * r["request"]["height"], pass_cost(p)))
+            rows.append((params, raster_pixels(r), pass_cost(p)))
         if not rows:
             continue
         terms, resid, dropped = fit_terms(t["terms"], rows)
@@ -543,9 +576,9 @@ def fit(records, command, runs=()):
         pts = []
         for r in errs:
             params = {k: r["request"]["passes"][name][k] for k in t["configs"][0]}
-            px = r["request"]["width"] * r["request"]["height"]
+            px = raster_pixels(r)
             pts.append({"params": params, "error": r["metrics"]["rmse"],
-                        "predicted_ms": predict(terms, with_counts(params, r), px)})
+                        "predicted_ms": predict(terms, with_counts(params, r, t["terms"]), px)})
         pts.sort(key=lambda q: (q["predicted_ms"], q["error"]))  # of equal cost, only the most accurate stays
         front = []
         for q in pts:

@@ -679,7 +679,10 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     api::RenderRequest supersampled = request;
     supersampled.width *= k;
     supersampled.height *= k;
-    supersampled.supersampling = k;  // the k used (capped; 1 with the reference): api::costPixels reads it
+    supersampled.supersampling = k;  // the k used (capped; 1 with the reference)
+    // photon_gi's gather block at this k (its step grows with a supersampled frame): the model's block samples.
+    if (std::find(planned.begin(), planned.end(), "photon_gi") != planned.end())
+      counts.photonGatherBlock = api::photonGatherBlock(request, k);
     FrameView supersampledView = makeFrameView(scene, supersampled, inputs.environment);
     supersampledView.supersampling = k;
     // The environment's compact bright regions become shadowed directional lights of the raster when
@@ -730,8 +733,8 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     // without them, the request's own.
     stats.scene["counts"] = counts.toJson();
     // The supersampled request: the cost models' `pixels` are the raster's (the table was measured at
-    // k = 1, so a request that keeps its own supersampling under a budget is charged k^2 the pixels),
-    // except photon_gi's, whose gather follows the output pixels (api::costPixels).
+    // k = 1, so a request that keeps its own supersampling under a budget is charged k^2 the pixels);
+    // photon_gi's gather is charged its block samples (counts.photonGatherBlock).
     const nlohmann::json speedState = im.speed.toJson(speedScene);  // what this frame's choice used
     api::BudgetChoice choice = api::chooseConfiguration(api::PresetTable::builtin(), planned, supersampled,
                                                         inputs.limits, counts, im.speed.planningFactor(speedScene));
@@ -839,7 +842,7 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     // This frame's time against the table's prediction (before compare's reference, which the table
     // does not model): the speed factor's evidence when the frame is comparable with the table.
     im.lastFrame = {msSince(frameStart), api::predictFrameMs(api::PresetTable::builtin(), planned, choice.params,
-                                                             double(supersampled.width) * supersampled.height, counts, k)};
+                                                             double(supersampled.width) * supersampled.height, counts)};
     if (choice.active) {
       stats.budget = std::move(choice.stats);
       stats.budget["speed"] = speedState;

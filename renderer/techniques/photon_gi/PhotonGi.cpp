@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "api/Types.h"
 #include "renderer/frame/PassContext.h"
 #include "renderer/frame/RayScenes.h"
 #include "renderer/raytracing/PhotonTracer.h"
@@ -155,18 +156,14 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   // gather_step is in output pixels: on a k-times supersampled frame the block is k gather_step
   // samples wide, so the gather costs what it costs at k = 1 and the block's light is still spread over
   // the pixel's own surface samples (the estimator's surface test), which is what the anti-aliasing needs.
-  // Left out of the request, a supersampled frame's step grows with the frame: one output pixel in 64 of
-  // the frame's size (its geometric mean), at least 2 and at most 4: 2 below 160 px, 3 from 160, 4 from
-  // 224 px. The estimate is smooth over the smallest kernel, which a framed scene shows at a size that
-  // grows with the frame: at 256 x 256 px step 4 costs 0.37 of step 2 at the same error, at 64 px it
-  // would lose 1.8% of the light (docs/TECHNIQUES.md, photon_gi, gather_step). k = 1 keeps 2, where
-  // the preset table was measured.
+  // Left out of the request, a supersampled frame's step grows with the frame (api::photonGatherStep,
+  // which the cost model charges too). The estimate is smooth over the smallest kernel, which a framed
+  // scene shows at a size that grows with the frame: at 256 x 256 px step 4 costs 0.37 of step 2 at the
+  // same error, at 64 px it would lose 1.8% of the light (docs/TECHNIQUES.md, photon_gi, gather_step).
+  // k = 1 keeps the parameter's.
   const int k = std::max(1, view.supersampling);
-  int gatherStep = params.get<int>("gather_step");
-  if (!params.given("gather_step") && k >= 2) {
-    const double size = std::sqrt(double(view.width / k) * double(view.height / k));
-    gatherStep = std::clamp(static_cast<int>(std::lround(size / 64.0)), 2, 4);
-  }
+  const int gatherStep = api::photonGatherStep(params.get<int>("gather_step"), params.given("gather_step"),
+                                               view.width / k, view.height / k, k);
   splat_.gatherStep = gatherStep * k;
   // The denoiser (renderer/shading/Denoiser.h), guided by the estimator's relative noise: sqrt(int K^2)
   // / C' with C' the photons per kernel over pi, i.e. C, or C (photons / ppm_base)^(alpha / 2) on the

@@ -511,24 +511,49 @@ TEST(Presets, ASpeedFactorScalesEveryPredictionAndTheBudgetWithIt) {
   EXPECT_LT(predictFrameMs(t, kPlanned, c.params, 1e4, {}), 0.0);
 }
 
-// photon_gi's gather follows the output pixels (its gather_step is in output pixels), every other model
-// the raster's: a frame at supersampling k charges photon_gi pixels / k^2 (measured on cornell_box at
-// 256 x 256: k = 2 cost 1.14x of k = 1 where the raster's pixels predicted 4x).
-TEST(Presets, PhotonGiIsChargedTheOutputPixelsAndTheOthersTheRasters) {
-  const PresetTable t(syntheticTable());
-  EXPECT_DOUBLE_EQ(costPixels("photon_gi", 4e4, 2), 1e4);
-  EXPECT_DOUBLE_EQ(costPixels("photon_gi", 9e4, 3), 1e4);
-  EXPECT_DOUBLE_EQ(costPixels("direct", 4e4, 2), 4e4);
-  EXPECT_DOUBLE_EQ(costPixels("photon_gi", 1e4, 0), 1e4);  // k < 1 is 1
-  // A supersampled request (raster 200 x 200 at k = 2) under a budget: direct at 4e4 pixels, photon_gi at 1e4.
+// Issue 31: photon_gi's gather runs once per block of gather_step x gather_step output pixels, k x that in
+// raster samples, and a supersampled default frame's step grows with the frame (api::photonGatherStep: 3
+// from 160 px, 4 from 224 px), where the table's sweeps (k = 1) gather per 2 x 2. Its model's
+// "gather_samples" is the raster's pixels over the block's square (SceneCounts::photonGatherBlock, else
+// the parameters' gather_step); every model's "pixels" is the raster's. Before, photon_gi was charged the
+// output pixels at the sweeps' step: 3.2x its measured cost on cornell_box's default frame at 256 px.
+TEST(Presets, PhotonGiIsChargedItsGathersBlockSamplesAndTheRastersPixels) {
+  // The rule the pass runs (PhotonGi.cpp calls it).
+  EXPECT_EQ(photonGatherStep(2, false, 256, 256, 2), 4);
+  EXPECT_EQ(photonGatherStep(2, false, 200, 200, 3), 3);
+  EXPECT_EQ(photonGatherStep(2, false, 128, 128, 4), 2);
+  EXPECT_EQ(photonGatherStep(2, false, 1920, 1080, 2), 4);
+  EXPECT_EQ(photonGatherStep(2, false, 256, 256, 1), 2);  // k = 1: the parameter's, as the table measured
+  EXPECT_EQ(photonGatherStep(3, true, 256, 256, 2), 3);   // given: as asked
+  EXPECT_DOUBLE_EQ(photonGatherBlock(request({{"width", 256}, {"height", 256}}), 2), 8.0);
+  EXPECT_DOUBLE_EQ(photonGatherBlock(request({{"width", 256}, {"height", 256}}), 1), 2.0);
+  EXPECT_DOUBLE_EQ(
+      photonGatherBlock(request({{"width", 256}, {"height", 256}, {"passes", {{"photon_gi", {{"gather_step", 3}}}}}}), 2),
+      6.0);
+
+  json table = syntheticTable();
+  table["techniques"]["photon_gi"]["model"]["terms"] = json::parse(
+      R"([{"coef": 2, "vars": []}, {"coef": 1e-4, "vars": ["photons"]}, {"coef": 1e-6, "vars": ["pixels"]},
+          {"coef": 1e-5, "vars": ["gather_samples", "C", "C"]}])");
+  const PresetTable t(table);
+  const json p = techniqueParams("photon_gi", json{{"photons", 20000}, {"C", 10}});
+  SceneCounts blocks;
+  blocks.photonGatherBlock = 6;
+  EXPECT_DOUBLE_EQ(t.predictMs("photon_gi", p, 4e4, blocks), 2 + 2 + 1e-6 * 4e4 + 1e-5 * (4e4 / 36) * 100);
+  EXPECT_DOUBLE_EQ(t.predictMs("photon_gi", p, 4e4), 2 + 2 + 1e-6 * 4e4 + 1e-5 * (4e4 / 4) * 100);  // gather_step 2
+  // A supersampled request under a budget (raster 200 x 200 at k = 2, block 6): direct and photon_gi's pixels
+  // at the raster's 4e4, its gather at 4e4 / 36 block samples, in each technique's entry and the frame's total.
   RenderRequest r = request({{"time_budget_ms", 1}, {"supersampling", 2}});
   r.width = r.height = 200;
-  const BudgetChoice c = chooseConfiguration(t, kPlanned, r);
+  const BudgetChoice c = chooseConfiguration(t, kPlanned, r, nullptr, blocks);
   EXPECT_DOUBLE_EQ(c.stats["techniques"]["direct"]["predicted_ms"].get<double>(), 0.5 + 1e-5 * 4e4);
-  EXPECT_DOUBLE_EQ(c.stats["techniques"]["photon_gi"]["predicted_ms"].get<double>(), 2 + 1e-4 * 20000 + 1e-5 * 1e4 * 100);
+  EXPECT_DOUBLE_EQ(c.stats["techniques"]["photon_gi"]["predicted_ms"].get<double>(),
+                   2 + 2 + 1e-6 * 4e4 + 1e-5 * (4e4 / 36) * 100);
   const std::vector<std::string> modelled{"direct", "photon_gi"};
-  EXPECT_DOUBLE_EQ(predictFrameMs(t, modelled, c.params, 4e4, {}, 2),
-                   3 + 0.5 + 1e-5 * 4e4 + 2 + 1e-4 * 20000 + 1e-5 * 1e4 * 100);
+  EXPECT_DOUBLE_EQ(predictFrameMs(t, modelled, c.params, 4e4, blocks),
+                   3 + 0.5 + 1e-5 * 4e4 + 2 + 2 + 1e-6 * 4e4 + 1e-5 * (4e4 / 36) * 100);
+  EXPECT_EQ(SceneCounts::fromJson(blocks.toJson()).photonGatherBlock, 6.0);
+  EXPECT_FALSE(SceneCounts{}.toJson().contains("photon_gather_block"));
 }
 
 // The server's default frame budget (radiantd --default-frame-budget-ms): the planner's default frame
@@ -598,7 +623,7 @@ TEST(Presets, TheDefaultFrameBudgetLowersADefaultSupersamplingFirst) {
   ASSERT_FALSE(plain.supersamplingGiven);
   ASSERT_EQ(plain.supersampling, 4);
   const BudgetChoice asked = chooseConfiguration(t, modelled, plain);
-  auto at = [&](int k) { return predictFrameMs(t, modelled, asked.params, 1e4 * k * k, {}, k); };
+  auto at = [&](int k) { return predictFrameMs(t, modelled, asked.params, 1e4 * k * k, {}); };
   ASSERT_LT(at(2), at(3));
   ASSERT_LT(at(3), at(4));
   RequestLimits limits;
