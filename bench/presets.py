@@ -103,6 +103,8 @@ TECHNIQUES = {
         "terms": [[], ["photons"], ["pixels"], ["pixels", "C", "C"], ["gather_samples", "C", "C"]],
         "extra_cost_configs": [{"photons": n, "C": c, "gather_step": s, "supersampling": k}
                                for n in (20000, 250000) for c in (10, 20) for k, s in ((1, 4), (2, 2), (2, 4))],
+        # and at 128 px too: a default frame's raster (512 x 512 at 256 px) is far above the sweeps' 64 x 64.
+        "extra_cost_sizes": [32, 64, 128],
         "extra_cost_seed": 8000,
         "compare": {"aov": "indirect", "spp": 1024},
         "output_aov": "indirect",
@@ -160,6 +162,11 @@ TECHNIQUES = {
                   ["specular_objects", "cube_resolution", "cube_resolution", "layers", "photon_gi.C", "photon_gi.C"]],
         "variants": [{"field": 4}, {"field": 12}],
         "variant_configs": [{"cube_resolution": c, "layers": 3, "photon_gi.C": 10} for c in (64, 128, 256)],
+        # Cost-only points at larger frames: at 32 and 64 px alone the per-pixel search's term and the
+        # constant trade places (one fit put 0.025 ms per pixel: 6.6 s for a 512 x 512 raster that took 1.3 s).
+        "extra_cost_configs": [{"cube_resolution": c, "layers": 3, "photon_gi.C": 10} for c in (64, 256)],
+        "extra_cost_sizes": [128, 256],
+        "extra_cost_seed": 8100,
         "variant_seed": 7000,  # after every other technique's variant seeds, which stay as they were
         "compare": None,
         "no_front": "the reference has no ground truth for the specular AOV (docs/API.md, compare: no path-class "
@@ -337,7 +344,7 @@ def make_spec(server, out_dir, names):
                        "warmup": t.get("warmup", 0)})
         if t.get("extra_cost_configs"):  # cost-only points (no error sweep: not front candidates), own seeds
             eseed, extra = t["extra_cost_seed"], []
-            for size in SIZES:
+            for size in t.get("extra_cost_sizes", SIZES):
                 for config in t["extra_cost_configs"]:
                     extra.append((config, size, eseed))
                     eseed += 1
