@@ -156,11 +156,10 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   // gather_step is in output pixels: on a k-times supersampled frame the block is k gather_step
   // samples wide, so the gather costs what it costs at k = 1 and the block's light is still spread over
   // the pixel's own surface samples (the estimator's surface test), which is what the anti-aliasing needs.
-  // Left out of the request, a supersampled frame's step grows with the frame (api::photonGatherStep,
-  // which the cost model charges too). The estimate is smooth over the smallest kernel, which a framed
-  // scene shows at a size that grows with the frame: at 256 x 256 px step 4 costs 0.37 of step 2 at the
-  // same error, at 64 px it would lose 1.8% of the light (docs/TECHNIQUES.md, photon_gi, gather_step).
-  // k = 1 keeps the parameter's.
+  // Left out of the request, the step grows with the frame (api::photonGatherStep, which the cost model
+  // charges too). The estimate is smooth over the smallest kernel, which a framed scene shows at a size
+  // that grows with the frame: at 256 x 256 px step 4 costs 0.37 of step 2 at the same error, at 64 px it
+  // would lose 1.8% of the light (docs/TECHNIQUES.md, photon_gi, gather_step).
   const int k = std::max(1, view.supersampling);
   const int gatherStep = api::photonGatherStep(params.get<int>("gather_step"), params.given("gather_step"),
                                                view.width / k, view.height / k, k);

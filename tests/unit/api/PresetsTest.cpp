@@ -523,10 +523,12 @@ TEST(Presets, PhotonGiIsChargedItsGathersBlockSamplesAndTheRastersPixels) {
   EXPECT_EQ(photonGatherStep(2, false, 200, 200, 3), 3);
   EXPECT_EQ(photonGatherStep(2, false, 128, 128, 4), 2);
   EXPECT_EQ(photonGatherStep(2, false, 1920, 1080, 2), 4);
-  EXPECT_EQ(photonGatherStep(2, false, 256, 256, 1), 2);  // k = 1: the parameter's, as the table measured
+  EXPECT_EQ(photonGatherStep(2, false, 256, 256, 1), 4);   // at every k (the block is k times it)
+  EXPECT_EQ(photonGatherStep(2, false, 128, 128, 1), 2);   // the preset table's sweeps (32-128 px)
   EXPECT_EQ(photonGatherStep(3, true, 256, 256, 2), 3);   // given: as asked
   EXPECT_DOUBLE_EQ(photonGatherBlock(request({{"width", 256}, {"height", 256}}), 2), 8.0);
-  EXPECT_DOUBLE_EQ(photonGatherBlock(request({{"width", 256}, {"height", 256}}), 1), 2.0);
+  EXPECT_DOUBLE_EQ(photonGatherBlock(request({{"width", 256}, {"height", 256}}), 1), 4.0);
+  EXPECT_DOUBLE_EQ(photonGatherBlock(request({{"width", 64}, {"height", 64}}), 1), 2.0);
   EXPECT_DOUBLE_EQ(
       photonGatherBlock(request({{"width", 256}, {"height", 256}, {"passes", {{"photon_gi", {{"gather_step", 3}}}}}}), 2),
       6.0);
