@@ -28,8 +28,9 @@ double paramValue(const json& params, const std::string& n) {
 }
 
 // sum of coef * product of vars; a var is "pixels" (the raster's), a scene count ("particles", "beams",
-// "specular_objects"), photon_gi's "gather_samples" (its gather's block samples), a numeric parameter, or another technique's parameter ("photon_gi.C": its value in `frame`, 0 when that
-// technique is not in the frame).
+// "specular_objects"), photon_gi's "gather_samples" (its gather's block samples), a numeric parameter,
+// or another technique's parameter ("photon_gi.C": its value in `frame`, 0 when that technique is not
+// in the frame).
 double evalTerms(const json& terms, const json& params, double pixels, const SceneCounts& counts = {},
                  const FrameParams& frame = {}) {
   double ms = 0.0;
@@ -454,7 +455,7 @@ double photonGatherBlock(const RenderRequest& request, int k) {
   const json params = paramsOf(request, "photon_gi");
   auto named = request.explicitParams.find("photon_gi");
   const bool given = named != request.explicitParams.end() && named->second.count("gather_step") > 0;
-  return double(k) * photonGatherStep(params["gather_step"].get<int>(), given, request.width, request.height, k);
+  return double(k) * photonGatherStep(params["gather_step"].get<int>(), given, request.width, request.height);
 }
 
 double predictFrameMs(const PresetTable& table, const std::vector<std::string>& planned,

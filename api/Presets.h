@@ -58,9 +58,9 @@ struct SceneCounts {
   // objects' size on screen (MetalRoughSpheres' 12 spheres at 64 texels, not the default 256).
   double specularMapTexels = 0;
   // Raster samples per side of photon_gi's gather block this frame (k x api::photonGatherStep); 0: the
-  // parameters' gather_step (k = 1, as the table was measured). photon_gi's model variable
-  // "gather_samples" is the raster's pixels over its square: the block samples, each a gather over the
-  // kernel's photons (at 256 x 256 px, k = 2 and step 4, a quarter of the samples at k = 1 and step 2).
+  // parameters' gather_step. photon_gi's model variable "gather_samples" is the raster's pixels over its
+  // square: the block samples, each a gather over the kernel's photons (at 256 x 256 px, step 4: a
+  // quarter of the samples of step 2, which the table's sweeps at 32-128 px run).
   double photonGatherBlock = 0;
   nlohmann::json toJson() const {
     nlohmann::json j{{"particles", particles}, {"beams", beams}, {"specular_objects", specularObjects}};

@@ -68,8 +68,7 @@ int defaultSupersampling(int width, int height) {
   return std::clamp(int(std::ceil(kSamplesPerAxis / side - 1e-9)), 2, 4);
 }
 
-int photonGatherStep(int requested, bool given, int width, int height, int supersampling) {
-  (void)supersampling;  // the step counts output pixels: the same rule at every k
+int photonGatherStep(int requested, bool given, int width, int height) {
   if (given) return requested;
   const double size = std::sqrt(std::max(1.0, double(width) * double(height)));
   return std::clamp(static_cast<int>(std::lround(size / 64.0)), 2, 4);

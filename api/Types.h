@@ -148,13 +148,13 @@ struct RenderRequest {
 // (docs/PERFORMANCE.md, render fidelity), while its cost is mostly per frame, not per pixel.
 int defaultSupersampling(int width, int height);
 
-// The output pixels per side of photon_gi's gather block on a frame of width x height output pixels at
-// supersampling k (its block is k times that in raster samples): `requested` (gather_step) when the request
+// The output pixels per side of photon_gi's gather block on a frame of width x height output pixels (at
+// supersampling k the block is k times that in raster samples): `requested` (gather_step) when the request
 // gives it, else one output pixel in 64 of the frame's size (its geometric mean), at least 2 and at most
 // 4: 2 below 160 px (the preset table's sweeps, 32-128 px), 3 from 160, 4 from 224 px, at every k
 // (docs/TECHNIQUES.md, photon_gi, gather_step). The pass runs it and the cost model charges it
 // (api::SceneCounts::photonGatherBlock).
-int photonGatherStep(int requested, bool given, int width, int height, int supersampling);
+int photonGatherStep(int requested, bool given, int width, int height);
 
 // Timing and counters for one pass that ran.
 struct PassStats {

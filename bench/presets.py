@@ -40,6 +40,12 @@ What is measured (TECHNIQUES below; each technique on its canonical built-in sce
                built-in scenes with other scatterers for light_volumes, bench/glass_metal_field.py's
                fields of 4 and 12 spheres, uploaded, for specular), and read per record from stats.scene.counts (the sweep
                record's scene_counts), the same numbers the daemon's budget chooser evaluates.
+  cost-only    "extra_cost_configs" (at "extra_cost_sizes"): cost points with no error sweep, so never
+               front candidates, for what the canonical points cannot tell apart: photon_gi at
+               gather_step 4 and supersampling 2 (its block samples against the raster's pixels),
+               specular at 128 and 256 px (its per-pixel term against its constant). A config key
+               "supersampling" is the request's; "photon_gi.C" is another technique's parameter, a
+               variable of this technique's model (specular's maps gather photon_gi's photons).
 
 The fit (Python standard library only):
   cost model   per technique, ms = sum of coef * product(vars) (vars: "pixels", the scene counts and the
@@ -96,8 +102,8 @@ TECHNIQUES = {
         "passes": {},
         "configs": [{"photons": n, "C": c} for n in (20000, 50000, 100000, 250000, 500000) for c in (10, 20)],
         # gather_samples: the gather's block samples (the raster's pixels over the square of the block,
-        # stats.scene.counts.photon_gather_block): a supersampled default frame gathers once per k x k
-        # samples times 3 x 3 or 4 x 4 output pixels (api::photonGatherStep), where these sweeps (k = 1)
+        # stats.scene.counts.photon_gather_block): a default frame of 224 px and more gathers once per
+        # 4 x 4 output pixels, k x 4 samples (api::photonGatherStep), where these sweeps (32-128 px, k = 1)
         # gather per 2 x 2; the cost-only points (extra_cost_configs: gather_step 4, supersampling 2) tell
         # that term from the raster's pixels (the upsampling, fix-ups and denoiser run per sample).
         "terms": [[], ["photons"], ["pixels"], ["pixels", "C", "C"], ["gather_samples", "C", "C"]],

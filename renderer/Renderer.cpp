@@ -680,7 +680,7 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     supersampled.width *= k;
     supersampled.height *= k;
     supersampled.supersampling = k;  // the k used (capped; 1 with the reference)
-    // photon_gi's gather block at this k (its step grows with a supersampled frame): the model's block samples.
+    // photon_gi's gather block at this k (its step grows with the frame): the model's block samples.
     if (std::find(planned.begin(), planned.end(), "photon_gi") != planned.end())
       counts.photonGatherBlock = api::photonGatherBlock(request, k);
     FrameView supersampledView = makeFrameView(scene, supersampled, inputs.environment);

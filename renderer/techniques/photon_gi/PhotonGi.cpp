@@ -162,7 +162,7 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   // would lose 1.8% of the light (docs/TECHNIQUES.md, photon_gi, gather_step).
   const int k = std::max(1, view.supersampling);
   const int gatherStep = api::photonGatherStep(params.get<int>("gather_step"), params.given("gather_step"),
-                                               view.width / k, view.height / k, k);
+                                               view.width / k, view.height / k);
   splat_.gatherStep = gatherStep * k;
   // The denoiser (renderer/shading/Denoiser.h), guided by the estimator's relative noise: sqrt(int K^2)
   // / C' with C' the photons per kernel over pi, i.e. C, or C (photons / ppm_base)^(alpha / 2) on the

@@ -512,20 +512,18 @@ TEST(Presets, ASpeedFactorScalesEveryPredictionAndTheBudgetWithIt) {
 }
 
 // Issue 31: photon_gi's gather runs once per block of gather_step x gather_step output pixels, k x that in
-// raster samples, and a supersampled default frame's step grows with the frame (api::photonGatherStep: 3
-// from 160 px, 4 from 224 px), where the table's sweeps (k = 1) gather per 2 x 2. Its model's
+// raster samples, and the step a request leaves out grows with the frame (api::photonGatherStep: 3 from
+// 160 px, 4 from 224 px, at every k), where the table's sweeps (32-128 px) gather per 2 x 2. Its model's
 // "gather_samples" is the raster's pixels over the block's square (SceneCounts::photonGatherBlock, else
 // the parameters' gather_step); every model's "pixels" is the raster's. Before, photon_gi was charged the
 // output pixels at the sweeps' step: 3.2x its measured cost on cornell_box's default frame at 256 px.
 TEST(Presets, PhotonGiIsChargedItsGathersBlockSamplesAndTheRastersPixels) {
   // The rule the pass runs (PhotonGi.cpp calls it).
-  EXPECT_EQ(photonGatherStep(2, false, 256, 256, 2), 4);
-  EXPECT_EQ(photonGatherStep(2, false, 200, 200, 3), 3);
-  EXPECT_EQ(photonGatherStep(2, false, 128, 128, 4), 2);
-  EXPECT_EQ(photonGatherStep(2, false, 1920, 1080, 2), 4);
-  EXPECT_EQ(photonGatherStep(2, false, 256, 256, 1), 4);   // at every k (the block is k times it)
-  EXPECT_EQ(photonGatherStep(2, false, 128, 128, 1), 2);   // the preset table's sweeps (32-128 px)
-  EXPECT_EQ(photonGatherStep(3, true, 256, 256, 2), 3);   // given: as asked
+  EXPECT_EQ(photonGatherStep(2, false, 256, 256), 4);
+  EXPECT_EQ(photonGatherStep(2, false, 200, 200), 3);
+  EXPECT_EQ(photonGatherStep(2, false, 128, 128), 2);   // the preset table's sweeps (32-128 px)
+  EXPECT_EQ(photonGatherStep(2, false, 1920, 1080), 4);
+  EXPECT_EQ(photonGatherStep(3, true, 256, 256), 3);    // given: as asked
   EXPECT_DOUBLE_EQ(photonGatherBlock(request({{"width", 256}, {"height", 256}}), 2), 8.0);
   EXPECT_DOUBLE_EQ(photonGatherBlock(request({{"width", 256}, {"height", 256}}), 1), 4.0);
   EXPECT_DOUBLE_EQ(photonGatherBlock(request({{"width", 64}, {"height", 64}}), 1), 2.0);
