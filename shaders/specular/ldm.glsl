@@ -127,9 +127,38 @@ bool sphereRoots(vec3 x, vec3 R, float r, out float dNear, out float dFar) {
   return true;
 }
 
+// Whether the point p (relative to the reference point, |p| = len > 0) lies on a surface the layer
+// stores: within three texels of the tangent plane of one of the four texels around its direction (the
+// ones linear filtering blends; their normals and distances), |len - stored| |cos| <= 3 texels + slack
+// |cos|, cos between the direction and the texel's normal. A point on a rubber sheet (the filtered
+// ramp across a depth discontinuity, see traceLayer) is in front of the far surface's plane and behind
+// the near one's by a good part of the jump, so it fails both; a radial test alone cannot tell a
+// sheet from a surface seen at a slant (a surface at inclination t from the direction steps by
+// 2/res tan(t) of the distance per texel), so it had to admit 16 texels and let sheets through: a
+// mirror sphere's rays passing just behind the tall box as seen from the sphere's centre "hit" the
+// sheet between the box and the ceiling (cornell_mirror's worst pixels, 40% too dark). slack: what the
+// refined bracket still spans.
+bool onStoredSurface(vec3 p, float len, float cube, float slack) {
+  vec3 dir = p / len;
+  vec4 gx = textureGather(t_ldmGeometry, vec4(dir, cube), 0);
+  vec4 gy = textureGather(t_ldmGeometry, vec4(dir, cube), 1);
+  vec4 gz = textureGather(t_ldmGeometry, vec4(dir, cube), 2);
+  for (int i = 0; i < 4; ++i) {
+    if (!(gz[i] > 0.0 && gz[i] < 1e30)) continue;
+    float c = abs(dot(dir, octDecode(vec2(gx[i], gy[i]))));
+    if (abs(len - gz[i]) * c <= 6.0 * gz[i] / u_cubeResolution + slack * c) return true;
+  }
+  return false;
+}
+
 // Linear search + secant refinement in one layer (thesis 5.1.2). x is the ray origin relative to the
 // reference point, R the unit direction. Returns the ray parameter of the first crossing in this layer.
-bool traceLayer(int object, int layer, vec3 x, vec3 R, out float dHit) {
+// dHidden: where no crossing is found, the ray parameter at which the ray first passed behind a nearer
+// surface's silhouette (as seen from the reference point; the refined bracket's end on the far
+// surface), or -1: the layer does not store what the ray would hit there (it is hidden from the
+// reference point), and the far surface next to the silhouette is the best stand-in the layer has.
+bool traceLayer(int object, int layer, vec3 x, vec3 R, out float dHit, out float dHidden) {
+  dHidden = -1.0;
   float cube = float(object * u_layers + layer);
   float rMin = 0.0;
   float rMax = objects[object].extent.x;
@@ -210,15 +239,21 @@ bool traceLayer(int object, int layer, vec3 x, vec3 R, out float dHit) {
       // to atan 8 ~ 83 deg) plus what the bracket itself still spans (few secant steps leave it wide).
       // A bracket that began in an empty texel is the edge of a surface against nothing (no sheet to
       // fear): the ray must come within one texel of the filtered surface there.
+      // The radial test is the coarse one; onStoredSurface's plane test tells a slanted surface from a
+      // sheet.
       Probe at = m.valid ? m : hi;
       float nearestStored = texture(t_ldmGeometry, vec4(at.len > 1e-30 ? x + R * at.d : R, cube)).z;
       float check = nearestStored > 0.0 && !fromEmpty ? nearestStored : at.stored;
-      float tol = fromEmpty ? 2.0 * at.stored / u_cubeResolution
-                            : 32.0 * at.stored / u_cubeResolution + abs(hi.len - lo.len);
-      if (at.valid && abs(at.len - check) <= tol) {
+      float span = abs(hi.len - lo.len);
+      float tol = fromEmpty ? 2.0 * at.stored / u_cubeResolution : 32.0 * at.stored / u_cubeResolution + span;
+      if (at.valid && abs(at.len - check) <= tol &&
+          (fromEmpty || at.len <= 1e-30 || onStoredSurface(x + R * at.d, at.len, cube, span))) {
         dHit = at.d;
         return true;
       }
+      // Passed behind a nearer surface (undershooting the far one, then overshooting the near one):
+      // remember the far side, the last point known to be in front of it.
+      if (crossIn && !fromEmpty && lo.valid && dHidden < 0.0) dHidden = lo.d;
     }
     prev = cur;
   }
@@ -255,17 +290,32 @@ float mapConvexCurvature(vec3 dir, float cube, vec4 geo, out float spacing) {
   return k;
 }
 
-// Algorithm 3's "for each layer ... find the closest intersection".
+// Algorithm 3's "for each layer ... find the closest intersection". Where no layer has one but the
+// ray passed behind a silhouette in some layer (what it meets is hidden from the reference point in
+// every layer: depth peeling, `layers` > 3, stores more of it), the nearest such far side stands in
+// for it: the surface next to the silhouette, not the sheet across it, nor a miss (the environment,
+// black inside a closed room).
 bool traceLayers(int object, vec3 originWorld, vec3 R, out float dHit, out int hitLayer) {
   vec3 x = originWorld - objects[object].referenceRadius.xyz;
   dHit = 3.4e38;
   hitLayer = -1;
+  float dStandIn = 3.4e38;
+  int standInLayer = -1;
   for (int l = 0; l < u_layers; ++l) {
-    float d;
-    if (traceLayer(object, l, x, R, d) && d < dHit) {
-      dHit = d;
-      hitLayer = l;
+    float d, hidden;
+    if (traceLayer(object, l, x, R, d, hidden)) {
+      if (d < dHit) {
+        dHit = d;
+        hitLayer = l;
+      }
+    } else if (hidden >= 0.0 && hidden < dStandIn) {
+      dStandIn = hidden;
+      standInLayer = l;
     }
+  }
+  if (hitLayer < 0 && standInLayer >= 0) {
+    dHit = dStandIn;
+    hitLayer = standInLayer;
   }
   return hitLayer >= 0;
 }
