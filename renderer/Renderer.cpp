@@ -776,9 +776,9 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
                                                                   plan.passes[i]->info().name);
       Technique* t = plan.passes[i];
       gl::DebugGroup group(t->info().name);
-      PassContext ctx{scene, gpu, view, params[i], im.resources, im.shaders, stats.passes[i]};
-      ctx.progress = [&, i](double f) { report(0.95 * (static_cast<double>(i) + std::clamp(f, 0.0, 1.0)) / passCount); };
-      ctx.cancel = cancelToken;
+      PassContext ctx{scene, gpu, view, params[i], im.resources, im.shaders, stats.passes[i],
+                      [&, i](double f) { report(0.95 * (static_cast<double>(i) + std::clamp(f, 0.0, 1.0)) / passCount); },
+                      cancelToken};
       im.resources.beginPass(t->info().name, declaredAccess(t->info()), FrameResources::Phase::Execute);
       {
         GpuProfiler::Scope scope(im.profiler, stats.passes[i]);
