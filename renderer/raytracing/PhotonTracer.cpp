@@ -21,7 +21,10 @@ bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y
 
 void tracePhoton(const RayScene& rays, const SceneLights& lights, const PhotonOptions& o, std::uint64_t index,
                  std::vector<PhotonRecord>& out, RayCounter& counter) {
-  Sampler sampler(index, 0, o.seed ^ 0x70686F746F6E73ull);  // "photons": not the camera's sequences
+  // "photons": not the camera's sequences. Low-discrepancy over the emission and the first bounce
+  // (Sampler.h, kLowDiscrepancyDims): the photons' first indirect hits cover the scene evenly instead of
+  // clumping as independent samples do.
+  Sampler sampler = Sampler::lowDiscrepancy(index, o.seed ^ 0x70686F746F6E73ull);
   Emission e;
   if (!lights.sampleLe(sampler, e)) return;
   glm::vec3 flux = e.flux;
