@@ -429,7 +429,10 @@ TEST(Specular, RaysPassingBehindANearerSurfaceFromTheReferencePointFindWhatIsBes
   scene.materials.push_back(bright);
   int ceilings = 0;
   for (MeshInstance& m : scene.meshes)
-    if (m.name == "ceiling") m.material = static_cast<int>(scene.materials.size()) - 1, ++ceilings;
+    if (m.name == "ceiling") {
+      m.material = static_cast<int>(scene.materials.size()) - 1;
+      ++ceilings;
+    }
   ASSERT_EQ(ceilings, 1);
   scene.digest += "|black-box|bright-ceiling";
   scene.features = computeFeatures(scene);
