@@ -433,7 +433,8 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
 
 int supersamplingWithinDefaultBudget(const PresetTable& table, const std::vector<std::string>& planned,
                                      const RenderRequest& request, int k, const RequestLimits* limits,
-                                     const SceneCounts& counts, double speed) {
+                                     const SceneCounts& counts, double speed,
+                                     const std::function<double(int)>& specularMapTexelsAt) {
   const double budget = defaultFrameBudget(request, limits);
   if (!(budget > 0) || k <= 1 || request.supersamplingGiven) return k;
   if (!(speed > 0.0) || !std::isfinite(speed)) speed = 1.0;
@@ -443,6 +444,7 @@ int supersamplingWithinDefaultBudget(const PresetTable& table, const std::vector
   for (; k > 1; --k) {
     SceneCounts atK = counts;
     atK.photonGatherBlock = photons ? photonGatherBlock(request, k) : 0.0;
+    if (specularMapTexelsAt) atK.specularMapTexels = specularMapTexelsAt(k);
     const double ms = predictFrameMs(table, planned, defaults.params, outputPixels * k * k, atK);
     if (ms < 0) return k;  // a pass the table does not model: no prediction, as asked
     if (ms * speed <= budget) return k;

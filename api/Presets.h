@@ -17,6 +17,7 @@
 // Precedence (docs/API.md): a parameter the request gives in "passes" > the preset or budget choice >
 // the schema default. A technique the table does not model keeps its parameters; its cost is charged
 // when the table has a model for it.
+#include <functional>
 #include <map>
 #include <set>
 #include <string>
@@ -155,10 +156,14 @@ BudgetChoice chooseConfiguration(const PresetTable& table, const std::vector<std
 // the default configuration's predicted ms (times `speed`) fits limits->defaultFrameBudgetMs, or 1;
 // k itself otherwise. `request` is the output-size one; `planned` the frame's passes. Supersampling
 // goes first because the budget binds on large frames, where the raster's extra samples buy the least
-// (its cost is k^2 of every raster pass and of the readback).
+// (its cost is k^2 of every raster pass and of the readback). Each k' is charged its own scene counts:
+// photon_gi's gather block (api::photonGatherBlock) and, when `specularMapTexelsAt` is given, the
+// specular maps' resolution at k' (the maps follow the objects' size in raster pixels, so they shrink
+// with k'; the renderer's chooseMapResolution), else counts.specularMapTexels at every k'.
 int supersamplingWithinDefaultBudget(const PresetTable& table, const std::vector<std::string>& planned,
                                      const RenderRequest& request, int k, const RequestLimits* limits,
-                                     const SceneCounts& counts = {}, double speed = 1.0);
+                                     const SceneCounts& counts = {}, double speed = 1.0,
+                                     const std::function<double(int)>& specularMapTexelsAt = {});
 
 // Predicted ms of a whole frame in the table's units (speed 1): the overhead plus every planned
 // technique's model with `params` (technique -> complete parameters); < 0 when a planned technique has

@@ -4,6 +4,7 @@
 #include <mutex>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <optional>
 #include <set>
@@ -644,7 +645,9 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     for (Technique* t : plan.passes) planned.push_back(t->info().name);
     // The cost models' scene variables (particles of the scene and the request's media, light_volumes' beams).
     api::SceneCounts counts = sceneCostCounts(scene, request.media);
-    // specular's maps follow the view: its model is charged the resolution the pass will choose.
+    // specular's maps follow the view: its model is charged the resolution the pass will choose at the
+    // frame's k (and each k the default frame budget weighs, below).
+    std::function<double(int)> specularMapTexelsAt;
     if (std::find(planned.begin(), planned.end(), "specular") != planned.end()) {
       const auto given = request.passes.find("specular");
       const auto named = request.explicitParams.find("specular");
@@ -652,15 +655,16 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
                                                            ? given->second
                                                            : nlohmann::json(nullptr)),
                       named == request.explicitParams.end() ? std::set<std::string>{} : named->second);
-      api::RenderRequest atK = request;
-      atK.width *= k;
-      atK.height *= k;
-      atK.supersampling = k;
       const auto owner = plan.lightPaths.find("LS+DE");
-      counts.specularMapTexels =
-          chooseMapResolution(scene, makeFrameView(scene, atK, inputs.environment), sp,
-                              owner != plan.lightPaths.end() && owner->second == "caustics")
-              .texels;
+      const bool forCaustics = owner != plan.lightPaths.end() && owner->second == "caustics";
+      specularMapTexelsAt = [&, sp, forCaustics](int atK) {
+        api::RenderRequest r = request;
+        r.width *= atK;
+        r.height *= atK;
+        r.supersampling = atK;
+        return double(chooseMapResolution(scene, makeFrameView(scene, r, inputs.environment), sp, forCaustics).texels);
+      };
+      counts.specularMapTexels = specularMapTexelsAt(k);
     }
     // The speed factor's scene (api::MachineSpeed): the scene and the passes it runs, whose own recent
     // frames measure the load and the models' error on it at once.
@@ -668,12 +672,14 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     for (const std::string& p : planned) speedScene += p + ",";
     // The server's default frame budget lowers a default supersampling first (api/Presets.h).
     if (const int within = api::supersamplingWithinDefaultBudget(api::PresetTable::builtin(), planned, request, k,
-                                                                 inputs.limits, counts, im.speed.planningFactor(speedScene));
+                                                                 inputs.limits, counts, im.speed.planningFactor(speedScene),
+                                                                 specularMapTexelsAt);
         within < k) {
       stats.warnings.push_back("supersampling " + std::to_string(within) + " instead of the default " + std::to_string(k) +
                                ": at " + std::to_string(k) + " the default frame is predicted above this server's default "
                                "frame budget (radiantd --default-frame-budget-ms); give \"supersampling\" to choose");
       k = within;
+      if (specularMapTexelsAt) counts.specularMapTexels = specularMapTexelsAt(k);  // the maps this k runs
     }
     stats.supersampling = k;
     api::RenderRequest supersampled = request;

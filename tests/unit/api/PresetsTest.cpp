@@ -744,6 +744,32 @@ TEST(Presets, SpecularIsChargedTheMapResolutionTheFrameRuns) {
   EXPECT_FALSE(twelve.toJson().contains("specular_map_texels"));
 }
 
+// The default frame budget weighs each supersampling k with the specular maps that k runs: the maps
+// follow the objects' size in raster pixels (the renderer passes its chooseMapResolution at each k), so a
+// lower k has smaller maps. Charged the default k's maps at every k, a budget that k = 2 fits with its
+// own maps is missed and the frame falls to k = 1.
+TEST(Presets, TheDefaultFrameBudgetChargesEachSupersamplingItsOwnMaps) {
+  const PresetTable& t = PresetTable::builtin();
+  const std::vector<std::string> planned{"gbuffer", "direct", "specular"};
+  const RenderRequest plain = request(json::object());  // 100 x 100, default supersampling 4
+  ASSERT_EQ(plain.supersampling, 4);
+  const auto texelsAt = [](int k) { return 32.0 * k; };  // faces of 32 texels per raster sample a pixel
+  SceneCounts counts{0, 0, 12};
+  counts.specularMapTexels = texelsAt(4);
+  const BudgetChoice asked = chooseConfiguration(t, planned, plain, nullptr, counts);
+  const auto at = [&](int k, double texels) {
+    SceneCounts c = counts;
+    c.specularMapTexels = texels;
+    return predictFrameMs(t, planned, asked.params, 1e4 * k * k, c);
+  };
+  RequestLimits limits;
+  limits.defaultFrameBudgetMs = at(2, texelsAt(2)) * 1.0001;
+  ASSERT_GT(at(2, texelsAt(4)), limits.defaultFrameBudgetMs);  // k = 4's maps would not fit at k = 2
+  ASSERT_GT(at(3, texelsAt(3)), limits.defaultFrameBudgetMs);
+  EXPECT_EQ(supersamplingWithinDefaultBudget(t, planned, plain, 4, &limits, counts, 1.0, texelsAt), 2);
+  EXPECT_EQ(supersamplingWithinDefaultBudget(t, planned, plain, 4, &limits, counts, 1.0), 1);
+}
+
 // Issue 31: specular's maps gather photon_gi's photons with photon_gi's kernel, so specular's cost grows with
 // photon_gi's C (the budget ladder's one feasible miss: cornell_glass at 4x ran 4.9-5.2 s for 4.6 s when
 // the chooser took C = 20 and charged specular at C = 10). A model term may name another technique's
