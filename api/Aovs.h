@@ -1,6 +1,8 @@
 #pragma once
 // The one table of AOVs (arbitrary output variables): every image a frame can return, with how it
-// is stored on the GPU, read back, named in an EXR file, written by the passes, and scored.
+// is stored on the GPU, read back, named in an EXR file, written by the passes, and scored. Assembled
+// from the frame's own rows (beauty, alpha, error) and the rows each technique's descriptor declares
+// (renderer/techniques/<name>/<name>.json, "aovs", merged into the schema at build time).
 // ARCHITECTURE.md, "Declared AOVs and resources" (Falcor RenderPassReflection, Mitsuba aov_names).
 //
 // Readers: the FramePlanner (what is requestable and who produces it), Renderer readback (resource,
@@ -48,6 +50,7 @@ struct AovInfo {
   // Radiance: a PNG shows it through the request's view transform (tone_map, renderer/io/ToneMap.h).
   // false for data (reflectance, geometry, occlusion, transmittance, error), which a PNG shows as stored.
   bool radiance = true;
+  std::string description;  // one sentence, served by /v1/info
 };
 
 const std::vector<AovInfo>& aovTable();
@@ -59,7 +62,7 @@ const char* toString(AovBlend b);   // "overwrite" | "accumulate"
 const char* toString(AovResolve r); // "average" | "nearest"
 
 // The table as GET /v1/info serves it: [{"name", "format", "channels": [EXR names], "blend",
-// "producer", "requestable", "ground_truth"}].
+// "producer", "requestable", "ground_truth", "description"}].
 nlohmann::json aovTableJson();
 
 }  // namespace radiant::api

@@ -300,6 +300,17 @@ const std::vector<TechniqueSchema>& techniqueSchemas() {
       t.description = s.value("description", "");
       t.outputs = s.value("x-outputs", std::vector<std::string>{});
       t.params = s.value("properties", json::object());
+      const json& d = s.at("x-technique");
+      t.summary = d.at("summary");
+      t.inputs = d.at("inputs");
+      t.optionalInputs = d.at("optional_inputs");
+      t.after = d.at("after");
+      t.resources = d.at("resources");
+      t.lightPaths = d.at("light_paths");
+      t.addsToBeauty = d.at("adds_to_beauty");
+      t.onByDefault = d.at("on_by_default");
+      t.claimsWhenNamed = d.at("claims_when_named");
+      t.exclusive = d.at("exclusive");
       out.push_back(std::move(t));
     }
     return out;
@@ -314,7 +325,11 @@ const TechniqueSchema* findTechnique(std::string_view name) {
 }
 
 json to_json_value(const TechniqueSchema& t) {
-  return json{{"name", t.name}, {"description", t.description}, {"outputs", t.outputs}, {"params", t.params}};
+  return json{{"name", t.name},
+              {"summary", t.summary},
+              {"description", t.description},
+              {"outputs", t.outputs},
+              {"params", t.params}};
 }
 
 const char* toString(ImageFormat f) { return f == ImageFormat::Exr ? "exr" : "png"; }

@@ -81,11 +81,17 @@ std::vector<std::pair<std::string, std::string>> costParameters(const nlohmann::
 // The merged request schema (technique parameter schemas included under properties.passes).
 const nlohmann::json& renderRequestSchema();
 
-// One technique as declared in api/schema/techniques/<name>.json, params in schema form.
+// One technique as its descriptor declares it (renderer/techniques/<name>/<name>.json, merged into
+// the schema at build time; docs/DEVELOPMENT.md, "Technique descriptors"): params in schema form, and
+// what the renderer's TechniqueInfo is made of (renderer/frame/Technique.h, describedTechnique).
 struct TechniqueSchema {
-  std::string name, description;
-  std::vector<std::string> outputs;
+  std::string name;
+  std::string summary;      // one line (/v1/info's technique list)
+  std::string description;  // the parameters' object's description (the docs, the schema)
+  std::vector<std::string> outputs;  // the AOVs a request may ask of it
   nlohmann::json params;  // name -> {type, default, minimum?, maximum?, enum?, description}
+  std::vector<std::string> inputs, optionalInputs, after, resources, lightPaths;
+  bool addsToBeauty = false, onByDefault = false, claimsWhenNamed = false, exclusive = false;
 };
 const std::vector<TechniqueSchema>& techniqueSchemas();
 const TechniqueSchema* findTechnique(std::string_view name);

@@ -35,7 +35,7 @@
 namespace radiant {
 namespace {
 
-// The split's options from `direct`'s parameters (api/schema/techniques/direct.json): they decide
+// The split's options from `direct`'s parameters (renderer/techniques/direct/direct.json): they decide
 // what `direct` lights with, and photon_gi and image-based lighting follow.
 EnvironmentLightOptions environmentLightOptions(const api::RenderRequest& request) {
   EnvironmentLightOptions o;

@@ -1,5 +1,8 @@
-// Build-time tool: completes api/schema/render_request.json with every technique's parameter schema
-// (api/schema/techniques/<name>.json) so the daemon, the client and the docs read one merged schema.
+// Build-time tool: completes api/schema/render_request.json with every technique's descriptor
+// (renderer/techniques/<name>/<name>.json: its parameters, what it reads and writes, its AOV rows and
+// light-path classes) so the daemon, the client, the renderer and the docs read one merged schema.
+// A technique's parameters go to properties.passes.properties.<name> (its declaration to the
+// annotation "x-technique" there), its AOV rows to the top-level "x-aovs" (api/Aovs.cpp).
 //   merge_schema <out.json> <render_request.json> <media.json> <technique.json>...
 // media.json (the particle-system schema) becomes properties.media.items (particles given inline) and
 // the annotation "x-gltf-media" (the RADIANT_particle_system node extension: particles as accessors).
@@ -9,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -76,6 +80,72 @@ json normaliseParam(const std::string& file, const std::string& name, const json
   return out;
 }
 
+// An optional array of names (resources, AOVs, light-path classes).
+json names(const std::string& file, const json& t, const char* key) {
+  const json v = t.value(key, json::array());
+  if (!v.is_array()) fail(file, std::string("\"") + key + "\" must be an array of names");
+  for (const auto& n : v)
+    if (!n.is_string() || n.get<std::string>().empty()) fail(file, std::string("\"") + key + "\" must hold names");
+  return v;
+}
+
+json flag(const std::string& file, const json& t, const char* key, bool required) {
+  if (!t.contains(key)) {
+    if (required) fail(file, std::string("missing \"") + key + "\" (true or false)");
+    return false;
+  }
+  if (!t[key].is_boolean()) fail(file, std::string("\"") + key + "\" must be true or false");
+  return t[key];
+}
+
+// One row of the AOV table (api/Aovs.h, AovInfo) with every default filled in: the resource is the
+// AOV's own name, channels 3 (R, G, B; 1: Y; 4: R, G, B, A), resolve average, radiance true.
+json aovRow(const std::string& file, const std::string& technique, const std::string& aov, const json& r) {
+  static const std::set<std::string> kAllowed{"format",      "resource",   "first_channel", "channels",   "channel_names",
+                                              "ground_truth", "resolve",   "radiance",      "description"};
+  const std::string where = "aovs." + aov;
+  if (!r.is_object()) fail(file, where + " must be an object");
+  for (const auto& [k, v] : r.items())
+    if (!kAllowed.count(k)) fail(file, where + ": unknown key \"" + k + "\"");
+  static const std::set<std::string> kFormats{"RGBA32F", "RGBA16F", "R32F"};
+  if (!r.contains("format") || !r["format"].is_string() || !kFormats.count(r["format"].get<std::string>()))
+    fail(file, where + ".format must be one of RGBA32F, RGBA16F, R32F");
+  if (!r.contains("description") || !r["description"].is_string()) fail(file, where + " has no description");
+  const int channels = r.value("channels", 3);
+  if (channels < 1 || channels > 4) fail(file, where + ".channels must be 1 to 4");
+  const int first = r.value("first_channel", 0);
+  const int capacity = r["format"] == "R32F" ? 1 : 4;
+  if (first < 0 || first + channels > capacity) fail(file, where + ": first_channel + channels exceed its format");
+  json suffixes = r.contains("channel_names") ? r["channel_names"]
+                  : channels == 1             ? json::array({"Y"})
+                  : channels == 4             ? json::array({"R", "G", "B", "A"})
+                                              : json::array({"R", "G", "B"});
+  if (!suffixes.is_array() || static_cast<int>(suffixes.size()) != channels)
+    fail(file, where + ".channel_names must name each of its channels");
+  json exr = json::array();
+  for (const auto& s : suffixes) {
+    if (!s.is_string()) fail(file, where + ".channel_names must be strings");
+    exr.push_back(aov + "." + s.get<std::string>());
+  }
+  const std::string resolve = r.value("resolve", "average");
+  if (resolve != "average" && resolve != "nearest") fail(file, where + ".resolve must be average or nearest");
+  const json radiance = r.value("radiance", json(true));
+  if (!radiance.is_boolean()) fail(file, where + ".radiance must be true or false");
+  const json truth = r.value("ground_truth", json(""));
+  if (!truth.is_string()) fail(file, where + ".ground_truth must be a reference mode");
+  return json{{"name", aov},
+              {"producer", technique},
+              {"format", r["format"]},
+              {"resource", r.value("resource", aov)},
+              {"first_channel", first},
+              {"channels", channels},
+              {"exr", exr},
+              {"ground_truth", truth},
+              {"resolve", resolve},
+              {"radiance", radiance},
+              {"description", r["description"]}};
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -88,6 +158,9 @@ int main(int argc, char** argv) {
     json& passes = request.at("properties").at("passes");
     passes["properties"] = json::object();
     std::set<std::string> aovs;
+    std::map<std::string, std::string> aovRows;     // AOV -> the technique that declares its row
+    std::map<std::string, std::string> outputFile;  // AOV -> the first descriptor that outputs it
+    json aovTable = json::array();
     {
       const std::string file = argv[3];
       const json media = readJson(file);
@@ -103,16 +176,40 @@ int main(int argc, char** argv) {
     for (int i = 4; i < argc; ++i) {
       const std::string file = argv[i];
       json t = readJson(file);
-      static const std::set<std::string> kAllowed{"name", "description", "outputs", "params"};
+      static const std::set<std::string> kAllowed{
+          "name",   "summary",   "description", "inputs",         "optional_inputs", "after",
+          "outputs", "resources", "aovs",       "adds_to_beauty", "on_by_default",   "light_paths",
+          "claims_when_named", "exclusive", "params"};
       for (const auto& [k, v] : t.items())
         if (!kAllowed.count(k)) fail(file, "unknown key \"" + k + "\"");
       if (!t.contains("name") || !t["name"].is_string()) fail(file, "missing \"name\"");
       const std::string name = t["name"];
       if (std::filesystem::path(file).stem().string() != name) fail(file, "name must match the file name");
-      if (!t.contains("description") || !t["description"].is_string()) fail(file, "missing \"description\"");
-      json outputs = t.value("outputs", json::array());
-      if (!outputs.is_array()) fail(file, "\"outputs\" must be an array of AOV names");
-      for (const auto& o : outputs) aovs.insert(o.get<std::string>());
+      for (const char* k : {"summary", "description"})
+        if (!t.contains(k) || !t[k].is_string()) fail(file, std::string("missing \"") + k + "\"");
+      json outputs = names(file, t, "outputs");
+      for (const auto& o : outputs) {
+        aovs.insert(o.get<std::string>());
+        outputFile.emplace(o.get<std::string>(), file);
+      }
+      json technique = {{"summary", t["summary"]},
+                        {"inputs", names(file, t, "inputs")},
+                        {"optional_inputs", names(file, t, "optional_inputs")},
+                        {"after", names(file, t, "after")},
+                        {"resources", names(file, t, "resources")},
+                        {"adds_to_beauty", flag(file, t, "adds_to_beauty", true)},
+                        {"on_by_default", flag(file, t, "on_by_default", true)},
+                        {"light_paths", names(file, t, "light_paths")},
+                        {"claims_when_named", flag(file, t, "claims_when_named", false)},
+                        {"exclusive", flag(file, t, "exclusive", false)}};
+      const json declared = t.value("aovs", json::object());
+      if (!declared.is_object()) fail(file, "\"aovs\" must be an object of AOV rows");
+      for (const auto& [aov, row] : declared.items()) {
+        if (std::find(outputs.begin(), outputs.end(), aov) == outputs.end())
+          fail(file, "aovs." + aov + " is not one of its \"outputs\"");
+        if (!aovRows.emplace(aov, name).second) fail(file, "aovs." + aov + " is declared by " + aovRows[aov] + " too");
+        aovTable.push_back(aovRow(file, name, aov, row));
+      }
       json properties = json::object();
       const json params = t.value("params", json::object());
       if (!params.is_object()) fail(file, "\"params\" must be an object");
@@ -121,9 +218,16 @@ int main(int argc, char** argv) {
       passes["properties"][name] = json{{"type", "object"},
                                         {"description", t["description"]},
                                         {"x-outputs", outputs},
+                                        {"x-technique", technique},
                                         {"additionalProperties", false},
                                         {"properties", properties}};
     }
+    // Every AOV a technique outputs has one row, declared by one technique (the media AOVs, which
+    // several exclusive techniques write, by the default owner).
+    for (const std::string& aov : aovs)
+      if (!aovRows.count(aov))
+        fail(outputFile[aov], "outputs: no technique declares the row of AOV \"" + aov + "\" (\"aovs\")");
+    request["x-aovs"] = aovTable;
     // The AOV names an output may ask for: "beauty" plus every technique's outputs.
     json aovEnum = json::array({"beauty"});
     for (const auto& a : aovs)

@@ -113,8 +113,8 @@ gl::Texture& FrameResources::texture(const std::string& name, GLenum target, GLe
                                                                   : GL_RGBA32F;
     if (internalFormat != declared)
       throw std::logic_error("FrameResources: '" + name + "' is the resource of AOV '" + a.name + "', declared " +
-                             api::toString(a.format) + " in the AOV table (api/Aovs.cpp); a pass asked for format 0x" +
-                             hex(internalFormat));
+                             api::toString(a.format) + " in the AOV table (its producer's descriptor, \"aovs\"); " +
+                             "a pass asked for format 0x" + hex(internalFormat));
   }
   auto it = textures_.find(name);
   if (it != textures_.end() && it->second.first == spec) {

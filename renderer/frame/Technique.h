@@ -1,11 +1,13 @@
 #pragma once
 // The one interface every illumination pass implements (see ARCHITECTURE.md, "A technique").
 // Adding a technique never touches another: it registers itself in renderer/techniques/Registry.cpp,
-// declares its parameters in api/schema/techniques/<name>.json and its method in docs/TECHNIQUES.md.
+// declares itself (parameters, what it reads and writes, its AOVs and light-path classes) in its
+// descriptor renderer/techniques/<name>/<name>.json, and its method in docs/techniques/<name>.md.
 
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -41,6 +43,12 @@ struct TechniqueInfo {
   bool exclusive = false;
 };
 
+// A technique's TechniqueInfo as its descriptor declares it (renderer/techniques/<name>/<name>.json,
+// merged into the schema at build time): every info() returns this, so nothing of it is written twice.
+// "after" (passes it runs after when they run, without reading what they write: beauty's order until
+// the frame graph derives it) joins optionalInputs. Throws std::logic_error for an undeclared name.
+TechniqueInfo describedTechnique(std::string_view name);
+
 // Run or skip, and the reason if skipped. The planner records the reason in the frame stats.
 struct Requirements {
   bool run = true;
@@ -60,7 +68,7 @@ public:
   explicit Params(nlohmann::json j, std::set<std::string> given = {})
       : json_(j.is_object() ? std::move(j) : nlohmann::json::object()), given_(std::move(given)) {}
   bool given(const char* key) const { return given_.count(key) != 0; }
-  // The value of `key`: the schema gives every parameter a default (api/schema/techniques/*.json; tests
+  // The value of `key`: the schema gives every parameter a default (renderer/techniques/*/*.json; tests
   // Schema.EveryTechniqueFileIsMergedWithDocumentedParams, Params.*), the one place it is written; a key
   // that is not there is a programmer error.
   template <class T>
@@ -86,7 +94,7 @@ private:
 };
 
 // What scores one of a technique's AOVs (ARCHITECTURE.md, "A technique owns its knowledge"): the
-// parameters of the reference pass (api/schema/techniques/reference.json) that render its ground truth,
+// parameters of the reference pass (renderer/techniques/reference/reference.json) that render its ground truth,
 // e.g. {"aov": "ao", "ao_radius": 0.5, "ao_definition": "volumetric"}; null when the reference renderer
 // has none (the compare block then refuses instead of scoring the AOV against something else). A
 // "max_bounces" in it is the technique's own bounce range and wins over compare.max_bounces.

@@ -218,16 +218,7 @@ const char* methodName(ao::Method m) {
 }  // namespace
 
 const TechniqueInfo& AmbientOcclusionPass::info() const {
-  static const TechniqueInfo i{
-      "ambient_occlusion",
-      "Screen-space ambient occlusion (volumetric, containment, crytek, gtao) applied to the ambient light",
-      {"gbuffer_position", "normal", "albedo", "material", "geometric_normal", "emission", "gbuffer_layers",
-       "gbuffer_specular"},
-      {"direct"},  // runs after direct, which initialises beauty
-      {"ao"},
-      true,
-      true,
-      {"L(sky)DE"}};
+  static const TechniqueInfo i = describedTechnique("ambient_occlusion");
   return i;
 }
 

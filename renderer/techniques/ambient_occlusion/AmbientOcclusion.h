@@ -8,7 +8,7 @@
 //   gtao         Jimenez et al. 2016, cosine-weighted horizon-based ground-truth AO.
 // Writes the `ao` AOV (R32F, [0,1]) and adds L^a * ao * diffuseAlbedo to `beauty` (thesis eq. 4.1 and
 // L^r = a L^a O below it). The method is documented in docs/TECHNIQUES.md, the knobs in
-// api/schema/techniques/ambient_occlusion.json.
+// renderer/techniques/ambient_occlusion/ambient_occlusion.json.
 #include <array>
 #include <cstdint>
 #include <string>

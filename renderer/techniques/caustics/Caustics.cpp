@@ -60,15 +60,7 @@ constexpr float kMaxLightTan = 11.4f;  // tan(85 degrees)  // work-group side of
 }  // namespace
 
 const TechniqueInfo& CausticsPass::info() const {
-  static const TechniqueInfo i{
-      "caustics",
-      "Caustic triangles (thesis ch. 6): light through mirrors and refractors onto diffuse and glossy surfaces",
-      {"gbuffer_position", "normal", "albedo", "material", "emission", "geometric_normal", "specular_maps"},
-      {"shadow_maps"},
-      {"caustics"},
-      true,
-      true,
-      {"LS+DE", "LS+DS+E"}};
+  static const TechniqueInfo i = describedTechnique("caustics");
   return i;
 }
 
@@ -138,7 +130,7 @@ Requirements CausticsPass::requirements(const Scene& scene, const api::RenderReq
 }
 
 void CausticsPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
-  // Fallbacks are the schema defaults (api/schema/techniques/caustics.json).
+  // Fallbacks are the schema defaults (renderer/techniques/caustics/caustics.json).
   method_ = params.get<std::string>("method") == "splat" ? Method::Splat : Method::Triangles;
   photonResolution_ = std::clamp(params.get<int>("photon_resolution"), 32, 256);
   cubeResolution_ = std::clamp(params.get<int>("cube_resolution"), 16, 1024);

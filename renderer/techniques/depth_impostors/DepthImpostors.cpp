@@ -15,17 +15,7 @@ constexpr int kBlocksPerStretch = 256;  // block impostors drawn between two can
 }  // namespace
 
 const TechniqueInfo& DepthImpostorsPass::info() const {
-  static const TechniqueInfo i{"depth_impostors",
-                               "Particle clouds as blocks with double-layered depth impostors and light slices "
-                               "(thesis ch. 8): self-shadowed single scattering",
-                               {},
-                               {"gbuffer_position"},
-                               {"media", "media_transmittance"},
-                               /*addsToBeauty=*/true,
-                               /*onByDefault=*/false,
-                               {"media"},
-                               /*claimsWhenNamed=*/true,
-                               /*exclusive=*/true};
+  static const TechniqueInfo i = describedTechnique("depth_impostors");
   return i;
 }
 

@@ -11,18 +11,10 @@
 
 namespace radiant {
 
+// Declared in direct.json; environment_map (an optional input) is the request's environment, a frame
+// resource the Renderer uploads (renderer/frame/FrameAllocation.h).
 const TechniqueInfo& DirectPass::info() const {
-  static const TechniqueInfo i{"direct",
-                               "Direct lighting from punctual lights (glTF BRDF, PCF shadow maps) plus emission",
-                               {"gbuffer_position", "normal", "albedo", "material", "emission", "geometric_normal",
-                                "gbuffer_layers", "gbuffer_specular"},
-                               // environment_map: the request's environment, a frame resource the Renderer
-                               // uploads (renderer/frame/FrameAllocation.h).
-                               {"shadow_maps", kEnvironmentMap},
-                               {"direct"},
-                               true,
-                               true,
-                               {"LE", "L(point)DE", "L(sky)GE"}};
+  static const TechniqueInfo i = describedTechnique("direct");
   return i;
 }
 

@@ -41,15 +41,7 @@ GLuint groups(int n) { return static_cast<GLuint>((n + 7) / 8); }
 }  // namespace
 
 const TechniqueInfo& EnvDiffusePass::info() const {
-  static const TechniqueInfo i{"env_diffuse",
-                               "Robust diffuse environment mapping: indirect diffuse light on receiver objects from "
-                               "distance cube maps with polygon-to-point form factors",
-                               {"gbuffer_position", "normal", "albedo", "material"},
-                               {"shadow_maps"},
-                               {"indirect_diffuse"},
-                               true,
-                               false,
-                               {"LD+DE"}};
+  static const TechniqueInfo i = describedTechnique("env_diffuse");
   return i;
 }
 

@@ -16,14 +16,7 @@ constexpr int kLayersTarget = 6;
 }  // namespace
 
 const TechniqueInfo& GBufferPass::info() const {
-  static const TechniqueInfo i{"gbuffer",
-                               "G-buffer: reversed-Z depth, world position, normals, albedo, material, emission",
-                               {},
-                               {},
-                               {"depth_buffer", "gbuffer_position", "depth", "normal", "albedo", "material",
-                                "emission", "geometric_normal", "gbuffer_layers", "gbuffer_specular"},
-                               false,
-                               false};
+  static const TechniqueInfo i = describedTechnique("gbuffer");
   return i;
 }
 

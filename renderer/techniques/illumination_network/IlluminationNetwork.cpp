@@ -64,16 +64,7 @@ std::string sourcesKey(const std::vector<network::DirectionalLight>& lights, boo
 }  // namespace
 
 const TechniqueInfo& IlluminationNetworkPass::info() const {
-  static const TechniqueInfo i{"illumination_network",
-                               "Multiple scattering in static particle media by illumination networks (thesis ch. 9)",
-                               {},
-                               {"gbuffer_position"},
-                               {"media", "media_transmittance"},
-                               true,
-                               false,
-                               {"media"},
-                               /*claimsWhenNamed=*/true,
-                               /*exclusive=*/true};  // owns the media AOV when the request names it
+  static const TechniqueInfo i = describedTechnique("illumination_network");
   return i;
 }
 

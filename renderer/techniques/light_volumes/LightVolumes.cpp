@@ -40,20 +40,11 @@ std::size_t bytesOf(const std::vector<T>& v) { return std::max<std::size_t>(1, v
 
 }  // namespace
 
+// Declared in light_volumes.json. Not on by default: on coarse glossy meshes (the Glosbox's block) the
+// tessellation fallback gives sharp specular beams where photon_gi, which owns LG+DE paths otherwise,
+// gets the blur right.
 const TechniqueInfo& LightVolumesPass::info() const {
-  static const TechniqueInfo i{"light_volumes",
-                               "Glossy light volumes (Duvenhage et al.): backward polygon beams from specular and "
-                               "glossy scatterers to diffuse receivers (LS+DE, LG+DE, first order)",
-                               {"gbuffer_position", "normal", "albedo", "material", "emission"},
-                               {"direct"},  // runs after direct, which initialises beauty
-                               {"light_volumes"},
-                               true,
-                               // Not on by default: on coarse glossy meshes (the Glosbox's block) the
-                               // tessellation fallback gives sharp specular beams where photon_gi,
-                               // which owns LG+DE paths otherwise, gets the blur right.
-                               false,
-                               {"LS+DE", "LG+DE"},
-                               true};
+  static const TechniqueInfo i = describedTechnique("light_volumes");
   return i;
 }
 

@@ -98,21 +98,11 @@ float PhotonGiPass::kernelRadius(float C, double area, double n, bool ppm, doubl
   return static_cast<float>(std::sqrt(h2));
 }
 
+// Declared in photon_gi.json. photon_grid (a resource): the uploaded splat grid, read by specular's
+// distance maps (renderer/shading/PhotonGrid.h). LS+DE: punctual light through near-mirrors
+// (isSpecular() with a glossy lobe), which the tracer scatters; the caustics pass owns it when it runs.
 const TechniqueInfo& PhotonGiPass::info() const {
-  static const TechniqueInfo i{"photon_gi",
-                               "Photon tracing (Embree) and view-dependent photon splatting (Stürzlinger & Bastos "
-                               "1997): indirect light on every diffuse and glossy surface",
-                               {"gbuffer_position", "normal", "albedo", "material", "emission", "geometric_normal",
-                                "gbuffer_layers", "gbuffer_specular"},
-                               {"direct"},  // runs after direct, which initialises beauty
-                               // photon_grid: the uploaded splat grid (internal, read by specular's
-                               // distance maps; renderer/shading/PhotonGrid.h).
-                               {"indirect", "photon_grid"},
-                               true,
-                               true,
-                               // LS+DE: punctual light through near-mirrors (isSpecular() with a glossy
-                               // lobe), which the tracer scatters; the caustics pass owns it when it runs.
-                               {"LD+DE", "L(area)DE", "L(sky)DE", "L(sky)GE", "LS+DE"}};
+  static const TechniqueInfo i = describedTechnique("photon_gi");
   return i;
 }
 

@@ -147,13 +147,7 @@ const Image& referenceImage(FrameResources& res, const Scene& scene, const Frame
 }
 
 const TechniqueInfo& ReferencePass::info() const {
-  static const TechniqueInfo i{"reference",
-                               "CPU reference path tracer (Embree): the ground truth every technique is scored with",
-                               {},
-                               {},
-                               {"reference"},
-                               false,
-                               false};
+  static const TechniqueInfo i = describedTechnique("reference");
   return i;
 }
 

@@ -77,13 +77,7 @@ int ShadowMapsPass::sizeWithinBudget(int size, double coverage) {
 }
 
 const TechniqueInfo& ShadowMapsPass::info() const {
-  static const TechniqueInfo i{"shadow_maps",
-                               "Shadow maps: cube maps for point lights, 2D maps for spot and directional lights",
-                               {},
-                               {},
-                               {"shadow_maps"},
-                               false,
-                               false};
+  static const TechniqueInfo i = describedTechnique("shadow_maps");
   return i;
 }
 

@@ -77,18 +77,11 @@ MapResolution chooseMapResolution(const Scene& scene, const FrameView& view, con
   return r;
 }
 
+// Declared in specular.json: rays that leave the scene see the environment map; photon_grid is
+// photon_gi's splat grid, which lights the maps' diffuse texels with indirect light (L D+ D S+ E) when
+// photon_gi is planned; specular_maps (a resource) are the layered distance maps, read by caustics.
 const TechniqueInfo& SpecularPass::info() const {
-  static const TechniqueInfo i{
-      "specular",
-      "Multiple specular reflections and refractions traced in layered distance maps (thesis ch. 5)",
-      {"gbuffer_position", "normal", "albedo", "material", "emission"},
-      // rays that leave the scene see the environment map; photon_grid: photon_gi's splat grid, which
-      // lights the maps' diffuse texels with indirect light (L D+ D S+ E) when photon_gi is planned.
-      {"shadow_maps", "environment_map", "photon_grid"},
-      {"specular", "specular_maps"},  // specular_maps: the layered distance maps (internal, read by caustics)
-      true,
-      true,
-      {"LS+E", "LDS+E", "LD+DS+E"}};
+  static const TechniqueInfo i = describedTechnique("specular");
   return i;
 }
 
@@ -100,7 +93,7 @@ Requirements SpecularPass::requirements(const Scene& scene, const api::RenderReq
 }
 
 void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
-  // Fallbacks are the schema defaults (api/schema/techniques/specular.json).
+  // Fallbacks are the schema defaults (renderer/techniques/specular/specular.json).
   maxDepth_ = std::clamp(params.get<int>("max_depth"), 1, 8);
   linearSteps_ = std::clamp(params.get<int>("linear_steps"), 1, 256);
   secantSteps_ = std::clamp(params.get<int>("secant_steps"), 0, 32);

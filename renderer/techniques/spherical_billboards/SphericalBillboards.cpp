@@ -15,17 +15,7 @@ constexpr int kParticlesPerStretch = 4096;  // billboards drawn between two canc
 }  // namespace
 
 const TechniqueInfo& SphericalBillboardsPass::info() const {
-  static const TechniqueInfo i{"spherical_billboards",
-                               "Particle media as spherical billboards (thesis ch. 7): fire, smoke, dust; "
-                               "planar and soft-particle baselines",
-                               {},
-                               {"gbuffer_position"},
-                               {"media", "media_transmittance"},
-                               true,
-                               true,
-                               {"media"},
-                               /*claimsWhenNamed=*/false,
-                               /*exclusive=*/true};  // the default owner of the media AOV: first in the registry
+  static const TechniqueInfo i = describedTechnique("spherical_billboards");
   return i;
 }
 

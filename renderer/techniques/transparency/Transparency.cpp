@@ -11,14 +11,7 @@
 namespace radiant {
 
 const TechniqueInfo& TransparencyPass::info() const {
-  static const TechniqueInfo i{"transparency",
-                               "glTF alphaMode BLEND: blended surfaces shaded forward and composited over beauty, "
-                               "back to front",
-                               {"depth_buffer"},
-                               {"shadow_maps"},
-                               {},
-                               /*addsToBeauty=*/true,
-                               /*onByDefault=*/true};
+  static const TechniqueInfo i = describedTechnique("transparency");
   return i;
 }
 

@@ -22,6 +22,33 @@ TEST(SchemaConsistency, EveryTechniqueHasASchemaAndEverySchemaATechnique) {
   EXPECT_EQ(registry, schema);
 }
 
+// A technique's TechniqueInfo is its descriptor's (renderer/techniques/<name>/<name>.json): no
+// technique declares its inputs, outputs, AOVs or light paths a second time in C++.
+TEST(SchemaConsistency, EveryTechniqueIsWhatItsDescriptorDeclares) {
+  for (const auto& t : createTechniques()) {
+    const TechniqueInfo& info = t->info();
+    const TechniqueInfo d = describedTechnique(info.name);
+    EXPECT_EQ(info.description, d.description) << info.name;
+    EXPECT_EQ(info.inputs, d.inputs) << info.name;
+    EXPECT_EQ(info.optionalInputs, d.optionalInputs) << info.name;
+    EXPECT_EQ(info.outputs, d.outputs) << info.name;
+    EXPECT_EQ(info.addsToBeauty, d.addsToBeauty) << info.name;
+    EXPECT_EQ(info.onByDefault, d.onByDefault) << info.name;
+    EXPECT_EQ(info.lightPaths, d.lightPaths) << info.name;
+    EXPECT_EQ(info.claimsWhenNamed, d.claimsWhenNamed) << info.name;
+    EXPECT_EQ(info.exclusive, d.exclusive) << info.name;
+    // Each AOV row a technique's outputs name was declared by one technique that outputs it.
+    for (const std::string& out : info.outputs)
+      if (const api::AovInfo* a = api::findAov(out)) {
+        const api::TechniqueSchema* producer = api::findTechnique(a->producer);
+        ASSERT_NE(producer, nullptr) << out;
+        EXPECT_NE(std::find(producer->outputs.begin(), producer->outputs.end(), out), producer->outputs.end()) << out;
+        EXPECT_FALSE(a->description.empty()) << out;
+      }
+  }
+  EXPECT_THROW(describedTechnique("no_such_technique"), std::logic_error);
+}
+
 TEST(SchemaConsistency, EveryAovTheSchemaOffersHasAProducer) {
   std::set<std::string> produced{"beauty"};
   for (const auto& t : Renderer::techniques()) produced.insert(t.outputs.begin(), t.outputs.end());

@@ -1,4 +1,4 @@
-// A technique's parameters have one source: the schema (api/schema/techniques/*.json) gives every one a
+// A technique's parameters have one source: the schema (renderer/techniques/*/*.json) gives every one a
 // default, api::techniqueParams fills them in, and Params::get reads them without a fallback of its
 // own (issue 33: the C++ fallbacks had drifted from the schema, e.g. photon_gi's ppm_alpha 2/3 against
 // 0.6667, light_volumes' sigma_scale a constant beside 1.58).

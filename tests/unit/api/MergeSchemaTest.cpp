@@ -1,0 +1,160 @@
+// The technique descriptors (renderer/techniques/<name>/<name>.json) are merged into the request
+// schema at build time by radiant_merge_schema: the AOV rows they declare are completed with their
+// defaults, and a descriptor that breaks a rule fails the build naming its file and key (docs/API.md,
+// "A technique declares itself in one file"). Run here on descriptors written by the test.
+#include <cstdio>
+#include <cstdlib>
+#include <unistd.h>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+struct Merge {
+  int status = -1;
+  std::string log;
+  json merged;
+};
+
+class MergeSchema : public ::testing::Test {
+protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("radiant-merge-" + std::to_string(::getpid()) + "-" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+    write("render_request.json", json{{"type", "object"},
+                                      {"properties",
+                                       {{"passes", {{"type", "object"}}},
+                                        {"media", {{"type", "array"}}},
+                                        {"outputs", {{"items", {{"properties", {{"aovs", {{"items", json::object()}}}}}}}}},
+                                        {"compare", {{"properties", {{"aov", json::object()}}}}},
+                                        {"refine", {{"properties", {{"aov", json::object()}}}}}}}});
+    write("media.json", json{{"system", json::object()},
+                             {"request_particles", json::object()},
+                             {"gltf_particles", json::object()}});
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  void write(const std::string& name, const json& j) { std::ofstream(dir_ / name) << j.dump(1); }
+
+  // A minimal valid descriptor of technique `name`, writing AOV `aov`.
+  static json descriptor(const std::string& name, const std::string& aov) {
+    return json{{"name", name},
+                {"summary", "s"},
+                {"description", "d"},
+                {"inputs", json::array()},
+                {"outputs", {aov}},
+                {"aovs", {{aov, {{"format", "RGBA32F"}, {"description", "an image"}}}}},
+                {"adds_to_beauty", true},
+                {"on_by_default", false},
+                {"params", json::object()}};
+  }
+
+  Merge run(const std::vector<json>& techniques) {
+    std::string cmd = std::string(MERGE_SCHEMA_PATH) + " " + (dir_ / "out.json").string() + " " +
+                      (dir_ / "render_request.json").string() + " " + (dir_ / "media.json").string();
+    for (const json& t : techniques) {
+      const std::string file = t["name"].get<std::string>() + ".json";
+      write(file, t);
+      cmd += " " + (dir_ / file).string();
+    }
+    cmd += " 2>" + (dir_ / "log.txt").string();
+    Merge m;
+    m.status = std::system(cmd.c_str());
+    std::ifstream log(dir_ / "log.txt");
+    m.log.assign(std::istreambuf_iterator<char>(log), {});
+    if (m.status == 0) m.merged = json::parse(std::ifstream(dir_ / "out.json"));
+    return m;
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(MergeSchema, AovRowsAreCompletedWithTheirDefaults) {
+  json t = descriptor("alpha_pass", "glow");
+  t["outputs"] = {"glow", "glow_mask"};
+  t["resources"] = {"glow_cache"};
+  t["aovs"]["glow_mask"] = {{"format", "RGBA16F"}, {"resource", "glow"}, {"first_channel", 3}, {"channels", 1},
+                            {"resolve", "nearest"}, {"radiance", false}, {"ground_truth", "beauty"},
+                            {"description", "its mask"}};
+  const Merge m = run({t});
+  ASSERT_EQ(m.status, 0) << m.log;
+  const json& rows = m.merged["x-aovs"];
+  ASSERT_EQ(rows.size(), 2u);
+  const json& glow = rows[0]["name"] == "glow" ? rows[0] : rows[1];
+  const json& mask = rows[0]["name"] == "glow" ? rows[1] : rows[0];
+  EXPECT_EQ(glow["producer"], "alpha_pass");
+  EXPECT_EQ(glow["resource"], "glow");
+  EXPECT_EQ(glow["first_channel"], 0);
+  EXPECT_EQ(glow["exr"], json({"glow.R", "glow.G", "glow.B"}));
+  EXPECT_EQ(glow["resolve"], "average");
+  EXPECT_EQ(glow["radiance"], true);
+  EXPECT_EQ(glow["ground_truth"], "");
+  EXPECT_EQ(mask["resource"], "glow");
+  EXPECT_EQ(mask["first_channel"], 3);
+  EXPECT_EQ(mask["exr"], json({"glow_mask.Y"}));
+  EXPECT_EQ(mask["resolve"], "nearest");
+  EXPECT_EQ(mask["radiance"], false);
+  EXPECT_EQ(mask["ground_truth"], "beauty");
+  // The declaration reaches the renderer (TechniqueInfo) through the pass's "x-technique", the
+  // requestable AOVs through the schema's enum.
+  const json& x = m.merged["properties"]["passes"]["properties"]["alpha_pass"]["x-technique"];
+  EXPECT_EQ(x["resources"], json({"glow_cache"}));
+  EXPECT_EQ(x["adds_to_beauty"], true);
+  EXPECT_EQ(x["exclusive"], false);
+  EXPECT_EQ(m.merged["properties"]["outputs"]["items"]["properties"]["aovs"]["items"]["enum"],
+            json({"beauty", "glow", "glow_mask"}));
+}
+
+// Each case breaks one rule; the build must fail and say where.
+TEST_F(MergeSchema, ABrokenDescriptorFailsNamingItsFileAndKey) {
+  struct Case {
+    const char* what;
+    std::vector<json> techniques;
+    const char* says;
+  };
+  json noRow = descriptor("a", "glow");
+  noRow.erase("aovs");
+  json twoRows = descriptor("b", "glow");
+  json notOutput = descriptor("a", "glow");
+  notOutput["aovs"]["other"] = {{"format", "RGBA32F"}, {"description", "x"}};
+  json badFormat = descriptor("a", "glow");
+  badFormat["aovs"]["glow"]["format"] = "RGB8";
+  json tooManyChannels = descriptor("a", "glow");
+  tooManyChannels["aovs"]["glow"]["format"] = "R32F";
+  json wrongNames = descriptor("a", "glow");
+  wrongNames["aovs"]["glow"]["channel_names"] = {"X"};
+  json noFlag = descriptor("a", "glow");
+  noFlag.erase("on_by_default");
+  json unknownKey = descriptor("a", "glow");
+  unknownKey["runs_first"] = true;
+  json badPaths = descriptor("a", "glow");
+  badPaths["light_paths"] = "LD+DE";
+  const std::vector<Case> cases = {
+      {"an output without a row", {noRow}, "no technique declares the row of AOV \"glow\""},
+      {"a row declared twice", {descriptor("a", "glow"), twoRows}, "aovs.glow is declared by a too"},
+      {"a row of no output", {notOutput}, "aovs.other is not one of its \"outputs\""},
+      {"an unknown format", {badFormat}, "aovs.glow.format must be one of"},
+      {"three channels of R32F", {tooManyChannels}, "aovs.glow: first_channel + channels exceed its format"},
+      {"channel names of another count", {wrongNames}, "aovs.glow.channel_names must name each of its channels"},
+      {"a required flag left out", {noFlag}, "missing \"on_by_default\""},
+      {"an unknown key", {unknownKey}, "unknown key \"runs_first\""},
+      {"light paths not an array", {badPaths}, "\"light_paths\" must be an array of names"},
+  };
+  for (const Case& c : cases) {
+    const Merge m = run(c.techniques);
+    EXPECT_NE(m.status, 0) << c.what;
+    EXPECT_NE(m.log.find(c.says), std::string::npos) << c.what << ": " << m.log;
+    EXPECT_NE(m.log.find(".json"), std::string::npos) << c.what << " names no file: " << m.log;
+  }
+}
+
+}  // namespace
