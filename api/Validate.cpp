@@ -307,6 +307,7 @@ const std::vector<TechniqueSchema>& techniqueSchemas() {
       t.after = d.at("after");
       t.resources = d.at("resources");
       t.lightPaths = d.at("light_paths");
+      t.requiredPaths = d.at("requires_paths");
       t.addsToBeauty = d.at("adds_to_beauty");
       t.onByDefault = d.at("on_by_default");
       t.claimsWhenNamed = d.at("claims_when_named");

@@ -90,7 +90,7 @@ struct TechniqueSchema {
   std::string description;  // the parameters' object's description (the docs, the schema)
   std::vector<std::string> outputs;  // the AOVs a request may ask of it
   nlohmann::json params;  // name -> {type, default, minimum?, maximum?, enum?, description}
-  std::vector<std::string> inputs, optionalInputs, after, resources, lightPaths;
+  std::vector<std::string> inputs, optionalInputs, after, resources, lightPaths, requiredPaths;
   bool addsToBeauty = false, onByDefault = false, claimsWhenNamed = false, exclusive = false;
 };
 const std::vector<TechniqueSchema>& techniqueSchemas();

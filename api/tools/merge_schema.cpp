@@ -179,7 +179,7 @@ int main(int argc, char** argv) {
       static const std::set<std::string> kAllowed{
           "name",   "summary",   "description", "inputs",         "optional_inputs", "after",
           "outputs", "resources", "aovs",       "adds_to_beauty", "on_by_default",   "light_paths",
-          "claims_when_named", "exclusive", "params"};
+          "requires_paths", "claims_when_named", "exclusive", "params"};
       for (const auto& [k, v] : t.items())
         if (!kAllowed.count(k)) fail(file, "unknown key \"" + k + "\"");
       if (!t.contains("name") || !t["name"].is_string()) fail(file, "missing \"name\"");
@@ -200,8 +200,12 @@ int main(int argc, char** argv) {
                         {"adds_to_beauty", flag(file, t, "adds_to_beauty", true)},
                         {"on_by_default", flag(file, t, "on_by_default", true)},
                         {"light_paths", names(file, t, "light_paths")},
+                        {"requires_paths", names(file, t, "requires_paths")},
                         {"claims_when_named", flag(file, t, "claims_when_named", false)},
                         {"exclusive", flag(file, t, "exclusive", false)}};
+      for (const auto& c : technique["requires_paths"])
+        if (std::find(technique["light_paths"].begin(), technique["light_paths"].end(), c) == technique["light_paths"].end())
+          fail(file, "requires_paths: \"" + c.get<std::string>() + "\" is not one of its \"light_paths\"");
       const json declared = t.value("aovs", json::object());
       if (!declared.is_object()) fail(file, "\"aovs\" must be an object of AOV rows");
       for (const auto& [aov, row] : declared.items()) {

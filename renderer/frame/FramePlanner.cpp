@@ -71,21 +71,32 @@ FramePlan planFrame(const std::vector<Technique*>& techniques, const Scene& scen
                           "/passes/" + name);
     wanted.insert(it->second);
   }
-  // Two named techniques that each must be the only supplier of a light-path class (the media
-  // techniques): the request is contradictory. The pointer names the later one in registry order.
-  std::map<std::string, std::string> namedExclusive;  // class -> the first named exclusive claimant
-  for (Technique* t : techniques) {
-    const auto& info = t->info();
-    if (!info.exclusive || !request.passes.count(info.name)) continue;
-    for (const auto& cls : info.lightPaths) {
-      auto [it, fresh] = namedExclusive.emplace(cls, info.name);
-      if (!fresh)
-        throw api::ApiError(422, "conflicting-passes", "Conflicting passes",
-                            "passes names both " + it->second + " and " + info.name + ", which both supply '" + cls +
-                                "': one technique per frame owns it (name one of them)",
-                            "/passes/" + info.name);
+  // Two named techniques of which one must own a light-path class that the other supplies (two media
+  // techniques; photon_gi and env_diffuse, LD+DE): the request is contradictory, whatever the scene.
+  // The pointer names the later one in registry order. Only the planner reports such conflicts.
+  auto named = [&](const TechniqueInfo& info) {
+    return request.passes.count(info.name) != 0 && !request.disabledPasses.count(info.name);
+  };
+  // The classes a technique must own to run: an exclusive one's are all of its classes.
+  auto required = [](const TechniqueInfo& info) -> const std::vector<std::string>& {
+    return info.exclusive ? info.lightPaths : info.requiredPaths;
+  };
+  for (std::size_t a = 0; a < techniques.size(); ++a)
+    for (std::size_t b = 0; b < techniques.size(); ++b) {
+      const TechniqueInfo& need = techniques[a]->info();
+      const TechniqueInfo& other = techniques[b]->info();
+      if (a == b || !named(need) || !named(other)) continue;
+      for (const auto& cls : required(need))
+        if (std::find(other.lightPaths.begin(), other.lightPaths.end(), cls) != other.lightPaths.end()) {
+          const TechniqueInfo& first = a < b ? need : other;
+          const TechniqueInfo& later = a < b ? other : need;
+          throw api::ApiError(422, "conflicting-passes", "Conflicting passes",
+                              "passes names both " + first.name + " and " + later.name + ", which both supply '" +
+                                  cls + "', and " + need.name +
+                                  " must own it to run: one technique per frame owns it (name one of them)",
+                              "/passes/" + later.name);
+        }
     }
-  }
   for (Technique* t : techniques) {
     const auto& info = t->info();
     if (beautyWanted && info.onByDefault) wanted.insert(t);
@@ -141,24 +152,42 @@ FramePlan planFrame(const std::vector<Technique*>& techniques, const Scene& scen
     if (keep.count(t)) plan.passes.push_back(t);
   // Every light path is counted once: each class goes to the first planned technique claiming it, in
   // registry order, except that a technique with claimsWhenNamed takes its classes first when the
-  // request names it.
-  for (Technique* t : plan.passes)
-    if (t->info().claimsWhenNamed && request.passes.count(t->info().name))
+  // request names it. A technique that does not own a class it requires (TechniqueInfo::requiredPaths;
+  // an exclusive one: all of its classes) is dropped, and the classes are handed out again without it,
+  // so that what it would have supplied goes to the next claimant (photon_gi's sky light to
+  // ambient_occlusion when env_diffuse owns LD+DE). A pass that needs what a dropped one produces goes too.
+  for (bool dropped = true; dropped;) {
+    dropped = false;
+    plan.lightPaths.clear();
+    for (Technique* t : plan.passes)
+      if (t->info().claimsWhenNamed && request.passes.count(t->info().name))
+        for (const auto& cls : t->info().lightPaths) plan.lightPaths.emplace(cls, t->info().name);
+    for (Technique* t : plan.passes)
       for (const auto& cls : t->info().lightPaths) plan.lightPaths.emplace(cls, t->info().name);
-  for (Technique* t : plan.passes)
-    for (const auto& cls : t->info().lightPaths) plan.lightPaths.emplace(cls, t->info().name);
-  // An exclusive technique that lost one of its classes does not run at all (the media AOV has one
-  // writer per frame). Nothing reads the outputs of the exclusive techniques, so no pass loses an input.
-  std::erase_if(plan.passes, [&](Technique* t) {
-    const auto& info = t->info();
-    if (!info.exclusive) return false;
-    for (const auto& cls : info.lightPaths)
-      if (const std::string& owner = plan.lightPaths.at(cls); owner != info.name) {
-        plan.skipped[info.name] = cls + " is owned by " + owner;
-        return true;
-      }
-    return false;
-  });
+    for (auto it = plan.passes.begin(); it != plan.passes.end() && !dropped; ++it) {
+      const TechniqueInfo& info = (*it)->info();
+      for (const auto& cls : required(info))
+        if (const std::string& owner = plan.lightPaths.at(cls); owner != info.name) {
+          plan.skipped[info.name] = cls + " is owned by " + owner;
+          plan.passes.erase(it);
+          dropped = true;
+          break;
+        }
+    }
+    for (bool lost = dropped; lost;) {
+      lost = false;
+      for (auto it = plan.passes.begin(); it != plan.passes.end() && !lost; ++it)
+        for (const auto& in : (*it)->info().inputs) {
+          const auto p = producerOf.find(in);
+          if (p == producerOf.end() || !plan.skipped.count(p->second->info().name)) continue;
+          plan.skipped[(*it)->info().name] = "needs '" + in + "', which " + p->second->info().name +
+                                             " does not produce: " + plan.skipped.at(p->second->info().name);
+          plan.passes.erase(it);
+          lost = true;
+          break;
+        }
+    }
+  }
   return plan;
 }
 

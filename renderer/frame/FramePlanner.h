@@ -4,8 +4,9 @@
 // the on-by-default beauty contributors; then it pulls in the producers of their inputs. A pass whose
 // requirements() says skip is dropped with its reason; a pass whose required input has no producer is
 // dropped with "needs <input>, which <producer> did not produce: <reason>". Light-path classes go to
-// one technique each (TechniqueInfo::lightPaths, claimsWhenNamed); an exclusive technique that does
-// not own its classes is dropped with "<class> is owned by <owner>" (one media technique per frame).
+// one technique each (TechniqueInfo::lightPaths, claimsWhenNamed); a technique that does not own a
+// class it requires (requiredPaths; an exclusive one: all of its classes, one media technique per
+// frame) is dropped with "<class> is owned by <owner>" and the classes are handed out again.
 #include <map>
 #include <set>
 #include <string>
@@ -45,7 +46,8 @@ std::string undeclaredWrite(const TechniqueInfo& info, const std::set<std::strin
 
 // `techniques` is in the canonical execution order (renderer/techniques/Registry.cpp).
 // Throws api::ApiError (422) for a requested pass or AOV that no technique knows, and for a request
-// that names two exclusive techniques sharing a light-path class (pointer: the later one's /passes/<name>).
+// that names two techniques of which one requires a light-path class the other supplies (pointer: the
+// later one's /passes/<name>): the only place conflicts between passes are reported.
 FramePlan planFrame(const std::vector<Technique*>& techniques, const Scene& scene,
                     const api::RenderRequest& request);
 

@@ -20,6 +20,7 @@ TechniqueInfo describedTechnique(std::string_view name) {
   i.lightPaths = d->lightPaths;
   i.claimsWhenNamed = d->claimsWhenNamed;
   i.exclusive = d->exclusive;
+  i.requiredPaths = d->requiredPaths;
   return i;
 }
 

@@ -41,6 +41,10 @@ struct TechniqueInfo {
   // beside the owner, and a request that names two exclusive techniques sharing a class is a 422. The
   // media techniques: each writes the media AOV and composes it into beauty (class "media").
   bool exclusive = false;
+  // Classes it must own to run at all (beyond an exclusive technique's, which are all of its classes),
+  // because its estimate cannot leave them out: photon_gi's photons carry LD+DE, so where env_diffuse owns that
+  // class photon_gi is dropped ("LD+DE is owned by env_diffuse"), and a request naming both is a 422.
+  std::vector<std::string> requiredPaths = {};
 };
 
 // A technique's TechniqueInfo as its descriptor declares it (renderer/techniques/<name>/<name>.json,

@@ -111,15 +111,8 @@ Requirements PhotonGiPass::requirements(const Scene& scene, const api::RenderReq
   if (f.triangles == 0) return Requirements::skip("the scene has no triangles");
   if (f.lightCount() == 0 && !f.hasEmissive() && request.ambient == glm::vec3(0.f) && request.environment.empty())
     return Requirements::skip("nothing emits light: no lights, no emissive surfaces, no ambient or environment");
-  // Every light path is counted once: env_diffuse also supplies indirect diffuse light (LD+DE) on its
-  // receivers. When a request asks for env_diffuse and not for photon_gi, env_diffuse owns that light.
-  const bool envDiffuseAsked = request.passes.count("env_diffuse") != 0;
-  const bool photonsAsked = request.passes.count("photon_gi") != 0;
-  if (envDiffuseAsked && photonsAsked)
-    throw api::ApiError(422, "conflicting-passes", "Conflicting passes",
-                        "photon_gi and env_diffuse both supply indirect diffuse light (LD+DE); ask for one of them",
-                        "/passes/env_diffuse");
-  if (envDiffuseAsked) return Requirements::skip("env_diffuse owns indirect diffuse light (LD+DE) in this request");
+  // env_diffuse, which also supplies LD+DE, is the planner's business: photon_gi requires that class
+  // (photon_gi.json, requires_paths) and is dropped where env_diffuse owns it.
   return Requirements::ok();
 }
 

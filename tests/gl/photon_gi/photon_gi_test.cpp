@@ -784,7 +784,11 @@ TEST(PhotonGi, PlannerOwnershipAndOptOut) {
   env.passes["env_diffuse"] = nlohmann::json::object();
   const RenderOutput b = renderer().render(scene, env);
   EXPECT_EQ(pass(b, "photon_gi"), nullptr);
-  EXPECT_NE(b.stats.skipped.at("photon_gi").find("env_diffuse owns"), std::string::npos);
+  EXPECT_EQ(b.stats.skipped.at("photon_gi"), "LD+DE is owned by env_diffuse");
+  // What photon_gi would have supplied besides goes to the next claimant: the sky's first bounce to
+  // ambient_occlusion, which the box has no sky for (so no one owns it), the area lights' to no one.
+  EXPECT_EQ(b.stats.lightPaths.at("LD+DE"), "env_diffuse");
+  EXPECT_EQ(b.stats.lightPaths.count("L(area)DE"), 0u);
   env.passes["photon_gi"] = nlohmann::json::object();
   EXPECT_THROW(renderer().render(scene, env), api::ApiError);
 }

@@ -138,6 +138,9 @@ TEST_F(MergeSchema, ABrokenDescriptorFailsNamingItsFileAndKey) {
   unknownKey["runs_first"] = true;
   json badPaths = descriptor("a", "glow");
   badPaths["light_paths"] = "LD+DE";
+  json foreignRequirement = descriptor("a", "glow");
+  foreignRequirement["light_paths"] = {"LD+DE"};
+  foreignRequirement["requires_paths"] = {"LS+DE"};
   const std::vector<Case> cases = {
       {"an output without a row", {noRow}, "no technique declares the row of AOV \"glow\""},
       {"a row declared twice", {descriptor("a", "glow"), twoRows}, "aovs.glow is declared by a too"},
@@ -148,6 +151,7 @@ TEST_F(MergeSchema, ABrokenDescriptorFailsNamingItsFileAndKey) {
       {"a required flag left out", {noFlag}, "missing \"on_by_default\""},
       {"an unknown key", {unknownKey}, "unknown key \"runs_first\""},
       {"light paths not an array", {badPaths}, "\"light_paths\" must be an array of names"},
+      {"a required class it does not supply", {foreignRequirement}, "requires_paths: \"LS+DE\" is not one of its"},
   };
   for (const Case& c : cases) {
     const Merge m = run(c.techniques);
