@@ -322,9 +322,8 @@ static bool comparableWithPresetTable(const api::FrameStats& stats, bool compile
   if (compiledPrograms) return false;
   // Derived data keyed on the scene and its environment only (never on the seed or a quality knob):
   // the preset table's timing frames found these warm as well. Any other hit is reused work.
-  static const std::set<std::string> kSceneKeyed{"ray_scene",       "shadow_maps", "ibl_dfg", "ibl_prefiltered",
-                                                 "ibl_sh",          "environment_distribution",
-                                                 "photon_grid"};  // the grid's slot; its contents are rebuilt
+  static const std::set<std::string> kSceneKeyed{"ray_scene", "shadow_maps", "ibl_dfg", "ibl_prefiltered", "ibl_sh",
+                                                 "environment_distribution"};
   bool sceneResident = false;
   for (const api::CacheEvent& e : stats.cache) {
     if (e.what == "gpu_scene") sceneResident = e.hit;

@@ -68,6 +68,7 @@ void FrameResources::beginFrame(const GpuScene& gpu, const FrameView& view, std:
   cancel_ = {};
   endPass();  // a pass that threw last frame left its scope open
   written_.clear();
+  products_.clear();
   declaredThisFrame_.clear();
   usedThisFrame_.clear();
   releasedThisFrame_ = 0;

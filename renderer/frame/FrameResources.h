@@ -16,6 +16,7 @@
 // also kept within a byte budget over every key together (radiantd --derived-cache-bytes): when an entry
 // is added, the least recently used entries go first, never one this frame has looked up (a pass may
 // hold a reference to it).
+#include <any>
 #include <concepts>
 #include <cstdint>
 #include <functional>
@@ -23,7 +24,9 @@
 #include <map>
 #include <memory>
 #include <set>
+#include <stdexcept>
 #include <string>
+#include <typeinfo>
 #include <vector>
 
 #include "api/Types.h"
@@ -120,6 +123,30 @@ public:
   // resource the pass did not declare Write or Accumulate throws std::logic_error.
   void markWritten(const std::string& name);
   bool written(const std::string& name) const { return written_.count(name) != 0; }
+
+  // The frame's typed blackboard (Filament's FrameGraph blackboard): what a pass hands to later passes
+  // that is not one texture (photon_gi's splat grid, specular's layered distance maps) is a value
+  // published under one of the pass's declared outputs and read under one of the reader's declared
+  // inputs, so no pass looks up another's private resource names. publish() marks the name written
+  // (checked like markWritten); product() is nullptr until it is published this frame, and reading it
+  // as another type is a programmer error (std::logic_error). Products live for one frame.
+  template <class T>
+  void publish(const std::string& name, T value) {
+    markWritten(name);
+    products_[name] = std::move(value);
+  }
+  template <class T>
+  const T* product(const std::string& name) const {
+    checkAccess(name, false);
+    used(name);
+    const auto it = products_.find(name);
+    if (it == products_.end()) return nullptr;
+    const T* p = std::any_cast<T>(&it->second);
+    if (!p)
+      throw std::logic_error("FrameResources: '" + name + "' holds a " + it->second.type().name() + ", not a " +
+                             typeid(T).name());
+    return p;
+  }
 
   // Declared resource access. The shared resources are the names passes exchange: every technique's
   // outputs, the AOV table's resources and the frame resources (environment_map); the Renderer sets
@@ -239,6 +266,7 @@ private:
   std::map<std::string, std::string> holds_;  // resource -> digest of what it holds (holds())
   std::size_t derivedCapacity_ = 4;
   std::set<std::string> written_;
+  std::map<std::string, std::any> products_;  // the blackboard, cleared by beginFrame()
   std::map<std::string, std::string> lightPaths_;
   std::set<int> shadowMapExclusions_;
   std::set<std::string> declaredThisFrame_;

@@ -7,7 +7,7 @@
 //
 // Publishing (photon_gi, prepare): upload, then publishPhotonGrid(). Reading (a pass that declares
 // "photon_grid" as an optional input, in execute): publishedPhotonGrid() returns the grid, or nullptr
-// when photon_gi is not planned this frame. The grid's `digest` names the photon set and splat
+// when photon_gi is not planned this frame (the frame's blackboard, FrameResources::product). The grid's `digest` names the photon set and splat
 // settings it holds (photon_gi's splat cache key plus the kernel): derived data shaded from the photons
 // keys on it.
 #include <cstdint>
@@ -46,34 +46,20 @@ struct PhotonGrid {
   int kernel = 0;            // photon.glsl KERNEL_*
   float minRadius = 0.f;     // the smallest splat radius h (photon_gi's h_min): readers' surface tests
   bool renormalize = true;   // divide by the coverage points' kernel mass
+  gl::Buffer* splats = nullptr;  // photon_gi's splat and cell buffers, which hold the grid this frame
+  gl::Buffer* cells = nullptr;
   // Binds the splat and cell buffers (kPhotonSplatBinding, kPhotonCellBinding).
-  void bind(FrameResources& res) const {
-    res.buffer("photon_gi_splats").bindBase(GL_SHADER_STORAGE_BUFFER, kPhotonSplatBinding);
-    res.buffer("photon_gi_cells").bindBase(GL_SHADER_STORAGE_BUFFER, kPhotonCellBinding);
+  void bind() const {
+    splats->bindBase(GL_SHADER_STORAGE_BUFFER, kPhotonSplatBinding);
+    cells->bindBase(GL_SHADER_STORAGE_BUFFER, kPhotonCellBinding);
   }
 };
 
-// The description lives in one derived-data slot ("photon_grid" in stats.cache) that photon_gi
-// overwrites in every prepare(); it is valid only in a frame in which photon_gi marked "photon_grid"
-// written (FrameResources::written), which is what publishedPhotonGrid() checks.
-struct PublishedPhotonGrid {
-  PhotonGrid grid;
-};
-inline PhotonGrid& photonGridSlot(FrameResources& res) {
-  return res.cached<PublishedPhotonGrid>("photon_grid", "published", [] { return std::make_unique<PublishedPhotonGrid>(); })
-      .grid;
-}
-
-// photon_gi: the buffers hold `grid` now (after its upload); marks "photon_grid" written.
-inline void publishPhotonGrid(FrameResources& res, const PhotonGrid& grid) {
-  photonGridSlot(res) = grid;
-  res.markWritten("photon_grid");
-}
+// photon_gi: the buffers hold `grid` now (after its upload); publishes it on the frame's blackboard
+// under its output "photon_grid" (FrameResources::publish), which marks it written.
+inline void publishPhotonGrid(FrameResources& res, const PhotonGrid& grid) { res.publish("photon_grid", grid); }
 
 // The grid photon_gi published this frame, or nullptr when it is not planned.
-inline const PhotonGrid* publishedPhotonGrid(FrameResources& res) {
-  if (!res.written("photon_grid")) return nullptr;
-  return &photonGridSlot(res);
-}
+inline const PhotonGrid* publishedPhotonGrid(FrameResources& res) { return res.product<PhotonGrid>("photon_grid"); }
 
 }  // namespace radiant

@@ -12,6 +12,7 @@
 #include "renderer/frame/PassContext.h"
 #include "renderer/shading/DirectLighting.h"
 #include "renderer/shading/CubeFaces.h"
+#include "renderer/shading/SpecularMaps.h"
 #include "renderer/shading/SpecularObjects.h"
 
 namespace radiant {
@@ -237,24 +238,16 @@ void CausticsPass::execute(PassContext& ctx) {
   auto& counters = ctx.stats.counters;
   const int P = photonResolution_, C = cubeResolution_;
   const int G = static_cast<int>(generators_.size());
-  // The specular pass's maps (declared by it; this pass runs after it in the registry).
-  gl::Texture& ldmMaterial = res.texture("specular_ldm_material");
-  gl::Texture& ldmGeometry = res.texture("specular_ldm_geometry");
-  gl::Texture& ldmDistance = res.texture("specular_ldm_distance");
-  const int ldmResolution = ldmGeometry.width();
-  const int layers = G > 0 ? std::max(3, ldmGeometry.depth() / (6 * G)) : 3;
+  // The specular pass's maps (its product "specular_maps", an input: this pass runs after it).
+  const SpecularMaps* maps = publishedSpecularMaps(res);
+  if (!maps) throw std::logic_error("CausticsPass: specular published no maps this frame");
   auto bindMaps = [&](const gl::Program& prog) {
-    res.texture("specular_ldm_albedo").bindUnit(gpu::kUnitLdmAlbedo);
-    ldmMaterial.bindUnit(gpu::kUnitLdmMaterial);
-    ldmGeometry.bindUnit(gpu::kUnitLdmGeometry);
-    ldmDistance.bindUnit(gpu::kUnitLdmDistance);
-    res.buffer("specular_objects").bindBase(GL_SHADER_STORAGE_BUFFER, 3);
-    res.buffer("specular_minmax").bindBase(GL_SHADER_STORAGE_BUFFER, 4);
-    prog.set("u_layers", layers);
+    maps->bind();
+    prog.set("u_layers", maps->layers);
     prog.set("u_linearSteps", linearSteps_);
     prog.set("u_secantSteps", secantSteps_);
     prog.set("u_minmax", 1);
-    prog.set("u_cubeResolution", static_cast<float>(ldmResolution));
+    prog.set("u_cubeResolution", static_cast<float>(maps->resolution));
   };
 
   gl::Texture& cube = res.texture("caustics_cube");
@@ -265,11 +258,10 @@ void CausticsPass::execute(PassContext& ctx) {
   // the knobs below. The cubes are kept in caustics_cube and redrawn only when one of those changed; a
   // frame from another camera runs the camera passes (4) and (5) alone. energy_check recomputes (its
   // sums are counters of the drawing).
-  const std::string maps = res.heldDigest("specular_ldm_distance");
   std::string cubeDigest;
-  if (!maps.empty() && !energyCheck_) {
+  if (!maps->digest.empty() && !energyCheck_) {
     std::ostringstream key;
-    key << maps << "|caustics method=" << static_cast<int>(method_) << " P=" << P << " C=" << C
+    key << maps->digest << "|caustics method=" << static_cast<int>(method_) << " P=" << P << " C=" << C
         << " w=" << areaWeight_ << " depth=" << maxDepth_ << " steps=" << linearSteps_ << "," << secantSteps_
         << " r=" << splatRadius_ << " fresnel=" << fresnelReflection_ << " mips=" << footprintFilter_
         << " pairs=" << pairs_.size();

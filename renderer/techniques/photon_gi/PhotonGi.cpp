@@ -357,6 +357,8 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   published.kernel = static_cast<int>(splat_.kernel);
   published.minRadius = hMin_;
   published.renormalize = splat_.renormalize;
+  published.splats = &res.buffer("photon_gi_splats");
+  published.cells = &res.buffer("photon_gi_cells");
   publishPhotonGrid(res, published);
 }
 

@@ -14,6 +14,7 @@
 #include "renderer/shading/DirectLighting.h"
 #include "renderer/shading/ImageBasedLighting.h"
 #include "renderer/shading/PhotonGrid.h"
+#include "renderer/shading/SpecularMaps.h"
 #include "renderer/shading/SpecularObjects.h"
 #include "renderer/shading/Stretches.h"
 
@@ -373,7 +374,7 @@ void SpecularPass::execute(PassContext& ctx) {
       glMemoryBarrier(GL_ALL_BARRIER_BITS);
       const gl::Program& gather = ctx.shaders.program({"specular/map_indirect.comp"});
       gather.use();
-      photons->bind(res);
+      photons->bind();
       geometry.bindImage(0, GL_READ_ONLY, 0, true, 0);
       albedo.bindImage(1, GL_READ_ONLY, 0, true, 0);
       material.bindImage(2, GL_READ_WRITE, 0, true, 0);
@@ -468,7 +469,7 @@ void SpecularPass::execute(PassContext& ctx) {
     const gl::Program& reduce = ctx.shaders.program({"specular/minmax.comp"});
     reduce.use();
     geometry.bindImage(0, GL_READ_ONLY, 0, true, 0);
-    minmax.bindBase(GL_SHADER_STORAGE_BUFFER, 4);
+    minmax.bindBase(GL_SHADER_STORAGE_BUFFER, kSpecularMinmaxBinding);
     reduce.set("u_size", resolution_);
     for (int c = 0; c < objectCount * layers_; ++c) {
       reduce.set("u_cube", c);
@@ -481,7 +482,17 @@ void SpecularPass::execute(PassContext& ctx) {
     ctx.stats.counters["triangles_full"] = static_cast<double>(fullTriangles);
     res.setHolds("specular_ldm_distance", digest);  // after writing them
   }
-  res.markWritten("specular_maps");
+  SpecularMaps published;
+  published.material = &material;
+  published.geometry = &geometry;
+  published.distance = &distance;
+  published.albedo = &albedo;
+  published.objects = &objectBuffer;
+  published.minmax = &minmax;
+  published.layers = layers_;
+  published.resolution = resolution_;
+  published.digest = res.heldDigest("specular_ldm_distance");
+  publishSpecularMaps(res, published);
   ctx.stats.counters["cube_resolution"] = resolution_;
   ctx.stats.counters["map_bytes"] = mapBytes(static_cast<int>(objects_.size()), layers_, resolution_);
   if (!warning_.empty()) ctx.stats.warnings.push_back(warning_);
@@ -505,12 +516,7 @@ void SpecularPass::execute(PassContext& ctx) {
     glDisable(GL_BLEND);
     const char* inputs[] = {"gbuffer_position", "normal", "albedo", "material", "emission"};
     for (GLuint i = 0; i < std::size(inputs); ++i) res.texture(inputs[i]).bindUnit(i);
-    material.bindUnit(gpu::kUnitLdmMaterial);
-    geometry.bindUnit(gpu::kUnitLdmGeometry);
-    distance.bindUnit(gpu::kUnitLdmDistance);
-    albedo.bindUnit(gpu::kUnitLdmAlbedo);  // mirrors' F0 (specular/ldm.glsl, mapSpecularTexel)
-    objectBuffer.bindBase(GL_SHADER_STORAGE_BUFFER, 3);
-    minmax.bindBase(GL_SHADER_STORAGE_BUFFER, 4);
+    published.bind();  // the maps, and the albedo for mirrors' F0 (specular/ldm.glsl, mapSpecularTexel)
     const gl::Program& prog = ctx.shaders.program({"specular/map.vert", "specular/specular.frag"});
     prog.use();
     prog.setMat4("u_viewProj", &view.viewProj[0][0]);

@@ -661,6 +661,45 @@ TEST(AovTable, APassThatTouchesAnUndeclaredResourceFails) {
   EXPECT_NO_THROW(res.texture("specular", GL_TEXTURE_2D, GL_RGBA32F, 8, 8));
 }
 
+// The frame's typed blackboard (FrameResources::publish, product): a product that is not a texture
+// (photon_gi's grid, specular's maps) travels under the publisher's declared output and the reader's
+// declared input, and is read back as the type it was published as.
+TEST(AovTable, ProductsTravelUnderDeclaredNamesAsTheTypeTheyWerePublishedAs) {
+  renderer();  // a current GL context
+  gl::ShaderLibrary shaders;
+  FrameResources res(shaders);
+  res.setSharedResources({"beauty", "photon_grid", "specular_maps"});
+  struct Grid {
+    int cells = 0;
+  };
+  const TechniqueInfo reader{"specular", "", {}, {"photon_grid"}, {"specular", "specular_maps"}, true, true};
+  const TechniqueInfo writer{"photon_gi", "", {}, {}, {"indirect", "photon_grid"}, true, true};
+  res.beginPass(reader.name, declaredAccess(reader), FrameResources::Phase::Execute);
+  EXPECT_EQ(res.product<Grid>("photon_grid"), nullptr) << "nothing published yet";
+  const std::string wrote = testing::thrownMessage<std::logic_error>([&] { res.publish("photon_grid", Grid{1}); });
+  EXPECT_NE(wrote.find("declares Read only"), std::string::npos) << wrote;
+  res.endPass();
+  res.beginPass(writer.name, declaredAccess(writer), FrameResources::Phase::Prepare);
+  res.publish("photon_grid", Grid{27});
+  const std::string undeclared =
+      testing::thrownMessage<std::logic_error>([&] { res.publish("specular_maps", Grid{1}); });
+  EXPECT_NE(undeclared.find("pass photon_gi wrote 'specular_maps'"), std::string::npos) << undeclared;
+  res.endPass();
+  EXPECT_TRUE(res.written("photon_grid"));
+  res.beginPass(reader.name, declaredAccess(reader), FrameResources::Phase::Execute);
+  ASSERT_NE(res.product<Grid>("photon_grid"), nullptr);
+  EXPECT_EQ(res.product<Grid>("photon_grid")->cells, 27);
+  const std::string type = testing::thrownMessage<std::logic_error>([&] { res.product<int>("photon_grid"); });
+  EXPECT_NE(type.find("'photon_grid' holds a"), std::string::npos) << type;
+  res.endPass();
+  // A pass that does not declare the name cannot read it.
+  const TechniqueInfo other{"direct", "", {}, {}, {"direct"}, true, true};
+  res.beginPass(other.name, declaredAccess(other), FrameResources::Phase::Execute);
+  const std::string used = testing::thrownMessage<std::logic_error>([&] { res.product<Grid>("photon_grid"); });
+  EXPECT_NE(used.find("pass direct used 'photon_grid'"), std::string::npos) << used;
+  res.endPass();
+}
+
 // The Renderer allocates the planned passes' declared outputs and uploads the environment map as a frame
 // resource once per map: a second frame with the same map is a cache hit, and the direct pass (which
 // reads it, declared) shows the same sky in both.
