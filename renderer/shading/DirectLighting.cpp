@@ -7,11 +7,9 @@
 namespace radiant {
 
 void declareDirectLightingResources(FrameResources& res) {
-  if (!res.hasTexture("shadow_cube")) {
-    res.texture("shadow_cube", GL_TEXTURE_CUBE_MAP_ARRAY, GL_R32F, 1, 1, 6).setFilter(GL_NEAREST, GL_NEAREST);
-    res.texture("shadow_2d", GL_TEXTURE_2D_ARRAY, GL_R32F, 1, 1, 1).setFilter(GL_NEAREST, GL_NEAREST);
-  }
-  if (!res.hasBuffer("shadow_info")) res.buffer("shadow_info", sizeof(gpu::ShadowInfo));
+  res.texture("no_shadow_cube", GL_TEXTURE_CUBE_MAP_ARRAY, GL_R32F, 1, 1, 6).setFilter(GL_NEAREST, GL_NEAREST);
+  res.texture("no_shadow_2d", GL_TEXTURE_2D_ARRAY, GL_R32F, 1, 1, 1).setFilter(GL_NEAREST, GL_NEAREST);
+  if (!res.hasBuffer("no_shadow_info")) res.buffer("no_shadow_info", sizeof(gpu::ShadowInfo));
 }
 
 void declareFrameLights(FrameResources& res, const FrameView& view) {
@@ -24,16 +22,17 @@ void declareFrameLights(FrameResources& res, const FrameView& view) {
 
 void bindDirectLighting(const gl::Program& program, FrameResources& res, const GpuScene& gpu, int lightCount,
                         int pcfRadius) {
-  res.texture("shadow_cube").bindUnit(gpu::kUnitShadowCube);
-  res.texture("shadow_2d").bindUnit(gpu::kUnitShadow2D);
+  const ShadowMapSet* shadows = res.product<ShadowMapSet>("shadow_maps");
+  (shadows ? *shadows->cube : res.texture("no_shadow_cube")).bindUnit(gpu::kUnitShadowCube);
+  (shadows ? *shadows->flat : res.texture("no_shadow_2d")).bindUnit(gpu::kUnitShadow2D);
   gpu.bindSceneBuffers();
   if (res.hasBuffer("frame_lights")) res.buffer("frame_lights").bindBase(GL_SHADER_STORAGE_BUFFER, GpuScene::kLightBinding);
   program.set("u_sceneLightCount", std::min(lightCount, res.view().sceneLights));
   const int lights = static_cast<int>(res.view().lights.size());
   program.set("u_diffuseOnlyFrom", std::min(lightCount, lights - res.view().skyLights()));
-  res.buffer("shadow_info").bindBase(GL_SHADER_STORAGE_BUFFER, 2);
+  (shadows ? *shadows->info : res.buffer("no_shadow_info")).bindBase(GL_SHADER_STORAGE_BUFFER, 2);
   program.set("u_lightCount", lightCount);
-  program.set("u_hasShadows", res.written("shadow_maps") ? 1 : 0);
+  program.set("u_hasShadows", shadows ? 1 : 0);
   program.set("u_pcfRadius", pcfRadius);
 }
 

@@ -9,6 +9,7 @@
 #include "api/Types.h"
 #include "renderer/frame/FrameView.h"
 #include "renderer/frame/PassContext.h"
+#include "renderer/shading/DirectLighting.h"
 #include "renderer/shading/CubeFaces.h"
 #include "renderer/shading/Stretches.h"
 
@@ -198,8 +199,9 @@ void ShadowMapsPass::prepare(const Scene& scene, const Params& params, FrameReso
 
 void ShadowMapsPass::execute(PassContext& ctx) {
   FrameResources& res = ctx.resources;
-  res.buffer("shadow_info").upload(infos_.data(), infos_.size() * sizeof(gpu::ShadowInfo));
-  res.markWritten("shadow_maps");
+  gl::Buffer& info = res.buffer("shadow_info");
+  info.upload(infos_.data(), infos_.size() * sizeof(gpu::ShadowInfo));
+  res.publish("shadow_maps", ShadowMapSet{&res.texture("shadow_cube"), &res.texture("shadow_2d"), &info});
   ctx.stats.counters["maps_rendered"] = mapsValid_ ? 0.0 : static_cast<double>(draws_.size());
   ctx.stats.counters["meshes_excluded"] = static_cast<double>(excluded_.size());
   ctx.stats.counters["map_size"] = size_;
