@@ -565,7 +565,31 @@ void resetPipelineState() {
 }  // namespace
 
 RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requestIn, const std::atomic<bool>* cancel,
-                              const FrameInputs& inputsIn) {
+                              const FrameInputs& inputs) {
+  api::RenderRequest request = requestIn;
+  std::string lowered;
+  for (;;) {
+    try {
+      RenderOutput out = renderFrame(scene, request, cancel, inputs);
+      if (!lowered.empty()) out.stats.warnings.insert(out.stats.warnings.begin(), lowered);
+      return out;
+    } catch (const api::ApiError& e) {
+      // The frame released what it held as it failed (FrameResources::settleAfterFrame): a lower k
+      // allocates k^2 times fewer samples' targets.
+      if (e.status != 503 || e.type != "memory-busy" || request.supersamplingGiven || request.supersampling <= 1)
+        throw;
+      const int k = request.supersampling - 1;
+      lowered = "supersampling " + std::to_string(k) + " instead of the default " + std::to_string(requestIn.supersampling) +
+                ": at " + std::to_string(request.supersampling) + " the frame did not fit under this server's memory " +
+                "limit (radiantd --memory-limit-bytes; refused at " + (e.pointer.empty() ? "its targets" : e.pointer) +
+                "); give \"supersampling\" to choose";
+      request.supersampling = k;
+    }
+  }
+}
+
+RenderOutput Renderer::renderFrame(const Scene& scene, const api::RenderRequest& requestIn,
+                                   const std::atomic<bool>* cancel, const FrameInputs& inputsIn) {
   Impl& im = *impl_;
   im.device->makeCurrent();
   // The frame's memory claim (FrameResources::admit) ends with the frame, however it ends.
@@ -866,8 +890,9 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
       if (alpha) out.aovs.push_back(std::move(*alpha));
     }
     stats.renderMs = msSince(frameStart);
-    // The memory accountant: what this frame has not used goes when the resident set is over the target.
-    im.resources.makeRoom(0);
+    // The memory accountant: what this frame has not used goes when the resident set is over the target,
+    // and its own targets too when they leave it over the limit.
+    im.resources.settleAfterFrame();
     stats.memory = {{"resident_bytes", FrameResources::residentBytes()},
                     {"resource_bytes", im.resources.resourceBytes()},
                     {"derived_bytes", im.resources.derivedBytes()},
@@ -886,11 +911,13 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
     im.resources.forgetHeld();
     im.profiler.beginFrame();
     resetPipelineState();
+    im.resources.settleAfterFrame();  // a frame refused or stopped midway holds its targets too
     throw api::ApiError(409, "canceled", "Render canceled", c.what());
   } catch (const api::ApiError& e) {
     im.resources.setCancel({});
     im.profiler.beginFrame();
     if (e.status == 409) resetPipelineState();
+    im.resources.settleAfterFrame();
     throw;
   } catch (...) {
     im.resources.setCancel({});

@@ -79,6 +79,9 @@ public:
   // "error" (per-pixel error map) and "reference". The ground truth is the reference path tracer, or
   // inputs.compareTarget when the request compares against an uploaded image (the server resolves
   // it). A request naming an image that `inputs` does not supply is refused (422).
+  // A default supersampling (request.supersamplingGiven false) that the memory limit refuses (503
+  // memory-busy: on llvmpipe the frame's targets are host memory) is lowered one step at a time, with a
+  // warning, before the refusal reaches the caller.
   RenderOutput render(const Scene& scene, const api::RenderRequest& request,
                       const std::atomic<bool>* cancel = nullptr, const FrameInputs& inputs = {});
   static std::vector<TechniqueDescription> techniques();
@@ -107,6 +110,8 @@ public:
   void setSpeedFactor(double factor);
 
 private:
+  RenderOutput renderFrame(const Scene& scene, const api::RenderRequest& request, const std::atomic<bool>* cancel,
+                           const FrameInputs& inputs);
   void calibrateSpeed();
   struct Impl;
   std::unique_ptr<Impl> impl_;

@@ -232,6 +232,20 @@ std::size_t FrameResources::makeRoom(std::size_t bytes) {
   return released;
 }
 
+std::size_t FrameResources::settleAfterFrame() {
+  std::size_t released = makeRoom(0);
+  const std::size_t before = residentBytes();
+  if (!memoryLimit_ || before <= memoryLimit_) return released;
+  usedThisFrame_.clear();  // the frame is over: its targets are idle now
+  releaseIdle();
+  const std::size_t after = residentBytes();
+  if (before > after) {
+    released += before - after;
+    releasedThisFrame_ += before - after;
+  }
+  return released;
+}
+
 void FrameResources::admit(std::size_t bytes, const std::string& pointer) {
   if (!memoryLimit_) return;
   // The frame's earlier allocations are resident now: its claim is the next one alone.

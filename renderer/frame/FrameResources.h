@@ -211,6 +211,13 @@ public:
   // scenes). The Renderer calls it with 0 after each frame, so the resident set at rest stays under the
   // target too. Returns the bytes the resident set shrank by (0 when nothing was needed).
   std::size_t makeRoom(std::size_t bytes);
+  // After a frame (the Renderer, however the frame ended): makeRoom(0), and when the frame's own
+  // textures and buffers still leave the resident set above the memory limit (a 1920 x 1080 frame at
+  // supersampling 2 holds 1.9 GB on llvmpipe), they go too, so that the daemon at rest is under its
+  // limit: otherwise every later request body and decode would be refused (503 memory-busy) with no
+  // frame running that could free them. Cached derived data of this frame stays. Returns the bytes
+  // the resident set shrank by.
+  std::size_t settleAfterFrame();
   // Admission under the memory limit (radiantd --memory-limit-bytes, 0 = none): after makeRoom, an
   // estimate that still does not fit under it is refused, a 503 memory-busy (Retry-After) naming
   // `pointer`, the parameter that sized the allocation, before anything is allocated. An admitted

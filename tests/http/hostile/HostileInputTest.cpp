@@ -766,3 +766,49 @@ TEST(HostileService, AFrameOverTheMemoryLimitIsA503WithRetryAfter) {
   EXPECT_EQ(health->status, 200);
   fs::remove_all(dir);
 }
+
+// A frame whose own targets take the daemon over its memory limit (a 1024 x 1024 frame at
+// supersampling 2 holds about 1.1 GB on llvmpipe, where textures are host memory; on a GPU they are
+// device memory) gives them back when it ends, refused or not, so the daemon at rest is under its limit
+// and the next request renders. Before, such a frame (refused at its photon records' admission, after
+// its targets were allocated) left them resident, and every later request, its body included, got 503
+// memory-busy with nothing running that could free them. A default supersampling is lowered instead.
+TEST(HostileService, AFrameThatTakesTheDaemonOverItsMemoryLimitGivesItsTargetsBack) {
+  const auto dir = radiant::testing::scratch("memorysettle");
+  Daemon d(RADIANTD_PATH, {"--port", "0", "--memory-limit-bytes", "900000000", "--default-frame-budget-ms", "0"}, {},
+           dir / "stderr.log");
+  ASSERT_TRUE(d.waitReady(std::chrono::seconds(60)));
+  auto c = d.client();
+  c.set_read_timeout(300, 0);
+  auto big = c.Post("/v1/renders", R"({"scene":{"builtin":"cornell_box"},"width":1024,"height":1024,"seed":5})",
+                    "application/json");
+  ASSERT_TRUE(big);
+  // The default supersampling (2 at this size) is lowered rather than refused when the limit cannot
+  // hold its targets (llvmpipe), with a warning; where it can (a GPU), the frame runs at 2.
+  ASSERT_EQ(big->status, 200) << big->body;
+  const json stats = json::parse(big->body)["stats"];
+  EXPECT_LE(stats["memory"]["resident_bytes"].get<double>(), 900000000.0) << stats["memory"].dump();
+  if (stats["supersampling"] == 1) {
+    EXPECT_NE(stats["warnings"].dump().find("supersampling 1 instead of the default 2"), std::string::npos)
+        << stats["warnings"].dump();
+    EXPECT_NE(stats["warnings"].dump().find("memory limit"), std::string::npos) << stats["warnings"].dump();
+  } else {
+    EXPECT_EQ(stats["supersampling"], 2) << stats.dump();
+  }
+  // Asked for explicitly, the supersampling is not lowered: refused where it does not fit.
+  auto asked = c.Post("/v1/renders",
+                      R"({"scene":{"builtin":"cornell_box"},"width":1024,"height":1024,"seed":6,"supersampling":2})",
+                      "application/json");
+  ASSERT_TRUE(asked);
+  ASSERT_TRUE(asked->status == 200 || asked->status == 503) << asked->body;
+  if (asked->status == 200) EXPECT_EQ(json::parse(asked->body)["stats"]["supersampling"], 2);
+  else EXPECT_EQ(json::parse(asked->body)["type"], "https://radiant.dev/problems/memory-busy") << asked->body;
+  for (int seed = 1; seed <= 2; ++seed) {
+    auto small = c.Post("/v1/renders",
+                        R"({"scene":{"builtin":"cornell_box"},"width":16,"height":16,"seed":)" + std::to_string(seed) + "}",
+                        "application/json");
+    ASSERT_TRUE(small);
+    EXPECT_EQ(small->status, 200) << small->body;
+  }
+  fs::remove_all(dir);
+}
