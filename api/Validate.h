@@ -82,7 +82,7 @@ std::vector<std::pair<std::string, std::string>> costParameters(const nlohmann::
 const nlohmann::json& renderRequestSchema();
 
 // One technique as its descriptor declares it (renderer/techniques/<name>/<name>.json, merged into
-// the schema at build time; docs/DEVELOPMENT.md, "Technique descriptors"): params in schema form, and
+// the schema at build time; docs/API.md, "A technique declares itself"): params in schema form, and
 // what the renderer's TechniqueInfo is made of (renderer/frame/Technique.h, describedTechnique).
 struct TechniqueSchema {
   std::string name;
