@@ -13,26 +13,17 @@
 #include "renderer/techniques/gbuffer/GBuffer.h"
 #include "renderer/techniques/spherical_billboards/SphericalBillboards.h"
 #include "tests/support/SceneBuilder.h"
+#include "tests/support/StandInTechnique.h"
 
 namespace radiant {
 namespace {
 
-class MediaStandIn final : public Technique {
-public:
-  MediaStandIn(std::string name, bool runs)
-      : info_{std::move(name), "stand-in", {}, {"gbuffer_position"}, {"media", "media_transmittance"},
-              true, false, {"media"}, /*claimsWhenNamed=*/true, /*exclusive=*/true},
-        runs_(runs) {}
-  const TechniqueInfo& info() const override { return info_; }
-  Requirements requirements(const Scene&, const api::RenderRequest&) const override {
-    return runs_ ? Requirements::ok() : Requirements::skip("stand-in skips");
-  }
-  void prepare(const Scene&, const Params&, FrameResources&) override {}
-  void execute(PassContext&) override {}
-private:
-  TechniqueInfo info_;
-  bool runs_;
-};
+// depth_impostors or illumination_network as the planner sees them: exclusive owners of "media" when named.
+testing::StandInTechnique mediaStandIn(std::string name, bool runs) {
+  return testing::StandInTechnique({std::move(name), "stand-in", {}, {"gbuffer_position"}, {"media", "media_transmittance"},
+                                    true, false, {"media"}, /*claimsWhenNamed=*/true, /*exclusive=*/true},
+                                   runs);
+}
 
 api::RenderRequest withMedia(std::vector<std::string> named, std::vector<std::string> aovs = {"beauty"}) {
   api::RenderRequest r;
@@ -51,8 +42,8 @@ bool planned(const FramePlan& p, const std::string& name) {
 struct MediaRegistry {
   GBufferPass gbuffer;
   SphericalBillboardsPass billboards;
-  MediaStandIn impostors{"depth_impostors", true};
-  MediaStandIn network{"illumination_network", true};
+  testing::StandInTechnique impostors = mediaStandIn("depth_impostors", true);
+  testing::StandInTechnique network = mediaStandIn("illumination_network", true);
   std::vector<Technique*> all() { return {&gbuffer, &billboards, &impostors, &network}; }
 };
 
@@ -123,7 +114,7 @@ TEST(MediaOwnership, NamingTwoMediaTechniquesIsA422NamingTheSecond) {
 TEST(MediaOwnership, ANamedTechniqueThatCannotRunLeavesTheMediaToTheDefault) {
   GBufferPass gbuffer;
   SphericalBillboardsPass billboards;
-  MediaStandIn impostors{"depth_impostors", false};
+  testing::StandInTechnique impostors = mediaStandIn("depth_impostors", false);
   const std::vector<Technique*> all{&gbuffer, &billboards, &impostors};
   const Scene scene = testing::SceneBuilder().build("empty");
   const FramePlan p = planFrame(all, scene, withMedia({"depth_impostors"}));

@@ -10,23 +10,12 @@
 
 #include "renderer/frame/FramePlanner.h"
 #include "tests/support/SceneBuilder.h"
+#include "tests/support/StandInTechnique.h"
 
 namespace radiant {
 namespace {
 
-class StandIn final : public Technique {
-public:
-  StandIn(TechniqueInfo info, bool runs = true) : info_(std::move(info)), runs_(runs) {}
-  const TechniqueInfo& info() const override { return info_; }
-  Requirements requirements(const Scene&, const api::RenderRequest&) const override {
-    return runs_ ? Requirements::ok() : Requirements::skip("stand-in skips");
-  }
-  void prepare(const Scene&, const Params&, FrameResources&) override {}
-  void execute(PassContext&) override {}
-private:
-  TechniqueInfo info_;
-  bool runs_;
-};
+using testing::StandInTechnique;
 
 TechniqueInfo info(std::string name, std::vector<std::string> outputs, std::vector<std::string> paths, bool onByDefault,
                    std::vector<std::string> required = {}, std::vector<std::string> inputs = {}) {
@@ -42,7 +31,7 @@ struct Registry {
         photons(info("photon_gi", {"indirect", "photon_grid"}, {"LD+DE", "L(sky)DE"}, true, {"LD+DE"})),
         ao(info("ambient_occlusion", {"ao"}, {"L(sky)DE"}, true)),
         reader(info("grid_reader", {"grid_view"}, {}, false, {}, {"photon_grid"})) {}
-  StandIn env, photons, ao, reader;
+  StandInTechnique env, photons, ao, reader;
   std::vector<Technique*> all() { return {&env, &photons, &ao, &reader}; }
 };
 

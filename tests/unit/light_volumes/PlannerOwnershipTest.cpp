@@ -9,20 +9,14 @@
 #include "renderer/techniques/gbuffer/GBuffer.h"
 #include "renderer/techniques/light_volumes/LightVolumes.h"
 #include "tests/support/SceneBuilder.h"
+#include "tests/support/StandInTechnique.h"
 
 namespace radiant {
 namespace {
 
-class CausticsStandIn final : public Technique {
-public:
-  const TechniqueInfo& info() const override {
-    static const TechniqueInfo i{"caustics", "stand-in", {}, {}, {"caustics"}, true, true, {"LS+DE", "LG+DE"}};
-    return i;
-  }
-  Requirements requirements(const Scene&, const api::RenderRequest&) const override { return Requirements::ok(); }
-  void prepare(const Scene&, const Params&, FrameResources&) override {}
-  void execute(PassContext&) override {}
-};
+testing::StandInTechnique causticsStandIn() {
+  return testing::StandInTechnique({"caustics", "stand-in", {}, {}, {"caustics"}, true, true, {"LS+DE", "LG+DE"}});
+}
 
 Scene mirrorScene() {
   testing::SceneBuilder b;
@@ -43,7 +37,7 @@ api::RenderRequest asking(bool nameLightVolumes) {
 
 TEST(LightPathOwnership, CausticsOwnsByDefaultLightVolumesWhenNamed) {
   GBufferPass gbuffer;
-  CausticsStandIn caustics;
+  testing::StandInTechnique caustics = causticsStandIn();
   LightVolumesPass volumes;
   const std::vector<Technique*> registry{&gbuffer, &caustics, &volumes};
   const Scene scene = mirrorScene();
