@@ -1,8 +1,8 @@
 #include "api/Aovs.h"
 
-#include "api/Validate.h"
-
 #include <algorithm>
+
+#include "api/Validate.h"
 
 namespace radiant::api {
 
