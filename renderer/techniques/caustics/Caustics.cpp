@@ -131,7 +131,7 @@ Requirements CausticsPass::requirements(const Scene& scene, const api::RenderReq
 }
 
 void CausticsPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
-  // Fallbacks are the schema defaults (renderer/techniques/caustics/caustics.json).
+  // Every default is the descriptor's (caustics.json): Params has no fallback.
   method_ = params.get<std::string>("method") == "splat" ? Method::Splat : Method::Triangles;
   photonResolution_ = std::clamp(params.get<int>("photon_resolution"), 32, 256);
   cubeResolution_ = std::clamp(params.get<int>("cube_resolution"), 16, 1024);

@@ -94,7 +94,7 @@ Requirements SpecularPass::requirements(const Scene& scene, const api::RenderReq
 }
 
 void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
-  // Fallbacks are the schema defaults (renderer/techniques/specular/specular.json).
+  // Every default is the descriptor's (specular.json): Params has no fallback.
   maxDepth_ = std::clamp(params.get<int>("max_depth"), 1, 8);
   linearSteps_ = std::clamp(params.get<int>("linear_steps"), 1, 256);
   secantSteps_ = std::clamp(params.get<int>("secant_steps"), 0, 32);
