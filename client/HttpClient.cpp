@@ -61,8 +61,21 @@ HttpResponse HttpClient::send(const std::string& method, const std::string& path
                       : method == "DELETE" ? cli.Delete(path.c_str(), headers)
                       : method == "POST" ? cli.Post(path.c_str(), headers, *body, contentType.c_str())
                                          : cli.Put(path.c_str(), headers, *body, contentType.c_str());
+  if (!r && r.error() == httplib::Error::Read && fleet_->load()) {
+    HttpResponse lost;
+    lost.status = 502;
+    lost.headers.emplace("content-type", "application/problem+json");
+    lost.body = nlohmann::json{{"type", "https://radiant.dev/problems/daemon-unavailable"},
+                               {"title", "Daemon unavailable"},
+                               {"status", 502},
+                               {"detail", "the answer to " + method + " " + path + " from " + base_ +
+                                              " broke off mid-answer (its daemon went away); retry, or render again"}}
+                    .dump();
+    return lost;
+  }
   if (!r)
     throw UnreachableError("cannot reach " + base_ + " (" + method + " " + path + "): " + httplib::to_string(r.error()));
+  if (r->has_header("X-Radiant-Daemon")) fleet_->store(true);
   HttpResponse out;
   out.status = r->status;
   out.body = r->body;

@@ -1,7 +1,9 @@
 #pragma once
 // A small blocking HTTP client for the radiant CLI: base URL, optional bearer token, and the
 // error model mapped to exceptions the CLI turns into exit codes.
+#include <atomic>
 #include <map>
+#include <memory>
 #include <stdexcept>
 #include <string>
 
@@ -54,6 +56,12 @@ std::string problemType(const HttpResponse& r);
 enum class FleetRetry { None, Again, Reupload };
 FleetRetry fleetRetry(const HttpResponse& r);
 
+// A transport failure is an UnreachableError, with one exception: once an answer of this server carried
+// X-Radiant-Daemon (a proxy in front of a fleet, or a daemon of one), an answer that breaks off after the
+// request was sent (the connection closed mid-answer or timed out) is returned as the proxy's own
+// 502 daemon-unavailable, detail "the answer broke off", so that fleetRetry sends the request again.
+// nginx forwards a daemon's status line before its body; a daemon killed between the two leaves the
+// client a truncated answer, not a 502. A lone daemon's broken answer stays an UnreachableError.
 class HttpClient {
 public:
   // baseUrl: "http://host:port" (no TLS: put a proxy in front). token: "" = no Authorization header.
@@ -75,6 +83,8 @@ private:
                     const std::string& contentType, const Headers& extra = {}) const;
   std::string base_, token_;
   int timeout_;
+  // Set by the first answer that carries X-Radiant-Daemon; shared by copies (the same server).
+  std::shared_ptr<std::atomic<bool>> fleet_ = std::make_shared<std::atomic<bool>>(false);
 };
 
 }  // namespace radiant::client
