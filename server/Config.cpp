@@ -86,6 +86,10 @@ std::string usage() {
   --max-connections N       connections served at once, one worker thread each (default 256)
   --daemon-id ID            this daemon's name behind a proxy, [a-z0-9]{1,32}: render ids (and so the
                             job and frame URLs) start with "ID-" for the proxy to route on (docs/DEPLOYMENT.md)
+  --max-sessions N          progressive sessions open at once (default 8; docs/API.md, "Sessions")
+  --session-idle-s S        a session without an open event stream ends after S s untouched (default 60)
+  --ui auto|off             the viewer page at /ui/: auto serves it on a loopback address, or on any
+                            address when a token is required (default auto)
 )";
 }
 
@@ -180,10 +184,21 @@ void apply(ServerConfig& c, const std::string& name, const std::string& v, std::
     if (!ok) throw std::invalid_argument(flag + ": expected 1 to 32 of [a-z0-9], got \"" + v + "\"");
     c.daemonId = v;
   }
+  else if (name == "max-sessions") c.maxSessions = static_cast<int>(toInt(flag, v, 1, 1024));
+  else if (name == "session-idle-s") c.sessionIdleS = toDouble(flag, v);
+  else if (name == "ui") {
+    if (v != "auto" && v != "off") throw std::invalid_argument(flag + ": expected auto or off, got \"" + v + "\"");
+    c.ui = v == "auto";
+  }
   else throw std::invalid_argument("unknown option " + flag);
 }
 
 }  // namespace
+
+bool uiServed(const ServerConfig& c) {
+  const bool loopback = c.host == "127.0.0.1" || c.host == "localhost" || c.host == "::1" || c.host.rfind("127.", 0) == 0;
+  return c.ui && (loopback || !c.token.empty());
+}
 
 std::optional<ServerConfig> parseCommandLine(const std::vector<std::string>& args) {
   ServerConfig c;

@@ -58,7 +58,17 @@ struct ServerConfig {
   // become "<id>-r-<hex>", so the job and frame URLs it hands out route back to it; every response
   // carries X-Radiant-Daemon. "" = a lone daemon, ids "r-<hex>".
   std::string daemonId;
+  // Progressive sessions (server/Sessions.h): how many at once, and how long one without an open
+  // event stream lives untouched.
+  int maxSessions = 8;
+  double sessionIdleS = 60;
+  // The viewer page (/ui/): false = off. On, it is served when the daemon is bound to a loopback
+  // address or requires a token (uiServed()).
+  bool ui = true;
 };
+
+// Whether /ui/ is served: on, and either bound to loopback or behind a token.
+bool uiServed(const ServerConfig& c);
 
 // Parses argv (argv[0] skipped). Throws std::invalid_argument with a usage message on bad flags.
 // Reads --config and --token-file. Returns nullopt for --help (usage printed to stdout).

@@ -32,6 +32,8 @@
 #include "server/HttpTransport.h"
 #include "server/Metrics.h"
 #include "server/RenderService.h"
+#include "server/Sessions.h"
+#include "embedded/radiant_ui.h"
 #include "server/ContentStore.h"
 #include "renderer/ResidentMemory.h"
 #include "renderer/scene/GltfPackage.h"
@@ -415,6 +417,7 @@ struct HttpServer::Impl {
   DecodedScenes decoded;
   DecodedImages decodedImages;
   RenderService service;
+  SessionStore sessions;  // after the service: its jobs are canceled before the service goes
   BoundedServer http;
   std::atomic<bool> shuttingDown{false};
 
@@ -454,7 +457,14 @@ struct HttpServer::Impl {
         bodyMemory(std::max(config.bodyMemoryBytes, config.maxBodyBytes), &residentGate),
         decoded(config.sceneCacheEntries, config.sceneCacheBytes),
         decodedImages(std::min<std::size_t>(4, config.sceneCacheEntries), config.sceneCacheBytes / 2),
-        service(config, hooks, frames, metrics) {
+        service(config, hooks, frames, metrics),
+        sessions(
+            service,
+            [this](const json& request) {
+              httplib::Response unused;  // Retry-After for a full queue: set by wrap()
+              return submitRequest(api::parseRenderRequest(request, config.limits), nullptr, unused);
+            },
+            SessionLimits{config.maxSessions, config.sessionIdleS}, config.daemonId.empty() ? "" : config.daemonId + "-") {
     decodeMemory.setEvict([this](std::size_t bytes) {
       decodedImages.dropUnshared(bytes);
       decoded.dropUnshared(bytes);
@@ -711,6 +721,8 @@ struct HttpServer::Impl {
         f(req, res);
       } catch (const api::ApiError& e) {
         if (e.type == "decode-busy" || e.type == "memory-busy") res.set_header("Retry-After", "1");
+        if (e.type == "queue-full" || e.type == "sessions-full")
+          res.set_header("Retry-After", std::to_string(service.retryAfterSeconds()));
         sendProblem(res, e, tRequest.renderId);
       } catch (const std::exception& e) {
         sendProblem(res, 500, "internal-error", "Internal error", e.what(), "", tRequest.renderId);
@@ -785,6 +797,146 @@ struct HttpServer::Impl {
     res.set_header("Server-Timing", buf);
   }
 
+  // Checks a parsed render request's techniques, resolves its scene and images and queues it (POST
+  // /v1/renders, sessions). `req`: the HTTP request whose X-Radiant-Scene header routed it (none for a
+  // session's generations). Sets Retry-After on `res` for a full queue.
+  std::shared_ptr<Job> submitRequest(api::RenderRequest request, const httplib::Request* req, httplib::Response& res) {
+    if (!hooks.techniques.empty())
+      for (const auto& [name, params] : request.passes) {
+        bool known = false;
+        for (const auto& t : hooks.techniques) known = known || t.name == name;
+        if (!known)
+          throw api::ApiError(422, "technique-unavailable", "Technique unavailable",
+                              "/passes/" + name + ": this daemon does not implement \"" + name + "\"",
+                              api::pointerAppend("/passes", name));
+      }
+    // The header is checked before the scene is looked up where the request names its digest (a
+    // forged header routes the render to a daemon that may lack the scene: the header is at fault).
+    const bool named = request.scene.kind == api::SceneRef::Kind::Digest || request.scene.kind == api::SceneRef::Kind::Builtin;
+    if (named && req)
+      checkSceneHeader(*req, request.scene.kind == api::SceneRef::Kind::Digest ? request.scene.value
+                                                                              : builtinDigest(request.scene.value).value_or(""),
+                       "/scene");
+    auto scene = resolveScene(request.scene);
+    if (!named && req) checkSceneHeader(*req, scene->digest, "/scene");
+    // A queued job holds the decoded scene (charged to the decode memory), not the upload's bytes
+    // again: an inline scene's base64 (up to --max-body-bytes) is dropped once decoded.
+    if (request.scene.kind == api::SceneRef::Kind::Inline) std::string().swap(request.scene.value);
+    std::shared_ptr<const Image> compareTarget, environment;
+    if (request.compare && request.compare->against != "reference")
+      compareTarget = resolveImage(request.compare->against, "/compare/against");
+    if (!request.environment.empty()) environment = resolveImage(request.environment, "/environment");
+    try {
+      return service.submit(request, scene, compareTarget, environment, tSceneLoadMs);
+    } catch (const api::ApiError& e) {
+      if (e.type == "queue-full") res.set_header("Retry-After", std::to_string(service.retryAfterSeconds()));
+      throw;
+    }
+  }
+
+  // A refining job's current mean as EXR (the refined AOV and every AOV the outputs name) or PNG (the
+  // refined AOV), with its batch count, error estimate and elapsed time as headers.
+  void sendCurrent(httplib::Response& res, const Job& job, const RefineSnapshot& snap, const std::string& format) {
+    api::OutputSpec spec;
+    spec.format = format == "exr" ? api::ImageFormat::Exr : api::ImageFormat::Png;
+    spec.halfFloat = false;
+    spec.toneMap = job.request.toneMap;
+    spec.aovs = {job.request.refine->aov};
+    if (spec.format == api::ImageFormat::Exr)
+      for (const auto& o : job.request.outputs)
+        for (const auto& a : o.aovs)
+          if (std::find(spec.aovs.begin(), spec.aovs.end(), a) == spec.aovs.end()) spec.aovs.push_back(a);
+    std::string bytes = hooks.encodeFrame(snap.mean, spec, 0, job.request.exposure);
+    res.set_header("X-Radiant-Batches", std::to_string(snap.batches));
+    res.set_header("X-Radiant-Estimated-Rmse",
+                   std::isfinite(snap.estimatedRmse) ? std::to_string(snap.estimatedRmse) : std::string("null"));
+    res.set_header("X-Radiant-Elapsed-Ms", std::to_string(snap.elapsedMs));
+    // With a compare block: the current mean's RMSE against the ground truth (server/Refinement.h).
+    if (snap.metrics.is_object()) res.set_header("X-Radiant-Rmse", snap.metrics["rmse"].dump());
+    res.status = 200;
+    res.set_content(bytes, spec.format == api::ImageFormat::Exr ? "image/x-exr" : "image/png");
+  }
+
+  // One event stream's position: the events sent so far (their ids), and what of the session it has shown.
+  struct EventStream {
+    std::uint64_t sent = 0;
+    bool hello = false, finished = false;
+    int generation = -1, batches = 0;
+    Clock::time_point lastWrite = Clock::now();
+  };
+  static constexpr std::size_t kMaxSessionBodyBytes = 1u << 20;
+
+  // Writes what changed in the session since the stream last looked (httplib calls it again while it
+  // returns true); waits up to 250 ms for a change, so that shutdown and a closed client are noticed.
+  // The stream shows the session's state, not a queue of events: a client that reads slowly skips
+  // frames (each event says its batch count) and holds no memory here.
+  bool pumpEvents(Session& s, EventStream& st, httplib::DataSink& sink) {
+    bool wrote = false, failed = false;
+    auto emit = [&](const char* event, const json& data) {
+      const std::string text = "id: " + std::to_string(++st.sent) + "\nevent: " + event + "\ndata: " + api::dumpSafe(data) + "\n\n";
+      failed = failed || !sink.write(text.data(), text.size());
+      wrote = true;
+      st.lastWrite = Clock::now();
+    };
+    const auto until = Clock::now() + std::chrono::milliseconds(250);
+    while (!wrote && Clock::now() < until) {
+      const SessionStore::View v = sessions.view(s);
+      if (!st.hello) {
+        emit("session", {{"id", s.id}, {"generation", v.generation}});
+        st.hello = true;
+      }
+      if (v.generation != st.generation && v.job) {
+        emit("generation", {{"generation", v.generation}, {"render", v.job->id}});
+        st = EventStream{st.sent, true, false, v.generation, 0, st.lastWrite};
+      }
+      auto frame = [&] {
+        if (!v.job) return;
+        auto snap = service.current(*v.job);
+        if (!snap || snap->batches == st.batches) return;
+        st.batches = snap->batches;
+        json e{{"generation", v.generation},
+               {"render", v.job->id},
+               {"batches", snap->batches},
+               {"elapsed_ms", snap->elapsedMs},
+               {"estimated_rmse", std::isfinite(snap->estimatedRmse) ? json(snap->estimatedRmse) : json(nullptr)},
+               {"noise_rmse", std::isfinite(snap->noiseRmse) ? json(snap->noiseRmse) : json(nullptr)},
+               {"estimate_kind", snap->estimateKind},
+               {"url", "/v1/sessions/" + s.id + "/frame?generation=" + std::to_string(v.generation) + "&batches=" +
+                           std::to_string(snap->batches)},
+               {"stats", snap->batchStats}};
+        if (snap->metrics.is_object()) e["metrics"] = snap->metrics;
+        emit("frame", e);
+      };
+      frame();
+      if (v.job && !st.finished && service.terminal(*v.job)) {
+        frame();  // a last batch may have landed since
+        st.finished = true;
+        const json d = service.describe(*v.job);
+        if (d["state"] == "done")
+          emit("done", {{"generation", v.generation}, {"render", v.job->id}, {"batches", st.batches},
+                        {"stopped_by", d["stats"].value("refinement", json::object()).value("stopped_by", "")}});
+        else if (d["state"] == "failed")
+          emit("error", {{"generation", v.generation}, {"render", v.job->id}, {"error", d.value("error", json())}});
+        // canceled: superseded by the next generation, or the session ended (its event follows)
+      }
+      if (!v.ended.empty()) {
+        emit("ended", {{"reason", v.ended}});
+        if (!failed) sink.done();
+        return !failed;
+      }
+      if (!wrote) {
+        if (Clock::now() - st.lastWrite > std::chrono::seconds(15)) {  // a comment keeps proxies from timing out
+          static const std::string keepAlive = ": keep-alive\n\n";
+          failed = !sink.write(keepAlive.data(), keepAlive.size());
+          st.lastWrite = Clock::now();
+          break;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      }
+    }
+    return !failed && sink.is_writable();
+  }
+
   // ---- routes ---------------------------------------------------------------------------------
   void routes() {
     // Workers start as connections need them (slow clients must not queue health checks behind
@@ -812,7 +964,9 @@ struct HttpServer::Impl {
                     "only POST/PUT /v1/renders, /v1/scenes and /v1/images take a chunked or encoded body");
         return httplib::Server::HandlerResponse::Handled;
       }
-      if (!config.token.empty() && req.path != "/v1/health") {
+      // The viewer's files hold no data (the page asks for the token and sends it with every call).
+      const bool page = req.method == "GET" && (req.path == "/ui" || req.path.rfind("/ui/", 0) == 0);
+      if (!config.token.empty() && req.path != "/v1/health" && !page) {
         const std::string auth = req.get_header_value("Authorization");
         const std::string expected = "Bearer " + config.token;
         // Constant-time comparison: the time taken must not reveal how much of the token matched.
@@ -1025,38 +1179,7 @@ struct HttpServer::Impl {
       if (shuttingDown)
         throw api::ApiError(503, "shutting-down", "Shutting down", "the daemon is shutting down and accepts no new renders");
       api::RenderRequest request = api::parseRenderRequest(std::string_view(requestBody), config.limits);
-      if (!hooks.techniques.empty())
-        for (const auto& [name, params] : request.passes) {
-          bool known = false;
-          for (const auto& t : hooks.techniques) known = known || t.name == name;
-          if (!known)
-            throw api::ApiError(422, "technique-unavailable", "Technique unavailable",
-                                "/passes/" + name + ": this daemon does not implement \"" + name + "\"",
-                                api::pointerAppend("/passes", name));
-        }
-      // The header is checked before the scene is looked up where the request names its digest (a
-      // forged header routes the render to a daemon that may lack the scene: the header is at fault).
-      const bool named = request.scene.kind == api::SceneRef::Kind::Digest || request.scene.kind == api::SceneRef::Kind::Builtin;
-      if (named)
-        checkSceneHeader(req, request.scene.kind == api::SceneRef::Kind::Digest ? request.scene.value
-                                                                                : builtinDigest(request.scene.value).value_or(""),
-                         "/scene");
-      auto scene = resolveScene(request.scene);
-      if (!named) checkSceneHeader(req, scene->digest, "/scene");
-      // A queued job holds the decoded scene (charged to the decode memory), not the upload's bytes
-      // again: an inline scene's base64 (up to --max-body-bytes) is dropped once decoded.
-      if (request.scene.kind == api::SceneRef::Kind::Inline) std::string().swap(request.scene.value);
-      std::shared_ptr<const Image> compareTarget, environment;
-      if (request.compare && request.compare->against != "reference")
-        compareTarget = resolveImage(request.compare->against, "/compare/against");
-      if (!request.environment.empty()) environment = resolveImage(request.environment, "/environment");
-      std::shared_ptr<Job> job;
-      try {
-        job = service.submit(request, scene, compareTarget, environment, tSceneLoadMs);
-      } catch (const api::ApiError& e) {
-        if (e.type == "queue-full") res.set_header("Retry-After", std::to_string(service.retryAfterSeconds()));
-        throw;
-      }
+      std::shared_ptr<Job> job = submitRequest(request, &req, res);
       tRequest.renderId = job->id;
       res.set_header("X-Render-Id", job->id);
       if (request.async) {
@@ -1096,24 +1219,7 @@ struct HttpServer::Impl {
                               "render " + job->id +
                                   (job->request.refine ? " has not finished its first batch yet"
                                                        : " does not refine (the request has no \"refine\")"));
-        api::OutputSpec spec;
-        spec.format = format == "exr" ? api::ImageFormat::Exr : api::ImageFormat::Png;
-        spec.halfFloat = false;
-        spec.toneMap = job->request.toneMap;
-        spec.aovs = {job->request.refine->aov};
-        if (spec.format == api::ImageFormat::Exr)
-          for (const auto& o : job->request.outputs)
-            for (const auto& a : o.aovs)
-              if (std::find(spec.aovs.begin(), spec.aovs.end(), a) == spec.aovs.end()) spec.aovs.push_back(a);
-        std::string bytes = hooks.encodeFrame(snap->mean, spec, 0, job->request.exposure);
-        res.set_header("X-Radiant-Batches", std::to_string(snap->batches));
-        res.set_header("X-Radiant-Estimated-Rmse",
-                       std::isfinite(snap->estimatedRmse) ? std::to_string(snap->estimatedRmse) : std::string("null"));
-        res.set_header("X-Radiant-Elapsed-Ms", std::to_string(snap->elapsedMs));
-        // With a compare block: the current mean's RMSE against the ground truth (server/Refinement.h).
-        if (snap->metrics.is_object()) res.set_header("X-Radiant-Rmse", snap->metrics["rmse"].dump());
-        res.status = 200;
-        res.set_content(bytes, spec.format == api::ImageFormat::Exr ? "image/x-exr" : "image/png");
+        sendCurrent(res, *job, *snap, format);
         return;
       }
       json body = service.describe(*job);
@@ -1136,6 +1242,117 @@ struct HttpServer::Impl {
       }
     }));
 
+    // ---- sessions (server/Sessions.h, docs/API.md "Sessions") ----------------------------------
+    auto sessionBody = [this](const httplib::Request& req) {
+      if (mediaType(req) != "application/json" && mediaType(req) != "application/merge-patch+json")
+        throw api::ApiError(415, "unsupported-media-type", "Unsupported media type",
+                            "session requests are application/json (a change may be application/merge-patch+json), got \"" +
+                                mediaType(req) + "\"");
+      if (req.body.size() > kMaxSessionBodyBytes)
+        throw api::ApiError(413, "payload-too-large", "Payload too large",
+                            "a session request or change is at most " + std::to_string(kMaxSessionBodyBytes) +
+                                " bytes; upload scenes and images (PUT /v1/scenes, /v1/images) and name their digests");
+      return api::parseJson(req.body, config.limits.maxJsonDepth);
+    };
+    auto findSession = [this](const std::string& id) {
+      auto s = sessions.find(id);
+      if (!s)
+        throw api::ApiError(404, "unknown-session", "Unknown session",
+                            "no session " + api::truncateUtf8(id, 80) + " (sessions end on DELETE, after " +
+                                std::to_string(static_cast<int>(config.sessionIdleS)) +
+                                " s without an event stream or a request, and on shutdown)");
+      return s;
+    };
+    http.Post("/v1/sessions", wrap([this, sessionBody](const httplib::Request& req, httplib::Response& res) {
+      if (shuttingDown)
+        throw api::ApiError(503, "shutting-down", "Shutting down", "the daemon is shutting down and opens no sessions");
+      auto s = sessions.create(sessionBody(req));
+      res.set_header("Location", "/v1/sessions/" + s->id);
+      sendJson(res, 201, sessions.describe(*s));
+    }));
+    http.Get("/v1/sessions", wrap([this](const httplib::Request&, httplib::Response& res) {
+      sendJson(res, 200, {{"open", sessions.open()}, {"max_sessions", config.maxSessions}});
+    }));
+    http.Get(R"(/v1/sessions/([A-Za-z0-9_-]+))", wrap([this, findSession](const httplib::Request& req, httplib::Response& res) {
+      sendJson(res, 200, sessions.describe(*findSession(req.matches[1])));
+    }));
+    http.Patch(R"(/v1/sessions/([A-Za-z0-9_-]+))", wrap([this, findSession, sessionBody](const httplib::Request& req, httplib::Response& res) {
+      auto s = findSession(req.matches[1]);
+      if (shuttingDown)
+        throw api::ApiError(503, "shutting-down", "Shutting down", "the daemon is shutting down and renders nothing new");
+      sessions.patch(s, sessionBody(req));
+      sendJson(res, 200, sessions.describe(*s));
+    }));
+    http.Delete(R"(/v1/sessions/([A-Za-z0-9_-]+))", wrap([this, findSession](const httplib::Request& req, httplib::Response& res) {
+      auto s = findSession(req.matches[1]);
+      sessions.end(s->id, "deleted");
+      sendJson(res, 200, {{"id", s->id}, {"ended", "deleted"}});
+    }));
+    // The current generation's refined mean: PNG (default) or EXR, as GET /v1/renders/{id}?current=.
+    http.Get(R"(/v1/sessions/([A-Za-z0-9_-]+)/frame)", wrap([this, findSession](const httplib::Request& req, httplib::Response& res) {
+      auto s = findSession(req.matches[1]);
+      const std::string format = req.has_param("format") ? req.get_param_value("format") : "png";
+      if (format != "exr" && format != "png")
+        throw api::ApiError(400, "invalid-query", "Invalid query parameter", "format: \"" + api::truncateUtf8(format, 40) + "\" is not exr or png");
+      const SessionStore::View v = sessions.view(*s);
+      auto snap = v.job ? service.current(*v.job) : nullptr;
+      if (!snap)
+        throw api::ApiError(409, "no-current-frame", "No current frame",
+                            "session " + s->id + " generation " + std::to_string(v.generation) + " has not finished its first batch yet");
+      res.set_header("X-Radiant-Generation", std::to_string(v.generation));
+      res.set_header("Cache-Control", "no-store");
+      const std::string layer = req.has_param("layer") ? req.get_param_value("layer") : "mean";
+      if (layer == "reference") {  // the compare block's ground truth, in the frame's view transform
+        if (!snap->truth)
+          throw api::ApiError(409, "no-reference", "No reference",
+                              "session " + s->id + " is not scored against a reference (set \"compare\")");
+        RefineSnapshot truth = *snap;
+        truth.mean = {*snap->truth};
+        truth.mean[0].aov = v.job->request.refine->aov;
+        return sendCurrent(res, *v.job, truth, format);
+      }
+      if (layer != "mean")
+        throw api::ApiError(400, "invalid-query", "Invalid query parameter", "layer: \"" + api::truncateUtf8(layer, 40) + "\" is not mean or reference");
+      sendCurrent(res, *v.job, *snap, format);
+    }));
+    // Server-Sent Events: session, generation, frame, done, error, ended (docs/API.md "Sessions").
+    http.Get(R"(/v1/sessions/([A-Za-z0-9_-]+)/events)", wrap([this, findSession](const httplib::Request& req, httplib::Response& res) {
+      auto s = findSession(req.matches[1]);
+      sessions.streamOpened(*s);
+      auto state = std::make_shared<EventStream>();
+      res.set_header("Cache-Control", "no-store");
+      res.set_header("X-Accel-Buffering", "no");  // nginx passes events on as they come
+      res.set_chunked_content_provider(
+          "text/event-stream",
+          [this, s, state](std::size_t, httplib::DataSink& sink) { return pumpEvents(*s, *state, sink); },
+          [this, s](bool) { sessions.streamClosed(*s); });
+    }));
+
+    // ---- the viewer (server/ui, embedded) ------------------------------------------------------
+    auto page = [this](const std::string& name, const char* type) {
+      return wrap([this, name, type](const httplib::Request&, httplib::Response& res) {
+        if (!uiServed(config))
+          throw api::ApiError(404, "ui-off", "Viewer off",
+                              config.ui ? "the viewer is served on a loopback address, or with --token-file, only"
+                                        : "the viewer is off (--ui off)");
+        const std::string_view bytes = ui::find(name);
+        res.set_header("Content-Security-Policy",
+                       "default-src 'none'; script-src 'self'; style-src 'self'; img-src 'self' blob: data:; "
+                       "connect-src 'self'; base-uri 'none'; form-action 'none'; frame-ancestors 'none'");
+        res.set_header("X-Content-Type-Options", "nosniff");
+        res.set_header("Referrer-Policy", "no-referrer");
+        res.set_header("Cache-Control", "no-cache");
+        res.status = 200;
+        res.set_content(std::string(bytes), type);
+      });
+    };
+    http.Get("/ui", wrap([](const httplib::Request&, httplib::Response& res) {
+      res.status = 308;
+      res.set_header("Location", "/ui/");
+    }));
+    http.Get("/ui/", page("index.html", "text/html; charset=utf-8"));
+    http.Get("/ui/viewer.js", page("viewer.js", "text/javascript; charset=utf-8"));
+    http.Get("/ui/viewer.css", page("viewer.css", "text/css; charset=utf-8"));
     http.Get(R"(/v1/frames/([A-Za-z0-9_-]+)/([A-Za-z0-9_.-]+))", wrap([this](const httplib::Request& req, httplib::Response& res) {
       auto frame = frames.get(req.matches[1], req.matches[2]);
       if (!frame)
@@ -1172,6 +1389,7 @@ bool HttpServer::run() { return impl_->http.listen_after_bind(); }
 
 void HttpServer::shutdown() {
   impl_->shuttingDown = true;
+  impl_->sessions.endAll("shutdown");
   impl_->service.drain();
   // Grace period: the renders just finished still have frames to download and jobs to poll
   // (new renders get 503 meanwhile). It ends early once every stored frame has been fetched.

@@ -9,6 +9,7 @@
 // true error the estimate does not see.
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -54,6 +55,8 @@ struct RefineSnapshot {
   const char* estimateKind = "noise_only";
   double elapsedMs = 0;
   nlohmann::json metrics;
+  nlohmann::json batchStats;
+  std::shared_ptr<const Image> truth;  // with a compare block: the ground truth of the compared AOV  // the last batch's stats (passes and their times, camera): a session's events
 };
 
 }  // namespace radiant::server

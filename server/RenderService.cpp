@@ -185,6 +185,7 @@ RenderOutput RenderService::refine(RenderBackend& backend, const std::shared_ptr
   for (const auto& o : job->request.outputs)
     frameHasReference = frameHasReference || std::count(o.aovs.begin(), o.aovs.end(), "reference");
   Image truth;
+  std::shared_ptr<const Image> sharedTruth;  // the same for every snapshot
   json batchMetrics;
   constexpr std::uint64_t kMaxSeed = 9007199254740991ull;  // the schema's bound (2^53 - 1)
   for (int k = 0; k < spec.maxBatches; ++k) {
@@ -224,6 +225,11 @@ RenderOutput RenderService::refine(RenderBackend& backend, const std::shared_ptr
       snap->estimateKind = "against_ground_truth";
     }
     snap->elapsedMs = msBetween(start, Clock::now());
+    snap->batchStats = last.stats;
+    if (compare && !truth.pixels.empty()) {
+      if (!sharedTruth) sharedTruth = std::make_shared<const Image>(truth);
+      snap->truth = sharedTruth;
+    }
     const double estimate = snap->estimatedRmse;
     const double elapsed = snap->elapsedMs;
     {
@@ -287,6 +293,11 @@ RenderOutput RenderService::refine(RenderBackend& backend, const std::shared_ptr
   }
   out.stats.renderMs = msBetween(start, Clock::now());
   return out;
+}
+
+bool RenderService::terminal(const Job& job) {
+  std::lock_guard lock(mutex_);
+  return job.terminal();
 }
 
 RenderService::CancelResult RenderService::cancel(const std::string& id) {

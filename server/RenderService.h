@@ -92,6 +92,8 @@ public:
   // A refine job's current mean and its estimated error (null before its first batch, or not refining).
   std::shared_ptr<const RefineSnapshot> current(const Job& job);
 
+  bool terminal(const Job& job);  // done, failed or canceled (under the lock that guards job.state)
+
   enum class CancelResult { NotFound, Removed, Requested, Forgotten };
   CancelResult cancel(const std::string& id);
 
