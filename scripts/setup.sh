@@ -15,6 +15,7 @@ packages=(
   bsdutils      # `script`: tests/http/client runs radiant render on a pseudo-terminal
   nginx-light   # the reverse proxy in front of several daemons (deploy/nginx, tests/http/fleet)
   python3-yaml  # tests/unit/deploy parses the Kubernetes manifests
+  chromium      # tests/http/viewer drives the viewer page (/ui/) in headless Chromium over DevTools
 )
 
 missing=()
