@@ -168,7 +168,7 @@ async function showFrame(frame) {
       state.lastFrame = frame;
       const sent = state.changeSentAt[generation];
       if (sent !== undefined && batches >= 1 && !state.firstFrameMs.some((f) => f.generation === generation)) {
-        state.firstFrameMs.push({ generation, ms: performance.now() - sent });
+        state.firstFrameMs.push({ generation, width: bitmap.width, ms: performance.now() - sent });
       }
       learnCamera(frame.stats && frame.stats.camera);
       readout(frame);
@@ -298,9 +298,11 @@ async function change(patch) {
 }
 
 function cameraPatch(moving) {
-  // Moving: half resolution, so the frame follows the mouse; at rest: full size.
+  // Moving: half resolution and one raster sample per pixel, so that the frame follows the mouse; at
+  // rest: full size and the daemon's default supersampling.
   const size = moving ? Math.max(32, state.size >> 1) : state.size;
-  return { camera: { orbit: Object.assign({}, state.orbit), target: state.target }, width: size, height: size };
+  return { camera: { orbit: Object.assign({}, state.orbit), target: state.target }, width: size, height: size,
+    supersampling: moving ? 1 : null };
 }
 
 function setupMouse() {

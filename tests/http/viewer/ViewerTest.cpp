@@ -225,7 +225,11 @@ TEST(Viewer, ThePageShowsTheDaemonsFramesFollowsTheMouseAndTheSliders) {
   const json box = browser.eval("(() => { const r = document.getElementById('frame').getBoundingClientRect(); return [r.x, r.y, r.width, r.height]; })()");
   const double x = box[0].get<double>() + box[2].get<double>() / 2, y = box[1].get<double>() + box[3].get<double>() / 2;
   browser.mouse("mousePressed", x, y);
-  for (int step = 1; step <= 4; ++step) browser.mouse("mouseMoved", x + 10 * step, y);
+  browser.mouse("mouseMoved", x + 10, y);
+  // While the mouse is down the frames come at half size.
+  ASSERT_TRUE(browser.waitFor("radiantViewer.state.drawn.generation > " + std::to_string(generation0), 60));
+  EXPECT_EQ(browser.eval("radiantViewer.state.drawn.width"), size / 2) << "moving: half size";
+  for (int step = 2; step <= 4; ++step) browser.mouse("mouseMoved", x + 10 * step, y);
   browser.mouse("mouseReleased", x + 40, y);
   // The release sends the last change (full size); its frame is the one to check.
   ASSERT_TRUE(browser.waitFor("radiantViewer.state.drawn.generation > " + std::to_string(generation0) +
