@@ -457,6 +457,45 @@ TEST_F(Fleet, ZFailoverADaemonKilledMidSweepLosesNoPoint) {
             << " requests on to another daemon and answered 502 to " << badGateway << "\n";
 }
 
+// Sessions through the proxy: opened on the daemon holding the scene, and every session URL (the event
+// stream included, passed on as it comes: X-Accel-Buffering) routed to the daemon that owns it.
+TEST_F(Fleet, SessionsAreRoutedToTheirDaemonAndTheirEventsStreamThroughTheProxy) {
+  auto c = proxy();
+  ASSERT_EQ(c.Put("/v1/scenes", {{"X-Radiant-Scene", digests_[3]}}, scenes_[3], "model/gltf+json")->status / 100, 2);
+  const json request = {{"scene", {{"digest", digests_[3]}}}, {"width", 16}, {"height", 16}, {"refine", {{"max_batches", 2}}}};
+  auto r = c.Post("/v1/sessions", {{"X-Radiant-Scene", digests_[3]}}, request.dump(), "application/json");
+  ASSERT_TRUE(r && r->status == 201) << (r ? r->body : "");
+  const std::string id = json::parse(r->body)["id"];
+  std::smatch m;
+  ASSERT_TRUE(std::regex_match(id, m, std::regex(R"((d[0-2])-s-[0-9a-f]{16})"))) << id;
+  const std::string owner = m[1];
+  EXPECT_EQ(r->get_header_value("X-Radiant-Daemon"), owner);
+  // The stream delivers `done` while it is still open: nginx does not hold the events back.
+  std::string events;
+  auto stream = proxy();
+  stream.set_read_timeout(120, 0);
+  auto sr = stream.Get("/v1/sessions/" + id + "/events", [&](const char* data, std::size_t n) {
+    events.append(data, n);
+    return events.find("event: done") == std::string::npos;
+  });
+  EXPECT_NE(events.find("event: frame"), std::string::npos) << events;
+  EXPECT_NE(events.find("event: done"), std::string::npos) << events;
+  auto frame = c.Get("/v1/sessions/" + id + "/frame");
+  ASSERT_TRUE(frame && frame->status == 200) << (frame ? frame->body : "");
+  EXPECT_EQ(frame->get_header_value("Content-Type"), "image/png");
+  EXPECT_EQ(frame->get_header_value("X-Radiant-Daemon"), owner);
+  auto changed = c.Patch("/v1/sessions/" + id, R"({"seed": 3})", "application/merge-patch+json");
+  ASSERT_TRUE(changed && changed->status == 200) << (changed ? changed->body : "");
+  EXPECT_EQ(json::parse(changed->body)["generation"], 1);
+  // Another daemon's prefix on the same hex: that daemon's own 404.
+  const std::string other = kIds[(indexOf(owner) + 1) % 3];
+  auto forged = c.Get("/v1/sessions/" + other + id.substr(owner.size()));
+  EXPECT_EQ(problemType(forged), "unknown-session");
+  EXPECT_EQ(forged ? forged->get_header_value("X-Radiant-Daemon") : "", other);
+  EXPECT_EQ(c.Delete("/v1/sessions/" + id)->status, 200);
+  EXPECT_EQ(problemType(c.Get("/v1/sessions/" + id)), "unknown-session");
+}
+
 // A single `radiant render` through the proxy survives the loss of its daemon in the middle of the
 // render: the proxy answers 502, the client sends the render again, the next daemon on the ring lacks
 // the scene (404 unknown-scene), the client uploads it there, and the frame is the one the same request
