@@ -460,10 +460,7 @@ struct HttpServer::Impl {
         service(config, hooks, frames, metrics),
         sessions(
             service,
-            [this](const json& request) {
-              httplib::Response unused;  // Retry-After for a full queue: set by wrap()
-              return submitRequest(api::parseRenderRequest(request, config.limits), nullptr, unused);
-            },
+            [this](const json& request) { return submitRequest(api::parseRenderRequest(request, config.limits), nullptr); },
             SessionLimits{config.maxSessions, config.sessionIdleS}, config.daemonId.empty() ? "" : config.daemonId + "-") {
     decodeMemory.setEvict([this](std::size_t bytes) {
       decodedImages.dropUnshared(bytes);
@@ -707,6 +704,7 @@ struct HttpServer::Impl {
         f(req, body, res);
       } catch (const api::ApiError& e) {
         if (e.type == "decode-busy" || e.type == "body-busy" || e.type == "memory-busy") res.set_header("Retry-After", "1");
+        if (e.type == "queue-full") res.set_header("Retry-After", std::to_string(service.retryAfterSeconds()));
         sendProblem(res, e, tRequest.renderId);
       } catch (const std::exception& e) {
         sendProblem(res, 500, "internal-error", "Internal error", e.what(), "", tRequest.renderId);
@@ -799,8 +797,8 @@ struct HttpServer::Impl {
 
   // Checks a parsed render request's techniques, resolves its scene and images and queues it (POST
   // /v1/renders, sessions). `req`: the HTTP request whose X-Radiant-Scene header routed it (none for a
-  // session's generations). Sets Retry-After on `res` for a full queue.
-  std::shared_ptr<Job> submitRequest(api::RenderRequest request, const httplib::Request* req, httplib::Response& res) {
+  // session's generations). A full queue's 503 gets its Retry-After from wrap() / wrapBody().
+  std::shared_ptr<Job> submitRequest(api::RenderRequest request, const httplib::Request* req) {
     if (!hooks.techniques.empty())
       for (const auto& [name, params] : request.passes) {
         bool known = false;
@@ -826,12 +824,7 @@ struct HttpServer::Impl {
     if (request.compare && request.compare->against != "reference")
       compareTarget = resolveImage(request.compare->against, "/compare/against");
     if (!request.environment.empty()) environment = resolveImage(request.environment, "/environment");
-    try {
-      return service.submit(request, scene, compareTarget, environment, tSceneLoadMs);
-    } catch (const api::ApiError& e) {
-      if (e.type == "queue-full") res.set_header("Retry-After", std::to_string(service.retryAfterSeconds()));
-      throw;
-    }
+    return service.submit(request, scene, compareTarget, environment, tSceneLoadMs);
   }
 
   // A refining job's current mean as EXR (the refined AOV and every AOV the outputs name) or PNG (the
@@ -1063,6 +1056,7 @@ struct HttpServer::Impl {
       std::map<std::string, std::pair<std::string, double>> gauges{
           {"radiant_queue_depth", {"Jobs waiting for the render thread.", double(service.queueDepth())}},
           {"radiant_jobs_active", {"Jobs rendering or encoding.", double(service.active())}},
+          {"radiant_sessions_open", {"Progressive sessions open.", double(sessions.open())}},
           {"radiant_ready", {"1 once the render thread has a GL context.", service.ready() ? 1.0 : 0.0}},
           {"radiant_scene_store_bytes", {"Bytes of uploaded scenes stored.", double(scenes.totalBytes())}},
           {"radiant_scene_cache_bytes", {"Bytes of decoded scenes kept in memory (--scene-cache-bytes).", double(decoded.totalBytes())}},
@@ -1179,7 +1173,7 @@ struct HttpServer::Impl {
       if (shuttingDown)
         throw api::ApiError(503, "shutting-down", "Shutting down", "the daemon is shutting down and accepts no new renders");
       api::RenderRequest request = api::parseRenderRequest(std::string_view(requestBody), config.limits);
-      std::shared_ptr<Job> job = submitRequest(request, &req, res);
+      std::shared_ptr<Job> job = submitRequest(request, &req);
       tRequest.renderId = job->id;
       res.set_header("X-Render-Id", job->id);
       if (request.async) {
@@ -1318,7 +1312,10 @@ struct HttpServer::Impl {
     // Server-Sent Events: session, generation, frame, done, error, ended (docs/API.md "Sessions").
     http.Get(R"(/v1/sessions/([A-Za-z0-9_-]+)/events)", wrap([this, findSession](const httplib::Request& req, httplib::Response& res) {
       auto s = findSession(req.matches[1]);
-      sessions.streamOpened(*s);
+      if (!sessions.streamOpened(*s))
+        throw api::ApiError(429, "too-many-streams", "Too many event streams",
+                            "session " + s->id + " already has " + std::to_string(SessionStore::kMaxStreams) +
+                                " event streams open (each holds a connection); close one");
       auto state = std::make_shared<EventStream>();
       res.set_header("Cache-Control", "no-store");
       res.set_header("X-Accel-Buffering", "no");  // nginx passes events on as they come

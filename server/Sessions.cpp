@@ -168,10 +168,12 @@ SessionStore::View SessionStore::view(const Session& s) {
   return {s.generation, s.job, s.ended};
 }
 
-void SessionStore::streamOpened(Session& s) {
+bool SessionStore::streamOpened(Session& s) {
   std::lock_guard lock(mutex_);
+  if (s.streams >= kMaxStreams) return false;
   ++s.streams;
   s.touched = Clock::now();
+  return true;
 }
 
 void SessionStore::streamClosed(Session& s) {

@@ -78,7 +78,10 @@ public:
     std::string ended;
   };
   View view(const Session& s);
-  void streamOpened(Session& s);
+  // Counts an event stream; false (and not counted) when the session has kMaxStreams open already:
+  // each holds an HTTP worker, so that sessions x streams bounds the workers they can take.
+  static constexpr int kMaxStreams = 4;
+  bool streamOpened(Session& s);
   void streamClosed(Session& s);
 
 private:

@@ -295,10 +295,17 @@ TEST(Sessions, TheSessionLimitIs503AndIdleSessionsEnd) {
   EXPECT_FALSE(full->get_header_value("Retry-After").empty());
   // b keeps an event stream open; a is left alone and ends after 0.5 s untouched.
   EventReader events(s.port, b);
+  // Each stream holds a worker: four per session, a fifth is 429.
+  std::vector<std::unique_ptr<EventReader>> more;
+  for (int i = 0; i < 3; ++i) more.push_back(std::make_unique<EventReader>(s.port, b));
+  for (auto& m : more) m->waitFor([](const Event& e) { return e.name == "session"; });
+  expectProblem(c.Get(("/v1/sessions/" + b + "/events").c_str()), 429, "too-many-streams", "");
+  more.clear();
   std::this_thread::sleep_for(std::chrono::milliseconds(1500));
   expectProblem(c.Get(("/v1/sessions/" + a).c_str()), 404, "unknown-session", "");
   EXPECT_EQ(c.Get(("/v1/sessions/" + b).c_str())->status, 200) << "a session with an open stream is not idle";
   EXPECT_EQ(post(c, sessionBody(4))->status, 201) << "the idle session's slot is free again";
+  EXPECT_NE(c.Get("/metrics")->body.find("\nradiant_sessions_open 2\n"), std::string::npos);
   events.stop();
 }
 
