@@ -3,6 +3,11 @@
 // mean s + (n-1)/2 + 0.25 after n batches, so every frame proves which request and batch it is.
 // The event stream, merge patches (a refused one changes nothing), the limits (sessions, idle, body
 // size), a flood of changes, 500 sessions without growth, shutdown, and the viewer page's headers.
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -334,6 +339,34 @@ TEST(Sessions, AFloodOfChangesKeepsOneJobPerSessionAndEndsOnTheLast) {
       EXPECT_GE(e.data["generation"].get<int>(), last) << e.name;
       last = e.data["generation"];
     }
+}
+
+TEST(Sessions, AClientThatNeverReadsItsStreamBlocksNoOne) {
+  TestServer s;
+  s.control.delayMs = 1;  // a thousand batches, each a frame event
+  auto c = s.client();
+  const std::string id = json::parse(post(c, sessionBody(1, 1000))->body)["id"];
+  // A raw connection that asks for the stream and never reads a byte of it.
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(static_cast<std::uint16_t>(s.port));
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
+  const int small = 4096;
+  setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &small, sizeof small);
+  const std::string get = "GET /v1/sessions/" + id + "/events HTTP/1.1\r\nHost: x\r\n\r\n";
+  ASSERT_EQ(write(fd, get.data(), get.size()), static_cast<ssize_t>(get.size()));
+  // Meanwhile a reading client sees the session refine to its end, and changes are taken.
+  EventReader events(s.port, id);
+  const Event done = events.waitFor([](const Event& e) { return e.name == "done"; });
+  EXPECT_EQ(done.data.value("batches", 0), 1000);
+  ASSERT_EQ(patch(c, id, {{"refine", {{"max_batches", 2}}}})->status, 200);
+  EXPECT_EQ(events.waitFor([](const Event& e) { return e.name == "done" && e.data["generation"] == 1; }).name, "done");
+  // (The stalled stream holds no queue by construction: pumpEvents writes the session's state when
+  // the socket takes it. This process's RSS would count the reading client's thousand events too.)
+  close(fd);
+  EXPECT_EQ(c.Get(("/v1/sessions/" + id).c_str())->status, 200);
 }
 
 TEST(Sessions, FiveHundredSessionsLeaveNoJobsAndNoGrowth) {
