@@ -72,8 +72,10 @@ async function openSession(scene) {
     done: null, ended: null });
   const request = Object.assign({ scene, width: state.size, height: state.size }, stripNulls(formRequest()));
   setStatus('opening a session…');
+  const sent = performance.now();
   state.session = await call('POST', '/v1/sessions', request);
-  state.changeSentAt[0] = performance.now();
+  state.changeSentAt = { 0: sent };
+  state.firstFrameMs = [];
   setStatus('session ' + state.session.id);
   listen(state.session.id);
 }
@@ -258,6 +260,7 @@ function drawCurve() {
 
 // The ground truth of the compare block, side by side, and the on-screen difference in false colour.
 async function drawReference(frame) {
+  if (!state.session) return;
   const r = await fetch('/v1/sessions/' + state.session.id + '/frame?layer=reference', { headers: headers() });
   if (!r.ok) return;
   const bitmap = await createImageBitmap(await r.blob());
