@@ -5,6 +5,7 @@
 // PNG; drags the mouse and checks the camera of the next frame's stats; moves the quality slider and
 // checks the session's configuration; and checks the event stream's order and that it ends with the
 // session. It records the time from a camera change to its first frame on screen (docs/PERFORMANCE.md).
+// And 500 sessions against the same daemon leave neither resident nor GL memory behind.
 // Without Chromium it skips, and says so.
 #include <fcntl.h>
 #include <poll.h>
@@ -16,6 +17,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -275,6 +277,58 @@ TEST(Viewer, ThePageShowsTheDaemonsFramesFollowsTheMouseAndTheSliders) {
   // For docs/PERFORMANCE.md: camera change -> its first frame on screen, as the page measured it.
   std::cout << "[viewer] GL " << json::parse(http.Get("/v1/info")->body)["device"].value("renderer", "?")
             << "; change -> first frame on screen (ms; " << size << " px, half that while dragging): " << firstFrames.dump() << "\n";
+  fs::remove_all(dir);
+}
+
+long residentKiB(pid_t pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/status");
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
+  return 0;
+}
+
+// 500 sessions on the real daemon, each opened, changed and ended; every tenth renders to its end with
+// a camera of its own. The daemon's resident set and the GL memory its frames report
+// (stats.memory.resource_bytes) do not grow between the 50th and the 500th.
+TEST(Viewer, FiveHundredSessionsOnTheDaemonLeaveNeitherRssNorGlMemoryBehind) {
+  const fs::path dir = testing::scratch("sessions500");
+  testing::Daemon daemon(RADIANTD_PATH, {"--port", "0"}, {}, dir / "daemon.log");
+  ASSERT_GT(daemon.port(), 0) << daemon.firstLine();
+  ASSERT_TRUE(daemon.waitReady(std::chrono::seconds(120)));
+  auto http = daemon.client();
+  http.set_read_timeout(120, 0);
+  long rss50 = 0;
+  double gl50 = 0, glLast = 0;
+  for (int i = 0; i < 500; ++i) {
+    const json request = {{"scene", {{"builtin", "cornell_box"}}}, {"width", 16}, {"height", 16},
+                          {"camera", {{"orbit", {{"theta_deg", (i * 37) % 360 - 180}, {"phi_deg", 60 + i % 40}}}}},
+                          {"refine", {{"max_batches", 2}}}};
+    auto r = http.Post("/v1/sessions", request.dump(), "application/json");
+    ASSERT_TRUE(r && r->status == 201) << (r ? r->body : "no answer");
+    const std::string id = json::parse(r->body)["id"];
+    ASSERT_EQ(http.Patch(("/v1/sessions/" + id).c_str(), R"({"seed": 1})", "application/merge-patch+json")->status, 200);
+    if (i % 10 == 9) {
+      json session;
+      for (int k = 0; k < 3000; ++k) {
+        session = json::parse(http.Get(("/v1/sessions/" + id).c_str())->body);
+        if (session["render"]["state"] == "done" || session["render"]["state"] == "failed") break;
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      }
+      ASSERT_EQ(session["render"]["state"], "done") << session.dump();
+      glLast = session["render"]["stats"]["memory"].value("resource_bytes", 0.0);
+    }
+    ASSERT_EQ(http.Delete(("/v1/sessions/" + id).c_str())->status, 200);
+    if (i == 49) {
+      rss50 = residentKiB(daemon.pid());
+      gl50 = glLast;
+    }
+  }
+  const long rss500 = residentKiB(daemon.pid());
+  std::cout << "[sessions] RSS " << rss50 << " -> " << rss500 << " KiB, GL resources " << gl50 << " -> " << glLast << " bytes\n";
+  EXPECT_GT(gl50, 0);
+  EXPECT_LE(glLast, gl50 * 1.05 + 1e6) << "GL memory grew over 450 sessions";
+  EXPECT_LT(rss500 - rss50, 32 * 1024) << "KiB of resident growth over 450 sessions";
+  EXPECT_EQ(json::parse(http.Get("/v1/sessions")->body)["open"], 0);
   fs::remove_all(dir);
 }
 
