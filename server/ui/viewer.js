@@ -480,20 +480,101 @@ function setupForms() {
   drop.addEventListener('drop', (e) => {
     e.preventDefault();
     drop.classList.remove('over');
-    if (e.dataTransfer.files.length) upload(e.dataTransfer.files[0]);
+    if (e.dataTransfer.files.length) upload(e.dataTransfer.files);
   });
-  $('file').addEventListener('change', () => { if ($('file').files.length) upload($('file').files[0]); });
+  $('file').addEventListener('change', () => { if ($('file').files.length) upload($('file').files); });
 }
 
-async function upload(file) {
+// A .glb as it is; a .gltf with the files it names (chosen or dropped together) packed into one GLB
+// here, as `radiant render` packs it (renderer/scene/GltfPackage.h): buffers into the BIN chunk (each
+// start 16-byte aligned), external images into bufferViews with their mimeType.
+async function upload(files) {
+  const list = Array.from(files);
+  const main = list.find((f) => /\.(glb|gltf)$/i.test(f.name));
   try {
-    setStatus('uploading ' + file.name + '…');
-    const binary = file.name.toLowerCase().endsWith('.glb');
-    const answer = await call('PUT', '/v1/scenes', await file.arrayBuffer(), binary ? 'model/gltf-binary' : 'model/gltf+json');
+    if (!main) throw new Error('no .glb or .gltf among ' + list.map((f) => f.name).join(', '));
+    setStatus('uploading ' + main.name + '…');
+    const binary = /\.glb$/i.test(main.name);
+    const packed = binary ? null : await packGltf(main, list);  // null: self-contained, sent as it is
+    const answer = packed ? await call('PUT', '/v1/scenes', packed, 'model/gltf-binary')
+      : await call('PUT', '/v1/scenes', await main.arrayBuffer(), binary ? 'model/gltf-binary' : 'model/gltf+json');
     await openSession({ digest: answer.digest });
   } catch (e) {
-    setStatus(file.name + ': ' + e.message, true);
+    setStatus((main ? main.name : 'upload') + ': ' + e.message, true);
   }
+}
+
+const PNG = [0x89, 0x50, 0x4e, 0x47], JPEG = [0xff, 0xd8, 0xff], WEBP = [0x52, 0x49, 0x46, 0x46];
+function mimeOf(bytes) {
+  const starts = (sig) => sig.every((b, i) => bytes[i] === b);
+  if (starts(PNG)) return 'image/png';
+  if (starts(JPEG)) return 'image/jpeg';
+  if (starts(WEBP) && String.fromCharCode(...bytes.slice(8, 12)) === 'WEBP') return 'image/webp';
+  throw new Error('an image is not PNG, JPEG or WebP');
+}
+
+async function packGltf(gltfFile, files) {
+  const doc = JSON.parse(await gltfFile.text());
+  const byName = new Map(files.map((f) => [f.name, f]));
+  const fileFor = async (uri, pointer) => {
+    if (/^[a-z][a-z0-9+.-]*:/i.test(uri)) throw new Error(pointer + ': only relative URIs and data: URIs are packed');
+    const path = decodeURIComponent(uri);
+    if (path.split('/').includes('..')) throw new Error(pointer + ': a ".." segment');
+    const f = byName.get(path.split('/').pop());
+    if (!f) throw new Error(pointer + ': choose or drop ' + path + ' together with ' + gltfFile.name);
+    return new Uint8Array(await f.arrayBuffer());
+  };
+  const dataUri = (uri) => Uint8Array.from(atob(uri.slice(uri.indexOf(',') + 1)), (c) => c.charCodeAt(0));
+  const chunks = [];
+  let length = 0;
+  const append = (bytes) => {
+    const pad = (16 - length % 16) % 16;
+    if (pad) { chunks.push(new Uint8Array(pad)); length += pad; }
+    const offset = length;
+    chunks.push(bytes);
+    length += bytes.length;
+    return offset;
+  };
+  const buffers = doc.buffers || [];
+  if (buffers.some((b) => b.uri === undefined)) throw new Error('buffers without a uri (EXT_meshopt_compression fallbacks): upload it with `radiant render`');
+  if (!buffers.length && !(doc.images || []).some((i) => i.uri && !i.uri.startsWith('data:'))) return null;  // self-contained
+  const offsets = [];
+  for (const [i, b] of buffers.entries())
+    offsets.push(append(b.uri.startsWith('data:') ? dataUri(b.uri) : await fileFor(b.uri, '/buffers/' + i + '/uri')));
+  const rebase = (v) => { v.byteOffset = (v.byteOffset || 0) + offsets[v.buffer]; v.buffer = 0; };
+  for (const v of doc.bufferViews || []) {
+    rebase(v);
+    const m = v.extensions && v.extensions.EXT_meshopt_compression;
+    if (m) rebase(m);
+  }
+  doc.bufferViews = doc.bufferViews || [];
+  for (const [i, img] of (doc.images || []).entries()) {
+    if (!img.uri || img.uri.startsWith('data:')) continue;
+    const bytes = await fileFor(img.uri, '/images/' + i + '/uri');
+    img.mimeType = mimeOf(bytes);
+    img.bufferView = doc.bufferViews.length;
+    doc.bufferViews.push({ buffer: 0, byteOffset: append(bytes), byteLength: bytes.length });
+    delete img.uri;
+  }
+  doc.buffers = [{ byteLength: length }];
+  // GLB: header, JSON chunk (padded with spaces), BIN chunk (padded with zeros), 4-byte aligned.
+  const json = new TextEncoder().encode(JSON.stringify(doc));
+  const jsonLength = (json.length + 3) & ~3, binLength = (length + 3) & ~3;
+  const total = 12 + 8 + jsonLength + 8 + binLength;
+  const out = new Uint8Array(total);
+  const view = new DataView(out.buffer);
+  view.setUint32(0, 0x46546c67, true);  // "glTF"
+  view.setUint32(4, 2, true);
+  view.setUint32(8, total, true);
+  view.setUint32(12, jsonLength, true);
+  view.setUint32(16, 0x4e4f534a, true);  // "JSON"
+  out.set(json, 20);
+  out.fill(0x20, 20 + json.length, 20 + jsonLength);
+  view.setUint32(20 + jsonLength, binLength, true);
+  view.setUint32(24 + jsonLength, 0x004e4942, true);  // "BIN\0"
+  let at = 28 + jsonLength;
+  for (const c of chunks) { out.set(c, at); at += c.length; }
+  return out.buffer;
 }
 
 async function init() {

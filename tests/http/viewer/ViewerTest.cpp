@@ -287,6 +287,56 @@ long residentKiB(pid_t pid) {
   return 0;
 }
 
+// A .gltf chosen with its .bin and image is packed into a GLB by the page and renders exactly as the
+// sample's own .glb does (same request, same frame bytes); the two uploads are different files.
+TEST(Viewer, AGltfWithItsFilesIsPackedByThePageAndRendersAsItsGlb) {
+  const std::string exe = chromiumPath();
+  if (exe.empty()) GTEST_SKIP() << "Chromium is not installed (scripts/setup.sh installs Debian's chromium): the viewer is untested here";
+  const fs::path sample = fs::path(RADIANT_GLTF_SAMPLES_DIR) / "BoxTextured";
+  if (!fs::exists(sample / "glTF" / "BoxTextured.gltf")) GTEST_SKIP() << "no BoxTextured sample in " << RADIANT_GLTF_SAMPLES_DIR;
+  const fs::path dir = testing::scratch("viewer-upload");
+  testing::Daemon daemon(RADIANTD_PATH, {"--port", "0"}, {}, dir / "daemon.log");
+  ASSERT_GT(daemon.port(), 0) << daemon.firstLine();
+  ASSERT_TRUE(daemon.waitReady(std::chrono::seconds(120)));
+  auto http = daemon.client();
+  Browser browser(exe, dir / "profile");
+  browser.open("http://127.0.0.1:" + std::to_string(daemon.port()) + "/ui/");
+  ASSERT_TRUE(browser.waitFor("document.getElementById('status').textContent.startsWith('ready')", 60));
+  browser.eval(R"(const size = document.getElementById('size'); size.appendChild(new Option('64', '64')); size.value = '64';
+    document.getElementById('batches').value = '2'; true)");
+  // Chooses files in the page's file input (as a user would) and waits for that session's refined frame.
+  auto render = [&](const std::vector<std::string>& files) -> std::pair<std::string, std::string> {
+    const std::string before = browser.eval("radiantViewer.state.session ? radiantViewer.state.session.id : ''");
+    const int root = browser.call("DOM.getDocument")["root"]["nodeId"];
+    const int input = browser.call("DOM.querySelector", {{"nodeId", root}, {"selector", "#file"}})["nodeId"];
+    browser.call("DOM.setFileInputFiles", {{"nodeId", input}, {"files", files}});
+    EXPECT_TRUE(browser.waitFor("radiantViewer.state.session && radiantViewer.state.session.id !== '" + before +
+                                "' && radiantViewer.state.done && radiantViewer.state.drawn && "
+                                "radiantViewer.state.drawn.batches === radiantViewer.state.done.batches", 120))
+        << browser.eval("document.getElementById('status').textContent");
+    const std::string id = browser.eval("radiantViewer.state.session.id");
+    const json session = json::parse(http.Get(("/v1/sessions/" + id).c_str())->body);
+    return {session["request"]["scene"].value("digest", ""), http.Get(("/v1/sessions/" + id + "/frame").c_str())->body};
+  };
+  const fs::path gltf = sample / "glTF";
+  const auto [packedDigest, packedFrame] = render({(gltf / "BoxTextured.gltf").string(), (gltf / "BoxTextured0.bin").string(),
+                                                   (gltf / "CesiumLogoFlat.png").string()});
+  const auto [glbDigest, glbFrame] = render({(sample / "glTF-Binary" / "BoxTextured.glb").string()});
+  ASSERT_FALSE(packedDigest.empty());
+  EXPECT_NE(packedDigest, glbDigest) << "two different files were uploaded";
+  ASSERT_GT(packedFrame.size(), 100u);
+  EXPECT_TRUE(packedFrame == glbFrame) << "the packed .gltf renders differently from the sample's .glb";
+  // A .gltf without the files it names: a message naming the missing file, no session.
+  const std::string before = browser.eval("radiantViewer.state.session.id");
+  const int root = browser.call("DOM.getDocument")["root"]["nodeId"];
+  const int input = browser.call("DOM.querySelector", {{"nodeId", root}, {"selector", "#file"}})["nodeId"];
+  browser.call("DOM.setFileInputFiles", {{"nodeId", input}, {"files", {(gltf / "BoxTextured.gltf").string()}}});
+  EXPECT_TRUE(browser.waitFor("document.getElementById('status').textContent.includes('BoxTextured0.bin')", 30))
+      << browser.eval("document.getElementById('status').textContent");
+  EXPECT_EQ(browser.eval("radiantViewer.state.session.id"), before);
+  fs::remove_all(dir);
+}
+
 // 500 sessions on the real daemon, each opened, changed and ended; every tenth renders to its end with
 // a camera of its own. The daemon's resident set and the GL memory its frames report
 // (stats.memory.resource_bytes) do not grow between the 50th and the 500th.
