@@ -96,6 +96,10 @@ struct RefineSpec {
   double targetRmse = 0;   // 0 = no target
   int maxBatches = 64;
   std::string aov = "beauty";  // whose error is estimated
+  // Not in the schema: a session's next generation starts with the seed of the batch its previous one
+  // rendered last (that photon set's splats are on the GPU); the later batches are seed, seed + 1, ...
+  // without it (server/Sessions.h).
+  std::optional<std::uint64_t> firstSeed;
 };
 
 struct RenderRequest {

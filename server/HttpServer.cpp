@@ -460,7 +460,11 @@ struct HttpServer::Impl {
         service(config, hooks, frames, metrics),
         sessions(
             service,
-            [this](const json& request) { return submitRequest(api::parseRenderRequest(request, config.limits), nullptr); },
+            [this](const json& request, std::optional<std::uint64_t> firstSeed) {
+              api::RenderRequest parsed = api::parseRenderRequest(request, config.limits);
+              if (parsed.refine) parsed.refine->firstSeed = firstSeed;
+              return submitRequest(std::move(parsed), nullptr);
+            },
             SessionLimits{config.maxSessions, config.sessionIdleS}, config.daemonId.empty() ? "" : config.daemonId + "-") {
     decodeMemory.setEvict([this](std::size_t bytes) {
       decodedImages.dropUnshared(bytes);

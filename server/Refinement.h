@@ -8,6 +8,7 @@
 // It estimates the variance part of the error only: a biased estimator (photon_gi's kernel blur) has a
 // true error the estimate does not see.
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <memory>
 #include <string>
@@ -50,6 +51,7 @@ nlohmann::json scoreMean(const nlohmann::json& batchMetrics, const Image& mean, 
 struct RefineSnapshot {
   std::vector<Image> mean;
   int batches = 0;
+  std::uint64_t lastSeed = 0;  // the seed of the last batch in the mean
   double estimatedRmse = std::numeric_limits<double>::quiet_NaN();
   double noiseRmse = std::numeric_limits<double>::quiet_NaN();  // BatchMean::estimatedRmse, always
   const char* estimateKind = "noise_only";

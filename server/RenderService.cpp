@@ -168,6 +168,17 @@ std::shared_ptr<const RefineSnapshot> RenderService::current(const Job& job) {
   return job.current;
 }
 
+// Batch k's seed: seed + k (mod m); with a first seed f (a session's next generation), f first, then
+// seed, seed + 1, ... without f, so that the batches' seeds stay distinct.
+std::uint64_t batchSeed(std::uint64_t seed, std::optional<std::uint64_t> first, int k, std::uint64_t m) {
+  const std::uint64_t base = seed % m;
+  if (!first) return (base + static_cast<std::uint64_t>(k)) % m;
+  if (k == 0) return *first % m;
+  const std::uint64_t j = static_cast<std::uint64_t>(k - 1);
+  const std::uint64_t firstOffset = (*first % m + m - base) % m;  // where f sits in seed, seed + 1, ...
+  return (base + j + (firstOffset <= j ? 1 : 0)) % m;
+}
+
 RenderOutput RenderService::refine(RenderBackend& backend, const std::shared_ptr<Job>& job, const Scene& scene,
                                    const FrameInputs& inputs) {
   const api::RefineSpec spec = *job->request.refine;
@@ -198,7 +209,7 @@ RenderOutput RenderService::refine(RenderBackend& backend, const std::shared_ptr
         const double byTime = spec.untilMs > 0 ? msBetween(start, Clock::now()) / spec.untilMs : 0.0;
         inputs.progress(std::clamp(std::max(byBatches, byTime), 0.0, 0.99));
       };
-    batch.seed = (job->request.seed + static_cast<std::uint64_t>(k)) % (kMaxSeed + 1);
+    batch.seed = batchSeed(job->request.seed, spec.firstSeed, k, kMaxSeed + 1);
     const auto t0 = Clock::now();
     last = backend.render(scene, batch, &job->cancel, in);
     slowestBatchMs = std::max(slowestBatchMs, msBetween(t0, Clock::now()));
@@ -215,6 +226,7 @@ RenderOutput RenderService::refine(RenderBackend& backend, const std::shared_ptr
     auto snap = std::make_shared<RefineSnapshot>();
     snap->mean = acc.mean();
     snap->batches = acc.batches();
+    snap->lastSeed = batch.seed;
     snap->noiseRmse = snap->estimatedRmse = acc.estimatedRmse(spec.aov);
     if (compare && !truth.pixels.empty())
       for (const Image& m : snap->mean)

@@ -74,6 +74,10 @@ struct Job {
 // AOV ("/outputs/1/aovs/0") when the passes that ran did not produce it.
 std::vector<Image> selectAovs(const std::vector<Image>& aovs, const api::OutputSpec& spec, std::size_t outputIndex);
 
+// The seed of a refining job's batch k (RenderService::refine): seed + k modulo m, or with a first seed
+// (api::RefineSpec::firstSeed) that one first and then seed, seed + 1, ... without it.
+std::uint64_t batchSeed(std::uint64_t seed, std::optional<std::uint64_t> first, int k, std::uint64_t m);
+
 class RenderService {
 public:
   RenderService(const ServerConfig& config, const BackendHooks& hooks, FrameStore& frames, Metrics& metrics);

@@ -73,7 +73,7 @@ std::shared_ptr<Session> SessionStore::create(const json& body) {
   }
   std::shared_ptr<Job> job;
   try {
-    job = submit_(request);
+    job = submit_(request, std::nullopt);
   } catch (...) {
     std::lock_guard lock(mutex_);
     --reserved_;
@@ -102,7 +102,19 @@ void SessionStore::patch(const std::shared_ptr<Session>& s, const json& change) 
     merged = mergePatch(s->request, change);
   }
   const json request = sessionRequest(merged);
-  std::shared_ptr<Job> job = submit_(request);  // throws: the session keeps its request and job
+  // The next generation's first batch has the seed of the last batch rendered, unless the change names
+  // a seed: that batch's photon set is the one on the GPU, so the cheap frame after a camera move does
+  // not rebuild and upload a splat grid (60-70 ms on llvmpipe; docs/PERFORMANCE.md, "The viewer").
+  std::optional<std::uint64_t> firstSeed;
+  if (!change.contains("seed")) {
+    std::shared_ptr<Job> current;
+    {
+      std::lock_guard lock(mutex_);
+      current = s->job;
+    }
+    if (auto snap = current ? service_.current(*current) : nullptr; snap && snap->batches > 0) firstSeed = snap->lastSeed;
+  }
+  std::shared_ptr<Job> job = submit_(request, firstSeed);  // throws: the session keeps its request and job
   std::shared_ptr<Job> old;
   {
     std::lock_guard lock(mutex_);

@@ -16,6 +16,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -47,7 +48,8 @@ class SessionStore {
 public:
   // Queues a refining job of a session's request (parse, resolve the scene and images, submit);
   // throws api::ApiError naming the field, as POST /v1/renders does.
-  using Submit = std::function<std::shared_ptr<Job>(const nlohmann::json& request)>;
+  // firstSeed: the first batch's seed (api::RefineSpec::firstSeed), or none.
+  using Submit = std::function<std::shared_ptr<Job>(const nlohmann::json& request, std::optional<std::uint64_t> firstSeed)>;
   SessionStore(RenderService& service, Submit submit, SessionLimits limits, std::string idPrefix);
   ~SessionStore();
   SessionStore(const SessionStore&) = delete;
@@ -61,7 +63,8 @@ public:
   // sessions-full, the queue's 503).
   std::shared_ptr<Session> create(const nlohmann::json& request);
   // Applies a JSON merge patch (RFC 7386) to the session's request; on success the next generation
-  // is queued and the previous job canceled. A refused patch changes nothing.
+  // is queued and the previous job canceled. A refused patch changes nothing. Unless the patch names
+  // `seed`, the new generation's first batch has the seed of the last batch rendered (batchSeed).
   void patch(const std::shared_ptr<Session>& s, const nlohmann::json& mergePatch);
   // nullptr when unknown or ended; touches it.
   std::shared_ptr<Session> find(const std::string& id);

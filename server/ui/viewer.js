@@ -301,9 +301,9 @@ async function change(patch) {
 }
 
 function cameraPatch(moving) {
-  // Moving: half resolution and one raster sample per pixel, so that the frame follows the mouse; at
-  // rest: full size and the daemon's default supersampling.
-  const size = moving ? Math.max(32, state.size >> 1) : state.size;
+  // Moving: a quarter of the resolution and one raster sample per pixel, so that the frame follows the
+  // mouse; at rest: full size and the daemon's default supersampling.
+  const size = moving ? Math.max(32, state.size >> 2) : state.size;
   return { camera: { orbit: Object.assign({}, state.orbit), target: state.target }, width: size, height: size,
     supersampling: moving ? 1 : null };
 }

@@ -24,6 +24,7 @@
 #include "FakeBackend.h"
 #include "server/Config.h"
 #include "server/HttpServer.h"
+#include "server/RenderService.h"
 
 using nlohmann::json;
 using radiant::server::HttpServer;
@@ -216,6 +217,15 @@ TEST(Sessions, EventsFollowEachGenerationInOrderAndFramesAreItsMeans) {
   EXPECT_EQ(f->get_header_value("X-Radiant-Generation"), "1");
   EXPECT_NEAR(frameValue(f->body), 21.25, 1e-5);
 
+  // A change that names no seed starts from the last batch's seed (its photons are on the GPU), then
+  // goes on from the request's seed without it: batches 22 and 20 (a restart would be 20 and 21).
+  r = patch(c, id, {{"width", 16}, {"refine", {{"max_batches", 2}}}});
+  ASSERT_EQ(r->status, 200) << r->body;
+  EXPECT_EQ(json::parse(r->body)["request"]["seed"], 20) << "the session's request keeps the seed it was given";
+  ASSERT_EQ(events.waitFor([](const Event& e) { return e.name == "done" && e.data["generation"] == 2; }).name, "done");
+  EXPECT_NEAR(frameValue(c.Get(("/v1/sessions/" + id + "/frame").c_str())->body), 21.25, 1e-5);
+  EXPECT_EQ(events.waitFor([](const Event& e) { return e.name == "done" && e.data["generation"] == 2; }).data["batches"], 2);
+
   ASSERT_EQ(c.Delete(("/v1/sessions/" + id).c_str())->status, 200);
   const Event ended = events.waitFor([](const Event& e) { return e.name == "ended"; });
   EXPECT_EQ(ended.data["reason"], "deleted");
@@ -226,7 +236,7 @@ TEST(Sessions, EventsFollowEachGenerationInOrderAndFramesAreItsMeans) {
   // In order: ids 1, 2, 3, ... without a gap; session first, ended last; per generation: generation,
   // frames with batches 1, 2, 3, done.
   const std::vector<Event> all = events.events();
-  ASSERT_GE(all.size(), 11u);
+  ASSERT_GE(all.size(), 16u);
   for (std::size_t i = 0; i < all.size(); ++i) EXPECT_EQ(all[i].id, long(i + 1)) << all[i].name;
   EXPECT_EQ(all.front().name, "session");
   EXPECT_EQ(all.back().name, "ended");
@@ -235,7 +245,8 @@ TEST(Sessions, EventsFollowEachGenerationInOrderAndFramesAreItsMeans) {
     names.push_back(e.name + (e.name == "frame" ? std::to_string(e.data["batches"].get<int>()) : "") +
                     (e.data.contains("generation") ? "@" + std::to_string(e.data["generation"].get<int>()) : ""));
   const std::vector<std::string> expected{"session@0", "generation@0", "frame1@0", "frame2@0", "frame3@0", "done@0",
-                                          "generation@1", "frame1@1",  "frame2@1", "frame3@1", "done@1", "ended"};
+                                          "generation@1", "frame1@1",  "frame2@1", "frame3@1", "done@1",
+                                          "generation@2", "frame1@2",  "frame2@2", "done@2", "ended"};
   EXPECT_EQ(names, expected);
   // A frame event carries what the viewer draws and plots.
   for (const Event& e : all)
@@ -245,6 +256,23 @@ TEST(Sessions, EventsFollowEachGenerationInOrderAndFramesAreItsMeans) {
       EXPECT_TRUE(e.data.contains("estimated_rmse")) << e.data;
     }
   expectProblem(c.Get(("/v1/sessions/" + id).c_str()), 404, "unknown-session", "");
+}
+
+TEST(Sessions, BatchSeedsStartWithTheFirstSeedAndStayDistinct) {
+  using radiant::server::batchSeed;
+  const std::uint64_t m = 9007199254740992ull;
+  EXPECT_EQ(batchSeed(10, std::nullopt, 3, m), 13u);
+  EXPECT_EQ(batchSeed(m - 1, std::nullopt, 2, m), 1u);  // wraps at the schema's bound
+  // First 12, then 10, 11, 13, 14 (12 skipped); a first seed outside the run skips nothing.
+  std::vector<std::uint64_t> seeds;
+  for (int k = 0; k < 5; ++k) seeds.push_back(batchSeed(10, 12, k, m));
+  EXPECT_EQ(seeds, (std::vector<std::uint64_t>{12, 10, 11, 13, 14}));
+  EXPECT_EQ(batchSeed(10, 5, 1, m), 10u);
+  EXPECT_EQ(batchSeed(10, 5, 3, m), 12u);
+  // Across the wrap: seed m-2, first 0: 0, m-2, m-1, 1.
+  seeds.clear();
+  for (int k = 0; k < 4; ++k) seeds.push_back(batchSeed(m - 2, 0, k, m));
+  EXPECT_EQ(seeds, (std::vector<std::uint64_t>{0, m - 2, m - 1, 1}));
 }
 
 TEST(Sessions, ARefusedRequestOrChangeNamesItsFieldAndChangesNothing) {
