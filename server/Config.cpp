@@ -88,6 +88,8 @@ std::string usage() {
                             job and frame URLs) start with "ID-" for the proxy to route on (docs/DEPLOYMENT.md)
   --max-sessions N          progressive sessions open at once (default 8; docs/API.md, "Sessions")
   --session-idle-s S        a session without an open event stream ends after S s untouched (default 60)
+  --reports-dir DIR         serve the sweep reports under DIR (radiant report -o DIR/NAME) read-only
+                            at /reports/, linked from the viewer
   --ui auto|off             the viewer page at /ui/: auto serves it on a loopback address, or on any
                             address when a token is required (default auto)
 )";
@@ -186,6 +188,7 @@ void apply(ServerConfig& c, const std::string& name, const std::string& v, std::
   }
   else if (name == "max-sessions") c.maxSessions = static_cast<int>(toInt(flag, v, 1, 1024));
   else if (name == "session-idle-s") c.sessionIdleS = toDouble(flag, v);
+  else if (name == "reports-dir") c.reportsDir = v;
   else if (name == "ui") {
     if (v != "auto" && v != "off") throw std::invalid_argument(flag + ": expected auto or off, got \"" + v + "\"");
     c.ui = v == "auto";

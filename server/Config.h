@@ -65,6 +65,8 @@ struct ServerConfig {
   // The viewer page (/ui/): false = off. On, it is served when the daemon is bound to a loopback
   // address or requires a token (uiServed()).
   bool ui = true;
+  // Sweep reports (`radiant report -o DIR/NAME`) served read-only under /reports/ ("" = none).
+  std::string reportsDir;
 };
 
 // Whether /ui/ is served: on, and either bound to loopback or behind a token.

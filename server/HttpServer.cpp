@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <functional>
 #include <future>
 #include <iostream>
@@ -1327,6 +1330,74 @@ struct HttpServer::Impl {
           "text/event-stream",
           [this, s, state](std::size_t, httplib::DataSink& sink) { return pumpEvents(*s, *state, sink); },
           [this, s](bool) { sessions.streamClosed(*s); });
+    }));
+
+    // ---- sweep reports (--reports-dir), read-only --------------------------------------------
+    // A report's files only: names of [A-Za-z0-9_.-] not starting with '.', at most one folder deep
+    // inside the report, resolved (through symlinks) inside the reports folder, of a known type.
+    static const std::map<std::string, std::string> kReportTypes{
+        {".html", "text/html; charset=utf-8"}, {".svg", "image/svg+xml"}, {".png", "image/png"},
+        {".md", "text/markdown; charset=utf-8"}, {".json", "application/json"}, {".jsonl", "application/x-ndjson"},
+        {".txt", "text/plain; charset=utf-8"}, {".csv", "text/csv; charset=utf-8"}};
+    auto reportHeaders = [](httplib::Response& res) {
+      // Reports carry inline styles and SVG, never scripts.
+      res.set_header("Content-Security-Policy",
+                     "default-src 'none'; img-src 'self' data:; style-src 'unsafe-inline'; base-uri 'none'; "
+                     "form-action 'none'; frame-ancestors 'none'");
+      res.set_header("X-Content-Type-Options", "nosniff");
+      res.set_header("Cache-Control", "no-cache");
+    };
+    auto reportsRoot = [this]() {
+      std::error_code ec;
+      const std::filesystem::path root = config.reportsDir.empty() ? std::filesystem::path() : std::filesystem::canonical(config.reportsDir, ec);
+      if (config.reportsDir.empty() || ec)
+        throw api::ApiError(404, "reports-off", "No reports",
+                            config.reportsDir.empty() ? "this daemon serves no sweep reports (radiantd --reports-dir DIR)"
+                                                      : "the reports folder " + config.reportsDir + " does not exist");
+      return root;
+    };
+    http.Get("/reports/", wrap([reportHeaders, reportsRoot](const httplib::Request&, httplib::Response& res) {
+      const std::filesystem::path root = reportsRoot();
+      std::vector<std::pair<std::filesystem::file_time_type, std::string>> reports;
+      std::error_code ec;
+      for (const auto& e : std::filesystem::directory_iterator(root, ec)) {
+        const std::string name = e.path().filename().string();
+        if (name.empty() || name[0] == '.' || !e.is_directory(ec) || !std::filesystem::is_regular_file(e.path() / "report.html", ec)) continue;
+        if (!std::all_of(name.begin(), name.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.'; }))
+          continue;
+        reports.emplace_back(std::filesystem::last_write_time(e.path() / "report.html", ec), name);
+      }
+      std::sort(reports.rbegin(), reports.rend());  // newest first
+      std::string page = "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>Sweep reports</title></head>\n"
+                         "<body><h1>Sweep reports</h1>\n<ul>\n";
+      for (const auto& [when, name] : reports) page += "<li><a href=\"" + name + "/report.html\">" + name + "</a></li>\n";
+      page += std::string("</ul>\n") + (reports.empty() ? "<p>None yet: <code>radiant report RESULTS.jsonl -o DIR/NAME</code>.</p>\n" : "") +
+              "</body></html>\n";
+      reportHeaders(res);
+      res.status = 200;
+      res.set_content(page, "text/html; charset=utf-8");
+    }));
+    http.Get(R"(/reports/([A-Za-z0-9_-][A-Za-z0-9_.-]*)/((?:[A-Za-z0-9_-][A-Za-z0-9_.-]*/)?[A-Za-z0-9_-][A-Za-z0-9_.-]*))",
+             wrap([reportHeaders, reportsRoot](const httplib::Request& req, httplib::Response& res) {
+      const std::filesystem::path root = reportsRoot();
+      const std::string rel = std::string(req.matches[1]) + "/" + std::string(req.matches[2]);
+      auto notFound = [&] {
+        return api::ApiError(404, "unknown-report-file", "Unknown report file", "no report file " + api::truncateUtf8(rel, 200));
+      };
+      if (rel.find("..") != std::string::npos) throw notFound();
+      std::error_code ec;
+      const std::filesystem::path file = std::filesystem::canonical(root / rel, ec);
+      const auto type = kReportTypes.find(file.extension().string());
+      if (ec || type == kReportTypes.end() || !std::filesystem::is_regular_file(file, ec)) throw notFound();
+      auto [inside, rest] = std::mismatch(root.begin(), root.end(), file.begin(), file.end());
+      if (inside != root.end()) throw notFound();  // a symlink out of the reports folder
+      const auto size = std::filesystem::file_size(file, ec);
+      if (ec || size > (std::uintmax_t(64) << 20)) throw notFound();
+      std::ifstream in(file, std::ios::binary);
+      std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      reportHeaders(res);
+      res.status = 200;
+      res.set_content(bytes, type->second);
     }));
 
     // ---- the viewer (server/ui, embedded) ------------------------------------------------------

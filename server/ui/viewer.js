@@ -592,6 +592,10 @@ async function init() {
     }
     if ([...select.options].some((o) => o.value === 'cornell_box')) select.value = 'cornell_box';
     buildPassForm(state.info.techniques || []);
+    // The sweep reports this daemon serves (radiantd --reports-dir), if any.
+    const reports = await fetch('/reports/', { method: 'HEAD', headers: headers() });
+    $('reports').hidden = !reports.ok;
+    $('no-reports').hidden = reports.ok;
     setStatus('ready: open a scene');
   } catch (e) {
     setStatus(e.status === 401 ? 'this daemon needs its token (above)' : e.message, true);

@@ -12,6 +12,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <filesystem>
 #include <fstream>
 #include <mutex>
 #include <string>
@@ -433,6 +434,49 @@ TEST(Sessions, ShutdownEndsEverySessionAndItsStream) {
   const Event ended = events.waitFor([](const Event& e) { return e.name == "ended"; });
   stopper.join();
   EXPECT_EQ(ended.data["reason"], "shutdown");
+}
+
+TEST(Sessions, SweepReportsAreServedReadOnlyFromTheReportsFolderOnly) {
+  const auto root = std::filesystem::temp_directory_path() / ("radiant-reports-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(root);
+  std::filesystem::create_directories(root / "reports" / "sweep-a" / "plots");
+  std::filesystem::create_directories(root / "reports" / "not-a-report");
+  std::ofstream(root / "reports" / "sweep-a" / "report.html") << "<html><body><img src=\"plots/p.svg\"></body></html>";
+  std::ofstream(root / "reports" / "sweep-a" / "plots" / "p.svg") << "<svg xmlns=\"http://www.w3.org/2000/svg\"/>";
+  std::ofstream(root / "reports" / "sweep-a" / "results.bin") << "x";
+  std::ofstream(root / "secret.html") << "TOP-SECRET-CONTENT";
+  std::filesystem::create_symlink(root / "secret.html", root / "reports" / "sweep-a" / "link.html");
+  {
+    TestServer off;
+    auto c = off.client();
+    expectProblem(c.Get("/reports/"), 404, "reports-off", "");
+  }
+  ServerConfig config;
+  config.reportsDir = (root / "reports").string();
+  TestServer s(config);
+  auto c = s.client();
+  auto list = c.Get("/reports/");
+  ASSERT_EQ(list->status, 200) << list->body;
+  EXPECT_NE(list->body.find("href=\"sweep-a/report.html\""), std::string::npos) << list->body;
+  EXPECT_EQ(list->body.find("not-a-report"), std::string::npos) << "a folder without report.html is not listed";
+  EXPECT_NE(list->get_header_value("Content-Security-Policy").find("default-src 'none'"), std::string::npos);
+  auto page = c.Get("/reports/sweep-a/report.html");
+  ASSERT_EQ(page->status, 200);
+  EXPECT_EQ(page->get_header_value("Content-Type"), "text/html; charset=utf-8");
+  EXPECT_EQ(page->get_header_value("Content-Security-Policy").find("script-src"), std::string::npos) << "no scripts run";
+  auto plot = c.Get("/reports/sweep-a/plots/p.svg");
+  ASSERT_EQ(plot->status, 200);
+  EXPECT_EQ(plot->get_header_value("Content-Type"), "image/svg+xml");
+  // Outside the folder, through a symlink, hidden, of an unknown type, or with '..': 404.
+  for (const std::string path : {"/reports/sweep-a/link.html", "/reports/sweep-a/results.bin", "/reports/../secret.html",
+                                 "/reports/sweep-a/..%2f..%2fsecret.html", "/reports/sweep-a/plots/../../../secret.html",
+                                 "/reports/.hidden/report.html", "/reports/sweep-a/missing.html"}) {
+    auto r = c.Get(path.c_str());
+    ASSERT_TRUE(r) << path;
+    EXPECT_EQ(r->status, 404) << path << ": " << r->body;
+    EXPECT_EQ(r->body.find("TOP-SECRET-CONTENT"), std::string::npos) << path;
+  }
+  std::filesystem::remove_all(root);
 }
 
 TEST(Sessions, TheViewerIsSameOriginWithAStrictPolicyAndOffWhenExposedWithoutAToken) {

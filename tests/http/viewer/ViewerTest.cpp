@@ -175,6 +175,7 @@ TEST(Viewer, ThePageShowsTheDaemonsFramesFollowsTheMouseAndTheSliders) {
   browser.open(base + "/ui/");
   ASSERT_TRUE(browser.waitFor("document.getElementById('status').textContent.startsWith('ready')", 60))
       << browser.eval("document.getElementById('status').textContent");
+  EXPECT_EQ(browser.eval("document.getElementById('reports').hidden"), true) << "no --reports-dir: no link";
 
   // Open the Cornell box at 64x64 (RADIANT_VIEWER_SIZE: another size, for docs/PERFORMANCE.md),
   // refining 4 batches.
