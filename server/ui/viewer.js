@@ -87,29 +87,32 @@ async function endSession() {
   if (s) { try { await call('DELETE', '/v1/sessions/' + s.id); } catch (e) { /* already ended */ } }
 }
 
+// Reads the session's event stream; when the connection drops while the session is still this page's
+// (a proxy's timeout, a network change), it connects again a second later: the new stream starts with
+// the session's state, so nothing is lost but skipped frames.
 async function listen(id) {
   const ctrl = new AbortController();
   abortEvents = ctrl;
-  let r;
   try {
-    r = await fetch('/v1/sessions/' + id + '/events', { headers: headers(), signal: ctrl.signal });
-  } catch (e) { return; }
-  if (!r.ok) { setStatus('events: HTTP ' + r.status, true); return; }
-  const reader = r.body.getReader();
-  const decoder = new TextDecoder();
-  let buffer = '';
-  for (;;) {
-    let chunk;
-    try { chunk = await reader.read(); } catch (e) { return; }
-    if (chunk.done) return;
-    buffer += decoder.decode(chunk.value, { stream: true });
-    let end;
-    while ((end = buffer.indexOf('\n\n')) >= 0) {
-      const block = buffer.slice(0, end);
-      buffer = buffer.slice(end + 2);
-      parseEvent(block);
+    const r = await fetch('/v1/sessions/' + id + '/events', { headers: headers(), signal: ctrl.signal });
+    if (!r.ok) { setStatus('events: HTTP ' + r.status, true); return; }
+    const reader = r.body.getReader();
+    const decoder = new TextDecoder();
+    let buffer = '';
+    for (;;) {
+      const chunk = await reader.read();
+      if (chunk.done) break;
+      buffer += decoder.decode(chunk.value, { stream: true });
+      let end;
+      while ((end = buffer.indexOf('\n\n')) >= 0) {
+        const block = buffer.slice(0, end);
+        buffer = buffer.slice(end + 2);
+        parseEvent(block);
+      }
     }
-  }
+  } catch (e) { /* aborted, or the connection broke */ }
+  if (!ctrl.signal.aborted && !state.ended && state.session && state.session.id === id)
+    setTimeout(() => { if (state.session && state.session.id === id && !state.ended) listen(id); }, 1000);
 }
 
 function parseEvent(block) {
