@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "FakeBackend.h"
+#include "TestServer.h"
 #include "api/Sha256.h"
 #include "server/Config.h"
 #include "server/HttpServer.h"
@@ -25,44 +26,9 @@ using nlohmann::json;
 using radiant::server::HttpServer;
 using radiant::server::ServerConfig;
 using radiant::test::FakeControl;
+using radiant::test::TestServer;
 
 namespace {
-
-struct TestServer {
-  FakeControl control;
-  std::unique_ptr<HttpServer> server;
-  std::thread thread;
-  int port = 0;
-
-  explicit TestServer(ServerConfig config = {}) {
-    config.port = 0;
-    server = std::make_unique<HttpServer>(config, radiant::test::fakeHooks(control));
-    port = server->bind();
-    thread = std::thread([this] { server->run(); });
-  }
-  ~TestServer() { stop(); }
-  void stop() {
-    if (!server) return;
-    control.open();
-    server->shutdown();
-    thread.join();
-    server.reset();
-  }
-  httplib::Client client(int readTimeoutS = 20) const {
-    httplib::Client c("127.0.0.1", port);
-    c.set_read_timeout(readTimeoutS, 0);
-    return c;
-  }
-  void waitReady() {
-    auto c = client();
-    for (int i = 0; i < 500; ++i) {
-      auto r = c.Get("/v1/ready");
-      if (r && r->status == 200) return;
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    FAIL() << "not ready";
-  }
-};
 
 json renderBody(std::uint64_t seed = 1, int w = 8, int h = 4) {
   return json{{"scene", {{"builtin", "tiny"}}}, {"width", w}, {"height", h}, {"seed", seed}};

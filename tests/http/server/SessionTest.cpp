@@ -23,6 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include "FakeBackend.h"
+#include "TestServer.h"
 #include "server/Config.h"
 #include "server/HttpServer.h"
 #include "server/RenderService.h"
@@ -34,36 +35,11 @@ using radiant::test::FakeControl;
 
 namespace {
 
-struct TestServer {
-  FakeControl control;
-  std::unique_ptr<HttpServer> server;
-  std::thread thread;
-  int port = 0;
-
-  explicit TestServer(ServerConfig config = {}) {
-    config.port = 0;
-    server = std::make_unique<HttpServer>(config, radiant::test::fakeHooks(control));
-    port = server->bind();
-    thread = std::thread([this] { server->run(); });
-    auto c = client();
-    for (int i = 0; i < 500; ++i) {
-      auto r = c.Get("/v1/ready");
-      if (r && (r->status == 200 || r->status == 401)) break;  // 401: a token is required
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-  }
-  ~TestServer() { stop(); }
-  void stop() {
-    if (!server) return;
-    control.open();
-    server->shutdown();
-    thread.join();
-    server.reset();
-  }
-  httplib::Client client() const {
-    httplib::Client c("127.0.0.1", port);
-    c.set_read_timeout(20, 0);
-    return c;
+// The shared in-process server, up and ready (a server that requires a token is only up: /v1/ready is
+// then 401 without it).
+struct TestServer : radiant::test::TestServer {
+  explicit TestServer(ServerConfig config = {}) : radiant::test::TestServer(config) {
+    if (config.token.empty()) waitReady();
   }
 };
 
