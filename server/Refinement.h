@@ -57,8 +57,8 @@ struct RefineSnapshot {
   const char* estimateKind = "noise_only";
   double elapsedMs = 0;
   nlohmann::json metrics;
-  nlohmann::json batchStats;
-  std::shared_ptr<const Image> truth;  // with a compare block: the ground truth of the compared AOV  // the last batch's stats (passes and their times, camera): a session's events
+  nlohmann::json batchStats;  // the last batch's stats (passes and their times, camera): a session's events
+  std::shared_ptr<const Image> truth;  // with a compare block: the ground truth of the compared AOV
 };
 
 }  // namespace radiant::server
