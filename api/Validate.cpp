@@ -312,6 +312,7 @@ const std::vector<TechniqueSchema>& techniqueSchemas() {
       t.onByDefault = d.at("on_by_default");
       t.claimsWhenNamed = d.at("claims_when_named");
       t.exclusive = d.at("exclusive");
+      t.bench = d.at("bench");
       out.push_back(std::move(t));
     }
     return out;
@@ -330,7 +331,8 @@ json to_json_value(const TechniqueSchema& t) {
               {"summary", t.summary},
               {"description", t.description},
               {"outputs", t.outputs},
-              {"params", t.params}};
+              {"params", t.params},
+              {"bench", t.bench}};
 }
 
 const char* toString(ImageFormat f) { return f == ImageFormat::Exr ? "exr" : "png"; }

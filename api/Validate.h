@@ -92,6 +92,9 @@ struct TechniqueSchema {
   nlohmann::json params;  // name -> {type, default, minimum?, maximum?, enum?, description}
   std::vector<std::string> inputs, optionalInputs, after, resources, lightPaths, requiredPaths;
   bool addsToBeauty = false, onByDefault = false, claimsWhenNamed = false, exclusive = false;
+  // `radiant bench`'s preset: {"axes": {param: {"full": [...], "quick": [...]}}, "request": {...},
+  // "compare": {...}} (the descriptor's "bench", checked against the parameters at build time).
+  nlohmann::json bench;
 };
 const std::vector<TechniqueSchema>& techniqueSchemas();
 const TechniqueSchema* findTechnique(std::string_view name);

@@ -98,6 +98,50 @@ json flag(const std::string& file, const json& t, const char* key, bool required
   return t[key];
 }
 
+// The technique's preset for `radiant bench` (client/commands/Sweep.cpp): the parameter values its
+// sweep crosses, in the full run and under --quick, the request fields it adds, and the compare block
+// used when none of its outputs has a ground truth. Every axis must be one of its parameters and every
+// value one its schema accepts, so the bench never sends a request the server refuses.
+//   "bench": {"axes": {"<param>": [v, ...] | {"full": [v, ...], "quick": [v, ...]}},
+//             "request": {...}, "compare": {...}}
+json benchPreset(const std::string& file, const json& t, const json& params) {
+  const json b = t.value("bench", json::object());
+  if (!b.is_object()) fail(file, "\"bench\" must be an object");
+  static const std::set<std::string> kAllowed{"axes", "request", "compare"};
+  for (const auto& [k, v] : b.items())
+    if (!kAllowed.count(k)) fail(file, "bench: unknown key \"" + k + "\"");
+  json out = {{"axes", json::object()},
+              {"request", b.value("request", json::object())},
+              {"compare", b.value("compare", json::object())}};
+  for (const char* k : {"request", "compare"})
+    if (!out[k].is_object()) fail(file, std::string("bench.") + k + " must be an object");
+  const json axes = b.value("axes", json::object());
+  if (!axes.is_object()) fail(file, "bench.axes must be an object");
+  for (const auto& [name, spec] : axes.items()) {
+    const std::string where = "bench.axes." + name;
+    if (!params.contains(name)) fail(file, where + " is not one of its \"params\"");
+    const json& p = params[name];
+    json modes = spec.is_array() ? json{{"full", spec}, {"quick", spec}} : spec;
+    if (!modes.is_object() || !modes.contains("full") || !modes.contains("quick") || modes.size() != 2)
+      fail(file, where + " must be an array of values or {\"full\": [...], \"quick\": [...]}");
+    for (const auto& [mode, values] : modes.items()) {
+      if (!values.is_array() || values.empty()) fail(file, where + "." + mode + " must be a non-empty array");
+      for (const auto& v : values) {
+        const std::string type = p["type"];
+        const bool typeOk = (type == "integer" && v.is_number_integer()) || (type == "number" && v.is_number()) ||
+                            (type == "boolean" && v.is_boolean()) || (type == "string" && v.is_string());
+        if (!typeOk) fail(file, where + ": " + v.dump() + " is not of type " + type);
+        if ((p.contains("minimum") && v.is_number() && v.get<double>() < p["minimum"].get<double>()) ||
+            (p.contains("maximum") && v.is_number() && v.get<double>() > p["maximum"].get<double>()) ||
+            (p.contains("enum") && std::find(p["enum"].begin(), p["enum"].end(), v) == p["enum"].end()))
+          fail(file, where + ": " + v.dump() + " is outside the parameter's range");
+      }
+    }
+    out["axes"][name] = modes;
+  }
+  return out;
+}
+
 // One row of the AOV table (api/Aovs.h, AovInfo) with every default filled in: the resource is the
 // AOV's own name, channels 3 (R, G, B; 1: Y; 4: R, G, B, A), resolve average, radiance true.
 json aovRow(const std::string& file, const std::string& technique, const std::string& aov, const json& r) {
@@ -179,7 +223,7 @@ int main(int argc, char** argv) {
       static const std::set<std::string> kAllowed{
           "name",   "summary",   "description", "inputs",         "optional_inputs", "after",
           "outputs", "resources", "aovs",       "adds_to_beauty", "on_by_default",   "light_paths",
-          "requires_paths", "claims_when_named", "exclusive", "params"};
+          "requires_paths", "claims_when_named", "exclusive", "params", "bench"};
       for (const auto& [k, v] : t.items())
         if (!kAllowed.count(k)) fail(file, "unknown key \"" + k + "\"");
       if (!t.contains("name") || !t["name"].is_string()) fail(file, "missing \"name\"");
@@ -219,6 +263,7 @@ int main(int argc, char** argv) {
       if (!params.is_object()) fail(file, "\"params\" must be an object");
       for (const auto& [pname, p] : params.items())
         properties[pname] = normaliseParam(file, pname, p);
+      technique["bench"] = benchPreset(file, t, properties);
       passes["properties"][name] = json{{"type", "object"},
                                         {"description", t["description"]},
                                         {"x-outputs", outputs},

@@ -153,9 +153,11 @@ int runReport(const GlobalOptions& g, ReportOptions ro) {
   return kExitOk;
 }
 
-// Presets per technique: axes over its parameters. Parameters this server's schema lacks, and values
-// outside its range or enum, are dropped, so the suite follows the techniques as they change. What
-// scores a technique is not a preset: benchCompare() reads it from the server.
+// A technique's preset: the descriptor's "bench" (renderer/techniques/<name>/<name>.json, served in
+// /v1/info's techniques[].bench): axes over its parameters, extra request fields, and the compare block
+// for a technique whose outputs have no ground truth. Parameters this server's schema lacks, and values
+// outside its range or enum, are dropped (fitToSchema), so the suite also runs against an older or
+// newer server. What scores a technique is not a preset: benchCompare() reads it from the server.
 struct Preset {
   json axes;      // dotted path -> values
   json compare;   // compare block for a technique whose outputs have no ground truth (scored on beauty)
@@ -177,25 +179,14 @@ json benchCompare(const json& technique, const json& fallback) {
   return fallback;
 }
 
-Preset presetFor(const std::string& t, bool quick) {
-  const std::string p = "passes." + t + ".";
-  if (t == "direct")
-    return {{{p + "pcf_radius", quick ? json{0, 2} : json{0, 1, 2}}}, json::object(), json::object()};
-  if (t == "ambient_occlusion")
-    return {{{p + "method", {"volumetric", "containment", "crytek", "gtao"}}, {p + "samples", quick ? json{8} : json{4, 16}}},
-            json::object(),
-            {{"ambient", {1, 1, 1}}}};
-  if (t == "env_diffuse")
-    return {{{p + "form_factor", {"polygon", "point", "classic"}},
-             {p + "downsample", quick ? json{2} : json{2, 4}},
-             {p + "cube_resolution", quick ? json{32} : json{64}}},
-            json::object(),
-            json::object()};
-  if (t == "specular")
-    return {{{p + "linear_steps", quick ? json{8} : json{8, 32}}, {p + "cube_resolution", quick ? json{64} : json{128}}},
-            {{"max_bounces", 5}},
-            json::object()};
-  return {json::object(), json::object(), json::object()};
+Preset presetFor(const json& technique, bool quick) {
+  const json bench = technique.value("bench", json::object());
+  Preset out{json::object(), bench.value("compare", json::object()), bench.value("request", json::object())};
+  const std::string prefix = "passes." + technique.value("name", "") + ".";
+  const json axes = bench.value("axes", json::object());
+  for (const auto& [param, modes] : axes.items())
+    if (modes.is_object() && modes.contains(quick ? "quick" : "full")) out.axes[prefix + param] = modes[quick ? "quick" : "full"];
+  return out;
 }
 
 json fitToSchema(const json& axes, const json& params, const std::string& technique) {
@@ -376,7 +367,7 @@ int runBench(const GlobalOptions& g, BenchOptions bo) {
     if (support.count(name) || !t.value("available", true)) continue;
     if (!bo.techniques.empty() && std::find(bo.techniques.begin(), bo.techniques.end(), name) == bo.techniques.end())
       continue;
-    const Preset preset = presetFor(name, quick);
+    const Preset preset = presetFor(t, quick);
     json axes{{"scene.builtin", sceneNames}};
     const json fitted = fitToSchema(preset.axes, t.value("params", json::object()), name);
     for (const auto& [path, values] : fitted.items())

@@ -338,8 +338,16 @@ TEST_F(SweepAgainstDaemon, BenchScoresEachTechniqueOnTheGroundTruthsInfoServes) 
   ASSERT_EQ(r.code, 0) << r.err;
   std::ifstream in(dir / "b" / "bench.spec.json");
   const json spec = json::parse(in);
-  std::map<std::string, json> compare;
-  for (const auto& s : spec["sweeps"]) compare[s["technique"]] = s["compare"];
+  std::map<std::string, json> compare, sweepOf;
+  for (const auto& s : spec["sweeps"]) compare[s["technique"]] = s["compare"], sweepOf[s["technique"]] = s;
+  // The axes and request fields come from each descriptor's "bench" through /v1/info (--quick values).
+  EXPECT_EQ(sweepOf["ambient_occlusion"]["axes"]["passes.ambient_occlusion.method"],
+            (json{"volumetric", "containment", "crytek", "gtao"}));
+  EXPECT_EQ(sweepOf["ambient_occlusion"]["axes"]["passes.ambient_occlusion.samples"], (json{8}));
+  EXPECT_EQ(sweepOf["ambient_occlusion"]["base"]["ambient"], (json{1, 1, 1}));
+  EXPECT_EQ(sweepOf["direct"]["axes"]["passes.direct.pcf_radius"], (json{0, 2}));
+  EXPECT_EQ(sweepOf["env_diffuse"]["axes"]["passes.env_diffuse.cube_resolution"], (json{32}));
+  EXPECT_EQ(sweepOf["specular"]["axes"]["passes.specular.linear_steps"], (json{8}));
   EXPECT_EQ(compare["ambient_occlusion"]["aov"], "ao");
   EXPECT_FALSE(compare["ambient_occlusion"].contains("max_bounces"));
   EXPECT_EQ(compare["env_diffuse"]["aov"], "indirect_diffuse");

@@ -114,6 +114,29 @@ TEST_F(MergeSchema, AovRowsAreCompletedWithTheirDefaults) {
             json({"beauty", "glow", "glow_mask"}));
 }
 
+// `radiant bench`'s preset travels in the descriptor: one list serves both modes, or a list per mode,
+// and the request fields and compare block come through as given (x-technique.bench, /v1/info).
+TEST_F(MergeSchema, TheBenchPresetIsCarriedWithBothModes) {
+  json t = descriptor("alpha_pass", "glow");
+  t["params"] = {{"taps", {{"type", "integer"}, {"default", 4}, {"minimum", 1}, {"maximum", 16}, {"description", "t"}}},
+                 {"mode", {{"type", "string"}, {"default", "x"}, {"enum", {"x", "y"}}, {"description", "m"}}}};
+  t["bench"] = {{"axes", {{"mode", {"x", "y"}}, {"taps", {{"full", {2, 16}}, {"quick", {4}}}}}},
+                {"request", {{"ambient", {1, 1, 1}}}},
+                {"compare", {{"max_bounces", 5}}}};
+  const Merge m = run({t});
+  ASSERT_EQ(m.status, 0) << m.log;
+  const json& b = m.merged["properties"]["passes"]["properties"]["alpha_pass"]["x-technique"]["bench"];
+  EXPECT_EQ(b["axes"]["mode"], (json{{"full", {"x", "y"}}, {"quick", {"x", "y"}}}));
+  EXPECT_EQ(b["axes"]["taps"], (json{{"full", {2, 16}}, {"quick", {4}}}));
+  EXPECT_EQ(b["request"], (json{{"ambient", {1, 1, 1}}}));
+  EXPECT_EQ(b["compare"], (json{{"max_bounces", 5}}));
+  // A descriptor without one has an empty preset.
+  const Merge none = run({descriptor("beta_pass", "glow")});
+  ASSERT_EQ(none.status, 0) << none.log;
+  EXPECT_EQ(none.merged["properties"]["passes"]["properties"]["beta_pass"]["x-technique"]["bench"],
+            (json{{"axes", json::object()}, {"request", json::object()}, {"compare", json::object()}}));
+}
+
 // Each case breaks one rule; the build must fail and say where.
 TEST_F(MergeSchema, ABrokenDescriptorFailsNamingItsFileAndKey) {
   struct Case {
@@ -141,7 +164,24 @@ TEST_F(MergeSchema, ABrokenDescriptorFailsNamingItsFileAndKey) {
   json foreignRequirement = descriptor("a", "glow");
   foreignRequirement["light_paths"] = {"LD+DE"};
   foreignRequirement["requires_paths"] = {"LS+DE"};
+  json benchAxis = descriptor("a", "glow");
+  benchAxis["params"] = {{"taps", {{"type", "integer"}, {"default", 4}, {"minimum", 1}, {"maximum", 16}, {"description", "t"}}},
+                         {"mode", {{"type", "string"}, {"default", "x"}, {"enum", {"x", "y"}}, {"description", "m"}}}};
+  json benchUnknownParam = benchAxis, benchOutOfRange = benchAxis, benchNotInEnum = benchAxis, benchWrongType = benchAxis,
+       benchNoQuick = benchAxis, benchUnknownKey = benchAxis;
+  benchUnknownParam["bench"] = {{"axes", {{"radius", {1, 2}}}}};
+  benchOutOfRange["bench"] = {{"axes", {{"taps", {{"full", {4, 32}}, {"quick", {4}}}}}}};
+  benchNotInEnum["bench"] = {{"axes", {{"mode", {"x", "z"}}}}};
+  benchWrongType["bench"] = {{"axes", {{"taps", {2.5}}}}};
+  benchNoQuick["bench"] = {{"axes", {{"taps", {{"full", {4}}}}}}};
+  benchUnknownKey["bench"] = {{"scenes", {"cornell_box"}}};
   const std::vector<Case> cases = {
+      {"a bench axis of no parameter", {benchUnknownParam}, "bench.axes.radius is not one of its \"params\""},
+      {"a bench value above the maximum", {benchOutOfRange}, "bench.axes.taps: 32 is outside the parameter's range"},
+      {"a bench value outside the enum", {benchNotInEnum}, "bench.axes.mode: \"z\" is outside the parameter's range"},
+      {"a bench value of another type", {benchWrongType}, "bench.axes.taps: 2.5 is not of type integer"},
+      {"a bench axis without its quick values", {benchNoQuick}, "bench.axes.taps must be an array of values or"},
+      {"an unknown bench key", {benchUnknownKey}, "bench: unknown key \"scenes\""},
       {"an output without a row", {noRow}, "no technique declares the row of AOV \"glow\""},
       {"a row declared twice", {descriptor("a", "glow"), twoRows}, "aovs.glow is declared by a too"},
       {"a row of no output", {notOutput}, "aovs.other is not one of its \"outputs\""},
