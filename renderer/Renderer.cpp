@@ -678,8 +678,8 @@ RenderOutput Renderer::renderFrame(const Scene& scene, const api::RenderRequest&
                                                            ? given->second
                                                            : nlohmann::json(nullptr)),
                       named == request.explicitParams.end() ? std::set<std::string>{} : named->second);
-      const auto owner = plan.lightPaths.find("LS+DE");
-      const bool forCaustics = owner != plan.lightPaths.end() && owner->second == "caustics";
+      const auto owned = plan.owned.find("caustics");
+      const bool forCaustics = owned != plan.owned.end() && (owned->second & api::kPathLSDE);
       specularMapTexelsAt = [&, sp, forCaustics](int atK) {
         api::RenderRequest r = request;
         r.width *= atK;
@@ -725,8 +725,8 @@ RenderOutput Renderer::renderFrame(const Scene& scene, const api::RenderRequest&
       // Sky lights stand for photon_gi's first-hit sky photons (the residual's L(sky)DE): only when it
       // owns that class (ambient_occlusion's SH irradiance times AO otherwise; docs/TECHNIQUES.md,
       // direct, "Sky lights").
-      const auto skyOwner = plan.lightPaths.find("L(sky)DE");
-      if (skyOwner == plan.lightPaths.end() || skyOwner->second != "photon_gi") o.skyLights = 0;
+      const auto owned = plan.owned.find("photon_gi");
+      if (owned == plan.owned.end() || !(owned->second & api::kPathSkyDE)) o.skyLights = 0;
       supersampledView.environmentLights = im.environmentLights(supersampledView, o, stats, cancelToken);
       supersampledView.environmentLightsKey = o.key();
       const auto& taken = supersampledView.environmentLights->lights;
@@ -746,7 +746,7 @@ RenderOutput Renderer::renderFrame(const Scene& scene, const api::RenderRequest&
 
     im.resources.beginFrame(gpu, view, &stats.cache);
     im.resources.setCancel(cancelToken);  // prepare() and the derived-data builders (photons, beams, BVH)
-    im.resources.setLightPathOwners(plan.lightPaths);
+    im.resources.setLightPathOwners(plan.lightPaths, plan.owned);
     // Declared resources (renderer/frame/FrameAllocation.h): the Renderer allocates the planned passes'
     // AOV outputs, beauty and the environment map; each pass then touches the shared resources only as
     // its TechniqueInfo declares (declaredAccess, checked by FrameResources in the pass scopes below).

@@ -20,6 +20,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "api/LightPaths.h"
+
 using nlohmann::json;
 
 namespace {
@@ -247,6 +249,11 @@ int main(int argc, char** argv) {
                         {"requires_paths", names(file, t, "requires_paths")},
                         {"claims_when_named", flag(file, t, "claims_when_named", false)},
                         {"exclusive", flag(file, t, "exclusive", false)}};
+      for (const char* k : {"light_paths", "requires_paths"})
+        for (const auto& c : technique[k])
+          if (radiant::api::lightPathBit(c.get<std::string>()) == 0)
+            fail(file, std::string(k) + ": \"" + c.get<std::string>() +
+                           "\" is not a light-path class (api/LightPaths.h lists them)");
       for (const auto& c : technique["requires_paths"])
         if (std::find(technique["light_paths"].begin(), technique["light_paths"].end(), c) == technique["light_paths"].end())
           fail(file, "requires_paths: \"" + c.get<std::string>() + "\" is not one of its \"light_paths\"");

@@ -41,6 +41,49 @@ std::string undeclaredWrite(const TechniqueInfo& info, const std::set<std::strin
   return {};
 }
 
+const std::vector<OwnershipRow>& ownershipPolicy() {
+  static const std::vector<OwnershipRow> rows = {
+      // The sky's glossy reflection: direct's prefiltered environment (image-based lighting) when it runs.
+      {"L(sky)GE", {"direct", "photon_gi"}},
+      // Indirect diffuse light: env_diffuse's cube maps where it is planned (photon_gi, which requires
+      // the class, then goes: its photons would carry it whatever owned it).
+      {"LD+DE", {"env_diffuse", "photon_gi"}},
+      // The sky's diffuse light: photon_gi's photons (visibility at any distance) ahead of ambient
+      // occlusion's (visibility within its radius).
+      {"L(sky)DE", {"photon_gi", "ambient_occlusion"}},
+      // Caustics: the caustic triangles (chapter 6), then photons, then light volumes (claims_when_named:
+      // first when the request names it).
+      {"LS+DE", {"caustics", "photon_gi", "light_volumes"}},
+      // Participating media, one technique per frame (exclusive): spherical billboards by default.
+      {"media", {"spherical_billboards", "depth_impostors", "illumination_network"}},
+  };
+  return rows;
+}
+
+namespace {
+
+// Where `technique` stands in the policy for `cls`: its place in the row, else after the row.
+std::size_t policyRank(std::string_view cls, std::string_view technique) {
+  for (const OwnershipRow& row : ownershipPolicy())
+    if (row.lightPath == cls) {
+      const auto it = std::find(row.order.begin(), row.order.end(), technique);
+      return it == row.order.end() ? row.order.size() : static_cast<std::size_t>(it - row.order.begin());
+    }
+  return 0;
+}
+
+// True when `a` owns `cls` ahead of `b`: a named claims_when_named technique first, then the policy's
+// order, then the names.
+bool ownsBefore(std::string_view cls, const TechniqueInfo& a, const TechniqueInfo& b, const api::RenderRequest& request) {
+  auto claims = [&](const TechniqueInfo& i) { return i.claimsWhenNamed && request.passes.count(i.name) != 0; };
+  if (claims(a) != claims(b)) return claims(a);
+  const std::size_t ra = policyRank(cls, a.name), rb = policyRank(cls, b.name);
+  if (ra != rb) return ra < rb;
+  return a.name < b.name;
+}
+
+}  // namespace
+
 FramePlan planFrame(const std::vector<Technique*>& techniques, const Scene& scene,
                     const api::RenderRequest& request) {
   std::map<std::string, Technique*> byName;
@@ -73,7 +116,7 @@ FramePlan planFrame(const std::vector<Technique*>& techniques, const Scene& scen
   }
   // Two named techniques of which one must own a light-path class that the other supplies (two media
   // techniques; photon_gi and env_diffuse, LD+DE): the request is contradictory, whatever the scene.
-  // The pointer names the later one in registry order. Only the planner reports such conflicts.
+  // The pointer names the one the ownership policy ranks later. Only the planner reports such conflicts.
   auto named = [&](const TechniqueInfo& info) {
     return request.passes.count(info.name) != 0 && !request.disabledPasses.count(info.name);
   };
@@ -88,8 +131,11 @@ FramePlan planFrame(const std::vector<Technique*>& techniques, const Scene& scen
       if (a == b || !named(need) || !named(other)) continue;
       for (const auto& cls : required(need))
         if (std::find(other.lightPaths.begin(), other.lightPaths.end(), cls) != other.lightPaths.end()) {
-          const TechniqueInfo& first = a < b ? need : other;
-          const TechniqueInfo& later = a < b ? other : need;
+          const bool needFirst = policyRank(cls, need.name) != policyRank(cls, other.name)
+                                     ? policyRank(cls, need.name) < policyRank(cls, other.name)
+                                     : need.name < other.name;
+          const TechniqueInfo& first = needFirst ? need : other;
+          const TechniqueInfo& later = needFirst ? other : need;
           throw api::ApiError(422, "conflicting-passes", "Conflicting passes",
                               "passes names both " + first.name + " and " + later.name + ", which both supply '" +
                                   cls + "', and " + need.name +
@@ -150,20 +196,21 @@ FramePlan planFrame(const std::vector<Technique*>& techniques, const Scene& scen
   }
   for (Technique* t : techniques)
     if (keep.count(t)) plan.passes.push_back(t);
-  // Every light path is counted once: each class goes to the first planned technique claiming it, in
-  // registry order, except that a technique with claimsWhenNamed takes its classes first when the
-  // request names it. A technique that does not own a class it requires (TechniqueInfo::requiredPaths;
+  // Every light path is counted once: each class goes to the planned technique the ownership policy
+  // puts first (ownsBefore: a named claimsWhenNamed technique, then the policy's row). A technique that does not own a class it requires (TechniqueInfo::requiredPaths;
   // an exclusive one: all of its classes) is dropped, and the classes are handed out again without it,
   // so that what it would have supplied goes to the next claimant (photon_gi's sky light to
   // ambient_occlusion when env_diffuse owns LD+DE). A pass that needs what a dropped one produces goes too.
   for (bool dropped = true; dropped;) {
     dropped = false;
     plan.lightPaths.clear();
+    std::map<std::string, const TechniqueInfo*> owner;
     for (Technique* t : plan.passes)
-      if (t->info().claimsWhenNamed && request.passes.count(t->info().name))
-        for (const auto& cls : t->info().lightPaths) plan.lightPaths.emplace(cls, t->info().name);
-    for (Technique* t : plan.passes)
-      for (const auto& cls : t->info().lightPaths) plan.lightPaths.emplace(cls, t->info().name);
+      for (const auto& cls : t->info().lightPaths) {
+        const TechniqueInfo*& o = owner[cls];
+        if (!o || ownsBefore(cls, t->info(), *o, request)) o = &t->info();
+      }
+    for (const auto& [cls, o] : owner) plan.lightPaths[cls] = o->name;
     for (auto it = plan.passes.begin(); it != plan.passes.end() && !dropped; ++it) {
       const TechniqueInfo& info = (*it)->info();
       for (const auto& cls : required(info))
@@ -188,6 +235,9 @@ FramePlan planFrame(const std::vector<Technique*>& techniques, const Scene& scen
         }
     }
   }
+  plan.owned.clear();
+  for (Technique* t : plan.passes) plan.owned[t->info().name] = 0;
+  for (const auto& [cls, name] : plan.lightPaths) plan.owned[name] |= api::lightPathBit(cls);
   return plan;
 }
 

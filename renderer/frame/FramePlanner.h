@@ -3,15 +3,17 @@
 // the request asks for and keeps the passes that produce them, plus the passes the request names and
 // the on-by-default beauty contributors; then it pulls in the producers of their inputs. A pass whose
 // requirements() says skip is dropped with its reason; a pass whose required input has no producer is
-// dropped with "needs <input>, which <producer> did not produce: <reason>". Light-path classes go to
-// one technique each (TechniqueInfo::lightPaths, claimsWhenNamed); a technique that does not own a
-// class it requires (requiredPaths; an exclusive one: all of its classes, one media technique per
-// frame) is dropped with "<class> is owned by <owner>" and the classes are handed out again.
+// dropped with "needs <input>, which <producer> did not produce: <reason>". Light-path classes
+// (api/LightPaths.h) go to one technique each by the ownership policy below, not by registry order; a
+// technique that does not own a class it requires (requiredPaths; an exclusive one: all of its
+// classes, one media technique per frame) is dropped with "<class> is owned by <owner>" and the
+// classes are handed out again.
 #include <map>
 #include <set>
 #include <string>
 #include <vector>
 
+#include "api/LightPaths.h"
 #include "api/Types.h"
 #include "renderer/frame/FrameResources.h"
 #include "renderer/frame/Technique.h"
@@ -22,7 +24,20 @@ struct FramePlan {
   std::vector<Technique*> passes;              // in execution order
   std::map<std::string, std::string> skipped;  // pass name -> reason
   std::map<std::string, std::string> lightPaths;  // light-path class -> the technique that owns it
+  // The classes each planned technique owns (api::LightPathMask bits of lightPaths).
+  std::map<std::string, api::LightPathMask> owned;
 };
+
+// The one ownership policy: for each light-path class that several techniques can supply, who owns it
+// when several of them are planned, first to last. A technique with claims_when_named that the request
+// names goes ahead of the list for its classes. A class not listed (one supplier), or a supplier a row
+// does not list, is ranked after the listed ones by name; `LightPathOwnership.EveryContestedClass...`
+// holds the real descriptors to a row for every class two of them supply.
+struct OwnershipRow {
+  std::string_view lightPath;
+  std::vector<std::string_view> order;
+};
+const std::vector<OwnershipRow>& ownershipPolicy();
 
 // AOVs that are not a technique's output but exist in every frame (the AOV table's accumulate AOVs).
 bool isFrameAov(const std::string& aov);
@@ -44,10 +59,11 @@ std::set<std::string> sharedResources(const std::vector<Technique*>& techniques)
 // Renderer fails the frame with std::logic_error on one.
 std::string undeclaredWrite(const TechniqueInfo& info, const std::set<std::string>& written);
 
-// `techniques` is in the canonical execution order (renderer/techniques/Registry.cpp).
+// `techniques` is in the canonical execution order (renderer/techniques/Registry.cpp); which technique
+// owns a light-path class does not depend on it.
 // Throws api::ApiError (422) for a requested pass or AOV that no technique knows, and for a request
 // that names two techniques of which one requires a light-path class the other supplies (pointer: the
-// later one's /passes/<name>): the only place conflicts between passes are reported.
+// one the policy ranks later, /passes/<name>): the only place conflicts between passes are reported.
 FramePlan planFrame(const std::vector<Technique*>& techniques, const Scene& scene,
                     const api::RenderRequest& request);
 

@@ -29,6 +29,7 @@
 #include <typeinfo>
 #include <vector>
 
+#include "api/LightPaths.h"
 #include "api/Types.h"
 #include "renderer/gl/Gl.h"
 #include "renderer/gl/ShaderLibrary.h"
@@ -103,15 +104,19 @@ public:
     return it == holds_.end() ? std::string() : it->second;
   }
 
-  // Which technique owns each light-path class this frame (FramePlan::lightPaths).
-  void setLightPathOwners(std::map<std::string, std::string> owners) { lightPaths_ = std::move(owners); }
-  bool ownsLightPath(const std::string& technique, const std::string& cls) const {
-    auto it = lightPaths_.find(cls);
-    return it != lightPaths_.end() && it->second == technique;
+  // Which technique owns each light-path class this frame (FramePlan::lightPaths, FramePlan::owned).
+  void setLightPathOwners(std::map<std::string, std::string> owners, std::map<std::string, api::LightPathMask> owned) {
+    lightPaths_ = std::move(owners);
+    owned_ = std::move(owned);
   }
-  // The technique that owns `cls` this frame ("" when none claims it).
-  std::string lightPathOwner(const std::string& cls) const {
-    auto it = lightPaths_.find(cls);
+  // Whether `technique` owns every class of `classes` (api::kPath* bits) this frame.
+  bool owns(const std::string& technique, api::LightPathMask classes) const {
+    auto it = owned_.find(technique);
+    return classes != 0 && it != owned_.end() && (it->second & classes) == classes;
+  }
+  // The technique that owns the class `cls` (one bit) this frame ("" when none claims it).
+  std::string ownerOf(api::LightPathMask cls) const {
+    auto it = lightPaths_.find(std::string(api::lightPathName(cls)));
     return it == lightPaths_.end() ? std::string() : it->second;
   }
 
@@ -275,6 +280,7 @@ private:
   std::set<std::string> written_;
   std::map<std::string, std::any> products_;  // the blackboard, cleared by beginFrame()
   std::map<std::string, std::string> lightPaths_;
+  std::map<std::string, api::LightPathMask> owned_;
   std::set<int> shadowMapExclusions_;
   std::set<std::string> declaredThisFrame_;
   // Textures, buffers and framebuffers looked up or declared this frame (releaseIdle keeps them).

@@ -410,7 +410,7 @@ void CausticsPass::execute(PassContext& ctx) {
 
   // (4) Camera pass: caustics AOV, and beauty += caustics when this pass owns LS+DE (a request that
   // names light_volumes gives the class to it: then the AOV is written but not added, counted once).
-  const bool owns = res.ownsLightPath("caustics", "LS+DE");
+  const bool owns = res.owns("caustics", api::kPathLSDE);
   const float pixelArea = 4.f / (ctx.view.proj[0][0] * ctx.view.proj[1][1] * ctx.view.width * ctx.view.height);
   const float maxLod = footprintFilter_ ? static_cast<float>(cube.levels() - 1) : 0.f;
   const glm::vec3 forward = -glm::normalize(glm::vec3(ctx.view.camera.world[2]));
@@ -455,7 +455,7 @@ void CausticsPass::execute(PassContext& ctx) {
   // (5) The caustics seen in mirrors and through glass (LS+DS+E): the specular objects rasterised from
   // the camera, their trees traced through the maps, the cubes looked up at the non-specular hits;
   // into beauty only (the caustics AOV stays exactly LS+DE, the reference's caustics class).
-  const bool secondary = specularLookup_ && !pairs_.empty() && res.ownsLightPath("caustics", "LS+DS+E");
+  const bool secondary = specularLookup_ && !pairs_.empty() && res.owns("caustics", api::kPathLSDSE);
   if (secondary) {
     res.framebuffer("caustics_secondary").bind();
     glViewport(0, 0, ctx.view.width, ctx.view.height);

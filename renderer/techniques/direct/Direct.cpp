@@ -57,7 +57,7 @@ void DirectPass::execute(PassContext& ctx) {
   ibl::bind(res, prog, gpu::kUnitIblDfg, gpu::kUnitIblPrefiltered);
   // The environment's specular lobe (split-sum) is the light path L(sky)GE: added only when this pass
   // owns it (the diffuse lobe, L(sky)DE, is ambient_occlusion's or photon_gi's).
-  const bool iblSpecular = imageBasedLighting_ && res.ownsLightPath("direct", "L(sky)GE");
+  const bool iblSpecular = imageBasedLighting_ && res.owns("direct", api::kPathSkyGE);
   if (!iblSpecular) prog.set("u_iblMode", ibl::kNone);
   prog.set("u_hasEnvironment", view.environment ? 1 : 0);
   prog.setMat4("u_invViewProj", &view.invViewProj[0][0]);

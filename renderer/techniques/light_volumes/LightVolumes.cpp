@@ -79,7 +79,7 @@ void LightVolumesPass::prepare(const Scene& scene, const Params& params, FrameRe
   bvh_ = params.get<std::string>("traversal") == "bvh";
   // Every light path is counted once: without LS+DE and LG+DE (another technique owns them) the pass
   // gathers nothing and adds nothing to beauty.
-  owns_ = res.ownsLightPath("light_volumes", "LS+DE") || res.ownsLightPath("light_volumes", "LG+DE");
+  owns_ = res.owns("light_volumes", api::kPathLSDE) || res.owns("light_volumes", api::kPathLGDE);
 
   const nlohmann::json key = {{"scene", res.sceneKey()},
                               {"lights", lightsKey(scene)},

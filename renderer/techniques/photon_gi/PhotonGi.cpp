@@ -208,7 +208,7 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   };
 
   // --- The splats: which records, their kernel radius per surface (eq. 3), coverage points.
-  const bool ownsSky = res.ownsLightPath("photon_gi", "L(sky)DE");
+  const bool ownsSky = res.owns("photon_gi", api::kPathSkyDE);
   // The sky's first hits of this class are shaded by the frame's sky lights (the residual's median cut,
   // with shadow maps, EnvironmentLights::skyLights) when the frame has them: the photons' estimate of
   // them had visibility only at the kernel's scale (contact shadows 1.3-2x the reference's light).
@@ -217,16 +217,16 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   // The glossy reflection of the sky (L(sky)GE) may belong to a prefiltered environment term in
   // `direct`, which comes first in the registry: then sky photons at their first hit are splatted with
   // the diffuse lobe only.
-  const bool ownsSkyGlossy = res.ownsLightPath("photon_gi", "L(sky)GE");
+  const bool ownsSkyGlossy = res.owns("photon_gi", api::kPathSkyGE);
   // Light from a punctual light through metal or glass only (L(S|G)+) onto a diffuse surface is
   // LS+DE / LG+DE: when another technique owns those classes (light_volumes), such photons are not
   // splatted on surfaces that are not themselves metal or glass (docs/TECHNIQUES.md).
-  const std::string narrowOwner = res.lightPathOwner("LG+DE");
+  const std::string narrowOwner = res.ownerOf(api::kPathLGDE);
   const bool leaveNarrowLobePaths = !narrowOwner.empty() && narrowOwner != "photon_gi";
   // Light from a punctual light that reached the surface through near-mirrors only (LS+D): the
   // caustics pass's when it owns LS+DE (its photons cover point, spot and directional lights; those
   // of emissive triangles and the sky stay here).
-  const bool ownsCaustics = res.ownsLightPath("photon_gi", "LS+DE");
+  const bool ownsCaustics = res.owns("photon_gi", api::kPathLSDE);
   const nlohmann::json splatKey = {{"photons", photonKey}, {"count", s.photons}, {"C", s.C}, {"sky", skyFirstHits},
                                    {"sky_glossy", ownsSkyGlossy}, {"leave_narrow_lobe_paths", leaveNarrowLobePaths},
                                    {"caustics", ownsCaustics},

@@ -129,7 +129,7 @@ void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResour
   // The maps' resolution follows what the camera sees of the specular objects (issue 31): a map's face
   // needs about as many texels across as the largest object covers pixels (mapResolution), not a fixed
   // 256 whatever its size on screen; at most cube_resolution (chooseMapResolution).
-  const MapResolution chosen = chooseMapResolution(scene, res.view(), params, res.lightPathOwner("LS+DE") == "caustics");
+  const MapResolution chosen = chooseMapResolution(scene, res.view(), params, res.owns("caustics", api::kPathLSDE));
   resolution_ = chosen.texels;
   largestObjectPixels_ = chosen.largestObjectPixels;
   causticsKeepMaps_ = chosen.keptForCaustics;
@@ -226,7 +226,7 @@ void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResour
   // And on the environment: its lights shade the texels and its residual their glossy lobe (the photon
   // set's digest covers it only when photon_gi runs).
   ibl::prepare(res);
-  mapsIbl_ = res.ownsLightPath("direct", "L(sky)GE") && ibl::modeFor(res) != ibl::kNone;
+  mapsIbl_ = res.owns("direct", api::kPathSkyGE) && ibl::modeFor(res) != ibl::kNone;
   const FrameView& v = res.view();
   digest_ = res.sceneKey() + "|res=" + std::to_string(resolution_) + "|layers=" + std::to_string(layers_) +
             "|objects=" + std::to_string(objects_.size()) + "|indirect_block=" + std::to_string(indirectBlock_) +

@@ -175,7 +175,10 @@ TEST_F(MergeSchema, ABrokenDescriptorFailsNamingItsFileAndKey) {
   benchWrongType["bench"] = {{"axes", {{"taps", {2.5}}}}};
   benchNoQuick["bench"] = {{"axes", {{"taps", {{"full", {4}}}}}}};
   benchUnknownKey["bench"] = {{"scenes", {"cornell_box"}}};
+  json unknownClass = descriptor("a", "glow");
+  unknownClass["light_paths"] = {"LD+DE", "LD*E"};
   const std::vector<Case> cases = {
+      {"an unknown light-path class", {unknownClass}, "light_paths: \"LD*E\" is not a light-path class"},
       {"a bench axis of no parameter", {benchUnknownParam}, "bench.axes.radius is not one of its \"params\""},
       {"a bench value above the maximum", {benchOutOfRange}, "bench.axes.taps: 32 is outside the parameter's range"},
       {"a bench value outside the enum", {benchNotInEnum}, "bench.axes.mode: \"z\" is outside the parameter's range"},
