@@ -938,7 +938,23 @@ struct HttpServer::Impl {
   }
 
   // ---- routes ---------------------------------------------------------------------------------
+  // The routes, one function per resource (issue 33: the facade split by concern), registered in this
+  // order; middleware() first (the worker pool, limits, authentication, problem+json errors, metrics
+  // and the access log).
   void routes() {
+    middleware();
+    serviceRoutes();
+    sceneRoutes();
+    imageRoutes();
+    renderRoutes();
+    sessionRoutes();
+    reportRoutes();
+    viewerRoutes();
+  }
+
+  // Worker pool, body limits and timeouts, authentication, problem+json for httplib's own errors and
+  // exceptions, per-status counts and the JSON access log.
+  void middleware() {
     // Workers start as connections need them (slow clients must not queue health checks behind
     // them), from --http-threads up to --max-connections.
     const int threads = config.httpThreads > 0 ? config.httpThreads : std::min(256, config.maxQueue + 8);
@@ -1024,7 +1040,10 @@ struct HttpServer::Impl {
       std::fprintf(stderr, "%s\n", api::dumpSafe(line).c_str());
       tRequest = RequestContext{};
     });
+  }
 
+  // /v1/health, /v1/ready, /v1/info, /metrics.
+  void serviceRoutes() {
     http.Get("/v1/health", wrap([](const httplib::Request&, httplib::Response& res) {
       sendJson(res, 200, {{"status", "ok"}});
     }));
@@ -1078,7 +1097,10 @@ struct HttpServer::Impl {
       res.status = 200;
       res.set_content(metrics.text(gauges), "text/plain; version=0.0.4; charset=utf-8");
     }));
+  }
 
+  // /v1/scenes: content-addressed glTF uploads (PUT/POST), the list, one scene's metadata (GET/HEAD).
+  void sceneRoutes() {
     auto upload = wrapBody([this](const httplib::Request& req, const std::string& body, httplib::Response& res) {
       static const std::set<std::string> kTypes{"model/gltf-binary", "model/gltf+json", "application/octet-stream",
                                                 "application/json"};
@@ -1134,7 +1156,10 @@ struct HttpServer::Impl {
       if (req.method == "HEAD") return;
       res.set_content(*bytes, ContentStore::formatOf(*bytes) == "glb" ? "model/gltf-binary" : "model/gltf+json");
     }));
+  }
 
+  // /v1/images: comparison images and environment maps, content-addressed like scenes.
+  void imageRoutes() {
     // Comparison images: content-addressed like scenes; a render's compare.against names one by digest.
     auto uploadImage = wrapBody([this](const httplib::Request& req, const std::string& body, httplib::Response& res) {
       static const std::set<std::string> kTypes{"image/x-exr", "image/vnd.radiance", "image/png",
@@ -1172,7 +1197,10 @@ struct HttpServer::Impl {
       const auto mime = kMime.find(ContentStore::formatOf(*bytes));  // the store holds only these formats
       res.set_content(*bytes, mime != kMime.end() ? mime->second : "application/octet-stream");
     }));
+  }
 
+  // /v1/renders (submit, poll, cancel) and /v1/frames (a finished frame's bytes).
+  void renderRoutes() {
     http.Post("/v1/renders", wrapBody([this](const httplib::Request& req, const std::string& requestBody, httplib::Response& res) {
       if (mediaType(req) != "application/json")
         throw api::ApiError(415, "unsupported-media-type", "Unsupported media type",
@@ -1242,8 +1270,19 @@ struct HttpServer::Impl {
           return sendJson(res, 200, {{"id", id}, {"deleted", true}});
       }
     }));
+    http.Get(R"(/v1/frames/([A-Za-z0-9_-]+)/([A-Za-z0-9_.-]+))", wrap([this](const httplib::Request& req, httplib::Response& res) {
+      auto frame = frames.get(req.matches[1], req.matches[2]);
+      if (!frame)
+        throw api::ApiError(404, "unknown-frame", "Unknown frame",
+                            "no frame " + std::string(req.matches[1]) + "/" + std::string(req.matches[2]) +
+                                " (frames expire after " + std::to_string(config.frameTtlS) + " s)");
+      res.status = 200;
+      res.set_content(*frame->bytes, frame->contentType);
+    }));
+  }
 
-    // ---- sessions (server/Sessions.h, docs/API.md "Sessions") ----------------------------------
+  // Progressive sessions (server/Sessions.h, docs/API.md "Sessions").
+  void sessionRoutes() {
     auto sessionBody = [this](const httplib::Request& req) {
       if (mediaType(req) != "application/json" && mediaType(req) != "application/merge-patch+json")
         throw api::ApiError(415, "unsupported-media-type", "Unsupported media type",
@@ -1331,8 +1370,10 @@ struct HttpServer::Impl {
           [this, s, state](std::size_t, httplib::DataSink& sink) { return pumpEvents(*s, *state, sink); },
           [this, s](bool) { sessions.streamClosed(*s); });
     }));
+  }
 
-    // ---- sweep reports (--reports-dir), read-only --------------------------------------------
+  // Sweep reports (--reports-dir), read-only.
+  void reportRoutes() {
     // A report's files only: names of [A-Za-z0-9_.-] not starting with '.', at most one folder deep
     // inside the report, resolved (through symlinks) inside the reports folder, of a known type.
     static const std::map<std::string, std::string> kReportTypes{
@@ -1399,8 +1440,10 @@ struct HttpServer::Impl {
       res.status = 200;
       res.set_content(bytes, type->second);
     }));
+  }
 
-    // ---- the viewer (server/ui, embedded) ------------------------------------------------------
+  // The viewer (server/ui, embedded).
+  void viewerRoutes() {
     auto page = [this](const std::string& name, const char* type) {
       return wrap([this, name, type](const httplib::Request&, httplib::Response& res) {
         if (!uiServed(config))
@@ -1425,15 +1468,6 @@ struct HttpServer::Impl {
     http.Get("/ui/", page("index.html", "text/html; charset=utf-8"));
     http.Get("/ui/viewer.js", page("viewer.js", "text/javascript; charset=utf-8"));
     http.Get("/ui/viewer.css", page("viewer.css", "text/css; charset=utf-8"));
-    http.Get(R"(/v1/frames/([A-Za-z0-9_-]+)/([A-Za-z0-9_.-]+))", wrap([this](const httplib::Request& req, httplib::Response& res) {
-      auto frame = frames.get(req.matches[1], req.matches[2]);
-      if (!frame)
-        throw api::ApiError(404, "unknown-frame", "Unknown frame",
-                            "no frame " + std::string(req.matches[1]) + "/" + std::string(req.matches[2]) +
-                                " (frames expire after " + std::to_string(config.frameTtlS) + " s)");
-      res.status = 200;
-      res.set_content(*frame->bytes, frame->contentType);
-    }));
   }
 };
 
