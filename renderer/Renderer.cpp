@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "api/Aovs.h"
+#include "api/Lru.h"
 #include "api/Presets.h"
 #include "api/Validate.h"
 #include "renderer/frame/FrameAllocation.h"
@@ -370,8 +371,8 @@ struct Renderer::Impl {
   FrameResources resources{shaders};
   GpuProfiler profiler;
   std::vector<std::unique_ptr<Technique>> techniques = createTechniques();
-  // GPU copies of recently used scenes, most recent last; keyed by digest (or address when unnamed).
-  std::vector<std::pair<std::string, std::unique_ptr<GpuScene>>> gpuScenes;
+  // GPU copies of recently used scenes, keyed by digest (or address when unnamed).
+  api::Lru<std::string, std::unique_ptr<GpuScene>> gpuScenes;
   std::size_t gpuSceneCapacity = 4;
   // The budget chooser's speed factor, and the last frame's times for the calibration (observeSpeed).
   api::MachineSpeed speed;
@@ -381,9 +382,9 @@ struct Renderer::Impl {
   } lastFrame;
   std::unique_ptr<Scene> calibrationScene;
 
-  // The raster's split of recent environment maps (renderer/shading/EnvironmentLights.h), most recent
-  // last: derived data of the map and the options only, computed once per change of either.
-  std::vector<std::pair<std::string, std::shared_ptr<const EnvironmentLights>>> environmentSplits;
+  // The raster's split of recent environment maps (renderer/shading/EnvironmentLights.h), the last 4:
+  // derived data of the map and the options only, computed once per change of either.
+  api::Lru<std::string, std::shared_ptr<const EnvironmentLights>> environmentSplits;
 
   std::function<void()> releaseHook;  // setReleaseHook: what the renderer's owner may drop
 
@@ -392,29 +393,21 @@ struct Renderer::Impl {
     const Image& map = *view.environment;
     const std::string key = view.environmentKey + "|" + std::to_string(map.width) + "x" + std::to_string(map.height) +
                             "|" + o.key();
-    auto it = std::find_if(environmentSplits.begin(), environmentSplits.end(), [&](const auto& e) { return e.first == key; });
-    const bool hit = it != environmentSplits.end();
-    stats.cache.push_back({"environment_lights", hit});
-    if (hit) {
-      std::rotate(it, it + 1, environmentSplits.end());
-      return environmentSplits.back().second;
-    }
+    const auto* found = environmentSplits.use(key);
+    stats.cache.push_back({"environment_lights", found != nullptr});
+    if (found) return *found;
     auto split = std::make_shared<const EnvironmentLights>(extractEnvironmentLights(map, o, cancel));
-    while (environmentSplits.size() >= 4) environmentSplits.erase(environmentSplits.begin());
-    environmentSplits.emplace_back(key, split);
+    environmentSplits.evict([](const auto& l) { return l.size() >= 4; });
+    environmentSplits.put(key, split);
     return split;
   }
 
   const GpuScene& gpuScene(const Scene& scene, api::FrameStats& stats, const rt::Cancel& cancel) {
     const std::string key = scene.digest.empty() ? "addr:" + std::to_string(reinterpret_cast<std::uintptr_t>(&scene))
                                                  : scene.digest;
-    auto it = std::find_if(gpuScenes.begin(), gpuScenes.end(), [&](const auto& e) { return e.first == key; });
-    const bool hit = it != gpuScenes.end();
-    stats.cache.push_back({"gpu_scene", hit});
-    if (hit) {
-      std::rotate(it, it + 1, gpuScenes.end());
-      return *gpuScenes.back().second;
-    }
+    const auto* found = gpuScenes.use(key);
+    stats.cache.push_back({"gpu_scene", found != nullptr});
+    if (found) return **found;
     // An upload is a large allocation like a pass's (on llvmpipe its textures and buffers are host
     // memory): released for and admitted under the memory limit before it is made.
     const std::size_t bytes = GpuScene::estimateBytes(scene);
@@ -423,20 +416,18 @@ struct Renderer::Impl {
     const auto t0 = Clock::now();
     auto g = std::make_unique<GpuScene>(scene, cancel);
     stats.uploadMs = msSince(t0);
-    while (gpuScenes.size() >= gpuSceneCapacity) gpuScenes.erase(gpuScenes.begin());
-    gpuScenes.emplace_back(key, std::move(g));
-    return *gpuScenes.back().second;
+    gpuScenes.evict([&](const auto& l) { return l.size() >= gpuSceneCapacity; });
+    return *gpuScenes.put(key, std::move(g)).value;
   }
 };
 
 Renderer::Renderer(const DeviceOptions& options) : impl_(std::make_unique<Impl>()) {
   impl_->device = EglDevice::create(options);
   // What the memory accountant may drop beyond the frame's own resources: the GPU copies of the scenes
-  // not being rendered (the current one is the most recently used, last) and their environment splits.
+  // not being rendered (the current one is the most recently used) and their environment splits.
   impl_->resources.setTrimHook([im = impl_.get()] {
-    if (im->gpuScenes.size() > 1) im->gpuScenes.erase(im->gpuScenes.begin(), im->gpuScenes.end() - 1);
-    if (im->environmentSplits.size() > 1)
-      im->environmentSplits.erase(im->environmentSplits.begin(), im->environmentSplits.end() - 1);
+    im->gpuScenes.evict([](const auto& l) { return l.size() > 1; });
+    im->environmentSplits.evict([](const auto& l) { return l.size() > 1; });
     if (im->releaseHook) im->releaseHook();
   });
   // Per-pass times (GpuProfiler.h): timer queries on a hardware device, glFinish brackets on a software one.
@@ -488,7 +479,7 @@ void Renderer::setMemoryLimit(std::size_t bytes) { impl_->resources.setMemoryLim
 void Renderer::setGpuSceneCapacity(std::size_t scenes) {
   impl_->gpuSceneCapacity = std::max<std::size_t>(1, scenes);
   impl_->resources.setDerivedCapacity(impl_->gpuSceneCapacity);
-  while (impl_->gpuScenes.size() > impl_->gpuSceneCapacity) impl_->gpuScenes.erase(impl_->gpuScenes.begin());
+  impl_->gpuScenes.evict([&](const auto& l) { return l.size() > impl_->gpuSceneCapacity; });
 }
 
 const DeviceInfo& Renderer::device() const { return impl_->device->info(); }

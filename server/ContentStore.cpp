@@ -56,11 +56,7 @@ ContentStore::ContentStore(fs::path cacheDir, std::size_t maxBytes, const std::s
     found.push_back({{digest, static_cast<std::size_t>(f.file_size()), ext.substr(1)}, f.last_write_time()});
   }
   std::sort(found.begin(), found.end(), [](const Found& a, const Found& b) { return a.mtime > b.mtime; });
-  for (auto& f : found) {
-    lru_.push_back(Entry{f.info, nullptr});
-    index_[f.info.digest] = std::prev(lru_.end());
-    total_ += f.info.bytes;
-  }
+  for (auto& f : found) lru_.put(f.info.digest, Entry{f.info, nullptr}, f.info.bytes, /*leastRecent=*/true);
   evictLocked("");
 }
 
@@ -68,29 +64,22 @@ fs::path ContentStore::fileFor(const Entry& e) const {
   return dir_ / (e.info.digest.substr(7) + "." + e.info.format);
 }
 
-void ContentStore::touch(std::list<Entry>::iterator it) {
-  lru_.splice(lru_.begin(), lru_, it);
+void ContentStore::touch(Lru::iterator it) {
+  lru_.touch(it);
   if (!dir_.empty()) {
     std::error_code ec;  // best effort: the order survives a restart
-    fs::last_write_time(fileFor(*it), fs::file_time_type::clock::now(), ec);
+    fs::last_write_time(fileFor(it->value), fs::file_time_type::clock::now(), ec);
   }
 }
 
 void ContentStore::evictLocked(const std::string& keep) {
-  while (total_ > maxBytes_ && !lru_.empty()) {
-    auto victim = std::prev(lru_.end());
-    if (victim->info.digest == keep) {
-      if (lru_.size() == 1) break;
-      victim = std::prev(victim);
-    }
-    total_ -= victim->info.bytes;
-    if (!dir_.empty()) {
-      std::error_code ec;
-      fs::remove(fileFor(*victim), ec);
-    }
-    index_.erase(victim->info.digest);
-    lru_.erase(victim);
-  }
+  lru_.evict([&](const Lru& l) { return l.bytes() > maxBytes_; },
+             [&](const Lru::Entry& e) { return e.key == keep; },
+             [&](Lru::Entry&& e) {
+               if (dir_.empty()) return;
+               std::error_code ec;
+               fs::remove(fileFor(e.value), ec);
+             });
 }
 
 bool ContentStore::put(const std::string& digest, std::string bytes) {
@@ -100,9 +89,9 @@ bool ContentStore::put(const std::string& digest, std::string bytes) {
                             std::to_string(maxBytes_));
   std::lock_guard lock(mutex_);
   // Already there, unless its file (found at start-up, not yet verified) is refused: then stored anew.
-  if (auto it = index_.find(digest);
-      it != index_.end() && (it->second->bytes || it->second->verified || readVerifiedLocked(it->second))) {
-    touch(it->second);
+  if (auto it = lru_.find(digest);
+      it != lru_.end() && (it->value.bytes || it->value.verified || readVerifiedLocked(it))) {
+    touch(it);
     return false;
   }
   Entry e{{digest, bytes.size(), formatOf(bytes)}, nullptr};
@@ -119,40 +108,40 @@ bool ContentStore::put(const std::string& digest, std::string bytes) {
     e.bytes = std::make_shared<const std::string>(std::move(bytes));
   }
   e.verified = true;
-  lru_.push_front(std::move(e));
-  index_[digest] = lru_.begin();
-  total_ += lru_.front().info.bytes;
+  const std::size_t size = e.info.bytes;
+  lru_.put(digest, std::move(e), size);
   evictLocked(digest);
   return true;
 }
 
 bool ContentStore::contains(const std::string& digest) {
   std::lock_guard lock(mutex_);
-  auto it = index_.find(digest);
-  if (it == index_.end()) return false;
+  auto it = lru_.find(digest);
+  if (it == lru_.end()) return false;
   // A file found at start-up is hashed on its first use, a HEAD too: a truncated or swapped file is a
   // miss, so a client uploads the scene again instead of rendering a 404.
-  if (!it->second->bytes && !it->second->verified && !readVerifiedLocked(it->second)) return false;
-  touch(it->second);
+  if (!it->value.bytes && !it->value.verified && !readVerifiedLocked(it)) return false;
+  touch(it);
   return true;
 }
 
 std::optional<std::string> ContentStore::get(const std::string& digest) {
   std::lock_guard lock(mutex_);
-  auto it = index_.find(digest);
-  if (it == index_.end()) return std::nullopt;
-  if (it->second->bytes) {
-    touch(it->second);
-    return *it->second->bytes;
+  auto it = lru_.find(digest);
+  if (it == lru_.end()) return std::nullopt;
+  if (it->value.bytes) {
+    touch(it);
+    return *it->value.bytes;
   }
-  std::optional<std::string> bytes = readVerifiedLocked(it->second);
-  if (bytes) touch(it->second);
+  std::optional<std::string> bytes = readVerifiedLocked(it);
+  if (bytes) touch(it);
   return bytes;
 }
 
-std::optional<std::string> ContentStore::readVerifiedLocked(std::list<Entry>::iterator it) {
-  const std::string path = fileFor(*it).string();
-  const std::string digest = it->info.digest;
+std::optional<std::string> ContentStore::readVerifiedLocked(Lru::iterator it) {
+  const Entry& entry = it->value;
+  const std::string path = fileFor(entry).string();
+  const std::string digest = entry.info.digest;
   std::optional<std::string> bytes;
   const char* reason = "unreadable";
   bool regular = false;
@@ -162,25 +151,25 @@ std::optional<std::string> ContentStore::readVerifiedLocked(std::list<Entry>::it
     struct stat st {};
     if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
       reason = "not a regular file";
-    } else if (static_cast<std::uint64_t>(st.st_size) != it->info.bytes) {
+    } else if (static_cast<std::uint64_t>(st.st_size) != entry.info.bytes) {
       regular = true;
       reason = "size changed";
     } else {
       regular = true;
       std::string data;
-      data.reserve(it->info.bytes);
+      data.reserve(entry.info.bytes);
       char buf[1 << 16];
       ssize_t n;
       // At most the recorded size (+1 to see growth during the read).
-      while (data.size() <= it->info.bytes && (n = ::read(fd, buf, sizeof buf)) > 0) data.append(buf, std::size_t(n));
-      if (data.size() != it->info.bytes || api::sceneDigest(data) != digest) reason = "digest mismatch";
-      else if (formatOf(data) != it->info.format) reason = "format mismatch";  // e.g. JSON named <its digest>.png
+      while (data.size() <= entry.info.bytes && (n = ::read(fd, buf, sizeof buf)) > 0) data.append(buf, std::size_t(n));
+      if (data.size() != entry.info.bytes || api::sceneDigest(data) != digest) reason = "digest mismatch";
+      else if (formatOf(data) != entry.info.format) reason = "format mismatch";  // e.g. JSON named <its digest>.png
       else bytes = std::move(data);
     }
     ::close(fd);
   }
   if (bytes) {
-    it->verified = true;
+    it->value.verified = true;
     return bytes;
   }
   // Anything else (edited, truncated, grown, swapped, replaced by a FIFO) is forgotten rather than
@@ -190,8 +179,6 @@ std::optional<std::string> ContentStore::readVerifiedLocked(std::list<Entry>::it
     std::error_code ec;
     fs::remove(path, ec);
   }
-  total_ -= it->info.bytes;
-  index_.erase(digest);
   lru_.erase(it);
   return std::nullopt;
 }
@@ -199,13 +186,13 @@ std::optional<std::string> ContentStore::readVerifiedLocked(std::list<Entry>::it
 std::vector<StoredBlobInfo> ContentStore::list() {
   std::lock_guard lock(mutex_);
   std::vector<StoredBlobInfo> out;
-  for (const auto& e : lru_) out.push_back(e.info);
+  for (const auto& e : lru_) out.push_back(e.value.info);
   return out;
 }
 
 std::size_t ContentStore::totalBytes() {
   std::lock_guard lock(mutex_);
-  return total_;
+  return lru_.bytes();
 }
 
 }  // namespace radiant::server

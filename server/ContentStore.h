@@ -13,13 +13,14 @@
 
 #include <cstddef>
 #include <filesystem>
-#include <list>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
+
+#include "api/Lru.h"
 
 namespace radiant::server {
 
@@ -49,18 +50,17 @@ private:
     std::shared_ptr<const std::string> bytes;  // in memory (no cache dir)
     bool verified = false;                     // its file was written or hashed by this process
   };
+  using Lru = api::Lru<std::string, Entry>;  // by digest, each entry's size its info.bytes
   std::filesystem::path fileFor(const Entry& e) const;
-  void touch(std::list<Entry>::iterator it);
+  void touch(Lru::iterator it);
   void evictLocked(const std::string& keep);
   // The entry's file, checked as above; nullopt (and the entry forgotten) when it is refused.
-  std::optional<std::string> readVerifiedLocked(std::list<Entry>::iterator it);
+  std::optional<std::string> readVerifiedLocked(Lru::iterator it);
 
   std::filesystem::path dir_;  // "" = memory only
   std::size_t maxBytes_;
   std::mutex mutex_;
-  std::list<Entry> lru_;  // front = most recently used
-  std::map<std::string, std::list<Entry>::iterator> index_;
-  std::size_t total_ = 0;
+  Lru lru_;
 };
 
 }  // namespace radiant::server

@@ -28,6 +28,7 @@
 #include "api/Aovs.h"
 #include "api/Base64.h"
 #include "api/JsonLimits.h"
+#include "api/Lru.h"
 #include "api/Presets.h"
 #include "api/Sha256.h"
 #include "api/Validate.h"
@@ -181,14 +182,12 @@ public:
   DecodedCache(std::size_t capacity, std::size_t maxBytes) : capacity_(capacity), maxBytes_(maxBytes) {}
   std::size_t totalBytes() {
     std::lock_guard lock(mutex_);
-    return bytes_;
+    return lru_.bytes();
   }
   std::shared_ptr<const T> get(const std::string& digest) {
     std::lock_guard lock(mutex_);
-    auto it = index_.find(digest);
-    if (it == index_.end()) return nullptr;
-    lru_.splice(lru_.begin(), lru_, it->second);
-    return it->second->second;
+    auto* value = lru_.use(digest);
+    return value ? *value : nullptr;
   }
   // Drops least recently used entries that nothing else holds (no job, no request in flight) until
   // `bytes` are freed or none is left: their decode memory is released with them (DecodeMemory).
@@ -196,39 +195,25 @@ public:
     std::vector<std::shared_ptr<const T>> dropped;  // destroyed after the lock is released
     {
       std::lock_guard lock(mutex_);
-      std::size_t freed = 0;
-      for (auto it = lru_.end(); it != lru_.begin() && freed < bytes;) {
-        --it;
-        if (it->second.use_count() != 1) continue;
-        const std::size_t size = SizeOf(*it->second);
-        freed += size;
-        bytes_ -= size;
-        index_.erase(it->first);
-        dropped.push_back(std::move(it->second));
-        it = lru_.erase(it);
-      }
+      const std::size_t target = lru_.bytes() > bytes ? lru_.bytes() - bytes : 0;
+      lru_.evict([&](const Lru& l) { return l.bytes() > target; },
+                 [](const typename Lru::Entry& e) { return e.value.use_count() != 1; },
+                 [&](typename Lru::Entry&& e) { dropped.push_back(std::move(e.value)); });
     }
   }
   void put(const std::string& digest, std::shared_ptr<const T> value) {
     const std::size_t size = SizeOf(*value);
     std::lock_guard lock(mutex_);
-    if (index_.count(digest) || size > maxBytes_) return;
-    lru_.emplace_front(digest, std::move(value));
-    index_[digest] = lru_.begin();
-    bytes_ += size;
-    while (lru_.size() > capacity_ || bytes_ > maxBytes_) {
-      bytes_ -= SizeOf(*lru_.back().second);
-      index_.erase(lru_.back().first);
-      lru_.pop_back();
-    }
+    if (lru_.find(digest) != lru_.end() || size > maxBytes_) return;
+    lru_.put(digest, std::move(value), size);
+    lru_.evict([&](const Lru& l) { return l.size() > capacity_ || l.bytes() > maxBytes_; });
   }
 
 private:
-  using Entry = std::pair<std::string, std::shared_ptr<const T>>;
+  using Lru = api::Lru<std::string, std::shared_ptr<const T>>;
   std::mutex mutex_;
-  std::size_t capacity_, maxBytes_, bytes_ = 0;
-  std::list<Entry> lru_;
-  std::map<std::string, typename std::list<Entry>::iterator> index_;
+  std::size_t capacity_, maxBytes_;
+  Lru lru_;
 };
 using DecodedScenes = DecodedCache<Scene, sceneBytes>;
 // Environment maps and comparison images, decoded once per digest (a 4k map took a decode per

@@ -79,8 +79,8 @@ const std::string& FrameResources::sceneKey() const { return gpu_->sceneKey; }
 std::size_t FrameResources::derivedBytes() const {
   std::size_t total = 0;
   for (const auto& [key, entries] : cache_)
-    for (const Entry& e : entries)
-      if (e.bytes) total += e.bytes();
+    for (const auto& e : entries)
+      if (e.value.bytes) total += e.value.bytes();
   return total;
 }
 
@@ -88,16 +88,16 @@ void FrameResources::keepWithinDerivedBytes() {
   std::size_t total = derivedBytes();
   while (total > derivedBytes_) {
     // The least recently used sized entry of an earlier frame: the oldest frame, then the back of its list.
-    std::list<Entry>* from = nullptr;
-    std::list<Entry>::iterator victim;
+    Family* from = nullptr;
+    Family::iterator victim;
     for (auto& [key, entries] : cache_)
       for (auto it = entries.begin(); it != entries.end(); ++it)
-        if (it->bytes && it->frame != frame_ && (!from || it->frame <= victim->frame)) {
+        if (it->value.bytes && it->value.frame != frame_ && (!from || it->value.frame <= victim->value.frame)) {
           from = &entries;
           victim = it;
         }
     if (!from) return;  // only this frame's entries are left
-    total -= victim->bytes();
+    total -= victim->value.bytes();
     from->erase(victim);
   }
 }
@@ -208,8 +208,9 @@ void FrameResources::releaseIdle() {
     holds_.erase(it->first);
     it = buffers_.erase(it);
   }
-  for (auto& [key, entries] : cache_)
-    entries.remove_if([&](const Entry& e) { return e.frame != frame_; });
+  for (auto& [key, entries] : cache_) entries.evict([](const Family&) { return true; },
+                                                    [&](const Family::Entry& e) { return e.value.frame == frame_; },
+                                                    [](Family::Entry&&) {});
   if (trimHook_) trimHook_();
   malloc_trim(0);
 }

@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "api/LightPaths.h"
+#include "api/Lru.h"
 #include "api/Types.h"
 #include "renderer/gl/Gl.h"
 #include "renderer/gl/ShaderLibrary.h"
@@ -172,26 +173,23 @@ public:
   // builds it with `build` and stores it. Logs "key" as a hit or a miss.
   template <class T>
   T& cached(const std::string& key, const std::string& inputsDigest, const std::function<std::unique_ptr<T>()>& build) {
-    std::list<Entry>& entries = cache_[key];  // most recently used first
-    auto it = entries.begin();
-    while (it != entries.end() && it->digest != inputsDigest) ++it;
-    const bool hit = it != entries.end();
+    Family& entries = cache_[key];  // by inputs digest
+    const bool hit = entries.use(inputsDigest) != nullptr;
     if (cacheLog_) cacheLog_->push_back({key, hit});
-    if (hit) {
-      entries.splice(entries.begin(), entries, it);
-    } else {
+    if (!hit) {
       auto value = build();
       T* raw = value.release();
       std::function<std::size_t()> bytes;
       if constexpr (requires(const T& v) { { v.bytes() } -> std::convertible_to<std::size_t>; })
         bytes = [raw] { return static_cast<std::size_t>(raw->bytes()); };
-      entries.push_front({inputsDigest, std::shared_ptr<void>(raw, [](void* p) { delete static_cast<T*>(p); }),
-                          std::move(bytes), frame_});
-      while (entries.size() > derivedCapacity_) entries.pop_back();
+      entries.put(inputsDigest,
+                  Entry{std::shared_ptr<void>(raw, [](void* p) { delete static_cast<T*>(p); }), std::move(bytes), frame_});
+      entries.evict([&](const Family& f) { return f.size() > derivedCapacity_; });
       keepWithinDerivedBytes();  // on insertion only: a budget below one set still reuses the set in use
     }
-    entries.front().frame = frame_;
-    return *static_cast<T*>(entries.front().value.get());
+    Entry& e = entries.begin()->value;  // the most recently used: this one
+    e.frame = frame_;
+    return *static_cast<T*>(e.value.get());
   }
   // Bytes the sized derived data may hold together (at least one entry is always kept: the one in use).
   void setDerivedBytes(std::size_t bytes) {
@@ -203,8 +201,7 @@ public:
   // Digests kept per cache key (at least 1; default 4).
   void setDerivedCapacity(std::size_t n) {
     derivedCapacity_ = n < 1 ? 1 : n;
-    for (auto& [key, entries] : cache_)
-      while (entries.size() > derivedCapacity_) entries.pop_back();
+    for (auto& [key, entries] : cache_) entries.evict([&](const Family& f) { return f.size() > derivedCapacity_; });
   }
   // Drops every cached entry and resource (after a GL failure the objects may be invalid).
   void clear();
@@ -258,7 +255,6 @@ private:
     bool operator==(const TextureSpec&) const = default;
   };
   struct Entry {
-    std::string digest;
     std::shared_ptr<void> value;
     std::function<std::size_t()> bytes;  // empty: the type does not report its size
     std::uint64_t frame = 0;             // the last frame that looked it up
@@ -274,7 +270,8 @@ private:
   std::map<std::string, std::pair<TextureSpec, gl::Texture>> textures_;
   std::map<std::string, gl::Framebuffer> framebuffers_;
   std::map<std::string, gl::Buffer> buffers_;
-  std::map<std::string, std::list<Entry>> cache_;
+  using Family = api::Lru<std::string, Entry>;  // one cache key's entries, by inputs digest
+  std::map<std::string, Family> cache_;
   std::map<std::string, std::string> holds_;  // resource -> digest of what it holds (holds())
   std::size_t derivedCapacity_ = 4;
   std::set<std::string> written_;
