@@ -15,6 +15,7 @@
 #include "api/Presets.h"
 #include "api/Validate.h"
 #include "renderer/frame/FrameAllocation.h"
+#include "renderer/frame/FrameLighting.h"
 #include "renderer/frame/FramePlanner.h"
 #include "renderer/frame/FrameResources.h"
 #include "renderer/frame/FrameView.h"
@@ -26,7 +27,6 @@
 #include "renderer/metrics/Metrics.h"
 #include "renderer/scene/BuiltinScenes.h"
 #include "renderer/scene/CostCounts.h"
-#include "renderer/scene/StudioEnvironment.h"
 #include "renderer/shading/DirectLighting.h"
 #include "renderer/shading/EnvironmentLights.h"
 #include "renderer/techniques/reference/ReferencePass.h"
@@ -599,45 +599,14 @@ RenderOutput Renderer::renderFrame(const Scene& scene, const api::RenderRequest&
   stats.scene = sceneStats(scene);
   stats.warnings = scene.warnings;
 
-  // Default lighting (renderer/scene/StudioEnvironment.h; docs/API.md, "Default lighting"): rendered
-  // without ambient or environment, a scene is lit by the studio map as if the request had named it when
-  // it brings no punctual light, whatever its emission (an emissive visor or screen lights little around
-  // it; every viewer shows such a model under its environment). Punctual lights of any type are a lighting
-  // set-up of their own (a room such as the Cornell boxes, a sun over an analytic test scene, a key light
-  // as GlamVelvetSofa's, which the reference path tracer renders near-black too): they stay the frame's
-  // only light, so that the default frame and the reference see the same scene.
-  api::RenderRequest effective = requestIn;
+  // Default lighting (renderer/frame/FrameLighting.h): the studio map for a scene without punctual
+  // lights when the request names no ambient or environment.
+  FrameLighting lit = frameLighting(scene, requestIn, inputsIn.environment);
+  api::RenderRequest effective = std::move(lit.request);
   FrameInputs inputs = inputsIn;
-  const bool sceneLit = !scene.lights.empty() || scene.features.hasEmissive();
-  const bool ambientGiven = requestIn.ambient != glm::vec3(0.f);
-  const std::string own = !scene.lights.empty() && scene.features.hasEmissive() ? "lights and emissive surfaces"
-                          : !scene.lights.empty()                               ? "lights"
-                          : scene.features.hasEmissive()                        ? "emissive surfaces"
-                                                                                : "";
-  std::string sky;
-  if (!requestIn.environment.empty()) {
-    sky = "environment";
-    stats.lightingReason = "the request's environment map";
-  } else if (ambientGiven) {
-    sky = "ambient";
-    stats.lightingReason = "the request's ambient";
-  } else if (requestIn.defaultLighting && scene.lights.empty()) {
-    sky = "default";
-    effective.environment = kStudioEnvironmentKey;
-    inputs.environment = &studioEnvironment();
-    stats.lightingReason = !sceneLit ? "the scene has no lights or emissive surfaces"
-                                     : "the scene has no punctual lights (its emissive surfaces light little "
-                                       "beyond themselves)";
-    stats.lightingReason += ", and the request names no ambient or environment";
-  } else if (!requestIn.defaultLighting) {
-    stats.lightingReason = "default_lighting is false";
-  } else {
-    stats.lightingReason = "the scene has punctual lights, a lighting set-up of its own (a room such as the "
-                           "Cornell boxes)";
-  }
-  stats.lighting = sceneLit ? (sky.empty() ? "scene" : "scene+" + sky) : (sky.empty() ? "none" : sky);
-  if (!own.empty()) stats.lightingReason += (sky.empty() ? ": the scene's own " : "; with the scene's own ") + own;
-  else if (sky.empty()) stats.lightingReason += ", and the scene has no lights or emissive surfaces: nothing";
+  inputs.environment = lit.environment;
+  stats.lighting = std::move(lit.lighting);
+  stats.lightingReason = std::move(lit.reason);
   const api::RenderRequest& request = effective;
   if (request.timeBudgetMs > 0 && im.speed.needsCalibration() && !im.calibrating) calibrateSpeed();
 

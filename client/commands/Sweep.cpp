@@ -180,10 +180,15 @@ json benchCompare(const json& technique, const json& fallback) {
 }
 
 Preset presetFor(const json& technique, bool quick) {
-  const json bench = technique.value("bench", json::object());
-  Preset out{json::object(), bench.value("compare", json::object()), bench.value("request", json::object())};
+  // What the server sent: anything but objects (an older server has no "bench") counts as no preset.
+  auto object = [](const json& j, const char* key) {
+    const auto it = j.find(key);
+    return it != j.end() && it->is_object() ? *it : json::object();
+  };
+  const json bench = object(technique, "bench");
+  Preset out{json::object(), object(bench, "compare"), object(bench, "request")};
   const std::string prefix = "passes." + technique.value("name", "") + ".";
-  const json axes = bench.value("axes", json::object());
+  const json axes = object(bench, "axes");
   for (const auto& [param, modes] : axes.items())
     if (modes.is_object() && modes.contains(quick ? "quick" : "full")) out.axes[prefix + param] = modes[quick ? "quick" : "full"];
   return out;

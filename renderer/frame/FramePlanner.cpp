@@ -197,10 +197,11 @@ FramePlan planFrame(const std::vector<Technique*>& techniques, const Scene& scen
   for (Technique* t : techniques)
     if (keep.count(t)) plan.passes.push_back(t);
   // Every light path is counted once: each class goes to the planned technique the ownership policy
-  // puts first (ownsBefore: a named claimsWhenNamed technique, then the policy's row). A technique that does not own a class it requires (TechniqueInfo::requiredPaths;
-  // an exclusive one: all of its classes) is dropped, and the classes are handed out again without it,
-  // so that what it would have supplied goes to the next claimant (photon_gi's sky light to
-  // ambient_occlusion when env_diffuse owns LD+DE). A pass that needs what a dropped one produces goes too.
+  // puts first (ownsBefore: a named claimsWhenNamed technique, then the policy's row). A technique
+  // that does not own a class it requires (TechniqueInfo::requiredPaths; an exclusive one: all of its
+  // classes) is dropped, and the classes are handed out again without it, so that what it would have
+  // supplied goes to the next claimant (photon_gi's sky light to ambient_occlusion when env_diffuse
+  // owns LD+DE). A pass that needs what a dropped one produces goes too.
   for (bool dropped = true; dropped;) {
     dropped = false;
     plan.lightPaths.clear();
