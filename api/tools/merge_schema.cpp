@@ -38,6 +38,19 @@ json readJson(const std::string& path) {
 
 void fail(const std::string& file, const std::string& what) { throw std::runtime_error(file + ": " + what); }
 
+// What is wrong with `v` as a value of the (normalised) parameter `p`: "is not of type T", "is below its
+// minimum", "is above its maximum", "is not in its enum", or "" when it is one the parameter accepts.
+std::string valueProblem(const json& p, const json& v) {
+  const std::string type = p["type"];
+  const bool typeOk = (type == "integer" && v.is_number_integer()) || (type == "number" && v.is_number()) ||
+                      (type == "boolean" && v.is_boolean()) || (type == "string" && v.is_string());
+  if (!typeOk) return "is not of type " + type;
+  if (p.contains("minimum") && v.is_number() && v.get<double>() < p["minimum"].get<double>()) return "is below its minimum";
+  if (p.contains("maximum") && v.is_number() && v.get<double>() > p["maximum"].get<double>()) return "is above its maximum";
+  if (p.contains("enum") && std::find(p["enum"].begin(), p["enum"].end(), v) == p["enum"].end()) return "is not in its enum";
+  return "";
+}
+
 // Technique parameters use the request schema's vocabulary; "min"/"max" are accepted as aliases.
 json normaliseParam(const std::string& file, const std::string& name, const json& p) {
   static const std::set<std::string> kAllowed{"type",    "default", "minimum",     "maximum", "min",
@@ -69,16 +82,8 @@ json normaliseParam(const std::string& file, const std::string& name, const json
                      ".x-cost must be one of samples, photons, particles, resolution, nodes, iterations, none");
     if (type != "integer") fail(file, "params." + name + " has an x-cost but is not an integer");
   }
-  const json& d = out["default"];
-  bool typeOk = (type == "integer" && d.is_number_integer()) || (type == "number" && d.is_number()) ||
-                (type == "boolean" && d.is_boolean()) || (type == "string" && d.is_string());
-  if (!typeOk) fail(file, "params." + name + ".default is not of type " + type);
-  if (out.contains("minimum") && d.is_number() && d.get<double>() < out["minimum"].get<double>())
-    fail(file, "params." + name + ".default is below its minimum");
-  if (out.contains("maximum") && d.is_number() && d.get<double>() > out["maximum"].get<double>())
-    fail(file, "params." + name + ".default is above its maximum");
-  if (out.contains("enum") && std::find(out["enum"].begin(), out["enum"].end(), d) == out["enum"].end())
-    fail(file, "params." + name + ".default is not in its enum");
+  if (const std::string problem = valueProblem(out, out["default"]); !problem.empty())
+    fail(file, "params." + name + ".default " + problem);
   return out;
 }
 
@@ -128,16 +133,9 @@ json benchPreset(const std::string& file, const json& t, const json& params) {
       fail(file, where + " must be an array of values or {\"full\": [...], \"quick\": [...]}");
     for (const auto& [mode, values] : modes.items()) {
       if (!values.is_array() || values.empty()) fail(file, where + "." + mode + " must be a non-empty array");
-      for (const auto& v : values) {
-        const std::string type = p["type"];
-        const bool typeOk = (type == "integer" && v.is_number_integer()) || (type == "number" && v.is_number()) ||
-                            (type == "boolean" && v.is_boolean()) || (type == "string" && v.is_string());
-        if (!typeOk) fail(file, where + ": " + v.dump() + " is not of type " + type);
-        if ((p.contains("minimum") && v.is_number() && v.get<double>() < p["minimum"].get<double>()) ||
-            (p.contains("maximum") && v.is_number() && v.get<double>() > p["maximum"].get<double>()) ||
-            (p.contains("enum") && std::find(p["enum"].begin(), p["enum"].end(), v) == p["enum"].end()))
-          fail(file, where + ": " + v.dump() + " is outside the parameter's range");
-      }
+      for (const auto& v : values)
+        if (const std::string problem = valueProblem(p, v); !problem.empty())
+          fail(file, where + ": " + v.dump() + " " + problem);
     }
     out["axes"][name] = modes;
   }

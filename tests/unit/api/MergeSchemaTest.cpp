@@ -180,8 +180,8 @@ TEST_F(MergeSchema, ABrokenDescriptorFailsNamingItsFileAndKey) {
   const std::vector<Case> cases = {
       {"an unknown light-path class", {unknownClass}, "light_paths: \"LD*E\" is not a light-path class"},
       {"a bench axis of no parameter", {benchUnknownParam}, "bench.axes.radius is not one of its \"params\""},
-      {"a bench value above the maximum", {benchOutOfRange}, "bench.axes.taps: 32 is outside the parameter's range"},
-      {"a bench value outside the enum", {benchNotInEnum}, "bench.axes.mode: \"z\" is outside the parameter's range"},
+      {"a bench value above the maximum", {benchOutOfRange}, "bench.axes.taps: 32 is above its maximum"},
+      {"a bench value outside the enum", {benchNotInEnum}, "bench.axes.mode: \"z\" is not in its enum"},
       {"a bench value of another type", {benchWrongType}, "bench.axes.taps: 2.5 is not of type integer"},
       {"a bench axis without its quick values", {benchNoQuick}, "bench.axes.taps must be an array of values or"},
       {"an unknown bench key", {benchUnknownKey}, "bench: unknown key \"scenes\""},
