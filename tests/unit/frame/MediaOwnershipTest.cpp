@@ -1,8 +1,9 @@
 // One owner of the media AOV per frame (FramePlanner, TechniqueInfo::exclusive): every media technique
 // writes the media AOVs and composes them into beauty, so exactly one runs. spherical_billboards
-// (first in the registry) owns the light-path class "media" by default; a media technique the request
-// names (claimsWhenNamed) owns it instead, and the others are skipped with "media is owned by X".
-// Naming two media techniques is a 422 whose pointer is the second one's /passes/<name>. Stand-ins
+// (first in the planner's ownership policy) owns the light-path class "media" by default; a media
+// technique the request names (claimsWhenNamed) owns it instead, and the others are skipped with
+// "media is owned by X".
+// Naming two media techniques is a 422 whose pointer is the one the policy ranks later. Stand-ins
 // for depth_impostors and illumination_network, registered after spherical_billboards as the registry
 // has them.
 #include <algorithm>

@@ -2,8 +2,9 @@
 // LD+DE, which its photons carry whatever owns it) is dropped by the planner where another planned
 // technique owns that class ("LD+DE is owned by env_diffuse"), and the classes are handed out again
 // without it: what it would have supplied goes to the next claimant. A request naming both is a 422
-// from the planner, not from a pass. Stand-ins with the registry's order: env_diffuse, photon_gi,
-// ambient_occlusion, and a pass that reads photon_gi's output.
+// from the planner, not from a pass. Stand-ins, owning as the planner's ownership policy says
+// (env_diffuse, then photon_gi, for LD+DE; photon_gi, then ambient_occlusion, for L(sky)DE), and a pass
+// that reads photon_gi's output.
 #include <algorithm>
 
 #include <gtest/gtest.h>

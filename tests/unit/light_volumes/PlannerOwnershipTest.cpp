@@ -41,7 +41,8 @@ TEST(LightPathOwnership, CausticsOwnsByDefaultLightVolumesWhenNamed) {
   LightVolumesPass volumes;
   const std::vector<Technique*> registry{&gbuffer, &caustics, &volumes};
   const Scene scene = mirrorScene();
-  // light_volumes planned for its AOV only: caustics, first in the registry, owns both classes.
+  // light_volumes planned for its AOV only: caustics owns both classes (LS+DE by the ownership policy;
+  // LG+DE, which only this stand-in of caustics also claims, by name, the policy having no row for it).
   FramePlan p = planFrame(registry, scene, asking(false));
   ASSERT_EQ(p.passes.size(), 3u);
   EXPECT_EQ(p.lightPaths.at("LS+DE"), "caustics");
