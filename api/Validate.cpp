@@ -304,7 +304,8 @@ const std::vector<TechniqueSchema>& techniqueSchemas() {
       t.summary = d.at("summary");
       t.inputs = d.at("inputs");
       t.optionalInputs = d.at("optional_inputs");
-      t.after = d.at("after");
+      t.prepareOutputs = d.at("prepare_outputs");
+      t.beautyBlend = d.at("beauty_blend");
       t.resources = d.at("resources");
       t.lightPaths = d.at("light_paths");
       t.requiredPaths = d.at("requires_paths");

@@ -90,7 +90,8 @@ struct TechniqueSchema {
   std::string description;  // the parameters' object's description (the docs, the schema)
   std::vector<std::string> outputs;  // the AOVs a request may ask of it
   nlohmann::json params;  // name -> {type, default, minimum?, maximum?, enum?, description}
-  std::vector<std::string> inputs, optionalInputs, after, resources, lightPaths, requiredPaths;
+  std::vector<std::string> inputs, optionalInputs, prepareOutputs, resources, lightPaths, requiredPaths;
+  std::string beautyBlend = "add";  // add, over or transmit (docs/API.md, "A technique declares itself")
   bool addsToBeauty = false, onByDefault = false, claimsWhenNamed = false, exclusive = false;
   // `radiant bench`'s preset: {"axes": {param: {"full": [...], "quick": [...]}}, "request": {...},
   // "compare": {...}} (the descriptor's "bench", checked against the parameters at build time).

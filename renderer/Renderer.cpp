@@ -442,6 +442,10 @@ Renderer::~Renderer() = default;
 
 void Renderer::setSpeedFactor(double factor) { impl_->speed.pin(factor); }
 
+void Renderer::setTechniques(std::vector<std::unique_ptr<Technique>> techniques) {
+  impl_->techniques = std::move(techniques);
+}
+
 void Renderer::setReleaseHook(std::function<void()> hook) { impl_->releaseHook = std::move(hook); }
 
 // The speed factor's calibration (api::MachineSpeed): the preset table's canonical frame, the built-in

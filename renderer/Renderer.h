@@ -13,6 +13,7 @@
 #include "renderer/scene/Scene.h"
 
 namespace radiant {
+class Technique;  // renderer/frame/Technique.h
 namespace api {
 struct RequestLimits;  // api/Validate.h
 }
@@ -108,6 +109,9 @@ public:
   // 0 measures it: a calibration frame before the first frame with a time budget, then the ratio of
   // measured to predicted time of recent frames comparable with the preset table. Default 0.
   void setSpeedFactor(double factor);
+  // The techniques, in the order that breaks the frame graph's ties (default createTechniques(),
+  // renderer/techniques/Registry.cpp). Tests reorder them: declarations alone order a frame.
+  void setTechniques(std::vector<std::unique_ptr<Technique>> techniques);
 
 private:
   RenderOutput renderFrame(const Scene& scene, const api::RenderRequest& request, const std::atomic<bool>* cancel,

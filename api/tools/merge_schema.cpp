@@ -221,11 +221,15 @@ int main(int argc, char** argv) {
       const std::string file = argv[i];
       json t = readJson(file);
       static const std::set<std::string> kAllowed{
-          "name",   "summary",   "description", "inputs",         "optional_inputs", "after",
-          "outputs", "resources", "aovs",       "adds_to_beauty", "on_by_default",   "light_paths",
-          "requires_paths", "claims_when_named", "exclusive", "params", "bench"};
+          "name",    "summary",   "description", "inputs",         "optional_inputs", "prepare_outputs",
+          "outputs", "resources", "aovs",        "adds_to_beauty", "beauty_blend",    "on_by_default",
+          "light_paths", "requires_paths", "claims_when_named", "exclusive", "params", "bench"};
       for (const auto& [k, v] : t.items())
-        if (!kAllowed.count(k)) fail(file, "unknown key \"" + k + "\"");
+        if (!kAllowed.count(k))
+          fail(file, "unknown key \"" + k + "\"" +
+                         (k == "after" ? std::string(" (gone: the frame graph orders passes by what they read "
+                                                     "and by their beauty_blend; docs/API.md)")
+                                       : std::string()));
       if (!t.contains("name") || !t["name"].is_string()) fail(file, "missing \"name\"");
       const std::string name = t["name"];
       if (std::filesystem::path(file).stem().string() != name) fail(file, "name must match the file name");
@@ -239,14 +243,27 @@ int main(int argc, char** argv) {
       json technique = {{"summary", t["summary"]},
                         {"inputs", names(file, t, "inputs")},
                         {"optional_inputs", names(file, t, "optional_inputs")},
-                        {"after", names(file, t, "after")},
+                        {"prepare_outputs", names(file, t, "prepare_outputs")},
                         {"resources", names(file, t, "resources")},
                         {"adds_to_beauty", flag(file, t, "adds_to_beauty", true)},
+                        {"beauty_blend", t.value("beauty_blend", json("add"))},
                         {"on_by_default", flag(file, t, "on_by_default", true)},
                         {"light_paths", names(file, t, "light_paths")},
                         {"requires_paths", names(file, t, "requires_paths")},
                         {"claims_when_named", flag(file, t, "claims_when_named", false)},
                         {"exclusive", flag(file, t, "exclusive", false)}};
+      // How it composes into beauty, which orders it among the frame's beauty writers (FramePlanner's
+      // executionOrder): add (commutes with the other adds), over (blended surfaces, after every add),
+      // transmit (media: beauty * T + C, after everything else).
+      if (const json& b = technique["beauty_blend"]; !b.is_string() || (b != "add" && b != "over" && b != "transmit"))
+        fail(file, "\"beauty_blend\" must be \"add\", \"over\" or \"transmit\"");
+      if (t.contains("beauty_blend") && !technique["adds_to_beauty"].get<bool>())
+        fail(file, "\"beauty_blend\" needs \"adds_to_beauty\": true");
+      // What prepare() publishes (before any pass's execute): readers need not run after this pass.
+      for (const auto& o : technique["prepare_outputs"])
+        if (std::find(outputs.begin(), outputs.end(), o) == outputs.end() &&
+            std::find(technique["resources"].begin(), technique["resources"].end(), o) == technique["resources"].end())
+          fail(file, "prepare_outputs: \"" + o.get<std::string>() + "\" is not one of its \"outputs\" or \"resources\"");
       for (const char* k : {"light_paths", "requires_paths"})
         for (const auto& c : technique[k])
           if (radiant::api::lightPathBit(c.get<std::string>()) == 0)

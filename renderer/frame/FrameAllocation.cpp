@@ -27,7 +27,17 @@ void allocateDeclaredOutputs(FrameResources& res, const std::vector<Technique*>&
       declared = declared || std::find(outs.begin(), outs.end(), a.name) != outs.end() ||
                  std::find(outs.begin(), outs.end(), a.resource) != outs.end();
     }
-    if (declared) res.texture(a.resource, GL_TEXTURE_2D, glFormat(a.format), w, h);
+    if (!declared) continue;
+    gl::Texture& t = res.texture(a.resource, GL_TEXTURE_2D, glFormat(a.format), w, h);
+    if (a.blend != api::AovBlend::Accumulate) continue;
+    // Zero, through a framebuffer: on llvmpipe a glClearTexImage here did not reach the next pass's
+    // draws (the frame added onto the last one's beauty).
+    gl::Framebuffer& fb = res.framebuffer("clear:" + a.resource);
+    fb.attach(GL_COLOR_ATTACHMENT0, t);
+    fb.setDrawBuffers({GL_COLOR_ATTACHMENT0});
+    const float zero[4] = {0.f, 0.f, 0.f, 0.f};
+    fb.checkComplete("allocateDeclaredOutputs");  // Mesa skips a clear of a framebuffer it has not validated
+    glClearNamedFramebufferfv(fb.id(), GL_COLOR, 0, zero);
   }
 }
 

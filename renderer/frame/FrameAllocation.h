@@ -13,7 +13,10 @@
 namespace radiant {
 
 // Every accumulate AOV (beauty) and every AOV-table resource among the planned passes' outputs, as
-// GL_TEXTURE_2D of the table's format and view.width x view.height.
+// GL_TEXTURE_2D of the table's format and view.width x view.height. The accumulate AOVs are cleared to
+// zero: every pass composes into beauty (BeautyBlend), none initialises it, so the passes that add to
+// it commute and the frame graph orders them freely (a frame without the direct pass once added onto
+// the previous frame's beauty).
 void allocateDeclaredOutputs(FrameResources& resources, const std::vector<Technique*>& passes);
 
 // The frame resource "environment_map" (kEnvironmentMap): view.environment as an RGBA32F equirect

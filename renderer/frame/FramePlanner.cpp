@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <set>
+#include <stdexcept>
 
 #include "api/Aovs.h"
 
@@ -17,7 +18,9 @@ std::vector<ResourceAccess> declaredAccess(const TechniqueInfo& info) {
   std::vector<ResourceAccess> out;
   for (const auto& in : info.inputs) out.push_back({in, Access::Read});
   for (const auto& in : info.optionalInputs) out.push_back({in, Access::Read});
-  for (const auto& o : info.outputs) out.push_back({o, Access::Write});
+  for (const auto& o : info.outputs)
+    out.push_back({o, std::count(info.prepareOutputs.begin(), info.prepareOutputs.end(), o) ? Access::WriteInPrepare
+                                                                                              : Access::Write});
   if (info.addsToBeauty)
     for (const api::AovInfo& a : api::aovTable())
       if (a.blend == api::AovBlend::Accumulate) out.push_back({a.resource, Access::Accumulate});
@@ -39,6 +42,41 @@ std::string undeclaredWrite(const TechniqueInfo& info, const std::set<std::strin
     return name;
   }
   return {};
+}
+
+std::vector<Technique*> executionOrder(const std::vector<Technique*>& planned) {
+  const std::size_t n = planned.size();
+  std::vector<std::set<std::size_t>> after(n);  // after[b]: the passes b must run after
+  auto reads = [](const TechniqueInfo& i, const std::string& name) {
+    return std::count(i.inputs.begin(), i.inputs.end(), name) + std::count(i.optionalInputs.begin(), i.optionalInputs.end(), name) > 0;
+  };
+  for (std::size_t a = 0; a < n; ++a)
+    for (std::size_t b = 0; b < n; ++b) {
+      if (a == b) continue;
+      const TechniqueInfo& pa = planned[a]->info();
+      const TechniqueInfo& pb = planned[b]->info();
+      for (const std::string& out : pa.outputs)
+        if (reads(pb, out) && !std::count(pa.prepareOutputs.begin(), pa.prepareOutputs.end(), out)) after[b].insert(a);
+      if (pa.addsToBeauty && pb.addsToBeauty && pa.beautyBlend < pb.beautyBlend) after[b].insert(a);
+    }
+  // Kahn's algorithm, taking the first ready pass in registry order each time.
+  std::vector<Technique*> order;
+  std::vector<bool> done(n, false);
+  while (order.size() < n) {
+    std::size_t next = n;
+    for (std::size_t b = 0; b < n && next == n; ++b)
+      if (!done[b] && std::all_of(after[b].begin(), after[b].end(), [&](std::size_t a) { return done[a]; })) next = b;
+    if (next == n) {
+      std::string cycle;
+      for (std::size_t b = 0; b < n; ++b)
+        if (!done[b]) cycle += (cycle.empty() ? "" : ", ") + planned[b]->info().name;
+      throw std::logic_error("frame graph: the declarations of " + cycle +
+                             " order them in a cycle (each reads what another writes, or their beauty_blend)");
+    }
+    done[next] = true;
+    order.push_back(planned[next]);
+  }
+  return order;
 }
 
 const std::vector<OwnershipRow>& ownershipPolicy() {
@@ -196,6 +234,7 @@ FramePlan planFrame(const std::vector<Technique*>& techniques, const Scene& scen
   }
   for (Technique* t : techniques)
     if (keep.count(t)) plan.passes.push_back(t);
+  plan.passes = executionOrder(plan.passes);
   // Every light path is counted once: each class goes to the planned technique the ownership policy
   // puts first (ownsBefore: a named claimsWhenNamed technique, then the policy's row). A technique
   // that does not own a class it requires (TechniqueInfo::requiredPaths; an exclusive one: all of its

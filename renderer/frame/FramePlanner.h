@@ -21,7 +21,7 @@
 namespace radiant {
 
 struct FramePlan {
-  std::vector<Technique*> passes;              // in execution order
+  std::vector<Technique*> passes;              // in execution order (executionOrder)
   std::map<std::string, std::string> skipped;  // pass name -> reason
   std::map<std::string, std::string> lightPaths;  // light-path class -> the technique that owns it
   // The classes each planned technique owns (api::LightPathMask bits of lightPaths).
@@ -59,8 +59,18 @@ std::set<std::string> sharedResources(const std::vector<Technique*>& techniques)
 // Renderer fails the frame with std::logic_error on one.
 std::string undeclaredWrite(const TechniqueInfo& info, const std::set<std::string>& written);
 
-// `techniques` is in the canonical execution order (renderer/techniques/Registry.cpp); which technique
-// owns a light-path class does not depend on it.
+// The frame graph's order (ARCHITECTURE.md, "The frame graph"): `planned` (in registry order) sorted so
+// that every pass runs after
+//   - the planned producers of what it reads (its inputs and optional inputs; not of what a producer
+//     publishes in prepare(), TechniqueInfo::prepareOutputs: every prepare runs before any execute), and
+//   - every beauty writer of an earlier BeautyBlend (Add, then Over, then Transmit).
+// Among passes these declarations leave unordered, the registry's order decides (it fixes the order
+// of beauty's floating-point sums, so a frame is reproducible bit for bit); no pass's result depends on
+// it (tests FrameGraph.*). Throws std::logic_error naming the passes of a cycle.
+std::vector<Technique*> executionOrder(const std::vector<Technique*>& planned);
+
+// `techniques` is the registry (renderer/techniques/Registry.cpp): neither the passes planned, their
+// order's constraints nor which technique owns a light-path class depend on its order.
 // Throws api::ApiError (422) for a requested pass or AOV that no technique knows, and for a request
 // that names two techniques of which one requires a light-path class the other supplies (pointer: the
 // one the policy ranks later, /passes/<name>): the only place conflicts between passes are reported.

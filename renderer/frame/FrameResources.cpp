@@ -22,6 +22,7 @@ const char* toString(Access access) {
   switch (access) {
     case Access::Read: return "Read";
     case Access::Write: return "Write";
+    case Access::WriteInPrepare: return "WriteInPrepare";
     default: return "Accumulate";
   }
 }
@@ -46,6 +47,10 @@ void FrameResources::checkAccess(const std::string& name, bool write) const {
                            (declared.empty() ? std::string("nothing") : declared) + ")");
   if (write && it->access == Access::Read)
     throw std::logic_error("FrameResources: pass " + pass_ + " wrote '" + name + "', which it declares Read only");
+  if (write && it->access == Access::WriteInPrepare && phase_ == Phase::Execute)
+    throw std::logic_error("FrameResources: pass " + pass_ + " wrote '" + name +
+                           "' in execute(), which it declares written in prepare() (prepare_outputs): its readers "
+                           "may already have run");
 }
 
 void FrameResources::checkNoAllocation(const std::string& what, const std::string& name) const {

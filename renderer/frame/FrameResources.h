@@ -42,9 +42,11 @@ class GpuScene;
 struct FrameView;
 
 // How a pass uses a shared resource (Falcor's RenderPassReflection, Filament's FrameGraph): Read (one of
-// its inputs or optional inputs), Write (an output it overwrites), Accumulate (adds into an accumulate
-// AOV: beauty). FramePlanner's declaredAccess() derives a pass's list from its TechniqueInfo.
-enum class Access { Read, Write, Accumulate };
+// its inputs or optional inputs), Write (an output it overwrites), WriteInPrepare (an output its
+// prepare() publishes, TechniqueInfo::prepareOutputs: written in execute() it is a breach), Accumulate
+// (composes into an accumulate AOV: beauty). FramePlanner's declaredAccess() derives a pass's list from
+// its TechniqueInfo.
+enum class Access { Read, Write, WriteInPrepare, Accumulate };
 struct ResourceAccess {
   std::string name;
   Access access;
@@ -144,6 +146,11 @@ public:
   template <class T>
   const T* product(const std::string& name) const {
     checkAccess(name, false);
+    // Products are read in execute(): in prepare() the frame graph's order promises nothing (every
+    // prepare runs before any execute, in an order that follows only what executes read).
+    if (inPass_ && phase_ == Phase::Prepare)
+      throw std::logic_error("FrameResources: pass " + pass_ + " read the product '" + name +
+                             "' in prepare(); products are read in execute()");
     used(name);
     const auto it = products_.find(name);
     if (it == products_.end()) return nullptr;

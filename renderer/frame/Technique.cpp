@@ -12,7 +12,10 @@ TechniqueInfo describedTechnique(std::string_view name) {
   i.description = d->summary;
   i.inputs = d->inputs;
   i.optionalInputs = d->optionalInputs;
-  i.optionalInputs.insert(i.optionalInputs.end(), d->after.begin(), d->after.end());
+  i.prepareOutputs = d->prepareOutputs;
+  i.beautyBlend = d->beautyBlend == "over"       ? BeautyBlend::Over
+                  : d->beautyBlend == "transmit" ? BeautyBlend::Transmit
+                                                 : BeautyBlend::Add;
   i.outputs = d->outputs;
   i.outputs.insert(i.outputs.end(), d->resources.begin(), d->resources.end());
   i.addsToBeauty = d->addsToBeauty;

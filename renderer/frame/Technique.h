@@ -21,13 +21,19 @@ namespace radiant {
 class FrameResources;
 struct PassContext;
 
+// How a pass composes its result into beauty, which orders it among the frame's beauty writers
+// (FramePlanner's executionOrder): Add commutes with the other adds (beauty starts each frame at zero);
+// Over (blended surfaces: beauty = a Ls + (1 - a) beauty) runs after every add; Transmit (media:
+// beauty = beauty T + C) after every add and over.
+enum class BeautyBlend { Add, Over, Transmit };
+
 struct TechniqueInfo {
   std::string name;         // as used in the API ("direct", "ambient_occlusion")
   std::string description;  // one line
   std::vector<std::string> inputs;    // resources it reads and cannot run without ("depth", "normal")
   std::vector<std::string> optionalInputs;  // resources it reads when present ("shadow_maps")
   std::vector<std::string> outputs;   // resources / AOVs it writes ("direct")
-  bool addsToBeauty = false;  // accumulates its result into "beauty"
+  bool addsToBeauty = false;  // composes its result into "beauty", as beautyBlend says
   bool onByDefault = false;   // wanted in every frame; requirements() then decides (e.g. AO: only with ambient light)
   // Light-path classes it can supply (ARCHITECTURE.md, "Every light path is counted once"), e.g.
   // "LD+DE". The planner gives each class to the first planned technique that claims it, in
@@ -45,12 +51,16 @@ struct TechniqueInfo {
   // because its estimate cannot leave them out: photon_gi's photons carry LD+DE, so where env_diffuse owns that
   // class photon_gi is dropped ("LD+DE is owned by env_diffuse"), and a request naming both is a 422.
   std::vector<std::string> requiredPaths = {};
+  BeautyBlend beautyBlend = BeautyBlend::Add;
+  // Outputs it publishes in prepare() (photon_gi's photon grid): every prepare runs before any execute,
+  // so a pass reading one in its execute() need not run after this one (FrameResources refuses a write
+  // of one in execute()).
+  std::vector<std::string> prepareOutputs = {};
 };
 
 // A technique's TechniqueInfo as its descriptor declares it (renderer/techniques/<name>/<name>.json,
 // merged into the schema at build time): every info() returns this, so nothing of it is written twice.
-// "after" (passes it runs after when they run, without reading what they write: beauty's order until
-// the frame graph derives it) joins optionalInputs. Throws std::logic_error for an undeclared name.
+// Throws std::logic_error for an undeclared name.
 TechniqueInfo describedTechnique(std::string_view name);
 
 // Run or skip, and the reason if skipped. The planner records the reason in the frame stats.

@@ -6,7 +6,7 @@
 
 namespace radiant {
 
-// Every technique, in canonical execution order (producers before consumers).
+// Every technique, in the order that breaks the frame graph's ties (Registry.cpp).
 std::vector<std::unique_ptr<Technique>> createTechniques();
 
 }  // namespace radiant

@@ -1,5 +1,6 @@
 // Direct lighting from punctual lights with shadow maps, plus emission, from the G-buffer.
-// Writes the `direct` AOV and initialises `beauty` with the same value (later passes add to beauty).
+// Writes the `direct` AOV and adds the same value to `beauty` (cleared to zero at the frame's start; every
+// beauty writer composes into it, FrameAllocation.h).
 #include "common/direct_lighting.glsl"
 #include "common/environment.glsl"
 #include "common/ibl.glsl"

@@ -324,7 +324,7 @@ void AmbientOcclusionPass::execute(PassContext& ctx) {
   //    add the ambient term to beauty.
   // The sky's direct light goes to beauty only when this pass owns it (photon_gi owns it when it runs:
   // its environment photons see the real visibility, AO only a neighbourhood of radius R).
-  const bool addAmbient = res.written("beauty") && res.owns("ambient_occlusion", api::kPathSkyDE) &&
+  const bool addAmbient = res.owns("ambient_occlusion", api::kPathSkyDE) &&
                           (view.ambient.x > 0.f || view.ambient.y > 0.f || view.ambient.z > 0.f);
   gl::Framebuffer& resolve = res.framebuffer("ao_resolve");
   resolve.bind();

@@ -19,8 +19,8 @@ const TechniqueInfo& DirectPass::info() const {
 }
 
 Requirements DirectPass::requirements(const Scene&, const api::RenderRequest&) const {
-  // Always runs: even without lights or emitters it writes the sky behind the geometry and
-  // initialises beauty. Lights and emission are handled per pixel in the shader.
+  // Always runs: even without lights or emitters it writes the sky behind the geometry. Lights and
+  // emission are handled per pixel in the shader.
   return Requirements::ok();
 }
 
@@ -45,6 +45,10 @@ void DirectPass::execute(PassContext& ctx) {
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_BLEND);
   glDisable(GL_CULL_FACE);
+  // direct overwrites its AOV and adds into beauty, which starts the frame at zero (BeautyBlend::Add).
+  glEnablei(GL_BLEND, 1);
+  glBlendEquationi(1, GL_FUNC_ADD);
+  glBlendFunci(1, GL_ONE, GL_ONE);
 
   const char* inputs[] = {"gbuffer_position", "normal", "albedo", "material", "emission", "geometric_normal"};
   for (GLuint i = 0; i < std::size(inputs); ++i) res.texture(inputs[i]).bindUnit(i);
@@ -67,6 +71,8 @@ void DirectPass::execute(PassContext& ctx) {
   prog.set("u_orthographic", view.camera.projection == ProjectionType::Orthographic ? 1 : 0);
   prog.set("u_background", &view.ambient[0], 3);
   glDrawArrays(GL_TRIANGLES, 0, 3);
+  glDisablei(GL_BLEND, 1);
+  glBlendFunci(1, GL_ONE, GL_ZERO);
   ctx.stats.counters["lights"] = static_cast<double>(ctx.scene.lights.size());
   // The environment's compact bright regions this pass lit as shadowed lights, and their share of the
   // map's power (renderer/shading/EnvironmentLights.h; the rest is image-based lighting's).

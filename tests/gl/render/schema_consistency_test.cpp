@@ -37,6 +37,8 @@ TEST(SchemaConsistency, EveryTechniqueIsWhatItsDescriptorDeclares) {
     EXPECT_EQ(info.lightPaths, d.lightPaths) << info.name;
     EXPECT_EQ(info.claimsWhenNamed, d.claimsWhenNamed) << info.name;
     EXPECT_EQ(info.exclusive, d.exclusive) << info.name;
+    EXPECT_EQ(info.beautyBlend, d.beautyBlend) << info.name;
+    EXPECT_EQ(info.prepareOutputs, d.prepareOutputs) << info.name;
     // Each AOV row a technique's outputs name was declared by one technique that outputs it.
     for (const std::string& out : info.outputs)
       if (const api::AovInfo* a = api::findAov(out)) {

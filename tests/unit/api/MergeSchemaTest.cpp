@@ -110,6 +110,8 @@ TEST_F(MergeSchema, AovRowsAreCompletedWithTheirDefaults) {
   EXPECT_EQ(x["resources"], json({"glow_cache"}));
   EXPECT_EQ(x["adds_to_beauty"], true);
   EXPECT_EQ(x["exclusive"], false);
+  EXPECT_EQ(x["beauty_blend"], "add");  // the default
+  EXPECT_EQ(x["prepare_outputs"], json::array());
   EXPECT_EQ(m.merged["properties"]["outputs"]["items"]["properties"]["aovs"]["items"]["enum"],
             json({"beauty", "glow", "glow_mask"}));
 }
@@ -177,7 +179,19 @@ TEST_F(MergeSchema, ABrokenDescriptorFailsNamingItsFileAndKey) {
   benchUnknownKey["bench"] = {{"scenes", {"cornell_box"}}};
   json unknownClass = descriptor("a", "glow");
   unknownClass["light_paths"] = {"LD+DE", "LD*E"};
+  json after = descriptor("a", "glow");
+  after["after"] = {"direct"};
+  json badBlend = descriptor("a", "glow"), blendOffBeauty = descriptor("a", "glow");
+  badBlend["beauty_blend"] = "multiply";
+  blendOffBeauty["beauty_blend"] = "over";
+  blendOffBeauty["adds_to_beauty"] = false;
+  json foreignPrepareOutput = descriptor("a", "glow");
+  foreignPrepareOutput["prepare_outputs"] = {"grid"};
   const std::vector<Case> cases = {
+      {"the retired \"after\"", {after}, "unknown key \"after\" (gone: the frame graph orders passes"},
+      {"an unknown beauty blend", {badBlend}, "\"beauty_blend\" must be \"add\", \"over\" or \"transmit\""},
+      {"a blend of a pass that adds nothing", {blendOffBeauty}, "\"beauty_blend\" needs \"adds_to_beauty\": true"},
+      {"a prepare output it does not write", {foreignPrepareOutput}, "prepare_outputs: \"grid\" is not one of its"},
       {"an unknown light-path class", {unknownClass}, "light_paths: \"LD*E\" is not a light-path class"},
       {"a bench axis of no parameter", {benchUnknownParam}, "bench.axes.radius is not one of its \"params\""},
       {"a bench value above the maximum", {benchOutOfRange}, "bench.axes.taps: 32 is above its maximum"},
