@@ -180,11 +180,68 @@ std::vector<std::string> writersOf(const std::string& aov, const std::vector<Tec
 // The seed of every ground truth compare() renders (see there).
 constexpr std::uint64_t kGroundTruthSeed = 0x6A09E667F3BCC909ull;
 
-// Scores the compared AOV against the ground truth; adds stats.metrics and the "error" and
-// "reference" AOVs.
+// A technique's parameters as the request gives them (api::techniqueParams: defaults filled in), with
+// the keys it set itself (Params::given).
+Params requestParams(const std::string& technique, const api::RenderRequest& request) {
+  const auto given = request.passes.find(technique);
+  const auto named = request.explicitParams.find(technique);
+  return Params(api::techniqueParams(technique, given != request.passes.end() && given->second.is_object()
+                                                    ? given->second
+                                                    : nlohmann::json(nullptr)),
+                named == request.explicitParams.end() ? std::set<std::string>{} : named->second);
+}
+
+// The compare block's 422s, found before the frame (Renderer::check, renderFrame): an image named but
+// not supplied, an uploaded image of another size than the frame, an AOV the reference renderer has no
+// ground truth for. Returns the ground truth compare() renders: the AOV's as its producer in this frame
+// declares it (Technique::groundTruth with the request's parameters of that technique; the media AOVs
+// have several producers, one per frame), or the AOV table's producer when it does not run (its AOV is
+// then read back empty and scored as such); none when the request compares against an uploaded image.
+GroundTruth checkedCompare(const api::RenderRequest& request, const Image* target, const std::vector<Technique*>& all,
+                           const FramePlan& plan) {
+  const api::CompareSpec& c = *request.compare;
+  const api::AovInfo* info = api::findAov(c.aov);
+  const Technique* producer = nullptr;
+  for (const Technique* p : plan.passes)
+    if (std::count(p->info().outputs.begin(), p->info().outputs.end(), c.aov)) producer = p;
+  for (const Technique* t : all)
+    if (!producer && info && t->info().name == info->producer) producer = t;
+  if (c.against != "reference") {
+    if (!target)
+      throw api::ApiError(422, "invalid-compare", "Nothing to compare against",
+                          "compare.against names an image (" + c.against + ") that was not supplied", "/compare/against");
+    if (target->width != request.width || target->height != request.height)
+      throw api::ApiError(422, "invalid-compare", "Size mismatch",
+                          "the comparison image is " + std::to_string(target->width) + "x" +
+                              std::to_string(target->height) + ", the frame " + std::to_string(request.width) + "x" +
+                              std::to_string(request.height),
+                          "/compare/against");
+    return {};
+  }
+  // A reference mode and its parameters, or none, which is an error rather than a score against
+  // something else (the specular AOV used to be scored against full beauty).
+  GroundTruth truth;
+  if (info && !info->producer.empty()) {
+    if (producer) truth = producer->groundTruth(requestParams(producer->info().name, request), c.aov);
+  } else if (info) {
+    truth = GroundTruth::fromAovTable(c.aov);  // beauty: the sum of every pass
+  }
+  if (!truth.exists()) {
+    std::string have;
+    for (const api::AovInfo& a : api::aovTable())
+      if (!a.groundTruth.empty()) have += (have.empty() ? "" : ", ") + a.name;
+    throw api::ApiError(422, "invalid-compare", "No ground truth",
+                        "the reference renderer has no ground truth for the AOV '" + c.aov +
+                            "' (AOVs with one: " + have + "); compare it against an uploaded image instead",
+                        "/compare/aov");
+  }
+  return truth;
+}
+
+// Scores the compared AOV against `truth` (checkedCompare) or the uploaded `target`; adds stats.metrics
+// and the "error" and "reference" AOVs.
 void compare(FrameResources& resources, const Scene& scene, const FrameView& view, const api::RenderRequest& request,
-             const Image* target, const std::vector<std::unique_ptr<Technique>>& techniques,
-             const std::vector<Technique*>& planned, RenderOutput& out) {
+             const Image* target, const GroundTruth& truth, RenderOutput& out) {
   const api::CompareSpec& c = *request.compare;
   auto test = std::find_if(out.aovs.begin(), out.aovs.end(), [&](const Image& i) { return i.aov == c.aov; });
   if (test == out.aovs.end())
@@ -192,43 +249,9 @@ void compare(FrameResources& resources, const Scene& scene, const FrameView& vie
                         "/compare/aov");
   nlohmann::json m = {{"against", c.against}, {"aov", c.aov}, {"rel_mse_epsilon", metrics::kRelMseEpsilon}};
   Image reference;
-  if (!target && c.against != "reference")
-    throw api::ApiError(422, "invalid-compare", "Nothing to compare against",
-                        "compare.against names an image (" + c.against + ") that was not supplied", "/compare/against");
   if (target) {
     reference = *target;
   } else {
-    // The ground truth of the AOV, as the technique that produced it declares it (Technique::
-    // groundTruth, with the frame's parameters of that technique): a reference mode and its
-    // parameters, or none, which is an error rather than a score against something else (the specular
-    // AOV used to be scored against full beauty).
-    // The producer is the frame's: the media AOVs have several, one per frame (FramePlanner).
-    const api::AovInfo* info = api::findAov(c.aov);
-    GroundTruth truth;
-    if (info && !info->producer.empty()) {
-      const Technique* producer = nullptr;
-      for (const Technique* p : planned)
-        if (std::count(p->info().outputs.begin(), p->info().outputs.end(), c.aov)) producer = p;
-      for (const auto& tech : techniques)
-        if (!producer && tech->info().name == info->producer) producer = tech.get();
-      if (producer) {
-        const std::string& name = producer->info().name;
-        auto given = request.passes.find(name);
-        const Params params(api::techniqueParams(name, given == request.passes.end() ? nlohmann::json() : given->second));
-        truth = producer->groundTruth(params, c.aov);
-      }
-    } else if (info) {
-      truth = GroundTruth::fromAovTable(c.aov);  // beauty: the sum of every pass
-    }
-    if (!truth.exists()) {
-      std::string have;
-      for (const api::AovInfo& a : api::aovTable())
-        if (!a.groundTruth.empty()) have += (have.empty() ? "" : ", ") + a.name;
-      throw api::ApiError(422, "invalid-compare", "No ground truth",
-                          "the reference renderer has no ground truth for the AOV '" + c.aov +
-                              "' (AOVs with one: " + have + "); compare it against an uploaded image instead",
-                          "/compare/aov");
-    }
     ReferenceRequest r = referenceRequestFrom(Params(api::techniqueParams("reference", truth.reference)));
     m["reference_mode"] = r.aov;
     // The mode's own parameters (ao: radius and definition) go into the metrics as the technique gave them.
@@ -261,11 +284,6 @@ void compare(FrameResources& resources, const Scene& scene, const FrameView& vie
     m["reference_ms"] = msSince(t0);
     if (r.aov == "media" || r.aov == "media_transmittance") m["media_mode"] = r.mediaMode;
   }
-  if (reference.width != test->width || reference.height != test->height)
-    throw api::ApiError(422, "invalid-compare", "Size mismatch",
-                        "the comparison image is " + std::to_string(reference.width) + "x" +
-                            std::to_string(reference.height) + ", the frame " + std::to_string(test->width) + "x" +
-                            std::to_string(test->height), "/compare/against");
   // Compare colour with colour and scalar with scalar.
   if (reference.channels != test->channels) {
     Image r = Image::make(reference.aov, reference.width, reference.height, test->channels);
@@ -557,7 +575,36 @@ void resetPipelineState() {
   while (glGetError() != GL_NO_ERROR) {
   }
 }
+// The frame's plan and every 422 it raises without GL but the techniques' own (validate(), called with
+// the parameters each frame runs): an environment the caller did not supply, the planner's (an unknown
+// AOV or pass, conflicting passes), the compare block's (checkedCompare, whose ground truth it returns).
+struct CheckedPlan {
+  FramePlan plan;
+  GroundTruth truth;
+};
+CheckedPlan checkedPlan(const std::vector<Technique*>& all, const Scene& scene, const api::RenderRequest& request,
+                        const FrameInputs& inputs) {
+  if (!request.environment.empty() && !inputs.environment)
+    throw api::ApiError(422, "invalid-value", "Environment not supplied",
+                        "the environment image " + request.environment + " was not supplied", "/environment");
+  CheckedPlan c{planFrame(all, scene, request), {}};
+  if (request.compare) c.truth = checkedCompare(request, inputs.compareTarget, all, c.plan);
+  return c;
+}
 }  // namespace
+
+void Renderer::check(const Scene& scene, const api::RenderRequest& requestIn, const FrameInputs& inputsIn) {
+  const std::vector<std::unique_ptr<Technique>> techniques = createTechniques();
+  std::vector<Technique*> all;
+  for (const auto& t : techniques) all.push_back(t.get());
+  // The request the frame would run (the default lighting), as renderFrame() makes it.
+  FrameLighting lit = frameLighting(scene, requestIn, inputsIn.environment);
+  FrameInputs inputs = inputsIn;
+  inputs.environment = lit.environment;
+  const CheckedPlan checked = checkedPlan(all, scene, lit.request, inputs);
+  for (Technique* t : checked.plan.passes) t->validate(scene, requestParams(t->info().name, lit.request));
+  makeFrameView(scene, lit.request);  // the camera's 422s
+}
 
 RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requestIn, const std::atomic<bool>* cancel,
                               const FrameInputs& inputs) {
@@ -617,12 +664,10 @@ RenderOutput Renderer::renderFrame(const Scene& scene, const api::RenderRequest&
   try {
     const auto frameStart = Clock::now();
     const std::size_t programsBefore = im.shaders.cachedPrograms();
-    if (!request.environment.empty() && !inputs.environment)
-      throw api::ApiError(422, "invalid-value", "Environment not supplied",
-                          "the environment image " + request.environment + " was not supplied", "/environment");
     std::vector<Technique*> all;
     for (auto& t : im.techniques) all.push_back(t.get());
-    FramePlan plan = planFrame(all, scene, request);
+    CheckedPlan checked = checkedPlan(all, scene, request, inputs);
+    FramePlan& plan = checked.plan;
     // The passes run on the supersampled view; readback resolves to outView (the request's size), on
     // which compare() renders the reference.
     int k = rasterSupersampling(
@@ -636,12 +681,7 @@ RenderOutput Renderer::renderFrame(const Scene& scene, const api::RenderRequest&
     // frame's k (and each k the default frame budget weighs, below).
     std::function<double(int)> specularMapTexelsAt;
     if (std::find(planned.begin(), planned.end(), "specular") != planned.end()) {
-      const auto given = request.passes.find("specular");
-      const auto named = request.explicitParams.find("specular");
-      const Params sp(api::techniqueParams("specular", given != request.passes.end() && given->second.is_object()
-                                                           ? given->second
-                                                           : nlohmann::json(nullptr)),
-                      named == request.explicitParams.end() ? std::set<std::string>{} : named->second);
+      const Params sp = requestParams("specular", request);
       const auto owned = plan.owned.find("caustics");
       const bool forCaustics = owned != plan.owned.end() && (owned->second & api::kPathLSDE);
       specularMapTexelsAt = [&, sp, forCaustics](int atK) {
@@ -739,6 +779,7 @@ RenderOutput Renderer::renderFrame(const Scene& scene, const api::RenderRequest&
       const auto given = request.explicitParams.find(t->info().name);
       params[i] = Params(choice.params.at(t->info().name),
                          given == request.explicitParams.end() ? std::set<std::string>{} : given->second);
+      t->validate(scene, params[i]);  // as Renderer::check did with the request's own, now with the frame's
       for (int m : t->shadowMapExclusions(scene, params[i])) shadowMapExclusions.insert(m);
     }
     im.resources.setShadowMapExclusions(std::move(shadowMapExclusions));
@@ -846,7 +887,7 @@ RenderOutput Renderer::renderFrame(const Scene& scene, const api::RenderRequest&
     if (observed) im.speed.observe(im.lastFrame.measuredMs, im.lastFrame.predictedMs, speedScene);
     if (choice.active) stats.budget["speed"]["observed"] = observed;  // this frame joined the window
     if (request.compare)
-      compare(im.resources, scene, outView, request, inputs.compareTarget, im.techniques, plan.passes, out);
+      compare(im.resources, scene, outView, request, inputs.compareTarget, checked.truth, out);
     if (presented) {
       nonFinite += sanitize(presented->pixels);
       *std::find_if(out.aovs.begin(), out.aovs.end(), [](const Image& i) { return i.aov == "beauty"; }) =

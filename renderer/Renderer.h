@@ -86,6 +86,13 @@ public:
   RenderOutput render(const Scene& scene, const api::RenderRequest& request,
                       const std::atomic<bool>* cancel = nullptr, const FrameInputs& inputs = {});
   static std::vector<TechniqueDescription> techniques();
+  // Every 422 render() would raise for this request on this scene that needs no GL, raised now: the
+  // planner's (an unknown AOV or pass, conflicting passes), an environment or compare image `inputs`
+  // does not supply, the compare block's (an AOV without ground truth, an image of another size), the
+  // camera's, and each planned technique's Technique::validate() (an
+  // unknown receiver, a network above its limits). Pure CPU and thread-safe: radiantd calls it on the
+  // HTTP thread before it queues the job, so these are answers to the POST, not failed jobs.
+  static void check(const Scene& scene, const api::RenderRequest& request, const FrameInputs& inputs);
   // How many scenes stay uploaded to the GPU, and how many input digests each kind of cached derived
   // data (BVH, photons, beams) keeps; least recently used evicted first. Maps held in shared frame
   // resources (shadow and cube maps) hold the last scene rendered (FrameResources::holds).

@@ -57,6 +57,10 @@ struct BackendHooks {
                             float exposureEV)>
       encodeFrame;
   std::vector<TechniqueDescription> techniques;  // what the backend implements (may be empty: unknown)
+  // The request's problems with its scene that need no GL (Renderer::check: the planner's, the camera's,
+  // the compare block's, each technique's validate()), thrown as api::ApiError before the job is
+  // queued. Pure CPU, called on HTTP threads; unset: the render finds them (tests' fake backends).
+  std::function<void(const Scene& scene, const api::RenderRequest& request, const FrameInputs& inputs)> checkFrame;
   // The process's resident set in bytes, which decodes and request bodies are admitted against under
   // --memory-limit-bytes (the renderer's own admission reads the same). Unset: radiant::residentBytes()
   // (renderer/ResidentMemory.h); tests inject one.

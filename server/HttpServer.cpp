@@ -816,6 +816,14 @@ struct HttpServer::Impl {
     if (request.compare && request.compare->against != "reference")
       compareTarget = resolveImage(request.compare->against, "/compare/against");
     if (!request.environment.empty()) environment = resolveImage(request.environment, "/environment");
+    // What no frame of this scene could render is the POST's 422, not a failed job (Renderer::check).
+    if (hooks.checkFrame) {
+      FrameInputs inputs;
+      inputs.compareTarget = compareTarget.get();
+      inputs.environment = environment.get();
+      inputs.limits = &config.limits;
+      hooks.checkFrame(*scene, request, inputs);
+    }
     return service.submit(request, scene, compareTarget, environment, tSceneLoadMs);
   }
 

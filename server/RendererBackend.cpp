@@ -134,6 +134,9 @@ BackendHooks rendererHooks(const ServerConfig& config) {
     return io::encodePng(chosen.front(), png);
   };
   h.techniques = Renderer::techniques();
+  h.checkFrame = [](const Scene& scene, const api::RenderRequest& request, const FrameInputs& inputs) {
+    Renderer::check(scene, request, inputs);
+  };
   return h;
 }
 

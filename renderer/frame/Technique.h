@@ -138,6 +138,15 @@ public:
   // scene is there for rules that need more, such as which nodes receive indirect light). Called by
   // the FramePlanner only.
   virtual Requirements requirements(const Scene& scene, const api::RenderRequest& request) const = 0;
+  // What this request's parameters ask of this scene that no frame could render, found without GL (an
+  // unknown receiver node, a network above its size limit): throws api::ApiError 422 naming the
+  // parameter. Called before the job is queued (Renderer::check, on radiantd's HTTP thread: keep it
+  // const and free of state) and at the frame's start with the frame's parameters, so prepare() need
+  // not check the same again.
+  virtual void validate(const Scene& scene, const Params& params) const {
+    (void)scene;
+    (void)params;
+  }
   // Allocate or reuse resources; build or fetch cached derived data. No drawing here.
   virtual void prepare(const Scene& scene, const Params& params, FrameResources& resources) = 0;
   // The only place GL is issued. Must not allocate GL objects.

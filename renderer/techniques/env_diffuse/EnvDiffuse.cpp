@@ -61,6 +61,18 @@ Requirements EnvDiffusePass::requirements(const Scene& scene, const api::RenderR
   return Requirements::ok();
 }
 
+void EnvDiffusePass::validate(const Scene& scene, const Params& params) const {
+  const int R = params.get<int>("cube_resolution"), M = params.get<int>("downsample"), bounces = params.get<int>("bounces");
+  const std::string method = params.get<std::string>("form_factor");
+  if (!isPowerOfTwoIn(R, 16, 1024)) badParam("cube_resolution", "must be a power of two in [16, 1024]");
+  if (!isPowerOfTwoIn(M, 1, 16) || M > R) badParam("downsample", "must be 1, 2, 4, 8 or 16 and at most cube_resolution");
+  if (bounces < 1 || bounces > 4) badParam("bounces", "must be in [1, 4]");
+  if (method != "polygon" && method != "point" && method != "classic")
+    badParam("form_factor", "must be polygon, point or classic, got '" + method + "'");
+  // Every named receiver and reference point exists (422 at receivers / reference_points).
+  env_diffuse::selectReceivers(scene, params.get<std::string>("receivers"), params.get<std::string>("reference_points"));
+}
+
 void EnvDiffusePass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
   cubeResolution_ = params.get<int>("cube_resolution");
   downsample_ = params.get<int>("downsample");
@@ -71,15 +83,9 @@ void EnvDiffusePass::prepare(const Scene& scene, const Params& params, FrameReso
   // hold only what surfaces send, so indirect_diffuse is exactly the reference's "indirect" (two or
   // more events) and nothing is counted twice; include_sky puts the sky back for use without AO.
   skyRadiance_ = params.get<bool>("include_sky") ? res.view().ambient : glm::vec3(0.f);
+  // validate() has checked the parameters and the receivers.
   const std::string method = params.get<std::string>("form_factor");
-  if (!isPowerOfTwoIn(cubeResolution_, 16, 1024)) badParam("cube_resolution", "must be a power of two in [16, 1024]");
-  if (!isPowerOfTwoIn(downsample_, 1, 16) || downsample_ > cubeResolution_)
-    badParam("downsample", "must be 1, 2, 4, 8 or 16 and at most cube_resolution");
-  if (bounces_ < 1 || bounces_ > 4) badParam("bounces", "must be in [1, 4]");
-  if (method == "polygon") method_ = kPolygon;
-  else if (method == "point") method_ = kPoint;
-  else if (method == "classic") method_ = kClassic;
-  else badParam("form_factor", "must be polygon, point or classic, got '" + method + "'");
+  method_ = method == "polygon" ? kPolygon : method == "point" ? kPoint : kClassic;
 
   const std::vector<env_diffuse::Receiver> selected =
       env_diffuse::selectReceivers(scene, params.get<std::string>("receivers"),

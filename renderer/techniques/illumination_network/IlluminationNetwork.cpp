@@ -81,8 +81,7 @@ int IlluminationNetworkPass::autoWindow(int nodes) {
   return std::max(1, static_cast<int>(std::lround(std::cbrt(4.0 * nodes / 3.14159265358979))));
 }
 
-void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
-  const FrameView& view = res.view();
+void IlluminationNetworkPass::validate(const Scene&, const Params& params) const {
   const int N = params.get<int>("nodes"), D = params.get<int>("directions");
   int M = params.get<int>("window");
   if (M == 0) M = autoWindow(N);
@@ -96,6 +95,13 @@ void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, 
                         "directions x window^2 = " + std::to_string(std::size_t(D) * M * M) + " exceeds " +
                             std::to_string(kMaxBins) + " bins",
                         "/passes/illumination_network/window");
+}
+
+void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
+  const FrameView& view = res.view();
+  const int N = params.get<int>("nodes"), D = params.get<int>("directions");
+  int M = params.get<int>("window");
+  if (M == 0) M = autoWindow(N);  // validate() has bounded N x D and D x M^2
   const auto seed = params.get<std::uint64_t>("seed");
   const bool fibonacci = params.get<std::string>("sampling") == "fibonacci";
   const float splatScale = params.get<float>("splat_radius");

@@ -774,6 +774,31 @@ TEST(FrameGraph, TheRegistryReversedRendersTheSameFrames) {
   }
 }
 
+// Beauty starts every frame at zero (allocateDeclaredOutputs): no pass initialises it. A frame without
+// the direct pass, which used to, holds exactly what its other passes add (here photon_gi's indirect
+// light), not that on top of the previous frame's beauty.
+TEST(FrameGraph, AFrameWithoutTheDirectPassStartsFromZero) {
+  const Scene scene = loadBuiltinScene("cornell_box");
+  api::RenderRequest lit = request(24, {"beauty"});
+  lit.passes.erase("shadow_maps");
+  api::RenderRequest unlit = lit;
+  unlit.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty", "indirect"}, false}};
+  unlit.disabledPasses.insert("direct");
+  renderer().render(scene, lit);  // leaves a lit beauty in the texture
+  const RenderOutput out = renderer().render(scene, unlit);
+  EXPECT_FALSE(std::any_of(out.stats.passes.begin(), out.stats.passes.end(), [](const auto& p) { return p.name == "direct"; }));
+  const Image& beauty = aov(out, "beauty");
+  const Image& indirect = aov(out, "indirect");
+  double peak = 0, worst = 0;
+  for (std::size_t p = 0; p < std::size_t(beauty.width) * beauty.height; ++p)
+    for (int c = 0; c < 3; ++c) {
+      peak = std::max(peak, double(indirect.pixels[p * indirect.channels + c]));
+      worst = std::max(worst, std::abs(double(beauty.pixels[p * beauty.channels + c]) - indirect.pixels[p * indirect.channels + c]));
+    }
+  EXPECT_GT(peak, 0.01);
+  EXPECT_LT(worst, 1e-6 * std::max(1.0, peak));
+}
+
 // The Renderer allocates the planned passes' declared outputs and uploads the environment map as a frame
 // resource once per map: a second frame with the same map is a cache hit, and the direct pass (which
 // reads it, declared) shows the same sky in both.

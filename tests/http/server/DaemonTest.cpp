@@ -269,6 +269,19 @@ TEST(RealDaemon, RendersBuiltinsRejectsBadInputAndStopsCleanly) {
   EXPECT_EQ(json::parse(r->body)["type"], "https://radiant.dev/problems/limit-exceeded");
   EXPECT_EQ(json::parse(r->body)["pointer"], "/media/0/generator/count");
   req.erase("media");
+  // What no frame of the scene could render is the POST's 422 before the job is queued (Renderer::check),
+  // even for an async request: not a 202 and a failed job.
+  req["async"] = true;
+  req["passes"] = {{"env_diffuse", {{"receivers", "no_such_node"}}}};
+  r = c.Post("/v1/renders", req.dump(), "application/json");
+  EXPECT_EQ(r->status, 422) << r->body;
+  EXPECT_EQ(json::parse(r->body)["pointer"], "/passes/env_diffuse/receivers");
+  req["passes"] = {{"photon_gi", json::object()}, {"env_diffuse", json::object()}};
+  r = c.Post("/v1/renders", req.dump(), "application/json");
+  EXPECT_EQ(r->status, 422) << r->body;
+  EXPECT_EQ(json::parse(r->body)["type"], "https://radiant.dev/problems/conflicting-passes");
+  req.erase("passes");
+  req.erase("async");
 
   // Eight concurrent clients, each with its own image size: every PNG has its own request's size.
   std::vector<std::future<std::string>> concurrent;
