@@ -40,7 +40,8 @@ double passCostMs(const PassStats& pass);
 using FrameParams = std::map<std::string, nlohmann::json>;
 
 // What the frame's scene holds that the cost models scale with (the models' scene variables). The
-// renderer computes them once per frame (renderer/scene/CostCounts.h, sceneCostCounts) and reports them
+// renderer computes them once per frame (renderer/frame/FramePlanner.h costCounts: the frame's particles,
+// then each technique's own variables, Technique::addCostCounts) and reports them
 // in stats.scene.counts, which is where bench/presets.py reads them from for the fit.
 struct SceneCounts {
   // Particles of every particle system of the frame: the scene's plus the request's `media`.

@@ -26,7 +26,6 @@
 #include "renderer/io/ImageIO.h"
 #include "renderer/metrics/Metrics.h"
 #include "renderer/scene/BuiltinScenes.h"
-#include "renderer/scene/CostCounts.h"
 #include "renderer/shading/DirectLighting.h"
 #include "renderer/shading/EnvironmentLights.h"
 #include "renderer/techniques/reference/ReferencePass.h"
@@ -676,7 +675,7 @@ RenderOutput Renderer::renderFrame(const Scene& scene, const api::RenderRequest&
     std::vector<std::string> planned;
     for (Technique* t : plan.passes) planned.push_back(t->info().name);
     // The cost models' scene variables (particles of the scene and the request's media, light_volumes' beams).
-    api::SceneCounts counts = sceneCostCounts(scene, request.media);
+    api::SceneCounts counts = costCounts(all, scene, request.media);
     // specular's maps follow the view: its model is charged the resolution the pass will choose at the
     // frame's k (and each k the default frame budget weighs, below).
     std::function<double(int)> specularMapTexelsAt;

@@ -5,6 +5,8 @@
 #include <stdexcept>
 
 #include "api/Aovs.h"
+#include "api/Presets.h"
+#include "renderer/scene/CostCounts.h"
 
 namespace radiant {
 
@@ -42,6 +44,13 @@ std::string undeclaredWrite(const TechniqueInfo& info, const std::set<std::strin
     return name;
   }
   return {};
+}
+
+api::SceneCounts costCounts(const std::vector<Technique*>& techniques, const Scene& scene,
+                            const std::vector<api::ParticleSystem>& media) {
+  api::SceneCounts counts = sceneCostCounts(scene, media);
+  for (const Technique* t : techniques) t->addCostCounts(scene, counts);
+  return counts;
 }
 
 std::vector<Technique*> executionOrder(const std::vector<Technique*>& planned) {

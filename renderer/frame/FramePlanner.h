@@ -39,6 +39,12 @@ struct OwnershipRow {
 };
 const std::vector<OwnershipRow>& ownershipPolicy();
 
+// The cost models' scene variables for this frame (api::SceneCounts): the scene's and `media`'s
+// particles (sceneCostCounts), then each technique's own (Technique::addCostCounts), whether or not it
+// is planned (the budget chooser weighs the planned ones).
+api::SceneCounts costCounts(const std::vector<Technique*>& techniques, const Scene& scene,
+                            const std::vector<api::ParticleSystem>& media);
+
 // AOVs that are not a technique's output but exist in every frame (the AOV table's accumulate AOVs).
 bool isFrameAov(const std::string& aov);
 

@@ -17,6 +17,9 @@
 #include "renderer/scene/Scene.h"
 
 namespace radiant {
+namespace api {
+struct SceneCounts;  // api/Presets.h
+}
 
 class FrameResources;
 struct PassContext;
@@ -36,11 +39,11 @@ struct TechniqueInfo {
   bool addsToBeauty = false;  // composes its result into "beauty", as beautyBlend says
   bool onByDefault = false;   // wanted in every frame; requirements() then decides (e.g. AO: only with ambient light)
   // Light-path classes it can supply (ARCHITECTURE.md, "Every light path is counted once"), e.g.
-  // "LD+DE". The planner gives each class to the first planned technique that claims it, in
-  // registry order; a technique adds a class to beauty only when it owns it (FrameResources).
+  // "LD+DE". The planner gives each class to one planned technique, as its ownership policy says
+  // (FramePlanner.h); a technique adds a class to beauty only when it owns it (FrameResources::owns).
   std::vector<std::string> lightPaths = {};
-  // When the request names this technique, it owns its classes ahead of registry order (a request
-  // that asks for light_volumes gets them even when caustics, earlier in the registry, also runs).
+  // When the request names this technique, it owns its classes ahead of the policy's order (a request
+  // that asks for light_volumes gets them even when caustics, ahead of it in the policy, also runs).
   bool claimsWhenNamed = false;
   // Its light-path classes admit one supplier per frame: when another planned technique owns one of
   // them, the planner drops this one (skipped: "<class> is owned by <owner>") instead of running it
@@ -151,6 +154,14 @@ public:
   virtual void prepare(const Scene& scene, const Params& params, FrameResources& resources) = 0;
   // The only place GL is issued. Must not allocate GL objects.
   virtual void execute(PassContext& context) = 0;
+  // The cost models' scene variables this technique's model scales with (api::SceneCounts, fitted by
+  // bench/presets.py against stats.scene.counts): light_volumes' beams, specular's objects. Computed
+  // here, beside the code whose cost they count, for every technique of the registry before planning
+  // the budget (FramePlanner's costCounts).
+  virtual void addCostCounts(const Scene& scene, api::SceneCounts& counts) const {
+    (void)scene;
+    (void)counts;
+  }
   // Meshes (Scene::meshes indices) to leave out of this frame's shadow maps because this pass supplies
   // their shadows itself (light_volumes' negative beams), so that the two never both apply. Called
   // before any prepare().

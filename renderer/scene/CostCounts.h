@@ -1,7 +1,9 @@
 #pragma once
-// The scene counts the preset table's cost models scale with (api::SceneCounts, api/Presets.h): the one
-// place that computes them. The Renderer passes them to the budget chooser and reports them in
-// stats.scene.counts (where bench/presets.py reads them for the fit).
+// The frame's own scene counts for the preset table's cost models (api::SceneCounts, api/Presets.h):
+// the particles of the scene's and the request's systems, which every media technique scales with. The
+// techniques add their own variables (Technique::addCostCounts: light_volumes' beams, specular's
+// objects); FramePlanner's costCounts() assembles both, the Renderer passes them to the budget chooser
+// and reports them in stats.scene.counts (where bench/presets.py reads them for the fit).
 #include <vector>
 
 #include "api/Media.h"

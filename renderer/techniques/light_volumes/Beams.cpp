@@ -559,6 +559,15 @@ void appendScattererBeams(const Light& light, const std::vector<TriangleInput>& 
   }
 }
 
+double beamCountBound(const Scene& scene) {
+  double perLight = 0;
+  for (const MeshInstance& m : scene.meshes) {
+    const Material& mat = scene.material(m.material);
+    if (mat.scattersNarrowLobe()) perLight += double(m.triangleCount()) * (mat.isTransmissive() ? 2.0 : 1.0);
+  }
+  return perLight * double(scene.lights.size());
+}
+
 BeamSet buildBeams(const Scene& scene, const BeamOptions& o, const ReceiverDistance& receiverDistance) {
   BeamSet out;
   std::vector<TriangleInput> triangles;

@@ -6,6 +6,7 @@
 #include <glm/gtc/type_ptr.hpp>
 #include <nlohmann/json.hpp>
 
+#include "api/Presets.h"
 #include "renderer/frame/PassContext.h"
 #include "renderer/frame/RayScenes.h"
 
@@ -53,6 +54,10 @@ Requirements LightVolumesPass::requirements(const Scene& scene, const api::Rende
   if (!hasScatterer(scene))
     return Requirements::skip("no specular or glossy scatterer (metal or glass with roughness <= 0.5)");
   return Requirements::ok();
+}
+
+void LightVolumesPass::addCostCounts(const Scene& scene, api::SceneCounts& counts) const {
+  counts.beams = light_volumes::beamCountBound(scene);
 }
 
 std::vector<int> LightVolumesPass::shadowMapExclusions(const Scene& scene, const Params& params) const {

@@ -25,6 +25,7 @@ public:
   void prepare(const Scene&, const Params&, FrameResources&) override;
   void execute(PassContext&) override;
   std::vector<int> shadowMapExclusions(const Scene&, const Params&) const override;
+  void addCostCounts(const Scene& scene, api::SceneCounts& counts) const override;
 
   struct Cache {
     light_volumes::BeamSet beams;

@@ -7,6 +7,7 @@
 #include <limits>
 #include <string>
 
+#include "api/Presets.h"
 #include "api/Types.h"
 #include "renderer/frame/GpuTypes.h"
 #include "renderer/frame/PassContext.h"
@@ -84,6 +85,11 @@ MapResolution chooseMapResolution(const Scene& scene, const FrameView& view, con
 const TechniqueInfo& SpecularPass::info() const {
   static const TechniqueInfo i = describedTechnique("specular");
   return i;
+}
+
+// It renders layered distance maps per object (specularMeshes: every mirror-like or transmissive mesh).
+void SpecularPass::addCostCounts(const Scene& scene, api::SceneCounts& counts) const {
+  counts.specularObjects = static_cast<double>(specularMeshes(scene).size());
 }
 
 Requirements SpecularPass::requirements(const Scene& scene, const api::RenderRequest&) const {

@@ -46,6 +46,7 @@ class SpecularPass final : public Technique {
 public:
   const TechniqueInfo& info() const override;
   Requirements requirements(const Scene&, const api::RenderRequest&) const override;
+  void addCostCounts(const Scene& scene, api::SceneCounts& counts) const override;
   void prepare(const Scene&, const Params&, FrameResources&) override;
   void execute(PassContext&) override;
 
