@@ -30,6 +30,9 @@ uniform int u_root;
 uniform int u_split;
 uniform int u_accumulate;
 uniform int u_addToBeauty;
+// The light-path classes whose beams join beauty (LightVolumesPass::execute): 1 LS+DE (specular
+// scatterers' beams, sigma 0), 2 LG+DE (glossy ones). The AOV holds every beam.
+uniform int u_beautyClasses;
 uniform vec3 u_eye;
 uniform vec3 u_viewForward;
 uniform int u_orthographic;
@@ -44,10 +47,19 @@ vec3 beamRadiance(int i, vec3 F, vec3 n, vec3 wo, MaterialParams mp) {
   return vec3(b.fluxSigma) * k * gltfBrdfCos(n, wo, -N, mp) / c;
 }
 
+// Whether beam i joins beauty: a shadow beam (negative flux) always, since it is its scatterer's first-order
+// shadow, which the shadow maps leave out (shadowMapExclusions); a beam of light only in a class this pass
+// owns, so that a class another technique owns (caustics' LS+DE) is not added twice.
+bool toBeauty(int i) {
+  vec4 fs = beams[i].fluxSigma;
+  if (fs.x + fs.y + fs.z < 0.0) return true;
+  return (u_beautyClasses & (fs.w == 0.0 ? 1 : 2)) != 0;
+}
+
 void main() {
   ivec2 px = ivec2(gl_GlobalInvocationID.xy);
   if (px.x >= u_size.x || px.y >= u_size.y) return;
-  vec3 L = vec3(0.0);
+  vec3 L = vec3(0.0), B = vec3(0.0);  // every beam (the AOV); those that join beauty
   vec4 P = texelFetch(t_position, px, 0);
   vec4 nUnlit = texelFetch(t_normal, px, 0);
   vec4 mat = texelFetch(t_material, px, 0);
@@ -60,7 +72,11 @@ void main() {
     MaterialParams mp = materialParams(texelFetch(t_albedo, px, 0).rgb, mat.x, mat.y, mat.w,
                                        texelFetch(t_emission, px, 0).a);
     if (u_traversal == 0) {
-      for (int i = u_begin; i < u_end; ++i) L += beamRadiance(i, F, n, wo, mp);
+      for (int i = u_begin; i < u_end; ++i) {
+        vec3 e = beamRadiance(i, F, n, wo, mp);
+        L += e;
+        if (toBeauty(i)) B += e;
+      }
     } else if (u_root >= 0) {
       int stack[32];
       int sp = 0;
@@ -83,7 +99,9 @@ void main() {
             float radius = c.originRadius.w + c.axisSlope.w * abs(s);
             vec3 radial = r - s * vec3(c.axisSlope);
             if (dot(radial, radial) > radius * radius) continue;
-            L += beamRadiance(i, F, n, wo, mp);
+            vec3 e = beamRadiance(i, F, n, wo, mp);
+            L += e;
+            if (toBeauty(i)) B += e;
           }
         }
         if (sp == 0) break;
@@ -94,5 +112,6 @@ void main() {
   vec4 acc = vec4(L, 1.0);
   if (u_accumulate != 0) acc.rgb += imageLoad(i_accum, px).rgb;
   imageStore(i_accum, px, acc);
-  if (u_addToBeauty != 0) imageStore(i_beauty, px, imageLoad(i_beauty, px) + vec4(acc.rgb, 0.0));
+  // Each dispatch adds its share of beauty (the AOV's sum is the last dispatch's acc).
+  if (u_addToBeauty != 0) imageStore(i_beauty, px, imageLoad(i_beauty, px) + vec4(B, 0.0));
 }

@@ -82,9 +82,11 @@ void LightVolumesPass::prepare(const Scene& scene, const Params& params, FrameRe
   o.cancel = res.cancel();
   split_ = params.get<std::string>("split") == "paper" ? light_volumes::Split::Paper : light_volumes::Split::TwoD;
   bvh_ = params.get<std::string>("traversal") == "bvh";
-  // Every light path is counted once: without LS+DE and LG+DE (another technique owns them) the pass
-  // gathers nothing and adds nothing to beauty.
-  owns_ = res.owns("light_volumes", api::kPathLSDE) || res.owns("light_volumes", api::kPathLGDE);
+  // Every light path is counted once: beauty takes the beams of the classes this pass owns (specular
+  // scatterers' LS+DE, glossy ones' LG+DE; caustics or photon_gi may own LS+DE while this pass, planned
+  // for its AOV, owns LG+DE) and every shadow beam (the scatterers' shadows, which the shadow maps leave
+  // out); the AOV holds every beam.
+  beautyClasses_ = (res.owns("light_volumes", api::kPathLSDE) ? 1 : 0) | (res.owns("light_volumes", api::kPathLGDE) ? 2 : 0);
 
   const nlohmann::json key = {{"scene", res.sceneKey()},
                               {"lights", lightsKey(scene)},
@@ -163,8 +165,9 @@ void LightVolumesPass::execute(PassContext& ctx) {
   prog.set("u_traversal", bvh_ ? 1 : 0);
   // One dispatch per slice (linear) or group (bvh); at least one, which clears the AOV.
   std::vector<std::pair<int, int>> work;  // linear: [begin, end); bvh: (root, 0)
-  const int count = owns_ ? static_cast<int>(c.beams.beams.size()) : 0;
-  if (bvh_ && owns_) {
+  const int count = static_cast<int>(c.beams.beams.size());
+  prog.set("u_beautyClasses", beautyClasses_);
+  if (bvh_) {
     for (int root : c.bvh.roots)
       if (root >= 0) work.push_back({root, 0});
   } else {
@@ -180,13 +183,13 @@ void LightVolumesPass::execute(PassContext& ctx) {
       prog.set("u_end", work[k].second);
     }
     prog.set("u_accumulate", k > 0 ? 1 : 0);
-    prog.set("u_addToBeauty", owns_ && k + 1 == work.size() ? 1 : 0);
+    prog.set("u_addToBeauty", 1);
     glDispatchCompute((view.width + 7) / 8, (view.height + 7) / 8, 1);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
   }
   glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
   res.markWritten("light_volumes");
-  if (owns_) res.markWritten("beauty");
+  res.markWritten("beauty");
 
   auto& s = ctx.stats.counters;
   const auto& b = c.beams;
@@ -230,7 +233,9 @@ void LightVolumesPass::execute(PassContext& ctx) {
   s["bvh_depth"] = c.bvh.depth;
   s["traversal_bvh"] = bvh_ ? 1.0 : 0.0;
   s["dispatches"] = static_cast<double>(work.size());
-  s["owns_light_paths"] = owns_ ? 1.0 : 0.0;
+  // Its classes in beauty: 1 LS+DE, 2 LG+DE, 3 both (shadow beams always).
+  s["owns_light_paths"] = beautyClasses_ != 0 ? 1.0 : 0.0;
+  s["beauty_classes"] = beautyClasses_;
 }
 
 }  // namespace radiant

@@ -35,7 +35,8 @@ public:
 
 private:
   const Cache* cache_ = nullptr;  // in FrameResources' cache, valid for this frame
-  bool upload_ = false, built_ = false, bvh_ = true, owns_ = true;
+  bool upload_ = false, built_ = false, bvh_ = true;
+  int beautyClasses_ = 3;  // which of its beams join beauty (execute; gather.comp u_beautyClasses)
   std::string digest_;  // what the beam buffers hold once uploaded (FrameResources::holds)
   light_volumes::Split split_ = light_volumes::Split::TwoD;
 };

@@ -282,6 +282,32 @@ TEST(LightVolumes, NegativeBeamsReplaceTheScatterersShadowMapShadows) {
   EXPECT_LT(worstLit, 1e-3) << "the two shadow modes away from the shadow";
 }
 
+// Planned only for its AOV (the request asks for it, passes does not name it), light_volumes does not
+// own LS+DE: caustics or photon_gi does, and adds the mirror's reflected light to beauty. light_volumes
+// owns LG+DE alone (no other technique supplies it), and beauty takes only that class's beams and its
+// shadow beams: the mirror's LS+DE light is counted once. Its AOV still holds every beam. The mirror,
+// above the light, shadows nothing the camera sees, so beauty is the frame without light_volumes (equal
+// on llvmpipe); counted twice it was light_volumes' whole AOV above it (+6.6%).
+TEST(LightVolumes, PlannedForItsAovItAddsOnlyTheClassesItOwnsToBeauty) {
+  const Scene scene = mirrorScene();
+  api::RenderRequest aovOnly = request(48);
+  aovOnly.passes.erase("light_volumes");
+  api::RenderRequest without = aovOnly;
+  without.disabledPasses.insert("light_volumes");
+  without.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty"}, false}};
+  const RenderOutput a = renderer().render(scene, without);
+  const RenderOutput b = renderer().render(scene, aovOnly);
+  ASSERT_TRUE(testing::allFinite(b));
+  ASSERT_NE(pass(b, "light_volumes"), nullptr);
+  EXPECT_NE(b.stats.lightPaths.at("LS+DE"), "light_volumes");
+  EXPECT_EQ(b.stats.lightPaths.at("LG+DE"), "light_volumes");
+  EXPECT_EQ(pass(b, "light_volumes")->counters.at("beauty_classes"), 2.0);
+  const double lv = sum(aov(b, "light_volumes")), beautyA = sum(aov(a, "beauty")), beautyB = sum(aov(b, "beauty"));
+  std::printf("beauty without light_volumes %.4f, with it for its AOV %.4f; its AOV %.4f\n", beautyA, beautyB, lv);
+  EXPECT_GT(lv, 0.05 * beautyA) << "the mirror's light is a visible share of the frame (6.6% at 48 px)";
+  EXPECT_NEAR(beautyB / beautyA, 1.0, 0.01) << "a double count adds the AOV: " << (beautyA + lv) / beautyA;
+}
+
 TEST(LightVolumes, SaysWhyItIsSkipped) {
   testing::SceneBuilder b;
   b.quad(glm::vec3(0.f), {1, 0, 0}, {0, 0, -1}, b.material(testing::lambertian()), "floor");

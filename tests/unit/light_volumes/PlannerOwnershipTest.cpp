@@ -1,7 +1,8 @@
-// Who owns LS+DE and LG+DE (docs/TECHNIQUES.md, light_volumes): the planner gives a light-path class
-// to the first planned technique claiming it in registry order, except that light_volumes
-// (TechniqueInfo::claimsWhenNamed) takes its classes first when the request names it. A stand-in for
-// the caustics technique (branch `caustics`), registered before light_volumes as the rule expects.
+// Who owns LS+DE and LG+DE (docs/techniques/light_volumes.md): the planner gives a light-path class to
+// the planned technique its ownership policy ranks first (a class without a row, such as LG+DE here, by
+// name), except that light_volumes (TechniqueInfo::claimsWhenNamed) takes its classes first when the
+// request names it. A stand-in for the caustics technique that also claims LG+DE (the real one does
+// not: there light_volumes owns LG+DE whenever it is planned).
 #include <gtest/gtest.h>
 
 #include "api/Validate.h"
