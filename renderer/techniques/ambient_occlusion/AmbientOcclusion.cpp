@@ -1,4 +1,5 @@
 #include "renderer/techniques/ambient_occlusion/AmbientOcclusion.h"
+#include "params/ambient_occlusion_params.h"
 
 #include <algorithm>
 #include <cmath>
@@ -121,7 +122,7 @@ SampleBlock buildSampleBlock(Method method, Falloff falloff, int samples) {
     throw std::invalid_argument("ao::buildSampleBlock(): samples " + std::to_string(samples) + " not in [1, 64]");
   SampleBlock b{};
   switch (method) {
-    case Method::Volumetric: {
+    case Method::kVolumetric: {
       const auto disk = poissonDisk(samples);
       for (int i = 0; i < samples; ++i) {
         const glm::vec2 p = disk[i];
@@ -129,7 +130,7 @@ SampleBlock buildSampleBlock(Method method, Falloff falloff, int samples) {
       }
       break;
     }
-    case Method::Containment: {
+    case Method::kContainment: {
       const auto disk = poissonDisk(samples);
       // Distances xi_i = (k + 1/2) / n, shuffled against the directions (fixed seed).
       std::vector<int> order(static_cast<std::size_t>(samples));
@@ -143,19 +144,19 @@ SampleBlock buildSampleBlock(Method method, Falloff falloff, int samples) {
         const float xi = (static_cast<float>(order[i]) + 0.5f) / static_cast<float>(samples);
         // r = mu^-1(xi): the step membership's derivative is a Dirac delta at R; (r/R)^3 inverts to
         // R xi^(1/3).
-        const float rOverR = falloff == Falloff::Step ? 1.f : std::cbrt(xi);
+        const float rOverR = falloff == Falloff::kStep ? 1.f : std::cbrt(xi);
         b.samples[i] = glm::vec4(omega * rOverR, 0.f);
       }
       break;
     }
-    case Method::Crytek: {
+    case Method::kCrytek: {
       // Antithetic pairs (p, -p): the kernel is balanced between the two half-balls of any plane through
       // x, so its open-plane value is the definition's 1/2 and not a property of the particular kernel.
       const auto ball = poissonBall((samples + 1) / 2);
       for (int i = 0; i < samples; ++i) b.samples[i] = glm::vec4(i % 2 ? -ball[i / 2] : ball[i / 2], 0.f);
       break;
     }
-    case Method::Gtao: break;
+    case Method::kGtao: break;
   }
   Pcg32 rng(0x0a7a7e5u);
   for (int j = 0; j < kPatternCells; ++j) {
@@ -176,44 +177,17 @@ GtaoLayout gtaoLayout(int samples) {
   return {slices, steps};
 }
 
-Method parseMethod(const std::string& s) {
-  if (s == "volumetric") return Method::Volumetric;
-  if (s == "containment") return Method::Containment;
-  if (s == "crytek") return Method::Crytek;
-  if (s == "gtao") return Method::Gtao;
-  throw api::ApiError(422, "invalid-value", "Invalid value",
-                      "/passes/ambient_occlusion/method: \"" + s + "\" is not one of volumetric, containment, crytek, gtao",
-                      "/passes/ambient_occlusion/method");
-}
-
-Falloff parseFalloff(const std::string& s) {
-  if (s == "step") return Falloff::Step;
-  if (s == "cubic") return Falloff::Cubic;
-  throw api::ApiError(422, "invalid-value", "Invalid value",
-                      "/passes/ambient_occlusion/falloff: \"" + s + "\" is not one of step, cubic",
-                      "/passes/ambient_occlusion/falloff");
-}
-
 }  // namespace ao
 
 namespace {
 const char* methodDefine(ao::Method m) {
   switch (m) {
-    case ao::Method::Volumetric: return "METHOD_VOLUMETRIC";
-    case ao::Method::Containment: return "METHOD_CONTAINMENT";
-    case ao::Method::Crytek: return "METHOD_CRYTEK";
-    case ao::Method::Gtao: return "METHOD_GTAO";
+    case ao::Method::kVolumetric: return "METHOD_VOLUMETRIC";
+    case ao::Method::kContainment: return "METHOD_CONTAINMENT";
+    case ao::Method::kCrytek: return "METHOD_CRYTEK";
+    case ao::Method::kGtao: return "METHOD_GTAO";
   }
   return "METHOD_VOLUMETRIC";
-}
-const char* methodName(ao::Method m) {
-  switch (m) {
-    case ao::Method::Volumetric: return "volumetric";
-    case ao::Method::Containment: return "containment";
-    case ao::Method::Crytek: return "crytek";
-    case ao::Method::Gtao: return "gtao";
-  }
-  return "volumetric";
 }
 }  // namespace
 
@@ -234,20 +208,21 @@ Requirements AmbientOcclusionPass::requirements(const Scene&, const api::RenderR
 }
 
 void AmbientOcclusionPass::prepare(const Scene&, const Params& params, FrameResources& res) {
-  method_ = ao::parseMethod(params.get<std::string>("method"));
-  falloff_ = ao::parseFalloff(params.get<std::string>("falloff"));
-  samples_ = std::clamp(params.get<int>("samples"), 1, ao::kMaxSamples);
-  radius_ = params.get<float>("radius");
+  const AmbientOcclusionParams p = AmbientOcclusionParams::from(params);
+  method_ = p.method;
+  falloff_ = p.falloff;
+  samples_ = std::clamp(p.samples, 1, ao::kMaxSamples);
+  radius_ = static_cast<float>(p.radius);
   if (!(radius_ > 0.f) || !std::isfinite(radius_))
     throw api::ApiError(422, "out-of-range", "Value out of range",
                         "/passes/ambient_occlusion/radius: must be a finite number above 0",
                         "/passes/ambient_occlusion/radius");
-  interleave_ = params.get<bool>("interleave");
-  blur_ = params.get<bool>("blur");
-  scale_ = params.get<std::string>("resolution_scale") == "half" ? 2 : 1;
+  interleave_ = p.interleave;
+  blur_ = p.blur;
+  scale_ = p.resolution_scale == AmbientOcclusionParams::ResolutionScale::kHalf ? 2 : 1;
 
   // The kernel depends on the method, the falloff and the sample count only: a radius sweep reuses it.
-  const std::string digest = std::string(methodName(method_)) + "/" + (falloff_ == ao::Falloff::Step ? "step" : "cubic") +
+  const std::string digest = std::string(AmbientOcclusionParams::toString(method_)) + "/" + AmbientOcclusionParams::toString(falloff_) +
                              "/" + std::to_string(samples_);
   block_ = &res.cached<ao::SampleBlock>("ambient_occlusion:kernel", digest, [&] {
     return std::make_unique<ao::SampleBlock>(ao::buildSampleBlock(method_, falloff_, samples_));
@@ -361,7 +336,7 @@ void AmbientOcclusionPass::execute(PassContext& ctx) {
 
   res.markWritten("ao");
   if (addAmbient) res.markWritten("beauty");
-  const double fetches = method_ == ao::Method::Gtao ? 2.0 * layout.slices * layout.steps : samples_;
+  const double fetches = method_ == ao::Method::kGtao ? 2.0 * layout.slices * layout.steps : samples_;
   ctx.stats.counters["samples"] = samples_;
   ctx.stats.counters["depth_fetches_per_pixel"] = fetches;
   ctx.stats.counters["ao_pixels"] = static_cast<double>(ww) * wh;
@@ -369,11 +344,11 @@ void AmbientOcclusionPass::execute(PassContext& ctx) {
 }
 
 GroundTruth AmbientOcclusionPass::groundTruth(const Params& params, const std::string& aov) const {
+  const AmbientOcclusionParams p = AmbientOcclusionParams::from(params);
   if (aov != "ao") return GroundTruth::fromAovTable(aov);
   return {nlohmann::json{{"aov", "ao"},
-                         {"ao_radius", params.get<double>("radius")},
-                         {"ao_definition", params.get<std::string>("method") == "volumetric" ? "volumetric"
-                                                                                                           : "cosine"}}};
+                         {"ao_radius", p.radius},
+                         {"ao_definition", p.method == ao::Method::kVolumetric ? "volumetric" : "cosine"}}};
 }
 
 }  // namespace radiant

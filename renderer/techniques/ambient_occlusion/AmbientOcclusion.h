@@ -16,14 +16,15 @@
 
 #include <glm/glm.hpp>
 
+#include "params/ambient_occlusion_params.h"
 #include "renderer/frame/Technique.h"
 
 namespace radiant {
 
 namespace ao {
 
-enum class Method { Volumetric, Containment, Crytek, Gtao };
-enum class Falloff { Step, Cubic };  // containment's fuzzy membership mu(r): [r >= R] or (r/R)^3
+using Method = AmbientOcclusionParams::Method;    // the schema's "method": volumetric, containment, crytek, gtao
+using Falloff = AmbientOcclusionParams::Falloff;  // containment's fuzzy membership mu(r): [r >= R] or (r/R)^3
 
 constexpr int kMaxSamples = 64;
 constexpr int kPatternCells = 16;  // 4x4 interleaved-sampling pattern (thesis 4.1.3)
@@ -62,8 +63,6 @@ struct GtaoLayout {
 };
 GtaoLayout gtaoLayout(int samples);
 
-Method parseMethod(const std::string& s);
-Falloff parseFalloff(const std::string& s);
 
 }  // namespace ao
 
@@ -78,8 +77,8 @@ public:
   void execute(PassContext&) override;
 
 private:
-  ao::Method method_ = ao::Method::Volumetric;
-  ao::Falloff falloff_ = ao::Falloff::Step;
+  ao::Method method_ = ao::Method::kVolumetric;
+  ao::Falloff falloff_ = ao::Falloff::kStep;
   int samples_ = 16;
   float radius_ = 0.5f;
   bool interleave_ = true;

@@ -1,4 +1,5 @@
 #include "renderer/techniques/caustics/Caustics.h"
+#include "params/caustics_params.h"
 
 #include <algorithm>
 #include <cmath>
@@ -131,21 +132,22 @@ Requirements CausticsPass::requirements(const Scene& scene, const api::RenderReq
 }
 
 void CausticsPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
+  const CausticsParams p = CausticsParams::from(params);
   // Every default is the descriptor's (caustics.json): Params has no fallback.
-  method_ = params.get<std::string>("method") == "splat" ? Method::Splat : Method::Triangles;
-  photonResolution_ = std::clamp(params.get<int>("photon_resolution"), 32, 256);
-  cubeResolution_ = std::clamp(params.get<int>("cube_resolution"), 16, 1024);
-  areaWeight_ = std::clamp(params.get<float>("area_weight"), 0.1f, 1.f);
-  visibilityTolerance_ = std::clamp(params.get<float>("visibility_tolerance"), 0.f, 64.f);
-  maxDepth_ = std::clamp(params.get<int>("max_depth"), 1, 8);
-  secondaryMaxDepth_ = std::clamp(params.get<int>("secondary_max_depth"), 1, 8);
-  linearSteps_ = std::clamp(params.get<int>("linear_steps"), 1, 256);
-  secantSteps_ = std::clamp(params.get<int>("secant_steps"), 0, 32);
-  splatRadius_ = std::clamp(params.get<float>("splat_radius"), 1e-4f, 10.f);
-  energyCheck_ = params.get<bool>("energy_check");
-  fresnelReflection_ = params.get<bool>("fresnel_reflection");
-  footprintFilter_ = params.get<bool>("footprint_filter");
-  specularLookup_ = params.get<bool>("specular_lookup");
+  method_ = p.method == CausticsParams::Method::kSplat ? Method::Splat : Method::Triangles;
+  photonResolution_ = std::clamp(p.photon_resolution, 32, 256);
+  cubeResolution_ = std::clamp(p.cube_resolution, 16, 1024);
+  areaWeight_ = std::clamp(static_cast<float>(p.area_weight), 0.1f, 1.f);
+  visibilityTolerance_ = std::clamp(static_cast<float>(p.visibility_tolerance), 0.f, 64.f);
+  maxDepth_ = std::clamp(p.max_depth, 1, 8);
+  secondaryMaxDepth_ = std::clamp(p.secondary_max_depth, 1, 8);
+  linearSteps_ = std::clamp(p.linear_steps, 1, 256);
+  secantSteps_ = std::clamp(p.secant_steps, 0, 32);
+  splatRadius_ = std::clamp(static_cast<float>(p.splat_radius), 1e-4f, 10.f);
+  energyCheck_ = p.energy_check;
+  fresnelReflection_ = p.fresnel_reflection;
+  footprintFilter_ = p.footprint_filter;
+  specularLookup_ = p.specular_lookup;
 
   generators_ = specularMeshes(scene);
   pairs_.clear();
@@ -192,7 +194,7 @@ void CausticsPass::prepare(const Scene& scene, const Params& params, FrameResour
     const std::string need = std::to_string(generators_.size()) + " generators' caustic cubes at " +
                              std::to_string(cubeResolution_) + "^2 texels need " + mib(cubeBytes(cubes, cubeResolution_)) +
                              " MiB, above the limit of " + mib(kMaxBytes) + " MiB";
-    if (params.given("cube_resolution"))
+    if (p.given.cube_resolution)
       throw api::ApiError(422, "limit-exceeded", "Server limit exceeded",
                           "/passes/caustics/cube_resolution: " + need + ": lower cube_resolution",
                           "/passes/caustics/cube_resolution");

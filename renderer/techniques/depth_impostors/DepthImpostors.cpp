@@ -1,4 +1,5 @@
 #include "renderer/techniques/depth_impostors/DepthImpostors.h"
+#include "params/depth_impostors_params.h"
 
 #include <algorithm>
 #include <numeric>
@@ -29,14 +30,15 @@ GroundTruth DepthImpostorsPass::groundTruth(const Params&, const std::string& ao
 }
 
 void DepthImpostorsPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
+  const DepthImpostorsParams p = DepthImpostorsParams::from(params);
   const FrameView& view = res.view();
-  particlesPerBlock_ = params.get<int>("particles_per_block");
-  requestedRes_ = params.get<int>("impostor_resolution");
-  const int K = params.get<int>("slices");
-  const int sliceRes = params.get<int>("slice_resolution");
-  clipScaling_ = params.get<std::string>("clip_scaling") == "linear" ? 0 : 1;
-  forwardScatter_ = params.get<bool>("forward_scatter") ? 1 : 0;
-  fourierTerms_ = params.get<std::string>("light_transmittance") == "fourier" ? params.get<int>("fourier_terms") : 0;
+  particlesPerBlock_ = p.particles_per_block;
+  requestedRes_ = p.impostor_resolution;
+  const int K = p.slices;
+  const int sliceRes = p.slice_resolution;
+  clipScaling_ = p.clip_scaling == DepthImpostorsParams::ClipScaling::kLinear ? 0 : 1;
+  forwardScatter_ = p.forward_scatter ? 1 : 0;
+  fourierTerms_ = p.light_transmittance == DepthImpostorsParams::LightTransmittance::kFourier ? p.fourier_terms : 0;
   const glm::vec3 forward = -glm::normalize(glm::vec3(view.camera.world[2]));
   const bool ortho = view.camera.projection == ProjectionType::Orthographic;
 

@@ -1,4 +1,5 @@
 #include "renderer/techniques/direct/Direct.h"
+#include "params/direct_params.h"
 
 #include <algorithm>
 #include <vector>
@@ -25,8 +26,9 @@ Requirements DirectPass::requirements(const Scene&, const api::RenderRequest&) c
 }
 
 void DirectPass::prepare(const Scene&, const Params& params, FrameResources& res) {
-  pcfRadius_ = params.get<int>("pcf_radius");
-  imageBasedLighting_ = params.get<bool>("image_based_lighting");
+  const DirectParams p = DirectParams::from(params);
+  pcfRadius_ = p.pcf_radius;
+  imageBasedLighting_ = p.image_based_lighting;
   gl::Framebuffer& fb = res.framebuffer("direct");
   fb.attach(GL_COLOR_ATTACHMENT0, res.texture("direct"));  // declared outputs: allocated by the Renderer
   fb.attach(GL_COLOR_ATTACHMENT1, res.texture("beauty"));

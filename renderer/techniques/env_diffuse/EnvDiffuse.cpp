@@ -1,4 +1,5 @@
 #include "renderer/techniques/env_diffuse/EnvDiffuse.h"
+#include "params/env_diffuse_params.h"
 
 #include <algorithm>
 #include <cmath>
@@ -62,34 +63,32 @@ Requirements EnvDiffusePass::requirements(const Scene& scene, const api::RenderR
 }
 
 void EnvDiffusePass::validate(const Scene& scene, const Params& params) const {
-  const int R = params.get<int>("cube_resolution"), M = params.get<int>("downsample"), bounces = params.get<int>("bounces");
-  const std::string method = params.get<std::string>("form_factor");
+  const EnvDiffuseParams p = EnvDiffuseParams::from(params);
+  const int R = p.cube_resolution, M = p.downsample, bounces = p.bounces;
   if (!isPowerOfTwoIn(R, 16, 1024)) badParam("cube_resolution", "must be a power of two in [16, 1024]");
   if (!isPowerOfTwoIn(M, 1, 16) || M > R) badParam("downsample", "must be 1, 2, 4, 8 or 16 and at most cube_resolution");
   if (bounces < 1 || bounces > 4) badParam("bounces", "must be in [1, 4]");
-  if (method != "polygon" && method != "point" && method != "classic")
-    badParam("form_factor", "must be polygon, point or classic, got '" + method + "'");
   // Every named receiver and reference point exists (422 at receivers / reference_points).
-  env_diffuse::selectReceivers(scene, params.get<std::string>("receivers"), params.get<std::string>("reference_points"));
+  env_diffuse::selectReceivers(scene, p.receivers, p.reference_points);
 }
 
 void EnvDiffusePass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
-  cubeResolution_ = params.get<int>("cube_resolution");
-  downsample_ = params.get<int>("downsample");
-  bounces_ = params.get<int>("bounces");
-  horizonClip_ = params.get<bool>("horizon_clip");
+  const EnvDiffuseParams p = EnvDiffuseParams::from(params);
+  cubeResolution_ = p.cube_resolution;
+  downsample_ = p.downsample;
+  bounces_ = p.bounces;
+  horizonClip_ = p.horizon_clip;
   // The sky seen by a receiver is direct light from the environment (one scattering event), which
   // ambient_occlusion adds, with occlusion, whenever there is ambient light. The cube maps therefore
   // hold only what surfaces send, so indirect_diffuse is exactly the reference's "indirect" (two or
   // more events) and nothing is counted twice; include_sky puts the sky back for use without AO.
-  skyRadiance_ = params.get<bool>("include_sky") ? res.view().ambient : glm::vec3(0.f);
+  skyRadiance_ = p.include_sky ? res.view().ambient : glm::vec3(0.f);
   // validate() has checked the parameters and the receivers.
-  const std::string method = params.get<std::string>("form_factor");
-  method_ = method == "polygon" ? kPolygon : method == "point" ? kPoint : kClassic;
+  using FormFactor = EnvDiffuseParams::FormFactor;
+  method_ = p.form_factor == FormFactor::kPolygon ? kPolygon : p.form_factor == FormFactor::kPoint ? kPoint : kClassic;
 
   const std::vector<env_diffuse::Receiver> selected =
-      env_diffuse::selectReceivers(scene, params.get<std::string>("receivers"),
-                                   params.get<std::string>("reference_points"));
+      env_diffuse::selectReceivers(scene, p.receivers, p.reference_points);
 
   const int R = cubeResolution_, M = downsample_, S = std::min(kConvolutionSourceSize, R);
   res.texture("env_diffuse_radiance_hi", GL_TEXTURE_CUBE_MAP, GL_RGBA32F, R, R).setFilter(GL_NEAREST, GL_NEAREST);
@@ -287,8 +286,9 @@ void EnvDiffusePass::execute(PassContext& ctx) {
 }
 
 GroundTruth EnvDiffusePass::groundTruth(const Params& params, const std::string& aov) const {
+  const EnvDiffuseParams p = EnvDiffuseParams::from(params);
   GroundTruth truth = GroundTruth::fromAovTable(aov);
-  if (aov == "indirect_diffuse" && truth.exists()) truth.reference["max_bounces"] = 1 + params.get<int>("bounces");
+  if (aov == "indirect_diffuse" && truth.exists()) truth.reference["max_bounces"] = 1 + p.bounces;
   return truth;
 }
 

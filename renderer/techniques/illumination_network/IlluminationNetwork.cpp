@@ -1,4 +1,5 @@
 #include "renderer/techniques/illumination_network/IlluminationNetwork.h"
+#include "params/illumination_network_params.h"
 
 #include <algorithm>
 #include <cmath>
@@ -82,8 +83,9 @@ int IlluminationNetworkPass::autoWindow(int nodes) {
 }
 
 void IlluminationNetworkPass::validate(const Scene&, const Params& params) const {
-  const int N = params.get<int>("nodes"), D = params.get<int>("directions");
-  int M = params.get<int>("window");
+  const IlluminationNetworkParams p = IlluminationNetworkParams::from(params);
+  const int N = p.nodes, D = p.directions;
+  int M = p.window;
   if (M == 0) M = autoWindow(N);
   if (std::size_t(N) * std::size_t(D) > kMaxLinks)
     throw api::ApiError(422, "invalid-value", "Network too large",
@@ -98,17 +100,18 @@ void IlluminationNetworkPass::validate(const Scene&, const Params& params) const
 }
 
 void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
+  const IlluminationNetworkParams p = IlluminationNetworkParams::from(params);
   const FrameView& view = res.view();
-  const int N = params.get<int>("nodes"), D = params.get<int>("directions");
-  int M = params.get<int>("window");
+  const int N = p.nodes, D = p.directions;
+  int M = p.window;
   if (M == 0) M = autoWindow(N);  // validate() has bounded N x D and D x M^2
-  const auto seed = params.get<std::uint64_t>("seed");
-  const bool fibonacci = params.get<std::string>("sampling") == "fibonacci";
-  const float splatScale = params.get<float>("splat_radius");
-  march_ = params.get<std::string>("final_render") == "march";
+  const auto seed = static_cast<std::uint64_t>(p.seed);
+  const bool fibonacci = p.sampling == IlluminationNetworkParams::Sampling::kFibonacci;
+  const float splatScale = static_cast<float>(p.splat_radius);
+  march_ = p.final_render == IlluminationNetworkParams::FinalRender::kMarch;
   marchFallback_ = false;
-  marchSteps_ = params.get<int>("march_steps");
-  const float kernelScale = params.get<float>("march_kernel");
+  marchSteps_ = p.march_steps;
+  const float kernelScale = static_cast<float>(p.march_kernel);
   const std::string digest = view.mediaKey + "|" + std::to_string(N) + "|" + std::to_string(D) + "|" +
                              std::to_string(M) + "|" + params.subsetKey({"seed", "sampling", "link_opacity"});
   fresh_ = false;
@@ -122,9 +125,9 @@ void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, 
     fresh_ = true;
     return n;
   });
-  iterations_ = params.get<int>("iterations");
-  linearSource_ = params.get<std::string>("link_source") == "linear";
-  exactLinks_ = params.get<std::string>("link_opacity") == "medium";
+  iterations_ = p.iterations;
+  linearSource_ = p.link_source == IlluminationNetworkParams::LinkSource::kLinear;
+  exactLinks_ = p.link_opacity == IlluminationNetworkParams::LinkOpacity::kMedium;
 
   // Directional lights (the network's lights) and their transmittance to every node, recomputed per
   // frame since lights move: exact through the medium, or from the network's chains along each light.
@@ -138,7 +141,7 @@ void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, 
     }
     lights_.push_back({glm::normalize(l.direction), l.color * l.intensity});
   }
-  const bool networkTransmittance = params.get<std::string>("light_transmittance") == "network";
+  const bool networkTransmittance = p.light_transmittance == IlluminationNetworkParams::LightTransmittance::kNetwork;
   transmittance_ = networkTransmittance ? network::lightTransmittance(net_->nodes, lights_, M)
                                        : network::lightTransmittance(net_->nodes, lights_, *net_->medium);
   // Warm start (a render service returns the same frame for the same request): resume only from a
@@ -146,7 +149,7 @@ void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, 
   // most `iterations` iterations, and run the rest. The result is then bitwise the cold start's (the
   // iteration is deterministic); moved lights or a changed sky start from 0.
   stateKey_ = sourcesKey(lights_, networkTransmittance, view.ambient, linearSource_);
-  warm_ = params.get<bool>("warm_start") && net_->stateIterations >= 0 && net_->stateKey == stateKey_ &&
+  warm_ = p.warm_start && net_->stateIterations >= 0 && net_->stateKey == stateKey_ &&
           net_->stateIterations <= iterations_;
   resumedFrom_ = warm_ ? net_->stateIterations : 0;
 
@@ -180,14 +183,15 @@ void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, 
   // The sky scattered once exactly costs D x particles chords per step of the march: "auto" affords it
   // up to kSkyExactBudget of them (a few big particles, the thesis' homogeneous cloud) and leaves it to
   // the network beyond.
-  const std::string sky = params.get<std::string>("sky_single_scatter");
-  if (march_ && sky == "exact" && particles_.size() * std::size_t(D) > kSkyExactMax)
+  using Sky = IlluminationNetworkParams::SkySingleScatter;
+  const Sky sky = p.sky_single_scatter;
+  if (march_ && sky == Sky::kExact && particles_.size() * std::size_t(D) > kSkyExactMax)
     throw api::ApiError(422, "invalid-value", "Exact sky single scattering too costly",
                         "sky_single_scatter exact sums particles x directions = " +
                             std::to_string(particles_.size() * std::size_t(D)) + " chords per step of the march, above " +
                             std::to_string(kSkyExactMax) + " (use auto or network, or fewer directions)",
                         "/passes/illumination_network/sky_single_scatter");
-  skyExact_ = march_ && (sky == "exact" || (sky == "auto" && particles_.size() * std::size_t(D) <= kSkyExactBudget));
+  skyExact_ = march_ && (sky == Sky::kExact || (sky == Sky::kAuto && particles_.size() * std::size_t(D) <= kSkyExactBudget));
   // The driver's loop budget per invocation and draw (network::shaderLoopBudget), read once per context.
   if (loopBudget_ == 0) {
     const auto* name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
@@ -200,7 +204,7 @@ void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, 
     // when one piece alone exceeds it (llvmpipe: e.g. > 30000 particles), the splats stand in.
     const long long P = static_cast<long long>(particles_.size()), L = static_cast<long long>(lights_.size());
     piecesLoops_ = network::marchPieceLoops(P, N, L, D, skyExact_);
-    const int asked = params.get<int>("march_stretch");
+    const int asked = p.march_stretch;
     marchStretch_ = static_cast<int>(std::min<long long>(marchSteps_, (loopBudget_ - P - 64) / piecesLoops_));
     if (asked > 0) marchStretch_ = std::min(marchStretch_, asked);
     if (marchStretch_ < 1) march_ = false, skyExact_ = false, marchFallback_ = true;  // too big for one piece

@@ -1,4 +1,5 @@
 #include "renderer/techniques/light_volumes/LightVolumes.h"
+#include "params/light_volumes_params.h"
 
 #include <algorithm>
 #include <chrono>
@@ -61,27 +62,29 @@ void LightVolumesPass::addCostCounts(const Scene& scene, api::SceneCounts& count
 }
 
 std::vector<int> LightVolumesPass::shadowMapExclusions(const Scene& scene, const Params& params) const {
+  const LightVolumesParams p = LightVolumesParams::from(params);
   // Negative beams are the scatterers' first-order shadows: the shadow maps must not add theirs too
   // (notes A7).
   std::vector<int> out;
-  if (params.get<std::string>("shadows") != "negative_beams") return out;
+  if (p.shadows != LightVolumesParams::Shadows::kNegativeBeams) return out;
   for (std::size_t m = 0; m < scene.meshes.size(); ++m)
     if (scene.material(scene.meshes[m].material).scattersNarrowLobe()) out.push_back(static_cast<int>(m));
   return out;
 }
 
 void LightVolumesPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
+  const LightVolumesParams p = LightVolumesParams::from(params);
   light_volumes::BeamOptions o;
-  o.sigmaScale = params.get<float>("sigma_scale");
-  o.negativeBeams = params.get<std::string>("shadows") == "negative_beams";
-  o.maxConcentration = params.get<float>("max_concentration");
-  o.maxTriangleSigma = params.get<float>("max_triangle_sigma");
-  o.specularFallback = params.get<std::string>("tessellation_fallback") == "specular";
-  o.cullSigmas = params.get<float>("cull_sigmas");
-  o.maxSubdivisionBeams = static_cast<std::size_t>(std::max(0, params.get<int>("max_subdivision_beams")));
+  o.sigmaScale = static_cast<float>(p.sigma_scale);
+  o.negativeBeams = p.shadows == LightVolumesParams::Shadows::kNegativeBeams;
+  o.maxConcentration = static_cast<float>(p.max_concentration);
+  o.maxTriangleSigma = static_cast<float>(p.max_triangle_sigma);
+  o.specularFallback = p.tessellation_fallback == LightVolumesParams::TessellationFallback::kSpecular;
+  o.cullSigmas = static_cast<float>(p.cull_sigmas);
+  o.maxSubdivisionBeams = static_cast<std::size_t>(std::max(0, p.max_subdivision_beams));
   o.cancel = res.cancel();
-  split_ = params.get<std::string>("split") == "paper" ? light_volumes::Split::Paper : light_volumes::Split::TwoD;
-  bvh_ = params.get<std::string>("traversal") == "bvh";
+  split_ = p.split == LightVolumesParams::Split::kPaper ? light_volumes::Split::Paper : light_volumes::Split::TwoD;
+  bvh_ = p.traversal == LightVolumesParams::Traversal::kBvh;
   // Every light path is counted once: beauty takes the beams of the classes this pass owns (specular
   // scatterers' LS+DE, glossy ones' LG+DE; caustics or photon_gi may own LS+DE while this pass, planned
   // for its AOV, owns LG+DE) and every shadow beam (the scatterers' shadows, which the shadow maps leave

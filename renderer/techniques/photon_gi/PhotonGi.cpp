@@ -1,4 +1,5 @@
 #include "renderer/techniques/photon_gi/PhotonGi.h"
+#include "params/photon_gi_params.h"
 
 #include <algorithm>
 #include <chrono>
@@ -117,24 +118,25 @@ Requirements PhotonGiPass::requirements(const Scene& scene, const api::RenderReq
 }
 
 void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
+  const PhotonGiParams p = PhotonGiParams::from(params);
   Settings s;
-  s.photons = static_cast<std::uint64_t>(params.get<std::int64_t>("photons"));
-  s.C = params.get<float>("C");
-  s.ppm = params.get<std::string>("h_schedule") == "ppm";
-  s.ppmAlpha = params.get<double>("ppm_alpha");
-  s.ppmBase = params.get<double>("ppm_base_photons");
-  s.maxBounces = params.get<int>("max_bounces");
-  s.environmentLightPhotons = params.get<float>("environment_light_photons");
+  s.photons = static_cast<std::uint64_t>(p.photons);
+  s.C = static_cast<float>(p.C);
+  s.ppm = p.h_schedule == PhotonGiParams::HSchedule::kPpm;
+  s.ppmAlpha = p.ppm_alpha;
+  s.ppmBase = p.ppm_base_photons;
+  s.maxBounces = p.max_bounces;
+  s.environmentLightPhotons = static_cast<float>(p.environment_light_photons);
   if (!(s.environmentLightPhotons >= 0.01f) || s.environmentLightPhotons > 1.f)
     badParam("environment_light_photons", "environment_light_photons must be in [0.01, 1]");
   if (!(s.C > 0.f) || !std::isfinite(s.C)) badParam("C", "C must be a positive number");
   settings_ = s;
-  splat_.method = params.get<std::string>("method") == "gather" ? photon_gi::Method::Gather
+  splat_.method = p.method == PhotonGiParams::Method::kGather ? photon_gi::Method::Gather
                                                                        : photon_gi::Method::Splat;
-  splat_.kernel = params.get<std::string>("kernel") == "epanechnikov" ? photon_gi::Kernel::Epanechnikov
+  splat_.kernel = p.kernel == PhotonGiParams::Kernel::kEpanechnikov ? photon_gi::Kernel::Epanechnikov
                                                                                   : photon_gi::Kernel::Biweight;
-  splat_.renormalize = params.get<bool>("renormalize");
-  splat_.minGlossyRoughness = params.get<float>("min_glossy_roughness");
+  splat_.renormalize = p.renormalize;
+  splat_.minGlossyRoughness = static_cast<float>(p.min_glossy_roughness);
   const FrameView& view = res.view();
   // gather_step is in output pixels: on a k-times supersampled frame the block is k gather_step
   // samples wide, so the gather costs what it costs at k = 1 and the block's light is still spread over
@@ -144,20 +146,20 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   // that grows with the frame: at 256 x 256 px step 4 costs 0.37 of step 2 at the same error, at 64 px it
   // would lose 1.8% of the light (docs/TECHNIQUES.md, photon_gi, gather_step).
   const int k = std::max(1, view.supersampling);
-  const int gatherStep = api::photonGatherStep(params.get<int>("gather_step"), params.given("gather_step"),
+  const int gatherStep = api::photonGatherStep(p.gather_step, p.given.gather_step,
                                                view.width / k, view.height / k);
   splat_.gatherStep = gatherStep * k;
   // The denoiser (renderer/shading/Denoiser.h), guided by the estimator's relative noise: sqrt(int K^2)
   // / C' with C' the photons per kernel over pi, i.e. C, or C (photons / ppm_base)^(alpha / 2) on the
   // ppm schedule (docs/TECHNIQUES.md).
-  denoise_ = params.get<bool>("denoise");
+  denoise_ = p.denoise;
   // The filter's steps count output pixels (k, 2k, ...: Denoiser.h baseStep); left out of the request,
   // a supersampled frame filters with 2 passes (reach 6 output pixels on each side), one at k = 1 with
   // 3 (14): within 0.6% of the former 3 passes of 1, 2, 4 samples, or below, on the Cornell boxes at
   // 64-256 px (docs/PERFORMANCE.md, "Denoiser").
   denoiseSettings_.baseStep = k;
-  denoiseSettings_.iterations = params.get<int>("denoise_iterations");
-  if (!params.given("denoise_iterations") && k >= 2) denoiseSettings_.iterations = 2;
+  denoiseSettings_.iterations = p.denoise_iterations;
+  if (!p.given.denoise_iterations && k >= 2) denoiseSettings_.iterations = 2;
   const double kernelNoise = splat_.kernel == photon_gi::Kernel::Epanechnikov ? 0.651 : 0.757;
   double effectiveC = s.C;
   if (s.ppm) effectiveC *= std::pow(static_cast<double>(s.photons) / s.ppmBase, 0.5 * s.ppmAlpha);

@@ -1,4 +1,5 @@
 #include "renderer/techniques/reference/ReferencePass.h"
+#include "params/reference_params.h"
 
 #include <algorithm>
 #include <climits>
@@ -167,16 +168,17 @@ Requirements ReferencePass::requirements(const Scene& scene, const api::RenderRe
 }
 
 ReferenceRequest referenceRequestFrom(const Params& params) {
+  const ReferenceParams p = ReferenceParams::from(params);
   ReferenceRequest r;
-  r.aov = params.get<std::string>("aov");
-  r.spp = params.get<int>("spp");
-  r.lightPathsPerPixel = params.get<int>("light_paths_per_pixel");
-  r.caustics = params.get<bool>("caustics");
-  r.maxBounces = params.get<int>("max_bounces");
-  r.russianRoulette = params.get<bool>("russian_roulette");
-  r.aoRadius = params.get<float>("ao_radius");
-  r.aoDefinition = params.get<std::string>("ao_definition");
-  r.mediaMode = params.get<std::string>("media_mode");
+  r.aov = ReferenceParams::toString(p.aov);
+  r.spp = p.spp;
+  r.lightPathsPerPixel = p.light_paths_per_pixel;
+  r.caustics = p.caustics;
+  r.maxBounces = p.max_bounces;
+  r.russianRoulette = p.russian_roulette;
+  r.aoRadius = static_cast<float>(p.ao_radius);
+  r.aoDefinition = ReferenceParams::toString(p.ao_definition);
+  r.mediaMode = ReferenceParams::toString(p.media_mode);
   return r;
 }
 

@@ -1,4 +1,5 @@
 #include "renderer/techniques/shadow_maps/ShadowMaps.h"
+#include "params/shadow_maps_params.h"
 
 #include <algorithm>
 #include <chrono>
@@ -92,8 +93,9 @@ Requirements ShadowMapsPass::requirements(const Scene& scene, const api::RenderR
 }
 
 void ShadowMapsPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
+  const ShadowMapsParams p = ShadowMapsParams::from(params);
   const std::vector<Light>& lights = res.view().lights;  // the scene's, then the environment's
-  size_ = params.get<int>("shadow_map_size");
+  size_ = p.shadow_map_size;
   // The maps depend on geometry, lights, size and the meshes left out (Technique::shadowMapExclusions);
   // their overdraw on all but the size.
   excluded_ = res.shadowMapExclusions();
@@ -111,7 +113,7 @@ void ShadowMapsPass::prepare(const Scene& scene, const Params& params, FrameReso
   }
   warning_.clear();
   const double fragments = coverage_ * double(size_) * size_;
-  if (params.given("shadow_map_size")) {
+  if (p.given.shadow_map_size) {
     if (fragments > kFragmentLimit)
       throw api::ApiError(
           422, "limit-exceeded", "Server limit exceeded",
@@ -130,8 +132,8 @@ void ShadowMapsPass::prepare(const Scene& scene, const Params& params, FrameReso
                " million: drawn at " + std::to_string(lowered) + "^2 (set shadow_maps.shadow_map_size to choose)";
     size_ = lowered;
   }
-  const float bias = params.get<float>("shadow_bias");
-  const float normalOffset = params.get<float>("normal_offset");
+  const float bias = static_cast<float>(p.shadow_bias);
+  const float normalOffset = static_cast<float>(p.normal_offset);
   const Bounds& b = scene.features.bounds;
   const float radius = std::max(b.radius(), 1e-6f);
   const glm::vec3 center = b.center();

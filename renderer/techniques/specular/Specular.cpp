@@ -1,4 +1,5 @@
 #include "renderer/techniques/specular/Specular.h"
+#include "params/specular_params.h"
 
 #include <algorithm>
 #include <cmath>
@@ -62,11 +63,12 @@ int mapResolution(double objectPixels, double texelsPerPixel, int maxResolution)
 }
 
 MapResolution chooseMapResolution(const Scene& scene, const FrameView& view, const Params& params, bool causticsOwnsLSDE) {
+  const SpecularParams p = SpecularParams::from(params);
   MapResolution r;
-  r.texels = std::clamp(params.get<int>("cube_resolution"), 16, 2048);
+  r.texels = std::clamp(p.cube_resolution, 16, 2048);
   // A cube_resolution the request gives is run as asked, unless it gives map_texels_per_pixel too.
-  r.adaptive = !params.given("cube_resolution") || params.given("map_texels_per_pixel");
-  const double texelsPerPixel = r.adaptive ? std::clamp(params.get<double>("map_texels_per_pixel"), 0.0, 64.0) : 0.0;
+  r.adaptive = !p.given.cube_resolution || p.given.map_texels_per_pixel;
+  const double texelsPerPixel = r.adaptive ? std::clamp(p.map_texels_per_pixel, 0.0, 64.0) : 0.0;
   if (texelsPerPixel <= 0.0) return r;
   for (std::size_t i : specularMeshes(scene))
     r.largestObjectPixels = std::max(r.largestObjectPixels, projectedDiameterPixels(view, scene.meshes[i].bounds));
@@ -100,13 +102,14 @@ Requirements SpecularPass::requirements(const Scene& scene, const api::RenderReq
 }
 
 void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
+  const SpecularParams p = SpecularParams::from(params);
   // Every default is the descriptor's (specular.json): Params has no fallback.
-  maxDepth_ = std::clamp(params.get<int>("max_depth"), 1, 8);
-  linearSteps_ = std::clamp(params.get<int>("linear_steps"), 1, 256);
-  secantSteps_ = std::clamp(params.get<int>("secant_steps"), 0, 32);
-  layers_ = std::clamp(params.get<int>("layers"), 3, 6);
-  indirectBlock_ = std::clamp(params.get<int>("map_indirect_block"), 1, 64);
-  minmax_ = params.get<bool>("minmax");
+  maxDepth_ = std::clamp(p.max_depth, 1, 8);
+  linearSteps_ = std::clamp(p.linear_steps, 1, 256);
+  secantSteps_ = std::clamp(p.secant_steps, 0, 32);
+  layers_ = std::clamp(p.layers, 3, 6);
+  indirectBlock_ = std::clamp(p.map_indirect_block, 1, 64);
+  minmax_ = p.minmax;
 
   const Bounds& sb = scene.features.bounds;
   objects_.clear();

@@ -1,4 +1,5 @@
 #include "renderer/techniques/spherical_billboards/SphericalBillboards.h"
+#include "params/spherical_billboards_params.h"
 
 #include <algorithm>
 #include <cmath>
@@ -24,16 +25,17 @@ Requirements SphericalBillboardsPass::requirements(const Scene& scene, const api
 }
 
 void SphericalBillboardsPass::prepare(const Scene&, const Params& params, FrameResources& res) {
+  const SphericalBillboardsParams p = SphericalBillboardsParams::from(params);
   const FrameView& view = res.view();
-  const std::string method = params.get<std::string>("method");
-  method_ = method == "planar" ? 1 : method == "soft" ? 2 : 0;
-  chord_ = params.get<std::string>("chord") == "screen_parallel" ? 1 : 0;
-  ratio_ = params.get<float>("resolution_ratio");
-  softScale_ = params.get<float>("soft_scale");
-  depthAware_ = params.get<std::string>("upsampling") == "depth_aware";
+  using Method = SphericalBillboardsParams::Method;
+  method_ = p.method == Method::kPlanar ? 1 : p.method == Method::kSoft ? 2 : 0;
+  chord_ = p.chord == SphericalBillboardsParams::Chord::kScreenParallel ? 1 : 0;
+  ratio_ = static_cast<float>(p.resolution_ratio);
+  softScale_ = static_cast<float>(p.soft_scale);
+  depthAware_ = p.upsampling == SphericalBillboardsParams::Upsampling::kDepthAware;
   const glm::vec3 forward = -glm::normalize(glm::vec3(view.camera.world[2]));
   const bool ortho = view.camera.projection == ProjectionType::Orthographic;
-  particles_ = mediaParticles(view.media, view.ambient, view.eye, forward, ortho, params.get<bool>("sort"));
+  particles_ = mediaParticles(view.media, view.ambient, view.eye, forward, ortho, p.sort);
 
   // Overdraw estimate: covered pixels of every particle's disc over the image (the cost driver, 7.3).
   const float pixelsPerUnit = ortho ? 0.5f * view.height / view.camera.ymag

@@ -1,4 +1,5 @@
 #include "renderer/techniques/transparency/Transparency.h"
+#include "params/transparency_params.h"
 
 #include <algorithm>
 #include <numeric>
@@ -22,7 +23,8 @@ Requirements TransparencyPass::requirements(const Scene& scene, const api::Rende
 }
 
 void TransparencyPass::prepare(const Scene&, const Params& params, FrameResources& res) {
-  pcfRadius_ = params.get<int>("pcf_radius");
+  const TransparencyParams p = TransparencyParams::from(params);
+  pcfRadius_ = p.pcf_radius;
   const int w = res.view().width, h = res.view().height;
   gl::Framebuffer& fb = res.framebuffer("transparency");
   fb.attach(GL_COLOR_ATTACHMENT0, res.texture("beauty"));

@@ -126,7 +126,7 @@ TEST(AmbientOcclusionClosedForms, SelfConsistent) {
 // |S| / (R^2 pi / (4 n)) = 2 R n / 3 (eq. 4.8: V = 3 / (2 R n) sum Delta z_i).
 TEST(AmbientOcclusionKernels, MatchTheirDistributions) {
   const int n = 64;
-  const auto vol = ao::buildSampleBlock(ao::Method::Volumetric, ao::Falloff::Step, n);
+  const auto vol = ao::buildSampleBlock(ao::Method::kVolumetric, ao::Falloff::kStep, n);
   double meanChord = 0.0, meanR2 = 0.0;
   for (int i = 0; i < n; ++i) {
     const glm::vec2 p(vol.samples[i]);
@@ -138,8 +138,8 @@ TEST(AmbientOcclusionKernels, MatchTheirDistributions) {
   EXPECT_NEAR(meanR2, 0.5, 0.02);           // uniform in area
   // Containment: cosine-distributed directions have E[cos theta] = 2/3; step distances are all R, the
   // cubic falloff's r = R xi^(1/3) has E[(r/R)^3] = 1/2.
-  const auto step = ao::buildSampleBlock(ao::Method::Containment, ao::Falloff::Step, n);
-  const auto cubic = ao::buildSampleBlock(ao::Method::Containment, ao::Falloff::Cubic, n);
+  const auto step = ao::buildSampleBlock(ao::Method::kContainment, ao::Falloff::kStep, n);
+  const auto cubic = ao::buildSampleBlock(ao::Method::kContainment, ao::Falloff::kCubic, n);
   double meanCos = 0.0, meanR3 = 0.0;
   for (int i = 0; i < n; ++i) {
     const glm::vec3 s(step.samples[i]);
@@ -151,7 +151,7 @@ TEST(AmbientOcclusionKernels, MatchTheirDistributions) {
   EXPECT_NEAR(meanCos, 2.0 / 3.0, 0.01);
   EXPECT_NEAR(meanR3, 0.5, 1e-3);
   // Crytek: antithetic pairs inside the unit ball, E|p|^2 = 3/5 for the uniform ball.
-  const auto cry = ao::buildSampleBlock(ao::Method::Crytek, ao::Falloff::Step, n);
+  const auto cry = ao::buildSampleBlock(ao::Method::kCrytek, ao::Falloff::kStep, n);
   double meanP2 = 0.0;
   for (int i = 0; i < n; i += 2) {
     EXPECT_EQ(glm::vec3(cry.samples[i]), -glm::vec3(cry.samples[i + 1]));

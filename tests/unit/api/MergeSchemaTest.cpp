@@ -7,7 +7,9 @@
 #include <unistd.h>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -64,9 +66,11 @@ protected:
     for (const json& t : techniques) {
       const std::string file = t["name"].get<std::string>() + ".json";
       write(file, t);
-      cmd += " " + (dir_ / file).string();
+      cmd += ' ';  // appended apart: GCC 12 warns falsely (-Wrestrict) on " " + std::string&&
+      cmd += (dir_ / file).string();
     }
-    cmd += " 2>" + (dir_ / "log.txt").string();
+    cmd += " 2>";
+    cmd += (dir_ / "log.txt").string();
     Merge m;
     m.status = std::system(cmd.c_str());
     std::ifstream log(dir_ / "log.txt");
@@ -216,6 +220,52 @@ TEST_F(MergeSchema, ABrokenDescriptorFailsNamingItsFileAndKey) {
     EXPECT_NE(m.log.find(c.says), std::string::npos) << c.what << ": " << m.log;
     EXPECT_NE(m.log.find(".json"), std::string::npos) << c.what << " names no file: " << m.log;
   }
+}
+
+// The typed parameter struct of a technique (api/tools/param_structs.cpp) is generated from the merged
+// schema: integers, numbers, booleans and strings become fields, a string enum an enum class of its
+// values in schema order; a parameter or value that cannot become a C++ name fails, naming it.
+TEST_F(MergeSchema, ParamStructsAreGeneratedFromTheMergedSchema) {
+  json t = descriptor("glow_pass", "glow");
+  t["params"] = {
+      {"taps", {{"type", "integer"}, {"default", 4}, {"minimum", 1}, {"maximum", 64}, {"description", "d"}}},
+      {"seed", {{"type", "integer"}, {"default", 0}, {"minimum", 0}, {"maximum", 4294967295u}, {"description", "d"}}},
+      {"gain", {{"type", "number"}, {"default", 0.5}, {"minimum", 0}, {"maximum", 1}, {"description", "d"}}},
+      {"split", {{"type", "string"}, {"default", "2d"}, {"enum", {"2d", "screen_parallel"}}, {"description", "d"}}},
+      {"label", {{"type", "string"}, {"default", ""}, {"description", "d"}}}};
+  ASSERT_EQ(run({t}).status, 0);
+  const auto structs = [&](const std::string& technique) {
+    std::string cmd = std::string(PARAM_STRUCTS_PATH) + " " + (dir_ / "out.json").string() + " " +
+                      (dir_ / "params").string() + " " + technique;
+    cmd += " 2>";
+    cmd += (dir_ / "log.txt").string();
+    const int status = std::system(cmd.c_str());
+    std::ifstream log(dir_ / "log.txt");
+    return std::make_pair(status, std::string(std::istreambuf_iterator<char>(log), {}));
+  };
+  ASSERT_EQ(structs("glow_pass").first, 0);
+  std::ifstream in(dir_ / "params" / "glow_pass_params.h");
+  const std::string h(std::istreambuf_iterator<char>(in), {});
+  for (const char* says : {"struct GlowPassParams {", "kTechnique = \"glow_pass\"", "  int taps;\n",
+                           "  std::int64_t seed;\n", "  double gain;\n", "  std::string label;\n",
+                           "enum class Split { k2d, kScreenParallel };", "  Split split;\n",
+                           "case Split::kScreenParallel: return \"screen_parallel\";",
+                           "out.given.gain = params.given(\"gain\");"})
+    EXPECT_NE(h.find(says), std::string::npos) << says << " not in:\n" << h;
+  const auto missing = structs("no_such_pass");
+  EXPECT_NE(missing.first, 0);
+  EXPECT_NE(missing.second.find("no_such_pass: not in the merged schema"), std::string::npos) << missing.second;
+
+  t["params"] = {{"default", {{"type", "boolean"}, {"default", true}, {"description", "d"}}}};
+  ASSERT_EQ(run({t}).status, 0);
+  const auto keyword = structs("glow_pass");
+  EXPECT_NE(keyword.first, 0);
+  EXPECT_NE(keyword.second.find("parameter \"default\" cannot be a field name"), std::string::npos) << keyword.second;
+  t["params"] = {{"mode", {{"type", "string"}, {"default", "a-b"}, {"enum", {"a-b"}}, {"description", "d"}}}};
+  ASSERT_EQ(run({t}).status, 0);
+  const auto value = structs("glow_pass");
+  EXPECT_NE(value.first, 0);
+  EXPECT_NE(value.second.find("enum value \"a-b\" cannot become a C++ name"), std::string::npos) << value.second;
 }
 
 }  // namespace

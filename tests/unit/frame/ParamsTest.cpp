@@ -1,13 +1,32 @@
 // A technique's parameters have one source: the schema (renderer/techniques/*/*.json) gives every one a
 // default, api::techniqueParams fills them in, and Params::get reads them without a fallback of its
 // own (issue 33: the C++ fallbacks had drifted from the schema, e.g. photon_gi's ppm_alpha 2/3 against
-// 0.6667, light_volumes' sigma_scale a constant beside 1.58).
+// 0.6667, light_volumes' sigma_scale a constant beside 1.58). A technique reads them through the
+// struct generated from its schema (generated/params/<name>_params.h, api/tools/param_structs.cpp):
+// fields and enums the compiler checks instead of string keys.
+#include <cstdint>
+#include <functional>
+#include <map>
 #include <stdexcept>
 #include <string>
 
 #include <gtest/gtest.h>
 
 #include "api/Validate.h"
+#include "params/ambient_occlusion_params.h"
+#include "params/caustics_params.h"
+#include "params/depth_impostors_params.h"
+#include "params/direct_params.h"
+#include "params/env_diffuse_params.h"
+#include "params/gbuffer_params.h"
+#include "params/illumination_network_params.h"
+#include "params/light_volumes_params.h"
+#include "params/photon_gi_params.h"
+#include "params/reference_params.h"
+#include "params/shadow_maps_params.h"
+#include "params/specular_params.h"
+#include "params/spherical_billboards_params.h"
+#include "params/transparency_params.h"
 #include "renderer/frame/Technique.h"
 
 namespace radiant {
@@ -38,6 +57,77 @@ TEST(Params, AKeyTheSchemaDoesNotDeclareIsAProgrammerErrorNamingIt) {
     EXPECT_NE(std::string(e.what()).find("no_such_key"), std::string::npos) << e.what();
   }
   EXPECT_THROW(Params().get<int>("photons"), std::logic_error);  // not from the schema
+}
+
+// Every technique's struct, by technique name: each reads a Params through its generated from().
+using Reader = std::function<void(const Params&)>;
+template <class... S>
+std::map<std::string, Reader> readers() {
+  std::map<std::string, Reader> m;
+  ((m[S::kTechnique] = [](const Params& p) { (void)S::from(p); }), ...);
+  return m;
+}
+const std::map<std::string, Reader>& everyStruct() {
+  static const auto m =
+      readers<AmbientOcclusionParams, CausticsParams, DepthImpostorsParams, DirectParams, EnvDiffuseParams,
+              GbufferParams, IlluminationNetworkParams, LightVolumesParams, PhotonGiParams, ReferenceParams,
+              ShadowMapsParams, SpecularParams, SphericalBillboardsParams, TransparencyParams>();
+  return m;
+}
+
+// Every technique's struct reads its schema's defaults: a field whose key or type (an integer enum
+// read as a string, a seed past int) no longer matches the schema throws here, not in a frame.
+TEST(Params, EveryTechniquesTypedStructReadsItsSchemasDefaults) {
+  for (const auto& t : api::techniqueSchemas()) {
+    ASSERT_TRUE(everyStruct().count(t.name)) << t.name << ": list its generated struct above";
+    EXPECT_NO_THROW(everyStruct().at(t.name)(Params(api::techniqueParams(t.name)))) << t.name;
+  }
+  const PhotonGiParams photons = PhotonGiParams::from(Params(api::techniqueParams("photon_gi")));
+  EXPECT_EQ(photons.ppm_alpha, 0.6667);
+  EXPECT_EQ(photons.photons, 250000);
+  EXPECT_EQ(photons.h_schedule, PhotonGiParams::HSchedule::kPaper);
+  EXPECT_FALSE(photons.given.photons);
+  EXPECT_STREQ(PhotonGiParams::toString(photons.method), "gather");
+}
+
+// Every value of every string enum parses (the generated parse lists the schema's values), and a value
+// the schema does not hold is a programmer error naming the parameter.
+TEST(Params, EveryEnumValueOfEverySchemaParses) {
+  int values = 0;
+  for (const auto& t : api::techniqueSchemas())
+    for (const auto& [key, spec] : t.params.items()) {
+      if (spec.at("type") != "string" || !spec.contains("enum")) continue;
+      for (const auto& v : spec["enum"]) {
+        EXPECT_NO_THROW(everyStruct().at(t.name)(Params(api::techniqueParams(t.name, nlohmann::json{{key, v}}))))
+            << t.name << "." << key << " = " << v;
+        ++values;
+      }
+    }
+  EXPECT_GE(values, 50);
+  EXPECT_EQ(ReferenceParams::from(Params(api::techniqueParams("reference", {{"aov", "media_transmittance"}}))).aov,
+            ReferenceParams::Aov::kMediaTransmittance);
+  EXPECT_EQ(LightVolumesParams::parseSplit("2d"), LightVolumesParams::Split::k2d);
+  try {
+    CausticsParams::parseMethod("splat ");
+    FAIL() << "no exception";
+  } catch (const std::logic_error& e) {
+    EXPECT_NE(std::string(e.what()).find("caustics.method"), std::string::npos) << e.what();
+  }
+}
+
+// What the request set reaches the field and its given flag; what it did not set stays a default.
+TEST(Params, AGivenValueReachesItsFieldAndItsGivenFlag) {
+  const nlohmann::json set = {{"method", "splat"}, {"cube_resolution", 64}};
+  const CausticsParams p = CausticsParams::from(Params(api::techniqueParams("caustics", set), {"method", "cube_resolution"}));
+  EXPECT_EQ(p.method, CausticsParams::Method::kSplat);
+  EXPECT_EQ(p.cube_resolution, 64);
+  EXPECT_TRUE(p.given.method);
+  EXPECT_TRUE(p.given.cube_resolution);
+  EXPECT_FALSE(p.given.area_weight);
+  // illumination_network's seed spans 32 unsigned bits: the field is 64-bit, not an int that wraps.
+  const IlluminationNetworkParams n =
+      IlluminationNetworkParams::from(Params(api::techniqueParams("illumination_network", {{"seed", 4294967295u}})));
+  EXPECT_EQ(n.seed, std::int64_t{4294967295});
 }
 
 }  // namespace
