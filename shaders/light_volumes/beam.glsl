@@ -20,12 +20,18 @@
 LV_CONST float kLvPi = 3.14159265358979f;
 LV_CONST int kLvSplitPaper = 0;  // the printed Fig. 12 split (D from the world-space edge point)
 LV_CONST int kLvSplit2d = 1;     // D = AB intersected with the ray O->C in the angular domain (continuous)
+// A scattered beam's light-path class (Beam::vertexC.w; gather.comp's u_beautyClasses bits): the
+// scatterer's material decides, not the beam's sigma, so a glossy scatterer's specular fallback beams
+// (tessellation_fallback, sigma 0) stay LG+DE.
+LV_CONST int kLvClassSpecular = 1;  // LS+DE: a mirror or smooth glass (roughness 0)
+LV_CONST int kLvClassGlossy = 2;    // LG+DE: glossy metal or glass (roughness > 0)
 
 // One beam: 8 x vec4 = 128 bytes, as the paper's 8 RGBA texels (§4.3).
 struct Beam {
   vec4 vertexA;    // xyz V_a (scatterer vertex), w: 1 / A_min, the irradiance clamp (Phi / A_perp <= Phi * w)
   vec4 vertexB;    // xyz V_b, w: 0 scattered beam, 1 shadow beam
-  vec4 vertexC;    // xyz V_c, w unused
+  vec4 vertexC;    // xyz V_c, w: the light-path class of a scattered beam, by its scatterer's material
+                   // (kLvClassSpecular, kLvClassGlossy; 0 for a shadow beam)
   vec4 dirA;       // xyz unit scattered (or, for a shadow beam, unscattered) direction at V_a
   vec4 dirB;
   vec4 dirC;

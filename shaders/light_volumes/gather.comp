@@ -49,11 +49,12 @@ vec3 beamRadiance(int i, vec3 F, vec3 n, vec3 wo, MaterialParams mp) {
 
 // Whether beam i joins beauty: a shadow beam (negative flux) always, since it is its scatterer's first-order
 // shadow, which the shadow maps leave out (shadowMapExclusions); a beam of light only in a class this pass
-// owns, so that a class another technique owns (caustics' LS+DE) is not added twice.
+// owns (its scatterer's material's, Beam::vertexC.w), so that a class another technique owns (caustics'
+// LS+DE) is not added twice.
 bool toBeauty(int i) {
   vec4 fs = beams[i].fluxSigma;
   if (fs.x + fs.y + fs.z < 0.0) return true;
-  return (u_beautyClasses & (fs.w == 0.0 ? 1 : 2)) != 0;
+  return (u_beautyClasses & int(beams[i].vertexC.w)) != 0;
 }
 
 void main() {

@@ -194,7 +194,8 @@ bool appendTriangleBeams(const Light& light, const TriangleInput& t, const BeamO
     Beam b;
     b.vertexA = v4(t.p[0], 0.f);
     b.vertexB = v4(t.p[1], shadowBeam ? 1.f : 0.f);
-    b.vertexC = v4(t.p[2], 0.f);
+    // Its light-path class by the material (beam.glsl, kLvClass*): the specular fallback keeps it.
+    b.vertexC = v4(t.p[2], shadowBeam ? 0.f : float(m.roughnessFactor > 0.f ? glsl::kLvClassGlossy : glsl::kLvClassSpecular));
     b.dirA = v4(d[0], 0.f);
     b.dirB = v4(d[1], 0.f);
     b.dirC = v4(d[2], 0.f);

@@ -89,7 +89,8 @@ void LightVolumesPass::prepare(const Scene& scene, const Params& params, FrameRe
   // scatterers' LS+DE, glossy ones' LG+DE; caustics or photon_gi may own LS+DE while this pass, planned
   // for its AOV, owns LG+DE) and every shadow beam (the scatterers' shadows, which the shadow maps leave
   // out); the AOV holds every beam.
-  beautyClasses_ = (res.owns("light_volumes", api::kPathLSDE) ? 1 : 0) | (res.owns("light_volumes", api::kPathLGDE) ? 2 : 0);
+  beautyClasses_ = (res.owns("light_volumes", api::kPathLSDE) ? light_volumes::glsl::kLvClassSpecular : 0) |
+                   (res.owns("light_volumes", api::kPathLGDE) ? light_volumes::glsl::kLvClassGlossy : 0);
 
   const nlohmann::json key = {{"scene", res.sceneKey()},
                               {"lights", lightsKey(scene)},

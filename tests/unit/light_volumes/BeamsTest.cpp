@@ -558,6 +558,37 @@ TEST(LightVolumesMath, SubdivisionBudgetExhaustedFallsBackToSpecularAndSaysSo) {
   EXPECT_EQ(none.glossy, 0u);
 }
 
+// A beam's light-path class (Beam::vertexC.w, which gather.comp's u_beautyClasses selects beauty's
+// beams by) is its scatterer's material's: a mirror's beams are LS+DE, a glossy plate's LG+DE even
+// when the plate fell back to specular beams (sigma 0), and shadow beams have none (they always join).
+TEST(LightVolumesMath, ABeamsClassIsItsMaterialsNotItsSigmas) {
+  const glm::vec3 L(-1.f, 1.5f, 0.f);
+  BeamOptions o;
+  o.negativeBeams = true;
+  o.maxSubdivisionBeams = 0;  // the coarse glossy plate cannot be subdivided: it falls back to specular
+  BeamSet glossy, smooth;
+  appendScattererBeams(pointLight(L, 1.f), plate(2, -0.2f, 0.2f, -0.2f, 0.2f, 0.f, mirror(0.3f)), o, ceilingAt2, glossy);
+  appendScattererBeams(pointLight(L, 1.f), plate(2, -0.2f, 0.2f, -0.2f, 0.2f, 0.f, mirror(0.f)), o, ceilingAt2, smooth);
+  ASSERT_EQ(glossy.specularFallbacks, 1u) << "the test needs a glossy plate that fell back";
+  auto classes = [](const BeamSet& s, float want, const char* what) {
+    int scattered = 0, shadows = 0;
+    for (const Beam& b : s.beams) {
+      if (b.vertexB.w == 1.f) {
+        EXPECT_EQ(b.vertexC.w, 0.f) << what << ": a shadow beam has no class";
+        ++shadows;
+        continue;
+      }
+      EXPECT_EQ(b.fluxSigma.w, 0.f) << what << ": specular beams (sigma 0)";
+      EXPECT_EQ(b.vertexC.w, want) << what;
+      ++scattered;
+    }
+    EXPECT_EQ(scattered, 8) << what;
+    EXPECT_EQ(shadows, 8) << what;
+  };
+  classes(glossy, float(glsl::kLvClassGlossy), "glossy plate after the fallback");
+  classes(smooth, float(glsl::kLvClassSpecular), "mirror");
+}
+
 TEST(LightVolumesMath, RefractedBeamsInsideAVolumeAreAttenuatedByBeerLambert) {
   // KHR_materials_volume: a glass slab 0.3 m thick (its top face 4 x 4 x 2 triangles at y = 0, its
   // bottom at y = -0.3), attenuationColor (0.5, 0.8, 1) at attenuationDistance 0.5 m, under a point
