@@ -67,8 +67,9 @@ std::set<std::string> schemaAovs() {
 }
 
 // Several producers of one overwrite AOV are allowed only when at most one can run per frame: all are
-// exclusive (TechniqueInfo::exclusive) and share a light-path class, and the table's producer is the
-// first of them in registry order (so it owns the class by default). The media techniques.
+// exclusive (TechniqueInfo::exclusive) and share a light-path class, and the table's producer is the one
+// the ownership policy (FramePlanner.h, ownershipPolicy) gives that class when all of them are planned:
+// the media techniques, whose AOVs spherical_billboards declares. Registry order plays no part.
 bool oneProducerPerFrame(const std::vector<std::string>& names, const std::string& tableProducer) {
   std::vector<std::unique_ptr<Technique>> all = createTechniques();
   std::set<std::string> shared;
@@ -77,13 +78,27 @@ bool oneProducerPerFrame(const std::vector<std::string>& names, const std::strin
     const TechniqueInfo& info = t->info();
     if (std::find(names.begin(), names.end(), info.name) == names.end()) continue;
     if (!info.exclusive) return false;
-    if (first && info.name != tableProducer) return false;
     const std::set<std::string> classes(info.lightPaths.begin(), info.lightPaths.end());
     if (first) shared = classes;
     std::erase_if(shared, [&](const std::string& c) { return !classes.count(c); });
     first = false;
   }
-  return !shared.empty();
+  // The policy's rank of `name` for `cls`: its place in the class's row, after the row if not in it.
+  auto rank = [](const std::string& cls, const std::string& name) {
+    for (const OwnershipRow& row : ownershipPolicy())
+      if (row.lightPath == cls) {
+        const auto it = std::find(row.order.begin(), row.order.end(), name);
+        return static_cast<std::size_t>(it - row.order.begin());
+      }
+    return std::size_t{0};
+  };
+  for (const std::string& cls : shared) {
+    std::string owner = names.front();
+    for (const std::string& n : names)
+      if (rank(cls, n) < rank(cls, owner) || (rank(cls, n) == rank(cls, owner) && n < owner)) owner = n;
+    if (owner == tableProducer) return true;
+  }
+  return false;
 }
 
 TEST(SchemaConsistency, EveryAovTheSchemaNamesHasOneProducerOrAnAccumulateRule) {
@@ -155,7 +170,9 @@ TEST(SchemaConsistency, AovTableIsWellFormed) {
     for (const auto& c : a.exr) EXPECT_TRUE(exrChannels.insert(c).second) << "EXR channel " << c << " used twice";
     EXPECT_LE(a.firstChannel + a.channels, a.format == api::AovFormat::R32F ? 1 : 4) << a.name;
     accumulate += a.blend == api::AovBlend::Accumulate;
-    if (a.blend == api::AovBlend::Accumulate) EXPECT_TRUE(a.producer.empty()) << a.name;
+    if (a.blend == api::AovBlend::Accumulate) {
+      EXPECT_TRUE(a.producer.empty()) << a.name;
+    }
     if (!a.groundTruth.empty()) {
       // A ground truth is a mode of the reference pass (its schema's aov enum).
       const auto& modes = api::findTechnique("reference")->params.at("aov").at("enum");
@@ -199,8 +216,12 @@ TEST(SchemaConsistency, EveryDeclaredReadHasAWriterAndOnlyBeautyAccumulates) {
     const TechniqueInfo& info = t->info();
     int accumulates = 0;
     for (const ResourceAccess& a : declaredAccess(info)) {
-      if (a.access == Access::Read) EXPECT_TRUE(written.count(a.name)) << info.name << " reads " << a.name;
-      if (a.access == Access::Write) EXPECT_NE(a.name, kEnvironmentMap) << info.name;
+      if (a.access == Access::Read) {
+        EXPECT_TRUE(written.count(a.name)) << info.name << " reads " << a.name;
+      }
+      if (a.access == Access::Write) {
+        EXPECT_NE(a.name, kEnvironmentMap) << info.name;
+      }
       if (a.access == Access::Accumulate) {
         EXPECT_EQ(a.name, "beauty") << info.name;
         ++accumulates;
