@@ -382,6 +382,12 @@ int rasterSupersampling(int requested, int width, int height, bool runsReference
   return k;
 }
 
+// renderFrame's stages (below, after checkedPlan): what the frame decided before any GL work, and what
+// its readback produced.
+struct FrameConfig;
+struct FrameReadback;
+struct FrameProgress;
+
 struct Renderer::Impl {
   std::unique_ptr<EglDevice> device;
   gl::ShaderLibrary shaders;
@@ -436,6 +442,18 @@ struct Renderer::Impl {
     gpuScenes.evict([&](const auto& l) { return l.size() >= gpuSceneCapacity; });
     return *gpuScenes.put(key, std::move(g)).value;
   }
+
+  // renderFrame's stages, in their order: configure -> beginResources -> passParameters -> runPasses ->
+  // readBack; then renderFrame's accounting, compare and background.
+  FrameConfig configure(const Scene& scene, const api::RenderRequest& request, const FrameInputs& inputs,
+                        api::FrameStats& stats, const rt::Cancel& cancel);
+  const GpuScene& beginResources(const Scene& scene, const FrameConfig& config, api::FrameStats& stats,
+                                 const rt::Cancel& cancel);
+  std::vector<Params> passParameters(const Scene& scene, FrameConfig& config, const api::RenderRequest& request,
+                                     const FrameInputs& inputs, api::FrameStats& stats);
+  void runPasses(const Scene& scene, const GpuScene& gpu, const FrameConfig& config, const std::vector<Params>& params,
+                 api::FrameStats& stats, FrameProgress& progress, const rt::Cancel& cancel);
+  FrameReadback readBack(const FrameConfig& config, const api::RenderRequest& request, RenderOutput& out);
 };
 
 Renderer::Renderer(const DeviceOptions& options) : impl_(std::make_unique<Impl>()) {
@@ -629,6 +647,275 @@ RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requ
   }
 }
 
+// What a frame decided before any GL work (Impl::configure, then passParameters): the plan and the
+// compare block's ground truth, the raster's supersampling k, the cost models' counts, the views (the
+// supersampled raster's, with the environment's lights, and the output's), the budget's choice.
+struct FrameConfig {
+  std::vector<Technique*> all;  // every registered technique (the planner's and the frame graph's input)
+  CheckedPlan checked;
+  std::vector<std::string> planned;  // the planned passes' names, in the frame graph's order
+  int k = 1;                         // the raster's supersampling
+  api::SceneCounts counts;           // the cost models' scene variables at this k
+  std::string speedScene;            // the speed factor's scene (api::MachineSpeed)
+  api::RenderRequest supersampled;   // the request at k (the cost models' pixels are the raster's)
+  FrameView view;                    // the raster's (k x the request's size)
+  FrameView outView;                 // the request's size, on which readback resolves and compare renders
+  api::BudgetChoice choice;          // each planned technique's parameters (presets, budgets, or the request's)
+  nlohmann::json speedState;         // the speed factor the choice used
+};
+
+// The readback's products (Impl::readBack): NaN and infinities it zeroed, and the beauty as presented
+// against the request's background (applied after compare) with its coverage.
+struct FrameReadback {
+  std::size_t nonFinite = 0;
+  std::vector<ZeroedValues> zeroed;
+  std::optional<Image> presented, alpha;
+};
+
+// Frame progress: monotone, and reported in order although a pass's callback may come from several
+// threads at once (hence the lock around the comparison and the call).
+struct FrameProgress {
+  explicit FrameProgress(const std::function<void(double)>& s) : sink(s) {}
+  const std::function<void(double)>& sink;
+  std::mutex mutex;
+  double soFar = 0.0;
+  void operator()(double value) {
+    if (!sink) return;
+    std::lock_guard lock(mutex);
+    if (!(value > soFar)) return;
+    soFar = value;
+    sink(value);
+  }
+};
+
+FrameConfig Renderer::Impl::configure(const Scene& scene, const api::RenderRequest& request, const FrameInputs& inputs,
+                                      api::FrameStats& stats, const rt::Cancel& cancel) {
+  FrameConfig c;
+  for (auto& t : techniques) c.all.push_back(t.get());
+  c.checked = checkedPlan(c.all, scene, request, inputs);
+  const FramePlan& plan = c.checked.plan;
+  // The passes run on the supersampled view; readback resolves to outView (the request's size), on
+  // which compare() renders the reference.
+  int k = rasterSupersampling(
+      request.supersampling, request.width, request.height,
+      std::any_of(plan.passes.begin(), plan.passes.end(), [](const Technique* t) { return t->info().name == "reference"; }));
+  for (Technique* t : plan.passes) c.planned.push_back(t->info().name);
+  const std::vector<std::string>& planned = c.planned;
+  // The cost models' scene variables (particles of the scene and the request's media, light_volumes' beams).
+  api::SceneCounts& counts = c.counts;
+  counts = costCounts(c.all, scene, request.media);
+  // specular's maps follow the view: its model is charged the resolution the pass will choose at the
+  // frame's k (and each k the default frame budget weighs, below).
+  std::function<double(int)> specularMapTexelsAt;
+  if (std::find(planned.begin(), planned.end(), "specular") != planned.end()) {
+    const Params sp = requestParams("specular", request);
+    const auto owned = plan.owned.find("caustics");
+    const bool forCaustics = owned != plan.owned.end() && (owned->second & api::kPathLSDE);
+    specularMapTexelsAt = [&, sp, forCaustics](int atK) {
+      api::RenderRequest r = request;
+      r.width *= atK;
+      r.height *= atK;
+      r.supersampling = atK;
+      return double(chooseMapResolution(scene, makeFrameView(scene, r, inputs.environment), sp, forCaustics).texels);
+    };
+    counts.specularMapTexels = specularMapTexelsAt(k);
+  }
+  // The speed factor's scene (api::MachineSpeed): the scene and the passes it runs, whose own recent
+  // frames measure the load and the models' error on it at once.
+  c.speedScene = (scene.digest.empty() ? "name:" + scene.name : scene.digest) + "|";
+  for (const std::string& p : planned) c.speedScene += p + ",";
+  // The server's default frame budget lowers a default supersampling first (api/Presets.h).
+  if (const int within = api::supersamplingWithinDefaultBudget(api::PresetTable::builtin(), planned, request, k,
+                                                               inputs.limits, counts, speed.planningFactor(c.speedScene),
+                                                               specularMapTexelsAt);
+      within < k) {
+    stats.warnings.push_back("supersampling " + std::to_string(within) + " instead of the default " + std::to_string(k) +
+                             ": at " + std::to_string(k) + " the default frame is predicted above this server's default "
+                             "frame budget (radiantd --default-frame-budget-ms); give \"supersampling\" to choose");
+    k = within;
+    if (specularMapTexelsAt) counts.specularMapTexels = specularMapTexelsAt(k);  // the maps this k runs
+  }
+  c.k = k;
+  stats.supersampling = k;
+  c.supersampled = request;
+  c.supersampled.width *= k;
+  c.supersampled.height *= k;
+  c.supersampled.supersampling = k;  // the k used (capped; 1 with the reference)
+  // photon_gi's gather block at this k (its step grows with the frame): the model's block samples.
+  if (std::find(planned.begin(), planned.end(), "photon_gi") != planned.end())
+    counts.photonGatherBlock = api::photonGatherBlock(request, k);
+  FrameView& view = c.view;
+  view = makeFrameView(scene, c.supersampled, inputs.environment);
+  view.supersampling = k;
+  // The environment's compact bright regions become shadowed directional lights of the raster when
+  // `direct` runs to light with them (docs/TECHNIQUES.md, "Environment lights"); the reference and
+  // the background keep the whole map.
+  const bool directPlanned = std::find(planned.begin(), planned.end(), "direct") != planned.end();
+  if (view.environment && directPlanned) {
+    EnvironmentLightOptions o = environmentLightOptions(request);
+    // Sky lights stand for photon_gi's first-hit sky photons (the residual's L(sky)DE): only when it
+    // owns that class (ambient_occlusion's SH irradiance times AO otherwise; docs/TECHNIQUES.md,
+    // direct, "Sky lights").
+    const auto owned = plan.owned.find("photon_gi");
+    if (owned == plan.owned.end() || !(owned->second & api::kPathSkyDE)) o.skyLights = 0;
+    view.environmentLights = environmentLights(view, o, stats, cancel);
+    view.environmentLightsKey = o.key();
+    const auto& taken = view.environmentLights->lights;
+    view.lights.insert(view.lights.end(), taken.begin(), taken.end());
+    const auto& sky = view.environmentLights->skyLights;
+    view.lights.insert(view.lights.end(), sky.begin(), sky.end());
+  }
+  c.outView = view;
+  c.outView.width = request.width;
+  c.outView.height = request.height;
+  c.outView.supersampling = 1;
+  return c;
+}
+
+// The scene on the GPU and the frame's resources: declared outputs allocated, beauty cleared, the
+// environment map and lights declared; the profiler and the per-pass stats ready.
+const GpuScene& Renderer::Impl::beginResources(const Scene& scene, const FrameConfig& config, api::FrameStats& stats,
+                                               const rt::Cancel& cancel) {
+  const FramePlan& plan = config.checked.plan;
+  stats.camera = cameraStats(config.view);
+  const GpuScene& gpu = gpuScene(scene, stats, cancel);
+  stats.skipped = plan.skipped;
+  stats.lightPaths = plan.lightPaths;
+
+  resources.beginFrame(gpu, config.view, &stats.cache);
+  resources.setCancel(cancel);  // prepare() and the derived-data builders (photons, beams, BVH)
+  resources.setLightPathOwners(plan.lightPaths, plan.owned);
+  // Declared resources (renderer/frame/FrameAllocation.h): the Renderer allocates the planned passes'
+  // AOV outputs, beauty and the environment map; each pass then touches the shared resources only as
+  // its TechniqueInfo declares (declaredAccess, checked by FrameResources in the pass scopes below).
+  resources.setSharedResources(sharedResources(config.all));
+  allocateDeclaredOutputs(resources, plan.passes);
+  declareEnvironmentMap(resources, config.view);
+  declareFrameLights(resources, config.view);
+  profiler.beginFrame();
+  // PassStats must not move while the profiler holds pointers to them.
+  stats.passes.resize(plan.passes.size());
+  return gpu;
+}
+
+// quality / time_budget_ms: each planned technique's parameters from the preset table (api/Presets.h);
+// without them, the request's own. Each pass validates the parameters it will run (as Renderer::check
+// did with the request's own) and names the meshes whose shadows it supplies itself (light_volumes).
+std::vector<Params> Renderer::Impl::passParameters(const Scene& scene, FrameConfig& config,
+                                                   const api::RenderRequest& request, const FrameInputs& inputs,
+                                                   api::FrameStats& stats) {
+  const FramePlan& plan = config.checked.plan;
+  std::vector<Params> params(plan.passes.size());
+  stats.scene["counts"] = config.counts.toJson();
+  // The supersampled request: the cost models' `pixels` are the raster's (the table was measured at
+  // k = 1, so a request that keeps its own supersampling under a budget is charged k^2 the pixels);
+  // photon_gi's gather is charged its block samples (counts.photonGatherBlock).
+  config.speedState = speed.toJson(config.speedScene);  // what this frame's choice used
+  config.choice = api::chooseConfiguration(api::PresetTable::builtin(), config.planned, config.supersampled,
+                                           inputs.limits, config.counts, speed.planningFactor(config.speedScene));
+  for (auto& w : config.choice.warnings) stats.warnings.push_back(std::move(w));
+  std::set<int> shadowMapExclusions;  // meshes whose shadows a pass supplies itself (light_volumes)
+  for (std::size_t i = 0; i < plan.passes.size(); ++i) {
+    Technique* t = plan.passes[i];
+    stats.passes[i].name = t->info().name;
+    const auto given = request.explicitParams.find(t->info().name);
+    params[i] = Params(config.choice.params.at(t->info().name),
+                       given == request.explicitParams.end() ? std::set<std::string>{} : given->second);
+    t->validate(scene, params[i]);
+    for (int m : t->shadowMapExclusions(scene, params[i])) shadowMapExclusions.insert(m);
+  }
+  resources.setShadowMapExclusions(std::move(shadowMapExclusions));
+  return params;
+}
+
+// Every planned pass's prepare(), then every execute(), in the frame graph's order, each inside the
+// scope of what it declares (FrameResources) and, for execute, timed by the profiler.
+void Renderer::Impl::runPasses(const Scene& scene, const GpuScene& gpu, const FrameConfig& config,
+                               const std::vector<Params>& params, api::FrameStats& stats, FrameProgress& progress,
+                               const rt::Cancel& cancel) {
+  const FramePlan& plan = config.checked.plan;
+  for (std::size_t i = 0; i < plan.passes.size(); ++i) {
+    Technique* t = plan.passes[i];
+    cancel.check("the frame's set-up, before preparing " + t->info().name);
+    resources.beginPass(t->info().name, declaredAccess(t->info()), FrameResources::Phase::Prepare);
+    t->prepare(scene, params[i], resources);
+    resources.endPass();
+    gl::checkError(("prepare " + t->info().name).c_str());
+  }
+  const double passCount = static_cast<double>(std::max<std::size_t>(1, plan.passes.size()));
+  for (std::size_t i = 0; i < plan.passes.size(); ++i) {
+    progress(0.95 * static_cast<double>(i) / passCount);
+    if (cancel.requested())
+      throw api::ApiError(409, "canceled", "Render canceled", "the render was cancelled before pass " +
+                                                                plan.passes[i]->info().name);
+    Technique* t = plan.passes[i];
+    gl::DebugGroup group(t->info().name);
+    PassContext ctx{scene, gpu, config.view, params[i], resources, shaders, stats.passes[i],
+                    [&, i](double f) { progress(0.95 * (static_cast<double>(i) + std::clamp(f, 0.0, 1.0)) / passCount); },
+                    cancel};
+    resources.beginPass(t->info().name, declaredAccess(t->info()), FrameResources::Phase::Execute);
+    {
+      GpuProfiler::Scope scope(profiler, stats.passes[i]);
+      t->execute(ctx);
+    }
+    // A pass writes only what it declares (its outputs; beauty if it adds to it): programmer error.
+    if (const std::string bad = undeclaredWrite(t->info(), resources.passWrites()); !bad.empty())
+      throw std::logic_error("Renderer: pass " + t->info().name + " wrote '" + bad +
+                             "', which its TechniqueInfo does not declare");
+    resources.endPass();
+    gl::checkError(("execute " + t->info().name).c_str());
+    for (auto& w : stats.passes[i].warnings) stats.warnings.push_back(t->info().name + ": " + std::move(w));
+    stats.passes[i].warnings.clear();
+  }
+}
+
+// Readback of every AOV the outputs name (beauty always, and the compared one), resolved from the
+// raster's k x k samples to the request's size; non-finite values zeroed and counted.
+FrameReadback Renderer::Impl::readBack(const FrameConfig& config, const api::RenderRequest& request, RenderOutput& out) {
+  const FrameView& view = config.view;
+  const FrameView& outView = config.outView;
+  const int k = config.k;
+  FrameReadback r;
+  std::vector<std::string> aovs{"beauty"};
+  for (const auto& o : request.outputs)
+    for (const auto& a : o.aovs)
+      if (std::find(aovs.begin(), aovs.end(), a) == aovs.end()) aovs.push_back(a);
+  if (request.compare && std::find(aovs.begin(), aovs.end(), request.compare->aov) == aovs.end())
+    aovs.push_back(request.compare->aov);
+  std::vector<float> rgba;  // the samples of an AOV resolved on the CPU (k = 1, or presentBackground)
+  // The background (api::Background), applied to the beauty after compare (which scores the frame with
+  // the environment behind it, as the reference renders it): the beauty as presented and its coverage.
+  const bool environmentBehind = request.background.kind == api::Background::Kind::Environment;
+  for (const std::string& aov : aovs) {
+    const AovSource src = aovSource(aov);
+    Image img = Image::make(aov, outView.width, outView.height, src.channels);
+    const bool drawn = resources.hasTexture(src.texture) && resources.written(aov);
+    // The beauty shown against another background needs its samples on the CPU (presentBackground).
+    const bool samplesNeeded = k == 1 || (aov == "beauty" && !environmentBehind);
+    if (drawn) {
+      if (samplesNeeded || !resolveSupersampledOnGpu(resources, shaders, resources.texture(src.texture), k, src, img)) {
+        if (rgba.empty()) rgba.resize(static_cast<std::size_t>(view.width) * view.height * 4);
+        resources.texture(src.texture).download(0, GL_RGBA, GL_FLOAT, rgba.data(), rgba.size() * sizeof(float));
+        resolveSupersampled(rgba, view.width, view.height, k, src, img);
+      }
+    } else if (aov == "beauty" || aov == "direct") {
+      // Nothing was drawn (no geometry): the frame shows the sky.
+      for (int i = 0; i < outView.width * outView.height; ++i)
+        for (int c = 0; c < 3; ++c) img.pixels[static_cast<std::size_t>(i) * 3 + c] = view.ambient[c];
+    }
+    if (aov == "beauty" && !environmentBehind)
+      presentBackground(resources, view, k, request.background, drawn ? &rgba : nullptr, r.presented, r.alpha);
+    if (const std::size_t bad = sanitize(img.pixels)) {
+      r.nonFinite += bad;
+      r.zeroed.push_back({aov, bad, writersOf(aov, config.checked.plan.passes)});
+    }
+    out.aovs.push_back(std::move(img));
+  }
+  return r;
+}
+
+// The frame: its default lighting, then the stages above; then its time against the cost model, compare,
+// the background and the memory accountant.
 RenderOutput Renderer::renderFrame(const Scene& scene, const api::RenderRequest& requestIn,
                                    const std::atomic<bool>* cancel, const FrameInputs& inputsIn) {
   Impl& im = *impl_;
@@ -663,235 +950,42 @@ RenderOutput Renderer::renderFrame(const Scene& scene, const api::RenderRequest&
   try {
     const auto frameStart = Clock::now();
     const std::size_t programsBefore = im.shaders.cachedPrograms();
-    std::vector<Technique*> all;
-    for (auto& t : im.techniques) all.push_back(t.get());
-    CheckedPlan checked = checkedPlan(all, scene, request, inputs);
-    FramePlan& plan = checked.plan;
-    // The passes run on the supersampled view; readback resolves to outView (the request's size), on
-    // which compare() renders the reference.
-    int k = rasterSupersampling(
-        request.supersampling, request.width, request.height,
-        std::any_of(plan.passes.begin(), plan.passes.end(), [](const Technique* t) { return t->info().name == "reference"; }));
-    std::vector<std::string> planned;
-    for (Technique* t : plan.passes) planned.push_back(t->info().name);
-    // The cost models' scene variables (particles of the scene and the request's media, light_volumes' beams).
-    api::SceneCounts counts = costCounts(all, scene, request.media);
-    // specular's maps follow the view: its model is charged the resolution the pass will choose at the
-    // frame's k (and each k the default frame budget weighs, below).
-    std::function<double(int)> specularMapTexelsAt;
-    if (std::find(planned.begin(), planned.end(), "specular") != planned.end()) {
-      const Params sp = requestParams("specular", request);
-      const auto owned = plan.owned.find("caustics");
-      const bool forCaustics = owned != plan.owned.end() && (owned->second & api::kPathLSDE);
-      specularMapTexelsAt = [&, sp, forCaustics](int atK) {
-        api::RenderRequest r = request;
-        r.width *= atK;
-        r.height *= atK;
-        r.supersampling = atK;
-        return double(chooseMapResolution(scene, makeFrameView(scene, r, inputs.environment), sp, forCaustics).texels);
-      };
-      counts.specularMapTexels = specularMapTexelsAt(k);
-    }
-    // The speed factor's scene (api::MachineSpeed): the scene and the passes it runs, whose own recent
-    // frames measure the load and the models' error on it at once.
-    std::string speedScene = (scene.digest.empty() ? "name:" + scene.name : scene.digest) + "|";
-    for (const std::string& p : planned) speedScene += p + ",";
-    // The server's default frame budget lowers a default supersampling first (api/Presets.h).
-    if (const int within = api::supersamplingWithinDefaultBudget(api::PresetTable::builtin(), planned, request, k,
-                                                                 inputs.limits, counts, im.speed.planningFactor(speedScene),
-                                                                 specularMapTexelsAt);
-        within < k) {
-      stats.warnings.push_back("supersampling " + std::to_string(within) + " instead of the default " + std::to_string(k) +
-                               ": at " + std::to_string(k) + " the default frame is predicted above this server's default "
-                               "frame budget (radiantd --default-frame-budget-ms); give \"supersampling\" to choose");
-      k = within;
-      if (specularMapTexelsAt) counts.specularMapTexels = specularMapTexelsAt(k);  // the maps this k runs
-    }
-    stats.supersampling = k;
-    api::RenderRequest supersampled = request;
-    supersampled.width *= k;
-    supersampled.height *= k;
-    supersampled.supersampling = k;  // the k used (capped; 1 with the reference)
-    // photon_gi's gather block at this k (its step grows with the frame): the model's block samples.
-    if (std::find(planned.begin(), planned.end(), "photon_gi") != planned.end())
-      counts.photonGatherBlock = api::photonGatherBlock(request, k);
-    FrameView supersampledView = makeFrameView(scene, supersampled, inputs.environment);
-    supersampledView.supersampling = k;
-    // The environment's compact bright regions become shadowed directional lights of the raster when
-    // `direct` runs to light with them (docs/TECHNIQUES.md, "Environment lights"); the reference and
-    // the background keep the whole map.
     const rt::Cancel cancelToken(cancel);
-    const bool directPlanned =
-        std::any_of(plan.passes.begin(), plan.passes.end(), [](const Technique* t) { return t->info().name == "direct"; });
-    if (supersampledView.environment && directPlanned) {
-      EnvironmentLightOptions o = environmentLightOptions(request);
-      // Sky lights stand for photon_gi's first-hit sky photons (the residual's L(sky)DE): only when it
-      // owns that class (ambient_occlusion's SH irradiance times AO otherwise; docs/TECHNIQUES.md,
-      // direct, "Sky lights").
-      const auto owned = plan.owned.find("photon_gi");
-      if (owned == plan.owned.end() || !(owned->second & api::kPathSkyDE)) o.skyLights = 0;
-      supersampledView.environmentLights = im.environmentLights(supersampledView, o, stats, cancelToken);
-      supersampledView.environmentLightsKey = o.key();
-      const auto& taken = supersampledView.environmentLights->lights;
-      supersampledView.lights.insert(supersampledView.lights.end(), taken.begin(), taken.end());
-      const auto& sky = supersampledView.environmentLights->skyLights;
-      supersampledView.lights.insert(supersampledView.lights.end(), sky.begin(), sky.end());
-    }
-    const FrameView& view = supersampledView;
-    FrameView outView = view;
-    outView.width = request.width;
-    outView.height = request.height;
-    outView.supersampling = 1;
-    stats.camera = cameraStats(view);
-    const GpuScene& gpu = im.gpuScene(scene, stats, cancelToken);
-    stats.skipped = plan.skipped;
-    stats.lightPaths = plan.lightPaths;
+    FrameConfig config = im.configure(scene, request, inputs, stats, cancelToken);
+    const GpuScene& gpu = im.beginResources(scene, config, stats, cancelToken);
+    const std::vector<Params> params = im.passParameters(scene, config, request, inputs, stats);
+    FrameProgress progress(inputs.progress);
+    im.runPasses(scene, gpu, config, params, stats, progress, cancelToken);
 
-    im.resources.beginFrame(gpu, view, &stats.cache);
-    im.resources.setCancel(cancelToken);  // prepare() and the derived-data builders (photons, beams, BVH)
-    im.resources.setLightPathOwners(plan.lightPaths, plan.owned);
-    // Declared resources (renderer/frame/FrameAllocation.h): the Renderer allocates the planned passes'
-    // AOV outputs, beauty and the environment map; each pass then touches the shared resources only as
-    // its TechniqueInfo declares (declaredAccess, checked by FrameResources in the pass scopes below).
-    im.resources.setSharedResources(sharedResources(all));
-    allocateDeclaredOutputs(im.resources, plan.passes);
-    declareEnvironmentMap(im.resources, view);
-    declareFrameLights(im.resources, view);
-    im.profiler.beginFrame();
-    // PassStats must not move while the profiler holds pointers to them.
-    stats.passes.resize(plan.passes.size());
-    std::vector<Params> params(plan.passes.size());
-    // quality / time_budget_ms: each planned technique's parameters from the preset table (api/Presets.h);
-    // without them, the request's own.
-    stats.scene["counts"] = counts.toJson();
-    // The supersampled request: the cost models' `pixels` are the raster's (the table was measured at
-    // k = 1, so a request that keeps its own supersampling under a budget is charged k^2 the pixels);
-    // photon_gi's gather is charged its block samples (counts.photonGatherBlock).
-    const nlohmann::json speedState = im.speed.toJson(speedScene);  // what this frame's choice used
-    api::BudgetChoice choice = api::chooseConfiguration(api::PresetTable::builtin(), planned, supersampled,
-                                                        inputs.limits, counts, im.speed.planningFactor(speedScene));
-    for (auto& w : choice.warnings) stats.warnings.push_back(std::move(w));
-    std::set<int> shadowMapExclusions;  // meshes whose shadows a pass supplies itself (light_volumes)
-    for (std::size_t i = 0; i < plan.passes.size(); ++i) {
-      Technique* t = plan.passes[i];
-      stats.passes[i].name = t->info().name;
-      const auto given = request.explicitParams.find(t->info().name);
-      params[i] = Params(choice.params.at(t->info().name),
-                         given == request.explicitParams.end() ? std::set<std::string>{} : given->second);
-      t->validate(scene, params[i]);  // as Renderer::check did with the request's own, now with the frame's
-      for (int m : t->shadowMapExclusions(scene, params[i])) shadowMapExclusions.insert(m);
-    }
-    im.resources.setShadowMapExclusions(std::move(shadowMapExclusions));
-    for (std::size_t i = 0; i < plan.passes.size(); ++i) {
-      Technique* t = plan.passes[i];
-      cancelToken.check("the frame's set-up, before preparing " + t->info().name);
-      im.resources.beginPass(t->info().name, declaredAccess(t->info()), FrameResources::Phase::Prepare);
-      t->prepare(scene, params[i], im.resources);
-      im.resources.endPass();
-      gl::checkError(("prepare " + t->info().name).c_str());
-    }
-    // Frame progress: monotone, and reported in order although a pass's callback may come from several
-    // threads at once (hence the lock around the comparison and the call).
-    std::mutex progressMutex;
-    double progressSoFar = 0.0;
-    const double passCount = static_cast<double>(std::max<std::size_t>(1, plan.passes.size()));
-    auto report = [&](double value) {
-      if (!inputs.progress) return;
-      std::lock_guard lock(progressMutex);
-      if (!(value > progressSoFar)) return;
-      progressSoFar = value;
-      inputs.progress(value);
-    };
-    for (std::size_t i = 0; i < plan.passes.size(); ++i) {
-      report(0.95 * static_cast<double>(i) / passCount);
-      if (cancelToken.requested())
-        throw api::ApiError(409, "canceled", "Render canceled", "the render was cancelled before pass " +
-                                                                  plan.passes[i]->info().name);
-      Technique* t = plan.passes[i];
-      gl::DebugGroup group(t->info().name);
-      PassContext ctx{scene, gpu, view, params[i], im.resources, im.shaders, stats.passes[i],
-                      [&, i](double f) { report(0.95 * (static_cast<double>(i) + std::clamp(f, 0.0, 1.0)) / passCount); },
-                      cancelToken};
-      im.resources.beginPass(t->info().name, declaredAccess(t->info()), FrameResources::Phase::Execute);
-      {
-        GpuProfiler::Scope scope(im.profiler, stats.passes[i]);
-        t->execute(ctx);
-      }
-      // A pass writes only what it declares (its outputs; beauty if it adds to it): programmer error.
-      if (const std::string bad = undeclaredWrite(t->info(), im.resources.passWrites()); !bad.empty())
-        throw std::logic_error("Renderer: pass " + t->info().name + " wrote '" + bad +
-                               "', which its TechniqueInfo does not declare");
-      im.resources.endPass();
-      gl::checkError(("execute " + t->info().name).c_str());
-      for (auto& w : stats.passes[i].warnings) stats.warnings.push_back(t->info().name + ": " + std::move(w));
-      stats.passes[i].warnings.clear();
-    }
-
-    // Readback of every AOV the outputs name (beauty always).
     const auto readStart = Clock::now();
-    std::vector<std::string> aovs{"beauty"};
-    for (const auto& o : request.outputs)
-      for (const auto& a : o.aovs)
-        if (std::find(aovs.begin(), aovs.end(), a) == aovs.end()) aovs.push_back(a);
-    if (request.compare && std::find(aovs.begin(), aovs.end(), request.compare->aov) == aovs.end())
-      aovs.push_back(request.compare->aov);
-    std::vector<float> rgba;  // the samples of an AOV resolved on the CPU (k = 1, or presentBackground)
-    std::size_t nonFinite = 0;
-    std::vector<ZeroedValues> zeroed;
-    // The background (api::Background), applied to the beauty after compare (which scores the frame with
-    // the environment behind it, as the reference renders it): the beauty as presented and its coverage.
-    const bool environmentBehind = request.background.kind == api::Background::Kind::Environment;
-    std::optional<Image> presented, alpha;
-    for (const std::string& aov : aovs) {
-      const AovSource src = aovSource(aov);
-      Image img = Image::make(aov, outView.width, outView.height, src.channels);
-      const bool drawn = im.resources.hasTexture(src.texture) && im.resources.written(aov);
-      // The beauty shown against another background needs its samples on the CPU (presentBackground).
-      const bool samplesNeeded = k == 1 || (aov == "beauty" && !environmentBehind);
-      if (drawn) {
-        if (samplesNeeded ||
-            !resolveSupersampledOnGpu(im.resources, im.shaders, im.resources.texture(src.texture), k, src, img)) {
-          if (rgba.empty()) rgba.resize(static_cast<std::size_t>(view.width) * view.height * 4);
-          im.resources.texture(src.texture).download(0, GL_RGBA, GL_FLOAT, rgba.data(), rgba.size() * sizeof(float));
-          resolveSupersampled(rgba, view.width, view.height, k, src, img);
-        }
-      } else if (aov == "beauty" || aov == "direct") {
-        // Nothing was drawn (no geometry): the frame shows the sky.
-        for (int i = 0; i < outView.width * outView.height; ++i)
-          for (int c = 0; c < 3; ++c) img.pixels[static_cast<std::size_t>(i) * 3 + c] = view.ambient[c];
-      }
-      if (aov == "beauty" && !environmentBehind)
-        presentBackground(im.resources, view, k, request.background, drawn ? &rgba : nullptr, presented, alpha);
-      if (const std::size_t bad = sanitize(img.pixels)) {
-        nonFinite += bad;
-        zeroed.push_back({aov, bad, writersOf(aov, plan.passes)});
-      }
-      out.aovs.push_back(std::move(img));
-    }
+    FrameReadback readback = im.readBack(config, request, out);
     stats.readbackMs = msSince(readStart);
     im.profiler.resolve();
-    report(0.95);
+    progress(0.95);
     if (const std::string w = blackFrameWarning(out, stats, scene, request); !w.empty()) stats.warnings.push_back(w);
     // This frame's time against the table's prediction (before compare's reference, which the table
     // does not model): the speed factor's evidence when the frame is comparable with the table.
-    im.lastFrame = {msSince(frameStart), api::predictFrameMs(api::PresetTable::builtin(), planned, choice.params,
-                                                             double(supersampled.width) * supersampled.height, counts)};
+    api::BudgetChoice& choice = config.choice;
+    im.lastFrame = {msSince(frameStart),
+                    api::predictFrameMs(api::PresetTable::builtin(), config.planned, choice.params,
+                                        double(config.supersampled.width) * config.supersampled.height, config.counts)};
     if (choice.active) {
       stats.budget = std::move(choice.stats);
-      stats.budget["speed"] = speedState;
+      stats.budget["speed"] = config.speedState;
       api::recordMeasured(stats.budget, stats, im.lastFrame.measuredMs);
     }
     const bool observed = !im.calibrating && !im.speed.pinned() && im.lastFrame.predictedMs > 0 &&
                           comparableWithPresetTable(stats, programsBefore != im.shaders.cachedPrograms());
-    if (observed) im.speed.observe(im.lastFrame.measuredMs, im.lastFrame.predictedMs, speedScene);
+    if (observed) im.speed.observe(im.lastFrame.measuredMs, im.lastFrame.predictedMs, config.speedScene);
     if (choice.active) stats.budget["speed"]["observed"] = observed;  // this frame joined the window
     if (request.compare)
-      compare(im.resources, scene, outView, request, inputs.compareTarget, checked.truth, out);
-    if (presented) {
-      nonFinite += sanitize(presented->pixels);
+      compare(im.resources, scene, config.outView, request, inputs.compareTarget, config.checked.truth, out);
+    std::size_t nonFinite = readback.nonFinite;
+    if (readback.presented) {
+      nonFinite += sanitize(readback.presented->pixels);
       *std::find_if(out.aovs.begin(), out.aovs.end(), [](const Image& i) { return i.aov == "beauty"; }) =
-          std::move(*presented);
-      if (alpha) out.aovs.push_back(std::move(*alpha));
+          std::move(*readback.presented);
+      if (readback.alpha) out.aovs.push_back(std::move(*readback.alpha));
     }
     stats.renderMs = msSince(frameStart);
     // The memory accountant: what this frame has not used goes when the resident set is over the target,
@@ -903,9 +997,9 @@ RenderOutput Renderer::renderFrame(const Scene& scene, const api::RenderRequest&
                     {"target_bytes", im.resources.memoryTarget()},
                     {"limit_bytes", im.resources.memoryLimit()},
                     {"released_bytes", im.resources.releasedThisFrame()}};
-    report(1.0);
+    progress(1.0);
     if (nonFinite) stats.passes.back().counters["non_finite_pixels_zeroed"] = static_cast<double>(nonFinite);
-    reportOutputRange(out, zeroed, request);  // after compare: its error and reference AOVs are outputs too
+    reportOutputRange(out, readback.zeroed, request);  // after compare: its error and reference AOVs are outputs too
     im.resources.setCancel({});  // the flag belongs to this request's job, which may go away after it
     return out;
   } catch (const rt::Cancelled& c) {
