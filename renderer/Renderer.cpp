@@ -619,8 +619,8 @@ void Renderer::check(const Scene& scene, const api::RenderRequest& requestIn, co
   FrameInputs inputs = inputsIn;
   inputs.environment = lit.environment;
   const CheckedPlan checked = checkedPlan(all, scene, lit.request, inputs);
-  for (Technique* t : checked.plan.passes) t->validate(scene, requestParams(t->info().name, lit.request));
-  makeFrameView(scene, lit.request);  // the camera's 422s
+  const FrameView view = makeFrameView(scene, lit.request);  // the camera's 422s
+  for (Technique* t : checked.plan.passes) t->validate(scene, view, requestParams(t->info().name, lit.request));
 }
 
 RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requestIn, const std::atomic<bool>* cancel,
@@ -821,7 +821,7 @@ std::vector<Params> Renderer::Impl::passParameters(const Scene& scene, FrameConf
     const auto given = request.explicitParams.find(t->info().name);
     params[i] = Params(config.choice.params.at(t->info().name),
                        given == request.explicitParams.end() ? std::set<std::string>{} : given->second);
-    t->validate(scene, params[i]);
+    t->validate(scene, config.view, params[i]);
     for (int m : t->shadowMapExclusions(scene, params[i])) shadowMapExclusions.insert(m);
   }
   resources.setShadowMapExclusions(std::move(shadowMapExclusions));

@@ -89,8 +89,8 @@ public:
   // Every 422 render() would raise for this request on this scene that needs no GL, raised now: the
   // planner's (an unknown AOV or pass, conflicting passes), an environment or compare image `inputs`
   // does not supply, the compare block's (an AOV without ground truth, an image of another size), the
-  // camera's, and each planned technique's Technique::validate() (an
-  // unknown receiver, a network above its limits). Pure CPU and thread-safe: radiantd calls it on the
+  // camera's, and each planned technique's Technique::validate() with the request's view (an
+  // unknown receiver, a network above its limits, an exact sky too costly for the frame's particles). Pure CPU and thread-safe: radiantd calls it on the
   // HTTP thread before it queues the job, so these are answers to the POST, not failed jobs.
   static void check(const Scene& scene, const api::RenderRequest& request, const FrameInputs& inputs);
   // How many scenes stay uploaded to the GPU, and how many input digests each kind of cached derived

@@ -22,6 +22,7 @@ struct SceneCounts;  // api/Presets.h
 }
 
 class FrameResources;
+struct FrameView;
 struct PassContext;
 
 // How a pass composes its result into beauty, which orders it among the frame's beauty writers
@@ -141,13 +142,15 @@ public:
   // scene is there for rules that need more, such as which nodes receive indirect light). Called by
   // the FramePlanner only.
   virtual Requirements requirements(const Scene& scene, const api::RenderRequest& request) const = 0;
-  // What this request's parameters ask of this scene that no frame could render, found without GL (an
-  // unknown receiver node, a network above its size limit): throws api::ApiError 422 naming the
-  // parameter. Called before the job is queued (Renderer::check, on radiantd's HTTP thread: keep it
-  // const and free of state) and at the frame's start with the frame's parameters, so prepare() need
-  // not check the same again.
-  virtual void validate(const Scene& scene, const Params& params) const {
+  // What this request's parameters ask of this scene and view that no frame could render, found without
+  // GL (an unknown receiver node, a network above its size limit, an exact sky too costly for the
+  // frame's particles): throws api::ApiError 422 naming the parameter. Called before the job is queued
+  // (Renderer::check, on radiantd's HTTP thread: keep it const and free of state; `view` is the
+  // request's, at its own size, without the environment's lights) and at the frame's start with the
+  // frame's parameters and view, so prepare() need not check the same again.
+  virtual void validate(const Scene& scene, const FrameView& view, const Params& params) const {
     (void)scene;
+    (void)view;
     (void)params;
   }
   // Allocate or reuse resources; build or fetch cached derived data. No drawing here.

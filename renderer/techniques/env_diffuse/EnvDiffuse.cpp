@@ -62,7 +62,7 @@ Requirements EnvDiffusePass::requirements(const Scene& scene, const api::RenderR
   return Requirements::ok();
 }
 
-void EnvDiffusePass::validate(const Scene& scene, const Params& params) const {
+void EnvDiffusePass::validate(const Scene& scene, const FrameView&, const Params& params) const {
   const EnvDiffuseParams p = EnvDiffuseParams::from(params);
   const int R = p.cube_resolution, M = p.downsample, bounces = p.bounces;
   if (!isPowerOfTwoIn(R, 16, 1024)) badParam("cube_resolution", "must be a power of two in [16, 1024]");

@@ -20,7 +20,7 @@ public:
 
   const TechniqueInfo& info() const override;
   Requirements requirements(const Scene&, const api::RenderRequest&) const override;
-  void validate(const Scene& scene, const Params& params) const override;
+  void validate(const Scene& scene, const FrameView& view, const Params& params) const override;
   void prepare(const Scene&, const Params&, FrameResources&) override;
   void execute(PassContext&) override;
   // indirect_diffuse: the reference's indirect (two or more scattering events) up to 1 + bounces, the

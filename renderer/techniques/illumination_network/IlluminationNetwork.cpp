@@ -82,7 +82,7 @@ int IlluminationNetworkPass::autoWindow(int nodes) {
   return std::max(1, static_cast<int>(std::lround(std::cbrt(4.0 * nodes / 3.14159265358979))));
 }
 
-void IlluminationNetworkPass::validate(const Scene&, const Params& params) const {
+void IlluminationNetworkPass::validate(const Scene&, const FrameView& view, const Params& params) const {
   const IlluminationNetworkParams p = IlluminationNetworkParams::from(params);
   const int N = p.nodes, D = p.directions;
   int M = p.window;
@@ -97,6 +97,22 @@ void IlluminationNetworkPass::validate(const Scene&, const Params& params) const
                         "directions x window^2 = " + std::to_string(std::size_t(D) * M * M) + " exceeds " +
                             std::to_string(kMaxBins) + " bins",
                         "/passes/illumination_network/window");
+  // The sky scattered once exactly costs D x particles chords per step of the march: the one product in
+  // the march's work that no server cap bounds. "exact" above kSkyExactMax is refused ("auto" leaves it
+  // to the network beyond kSkyExactBudget: prepare()).
+  using Sky = IlluminationNetworkParams::SkySingleScatter;
+  if (p.final_render == IlluminationNetworkParams::FinalRender::kMarch && p.sky_single_scatter == Sky::kExact) {
+    const std::size_t chords = mediaParticles(view.media, glm::vec3(0.f), view.eye, glm::vec3(0.f, 0.f, -1.f),
+                                              /*orthographic=*/false, /*sort=*/false)
+                                   .size() *
+                               std::size_t(D);
+    if (chords > kSkyExactMax)
+      throw api::ApiError(422, "invalid-value", "Exact sky single scattering too costly",
+                          "sky_single_scatter exact sums particles x directions = " + std::to_string(chords) +
+                              " chords per step of the march, above " + std::to_string(kSkyExactMax) +
+                              " (use auto or network, or fewer directions)",
+                          "/passes/illumination_network/sky_single_scatter");
+  }
 }
 
 void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
@@ -183,14 +199,9 @@ void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, 
   // The sky scattered once exactly costs D x particles chords per step of the march: "auto" affords it
   // up to kSkyExactBudget of them (a few big particles, the thesis' homogeneous cloud) and leaves it to
   // the network beyond.
+  // validate() refused "exact" above kSkyExactMax.
   using Sky = IlluminationNetworkParams::SkySingleScatter;
   const Sky sky = p.sky_single_scatter;
-  if (march_ && sky == Sky::kExact && particles_.size() * std::size_t(D) > kSkyExactMax)
-    throw api::ApiError(422, "invalid-value", "Exact sky single scattering too costly",
-                        "sky_single_scatter exact sums particles x directions = " +
-                            std::to_string(particles_.size() * std::size_t(D)) + " chords per step of the march, above " +
-                            std::to_string(kSkyExactMax) + " (use auto or network, or fewer directions)",
-                        "/passes/illumination_network/sky_single_scatter");
   skyExact_ = march_ && (sky == Sky::kExact || (sky == Sky::kAuto && particles_.size() * std::size_t(D) <= kSkyExactBudget));
   // The driver's loop budget per invocation and draw (network::shaderLoopBudget), read once per context.
   if (loopBudget_ == 0) {

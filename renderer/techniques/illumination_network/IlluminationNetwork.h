@@ -33,7 +33,7 @@ public:
   const TechniqueInfo& info() const override;
   GroundTruth groundTruth(const Params&, const std::string& aov) const override;
   Requirements requirements(const Scene&, const api::RenderRequest&) const override;
-  void validate(const Scene& scene, const Params& params) const override;
+  void validate(const Scene& scene, const FrameView& view, const Params& params) const override;
   void prepare(const Scene&, const Params&, FrameResources&) override;
   void execute(PassContext&) override;
 

@@ -57,6 +57,26 @@ TEST(FrameCheck, ATechniquesSceneAndParameterProblemsAre422NamingTheParameter) {
   EXPECT_EQ(e.pointer, "/passes/illumination_network/nodes");
 }
 
+// A limit that depends on the frame's particles, not only on parameters: illumination_network's exact
+// sky costs particles x directions chords per step of the march; 1024 particles x 128 directions is
+// above its 65536 and a 422 of the POST; 64 directions pass.
+TEST(FrameCheck, TheNetworksExactSkyIsCheckedAgainstTheRequestsParticles) {
+  const json many = {{"kind", "cloud"}, {"tau", 10.0}, {"albedo", {0.9, 0.9, 0.9}}, {"seed", 1},
+                     {"generator", {{"count", 1024}, {"extent", {1, 1, 1}}, {"radius", 0.1}}}};
+  auto body = [&](int directions) {
+    return box({{"media", json::array({many})},
+                {"passes", {{"spherical_billboards", false},
+                            {"illumination_network", {{"nodes", 64}, {"directions", directions},
+                                                      {"sky_single_scatter", "exact"}}}}}});
+  };
+  const api::ApiError e = checked(body(128));
+  EXPECT_EQ(e.status, 422);
+  EXPECT_EQ(e.pointer, "/passes/illumination_network/sky_single_scatter");
+  EXPECT_NE(e.detail().find("131072"), std::string::npos) << e.detail();
+  const api::RenderRequest fits = api::parseRenderRequest(body(64));
+  EXPECT_NO_THROW(Renderer::check(loadBuiltinScene("cornell_box"), fits, {}));
+}
+
 TEST(FrameCheck, TheCameraAndTheCompareBlockAre422BeforeAnyFrame) {
   // An orbit whose eye single precision cannot place (the parser cannot tell: it needs the camera built).
   api::ApiError e = checked(box(
