@@ -131,6 +131,32 @@ Requirements CausticsPass::requirements(const Scene& scene, const api::RenderReq
   return Requirements::ok();
 }
 
+CausticsPass::FittedCubes CausticsPass::fitCubes(int generators, int resolution, bool given) {
+  if (cubeBytes(generators, resolution) <= kMaxBytes) return {resolution, ""};
+  const auto mib = [](double b) { return std::to_string(static_cast<long long>(b / (1 << 20))); };
+  int lowered = resolution;
+  while (lowered > 16 && cubeBytes(generators, lowered) > kMaxBytes) lowered = std::max(16, lowered / 2);
+  const std::string need = std::to_string(generators) + " generators' caustic cubes at " + std::to_string(resolution) +
+                           "^2 texels need " + mib(cubeBytes(generators, resolution)) + " MiB, above the limit of " +
+                           mib(kMaxBytes) + " MiB";
+  if (given)
+    throw api::ApiError(422, "limit-exceeded", "Server limit exceeded",
+                        "/passes/caustics/cube_resolution: " + need + ": lower cube_resolution",
+                        "/passes/caustics/cube_resolution");
+  if (cubeBytes(generators, lowered) > kMaxBytes)
+    throw api::ApiError(422, "limit-exceeded", "Server limit exceeded",
+                        "/passes/caustics: " + need + ", and " + mib(cubeBytes(generators, lowered)) +
+                            " MiB even at 16 texels: turn the pass off (passes.caustics = false)",
+                        "/passes/caustics");
+  return {lowered, need + ": drawn at " + std::to_string(lowered) + "^2"};
+}
+
+// Every specular mesh is a generator with a cube (prepare()), lit or not.
+void CausticsPass::validate(const Scene& scene, const FrameView&, const Params& params) const {
+  const CausticsParams p = CausticsParams::from(params);
+  fitCubes(static_cast<int>(specularMeshes(scene).size()), p.cube_resolution, p.given.cube_resolution);
+}
+
 void CausticsPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
   const CausticsParams p = CausticsParams::from(params);
   // Every default is the descriptor's (caustics.json): Params has no fallback.
@@ -186,26 +212,9 @@ void CausticsPass::prepare(const Scene& scene, const Params& params, FrameResour
 
   // The caustic cubes' memory (kMaxBytes), before anything is allocated.
   const int cubes = std::max<int>(1, static_cast<int>(generators_.size()));
-  warning_.clear();
-  if (cubeBytes(cubes, cubeResolution_) > kMaxBytes) {
-    const auto mib = [](double b) { return std::to_string(static_cast<long long>(b / (1 << 20))); };
-    int lowered = cubeResolution_;
-    while (lowered > 16 && cubeBytes(cubes, lowered) > kMaxBytes) lowered /= 2;
-    const std::string need = std::to_string(generators_.size()) + " generators' caustic cubes at " +
-                             std::to_string(cubeResolution_) + "^2 texels need " + mib(cubeBytes(cubes, cubeResolution_)) +
-                             " MiB, above the limit of " + mib(kMaxBytes) + " MiB";
-    if (p.given.cube_resolution)
-      throw api::ApiError(422, "limit-exceeded", "Server limit exceeded",
-                          "/passes/caustics/cube_resolution: " + need + ": lower cube_resolution",
-                          "/passes/caustics/cube_resolution");
-    if (cubeBytes(cubes, lowered) > kMaxBytes)
-      throw api::ApiError(422, "limit-exceeded", "Server limit exceeded",
-                          "/passes/caustics: " + need + ", and " + mib(cubeBytes(cubes, lowered)) +
-                              " MiB even at 16 texels: turn the pass off (passes.caustics = false)",
-                          "/passes/caustics");
-    warning_ = need + ": drawn at " + std::to_string(lowered) + "^2";
-    cubeResolution_ = lowered;
-  }
+  const FittedCubes fitted = fitCubes(static_cast<int>(generators_.size()), cubeResolution_, p.given.cube_resolution);
+  cubeResolution_ = fitted.resolution;
+  warning_ = fitted.warning;
   const int C = cubeResolution_;
   int levels = 1;
   while ((C >> levels) > 0) ++levels;  // down to 1 x 1

@@ -60,6 +60,16 @@ public:
     for (int r = resolution; r > 0; r >>= 1) texels += double(r) * r;  // the mip chain down to 1 x 1
     return double(std::max(1, generators)) * 6.0 * texels * 16.0;
   }
+  // The cubes' resolution under kMaxBytes: `resolution` when they fit; else, when the request left it to
+  // the default, halved (not below 16) until they fit, with the warning saying so. A 422 when the request
+  // gave it, or when the generators do not fit even at 16 texels: validate() raises them before the
+  // queue (they depend on the scene and the parameters only), prepare() again for the frame's own.
+  struct FittedCubes {
+    int resolution = 0;
+    std::string warning;  // "" when the cubes fit as asked
+  };
+  static FittedCubes fitCubes(int generators, int resolution, bool given);
+  void validate(const Scene& scene, const FrameView& view, const Params& params) const override;
 
 private:
   struct Pair {

@@ -101,6 +101,38 @@ Requirements SpecularPass::requirements(const Scene& scene, const api::RenderReq
   return Requirements::ok();
 }
 
+SpecularPass::FittedMaps SpecularPass::fitMaps(int objects, int layers, int resolution, bool adaptive,
+                                               bool keptForCaustics) {
+  if (mapBytes(objects, layers, resolution) <= kMaxBytes) return {resolution, ""};
+  const auto mib = [](double b) { return std::to_string(static_cast<long long>(b / (1 << 20))); };
+  int lowered = resolution;
+  while (lowered > 16 && mapBytes(objects, layers, lowered) > kMaxBytes) lowered = std::max(16, lowered / 2);
+  const std::string need = std::to_string(objects) + " specular objects x " + std::to_string(layers) +
+                           " layers of 6 faces at " + std::to_string(resolution) + "^2 texels need " +
+                           mib(mapBytes(objects, layers, resolution)) + " MiB of maps, above the limit of " +
+                           mib(kMaxBytes) + " MiB";
+  if (!adaptive)
+    throw api::ApiError(422, "limit-exceeded", "Server limit exceeded",
+                        "/passes/specular/cube_resolution: " + need + ": lower cube_resolution or layers",
+                        "/passes/specular/cube_resolution");
+  if (mapBytes(objects, layers, lowered) > kMaxBytes)
+    throw api::ApiError(422, "limit-exceeded", "Server limit exceeded",
+                        "/passes/specular: " + need + ", and " + mib(mapBytes(objects, layers, lowered)) +
+                            " MiB even at 16 texels: turn the pass off (passes.specular = false) or give the "
+                            "scene fewer mirror-like and transmissive meshes",
+                        "/passes/specular");
+  return {lowered, need + ": drawn at " + std::to_string(lowered) + "^2" +
+                       (keptForCaustics ? " (the caustics' photons see coarser maps)" : "")};
+}
+
+// A resolution the pass chooses from the view only lowers the maps, and 16 texels is its floor: the
+// floor decides whether an adaptive choice fits.
+void SpecularPass::validate(const Scene& scene, const FrameView& view, const Params& params) const {
+  const MapResolution chosen = chooseMapResolution(scene, view, params, false);
+  const int objects = static_cast<int>(specularMeshes(scene).size());
+  fitMaps(objects, SpecularParams::from(params).layers, chosen.adaptive ? 16 : chosen.texels, chosen.adaptive, false);
+}
+
 void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
   const SpecularParams p = SpecularParams::from(params);
   // Every default is the descriptor's (specular.json): Params has no fallback.
@@ -145,30 +177,10 @@ void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResour
   const bool adaptive = chosen.adaptive;  // else a 422 above the memory bound below
 
   // The maps' memory (kMaxBytes), checked before anything is allocated.
-  warning_.clear();
   const int objectCount = static_cast<int>(objects_.size());
-  if (mapBytes(objectCount, layers_, resolution_) > kMaxBytes) {
-    const auto mib = [](double b) { return std::to_string(static_cast<long long>(b / (1 << 20))); };
-    int lowered = resolution_;
-    while (lowered > 16 && mapBytes(objectCount, layers_, lowered) > kMaxBytes) lowered /= 2;
-    const std::string need = std::to_string(objectCount) + " specular objects x " + std::to_string(layers_) +
-                             " layers of 6 faces at " + std::to_string(resolution_) + "^2 texels need " +
-                             mib(mapBytes(objectCount, layers_, resolution_)) + " MiB of maps, above the limit of " +
-                             mib(kMaxBytes) + " MiB";
-    if (!adaptive)
-      throw api::ApiError(422, "limit-exceeded", "Server limit exceeded",
-                          "/passes/specular/cube_resolution: " + need + ": lower cube_resolution or layers",
-                          "/passes/specular/cube_resolution");
-    if (mapBytes(objectCount, layers_, lowered) > kMaxBytes)
-      throw api::ApiError(422, "limit-exceeded", "Server limit exceeded",
-                          "/passes/specular: " + need + ", and " + mib(mapBytes(objectCount, layers_, lowered)) +
-                              " MiB even at 16 texels: turn the pass off (passes.specular = false) or give the "
-                              "scene fewer mirror-like and transmissive meshes",
-                          "/passes/specular");
-    warning_ = need + ": drawn at " + std::to_string(lowered) + "^2" +
-               (causticsKeepMaps_ ? " (the caustics' photons see coarser maps)" : "");
-    resolution_ = lowered;
-  }
+  const FittedMaps fitted = fitMaps(objectCount, layers_, resolution_, adaptive, causticsKeepMaps_);
+  resolution_ = fitted.resolution;
+  warning_ = fitted.warning;
 
   const int w = res.view().width, h = res.view().height;
   const int cubes = std::max<int>(1, objectCount * layers_);

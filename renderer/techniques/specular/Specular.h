@@ -47,6 +47,10 @@ public:
   const TechniqueInfo& info() const override;
   Requirements requirements(const Scene&, const api::RenderRequest&) const override;
   void addCostCounts(const Scene& scene, api::SceneCounts& counts) const override;
+  // The maps' memory limit where the view cannot change the answer (fitMaps): a cube_resolution the
+  // request gives above it, or specular objects that do not fit even at 16 texels, are 422s before the
+  // job is queued (Renderer::check).
+  void validate(const Scene& scene, const FrameView& view, const Params& params) const override;
   void prepare(const Scene&, const Params&, FrameResources&) override;
   void execute(PassContext&) override;
 
@@ -75,6 +79,15 @@ public:
   static double mapBytes(int objects, int layers, int resolution) {
     return double(std::max(1, objects * layers)) * 6.0 * double(resolution) * resolution * kBytesPerTexel;
   }
+  // The resolution the maps are drawn at under kMaxBytes: `resolution` when they fit; else, when the pass
+  // chose it (`adaptive`), halved (not below 16) until they fit, with the warning saying so. A 422 when
+  // the request gave it, or when they do not fit even at 16 texels: neither depends on the view, so
+  // validate() raises them before the queue and prepare() again for the frame's own parameters.
+  struct FittedMaps {
+    int resolution = 0;
+    std::string warning;  // "" when the maps fit as chosen
+  };
+  static FittedMaps fitMaps(int objects, int layers, int resolution, bool adaptive, bool keptForCaustics);
 
 private:
   struct Object {

@@ -11,6 +11,7 @@
 #include "renderer/Renderer.h"
 #include "renderer/scene/BuiltinScenes.h"
 #include "tests/support/Expect.h"
+#include "tests/support/SceneBuilder.h"
 
 namespace radiant {
 namespace {
@@ -75,6 +76,60 @@ TEST(FrameCheck, TheNetworksExactSkyIsCheckedAgainstTheRequestsParticles) {
   EXPECT_NE(e.detail().find("131072"), std::string::npos) << e.detail();
   const api::RenderRequest fits = api::parseRenderRequest(body(64));
   EXPECT_NO_THROW(Renderer::check(loadBuiltinScene("cornell_box"), fits, {}));
+}
+
+// `n` mirror quads under a point light above a lit floor (every mirror is a specular object of the
+// specular pass and a generator of caustics).
+Scene mirrors(int n) {
+  testing::SceneBuilder b;
+  Material m;
+  m.name = "mirror";
+  m.baseColorFactor = glm::vec4(0.9f, 0.9f, 0.9f, 1.f);
+  m.metallicFactor = 1.f;
+  m.roughnessFactor = 0.f;
+  const int mirror = b.material(m);
+  b.quad({0, 0, 0}, {0, 0, 2}, {2, 0, 0}, b.material(testing::lambertian()), "floor");  // facing +y
+  for (int i = 0; i < n; ++i)
+    b.quad({-1.f + 0.01f * float(i % 200), 1.f, -1.f + 0.01f * float(i / 200)}, {0, 0, 0.004f}, {0.004f, 0, 0}, mirror,
+           "mirror");
+  b.pointLight({0, 2, 0}, 5.f);
+  b.topDownOrtho(3.f, 2.f);
+  return b.build("mirrors-" + std::to_string(n));
+}
+
+api::ApiError checkedOn(const Scene& scene, const json& passes) {
+  const api::RenderRequest request = api::parseRenderRequest(box({{"passes", passes}}));
+  return testing::thrownApiError([&] { Renderer::check(scene, request, {}); });
+}
+
+// The layered distance maps' and the caustic cubes' memory limits (SpecularPass::kMaxBytes and
+// CausticsPass::kMaxBytes, 512 MiB each) depend on the scene's specular meshes and the parameters, not
+// on the view: a resolution the request gives above them, and meshes that do not fit even at 16
+// texels, are 422s of the POST. The frame still halves a resolution it chose itself (the GL tests).
+TEST(FrameCheck, TheSpecularMapsAndCausticCubesMemoryLimitsAreCheckedBeforeTheQueue) {
+  // One glass sphere's maps at 2048 texels: 3 layers x 6 faces x 2048^2 x 32 bytes = 2304 MiB.
+  api::ApiError e = checked(box({{"scene", {{"builtin", "cornell_glass"}}},
+                                 {"passes", {{"specular", {{"cube_resolution", 2048}}}}}}));
+  EXPECT_EQ(e.status, 422);
+  EXPECT_EQ(e.type, "limit-exceeded");
+  EXPECT_EQ(e.pointer, "/passes/specular/cube_resolution");
+  EXPECT_NE(e.detail().find("2304 MiB"), std::string::npos) << e.detail();
+  // The maps' floor: 6 layers of 6 faces at 16^2 x 32 bytes is 294,912 bytes an object, so 1820 objects
+  // fit the limit (536,756,224 bytes) and 1821 do not (537,051,136), whatever resolution the view chose.
+  const json sixLayers = {{"specular", {{"layers", 6}}}};
+  EXPECT_NO_THROW(Renderer::check(mirrors(1820), api::parseRenderRequest(box({{"passes", sixLayers}})), {}));
+  e = checkedOn(mirrors(1821), sixLayers);
+  EXPECT_EQ(e.status, 422);
+  EXPECT_EQ(e.pointer, "/passes/specular");
+  EXPECT_NE(e.detail().find("even at 16 texels"), std::string::npos) << e.detail();
+  // Caustic cubes of 1024 texels with their mip chains: 128 MiB a generator; 4 fit, 5 do not. Left to
+  // the default, the frame lowers the resolution and the check passes.
+  const json given = {{"caustics", {{"cube_resolution", 1024}}}};
+  EXPECT_NO_THROW(Renderer::check(mirrors(4), api::parseRenderRequest(box({{"passes", given}})), {}));
+  e = checkedOn(mirrors(5), given);
+  EXPECT_EQ(e.status, 422);
+  EXPECT_EQ(e.pointer, "/passes/caustics/cube_resolution");
+  EXPECT_NO_THROW(Renderer::check(mirrors(5), api::parseRenderRequest(box()), {}));
 }
 
 TEST(FrameCheck, TheCameraAndTheCompareBlockAre422BeforeAnyFrame) {
