@@ -85,7 +85,7 @@ void resolveSupersampled(const std::vector<float>& rgba, int width, int height, 
 // resolveSupersampled on the GPU (shaders/common/supersample_resolve.comp): the k x k samples are
 // resolved into an output-sized RGBA32F texture and only that is read back, k^2 times fewer bytes and
 // no per-sample loop on the CPU (at 1920x1080, k = 2 on an H200 the readback of the full frame and its
-// CPU resolve took 150-250 ms, the passes 70-120 ms; docs/PERFORMANCE.md, "GPU check"). False (nothing
+// CPU resolve took 198-314 ms, the passes 70-120 ms; docs/PERFORMANCE.md, "GPU check"). False (nothing
 // done) for a texture that texelFetch of a float sampler cannot read: integer formats.
 bool resolveSupersampledOnGpu(FrameResources& resources, gl::ShaderLibrary& shaders, const gl::Texture& samples,
                               int k, const AovSource& src, Image& out) {

@@ -31,7 +31,7 @@ struct Settings {
   // "Denoiser").
   int baseStep = 1;
   float relativeNoise = 0.1f;    // per-pixel relative standard deviation of the input
-  float sigmaLuminance = 1.5f;   // in noise widths (docs/PERFORMANCE.md, "Denoiser": 0.5-4 measured)
+  float sigmaLuminance = 1.5f;   // in noise widths (chosen, not swept: no figure for it is measured)
   float sigmaNormal = 64.f;     // cosine power
   float sigmaPlane = 1.f;       // in pixel footprints times the step
 };

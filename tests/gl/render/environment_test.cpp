@@ -640,8 +640,9 @@ TEST(Environment, AMirrorShowsThePlaneLitByTheMapsSun) {
 // (gather_step 1) on the same photons. Before the lobe test a block sample at a metal sphere's
 // silhouette (metallic 0.83, roughness 0.33: grazing view, the sunlit neighbours in a Fresnel-bright
 // reflection) lent its estimate to samples whose views were 20 degrees steeper: indirect 2.07 against
-// 0.033 at pixel (43,40), where the reference's whole pixel is 0.09 (docs/PERFORMANCE.md, render
-// fidelity). Measured (2026-12-05, llvmpipe; specular and ambient_occlusion off, which photon_gi's
+// 0.033 at pixel (43,40), where the reference's whole pixel is 0.09 (measured for this test; the
+// fidelity scores before and after: docs/performance/fidelity.md, "The glossy lobe in the borrowed
+// estimates"). Measured (2026-12-05, llvmpipe; specular and ambient_occlusion off, which photon_gi's
 // indirect does not depend on): largest difference 1.45 without the lobe test, 0.51 with it; the frame's
 // mean indirect 0.005.
 TEST(Environment, PhotonBlockSamplesOfGlossySpheresStayOnTheirLobe) {

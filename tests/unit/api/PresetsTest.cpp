@@ -688,9 +688,9 @@ TEST(Presets, MachineSpeedIsTheMedianOfTheCalibrationAndRecentFrames) {
   EXPECT_DOUBLE_EQ(p.factor(), 5.0);
 }
 
-// A scene whose frames the table's models get wrong (cornell_glass ran 1.4-3.2x its predictions where
-// the Cornell box ran 1x: docs/performance/presets-and-budgets.md) is predicted from its own recent
-// frames, and does not move the other scenes' budgets; once its frames are old, the machine's factor.
+// A scene whose frames the table's models get wrong (cornell_glass once ran 1.4-3.2x its predictions
+// where the Cornell box ran 1x, before the table was refitted) is predicted from its own recent frames,
+// and does not move the other scenes' budgets; once its frames are old, the machine's factor.
 TEST(Presets, MachineSpeedPredictsAScenesFramesFromItsOwnRecentFrames) {
   MachineSpeed m;
   m.calibrate(100, 100);
