@@ -1,7 +1,8 @@
 #pragma once
 // The C++ reading of shaders/common/shared.h, the one definition of the structs and constants C++ and
 // GLSL share (std430: every member is a vec4/ivec4/mat4, so the two layouts agree without padding
-// rules). The static_asserts below pin the layout GLSL sees.
+// rules). The static_asserts below pin the layout GLSL sees. A technique's own records and units
+// (shaders/<technique>/shared.h) are read the same way beside it, after this header.
 #include <cstddef>
 
 #include <glm/glm.hpp>
@@ -28,20 +29,14 @@ static_assert(offsetof(MaterialParams, clearcoat) == 48 && offsetof(MaterialPara
 static_assert(offsetof(MaterialParams, emission) == 16 && offsetof(MaterialParams, surface) == 32,
               "std430 MaterialParams: baseColor, emission, surface");
 static_assert(kUnitMaterial0 + kSlotLayer0 <= kUnitEnvironment, "material texture units overlap the environment");
-static_assert(kUnitLdmAlbedo < kUnitMaterialLayer0 && kUnitMaterialLayer0 + kSlotCount - kSlotLayer0 == kUnitCount,
+static_assert(kUnitMaterialLayer0 + kSlotCount - kSlotLayer0 == kUnitCount,
               "the layered extensions' material units are the last ones");
 // The unit material texture slot `slot` is bound to (GpuScene::bindMaterialTextures; material.glsl's bindings).
 constexpr int materialTextureUnit(int slot) {
   return slot < kSlotLayer0 ? kUnitMaterial0 + slot : kUnitMaterialLayer0 + (slot - kSlotLayer0);
 }
 static_assert(kUnitShadow2D < kUnitMaterial0, "shadow units overlap the material units");
-static_assert(kUnitLdmDistance < kUnitIblDfg && kUnitIblDfg < kUnitIblPrefiltered &&
-                  kUnitIblPrefiltered < kUnitAoEmission && kUnitAoEmission < kUnitCount,
-              "image-based lighting units follow the specular pass's units");
 static_assert(sizeof(MediaParticle) == 64, "std430 MediaParticle must be 64 bytes");
-static_assert(sizeof(NetworkNode) == 48 && sizeof(NetworkDirection) == 48 && sizeof(NetworkLight) == 32,
-              "std430 network records are whole vec4s");
-static_assert(sizeof(ImpostorBlock) == 64, "std430 ImpostorBlock must be 64 bytes");
 // Kept for existing callers: the first material texture unit.
 inline constexpr int kMaterialTextureUnit0 = kUnitMaterial0;
 

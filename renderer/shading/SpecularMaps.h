@@ -13,6 +13,10 @@
 #include "renderer/frame/GpuTypes.h"
 #include "renderer/gl/Gl.h"
 
+namespace radiant::gpu {
+#include "shaders/specular/shared.h"  // the maps' units and bindings
+}  // namespace radiant::gpu
+
 namespace radiant {
 
 // Shared by specular/ldm.glsl's readers: the objects' records and the cubes' min/max distances.

@@ -10,6 +10,7 @@
 // diffuse base as the direct pass's split-sum does (ibl.glsl's layered iblDiffuseWeight); their own
 // reflections of the environment are the direct pass's.
 #include "common/shared.h"
+#include "ambient_occlusion/shared.h"
 #include "common/brdf.glsl"
 #include "common/material.glsl"  // decodeLayers
 #include "common/ibl.glsl"

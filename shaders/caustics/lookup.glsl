@@ -3,6 +3,8 @@
 // specular/ldm.glsl (the generators' reference points) and caustics/cube.glsl.
 #ifndef RADIANT_CAUSTICS_LOOKUP
 #define RADIANT_CAUSTICS_LOOKUP
+#include "common/shared.h"
+#include "caustics/shared.h"
 layout(binding = kUnitCausticCube) uniform samplerCubeArray t_caustics;
 uniform int u_generators;
 uniform float u_visibilityTolerance;  // texels of the caustic cube

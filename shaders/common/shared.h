@@ -43,7 +43,12 @@ RADIANT_CONST int kLobeSpecular = 16;
 
 // ---------------------------------------------------------------------------------------------------
 // Texture units. Every sampler of every program has its own unit, so a pass can bind anything it
-// declares without overwriting another's input. Units 0-5 are a pass's own full-screen inputs.
+// declares without overwriting another's input. Units 0-5 are a pass's own full-screen inputs. The
+// units, bindings and records only one technique (or one technique's product) uses are declared in its
+// folder, shaders/<technique>/shared.h, under the same rules as this file (`grep -n "kUnit\|kBinding"
+// shaders/*/shared.h` lists them; ParityTest.SamplerUnitsAreUniqueAcrossTheFramesPrograms fails when
+// two samplers of a frame share a unit). Taken there: 15-18 and 25 (specular), 21 (ambient_occlusion),
+// 24 (caustics); storage bindings 4-5 (depth_impostors) and 8 (specular).
 RADIANT_CONST int kUnitShadowCube = 6;
 RADIANT_CONST int kUnitShadow2D = 7;
 // Material textures: slot s < kSlotLayer0 at unit kUnitMaterial0 + s, the layered extensions' slots
@@ -66,17 +71,10 @@ RADIANT_CONST int kSlotSpecular = 11;           // KHR_materials_specular: specu
 RADIANT_CONST int kSlotSpecularColor = 12;      // specularColorTexture, rgb (sRGB)
 RADIANT_CONST int kSlotCount = 13;
 RADIANT_CONST int kUnitEnvironment = 14;  // equirect environment radiance (direct, specular)
-RADIANT_CONST int kUnitPeel = 15;         // specular: previous layer of a distance-map face
-RADIANT_CONST int kUnitLdmMaterial = 16;  // specular: layered distance maps
-RADIANT_CONST int kUnitLdmGeometry = 17;
-RADIANT_CONST int kUnitLdmDistance = 18;
 RADIANT_CONST int kUnitIblDfg = 19;       // image-based lighting: split-sum DFG table (direct, ambient_occlusion)
 RADIANT_CONST int kUnitIblPrefiltered = 20;  // image-based lighting: GGX-prefiltered environment (direct)
-RADIANT_CONST int kUnitAoEmission = 21;   // ambient_occlusion resolve: the emission target (a = ior)
 RADIANT_CONST int kUnitGbufferLayers = 22;    // direct: the G-buffer's gbuffer_layers (KHR_materials_clearcoat, sheen)
 RADIANT_CONST int kUnitGbufferSpecular = 23;  // direct: the G-buffer's gbuffer_specular (KHR_materials_specular)
-RADIANT_CONST int kUnitCausticCube = 24;  // caustics: the caustic cube maps (irradiance per receiver area)
-RADIANT_CONST int kUnitLdmAlbedo = 25;  // specular: the maps' diffuse albedo (caustics, at secondary hits) and mirrors' F0
 RADIANT_CONST int kUnitMaterialLayer0 = 26;  // material slots kSlotLayer0.. (units 26-32)
 // Units used. A binding must be below GL_MAX_COMBINED_TEXTURE_IMAGE_UNITS (GL 4.5 guarantees 80); a
 // stage may read at most GL_MAX_TEXTURE_IMAGE_UNITS samplers (16 guaranteed, 32 on llvmpipe), which
@@ -88,8 +86,6 @@ RADIANT_CONST int kBindingMaterials = 0;
 RADIANT_CONST int kBindingLights = 1;
 RADIANT_CONST int kBindingShadows = 2;
 RADIANT_CONST int kBindingSheenAlbedo = 7;  // float[kSheenAlbedoSize^2] (GpuScene::sheenAlbedo)
-// uint[3]: the photon gathers of specular's maps, per kind (specular/map_indirect.comp, stats counters).
-RADIANT_CONST int kBindingMapGatherCounts = 8;
 
 // ---------------------------------------------------------------------------------------------------
 // Lights.
@@ -156,7 +152,7 @@ struct MaterialParams {
 };
 
 // ---------------------------------------------------------------------------------------------------
-// Participating media (renderer/techniques/spherical_billboards, shaders/spherical_billboards).
+// Participating media: the media layer of every media technique (renderer/shading/MediaLayer.h).
 
 RADIANT_CONST int kProfileConstant = 0;
 RADIANT_CONST int kProfileThesis = 1;       // thesis eq. 7.4
@@ -175,38 +171,6 @@ struct MediaParticle {
   vec4 sourceTau;     // rgb the direction-independent source ((1 - a) L_e + a L_ambient), w tau
   vec4 albedoG;       // rgb albedo (scales the punctual lights' in-scattering), w phase g
   ivec4 models;       // x density profile (kProfile*), y phase model (kPhase*), z block (depth_impostors), w unused
-};
-
-// depth_impostors (renderer/techniques/depth_impostors): one block of particles and its impostor tile.
-RADIANT_CONST int kBindingImpostorBlocks = 4;
-RADIANT_CONST int kBindingImpostorOrder = 5;  // int[]: the blocks back to front
-RADIANT_CONST int kMaxImpostorSlices = 16;  // K: 4 slices per RGBA texture, at most 4 textures
-struct ImpostorBlock {
-  vec4 centerRadius;  // xyz world centre, w radius of the sphere bounding its particles
-  vec4 source;        // rgb the particles' direction-independent source (tau r^3 weighted), w unused
-  vec4 albedoG;       // rgb albedo (tau r^3 weighted), w phase g
-  ivec4 info;         // x impostor tile, y phase model (kPhase*), z light group (slice), w particle count
-};
-
-// ---------------------------------------------------------------------------------------------------
-// Illumination networks (renderer/techniques/illumination_network, shaders/illumination_network).
-
-// One network node: a point of the medium with its local extinction, albedo and emission.
-struct NetworkNode {
-  vec4 positionTau;  // xyz world position, w extinction at the node
-  vec4 albedo;       // rgb single-scattering albedo, w unused
-  vec4 emission;     // rgb source per unit opacity ((1 - a) L_e), w unused
-};
-
-// One shared direction: w the direction of propagation, u and v the window's axes.
-struct NetworkDirection {
-  vec4 w, u, v;  // xyz, w unused
-};
-
-// One directional light as the network sees it: propagation direction and irradiance.
-struct NetworkLight {
-  vec4 direction;   // xyz unit, w unused
-  vec4 irradiance;  // rgb, w unused
 };
 
 #endif

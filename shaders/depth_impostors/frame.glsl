@@ -6,6 +6,7 @@
 #ifndef RADIANT_DEPTH_IMPOSTORS_FRAME
 #define RADIANT_DEPTH_IMPOSTORS_FRAME
 #include "common/shared.h"
+#include "depth_impostors/shared.h"
 
 layout(std430, binding = kBindingImpostorBlocks) readonly buffer Blocks { ImpostorBlock blocks[]; };
 

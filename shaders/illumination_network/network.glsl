@@ -4,6 +4,7 @@
 #ifndef RADIANT_NETWORK_GLSL
 #define RADIANT_NETWORK_GLSL
 #include "common/shared.h"
+#include "illumination_network/shared.h"
 #include "common/phase.glsl"
 
 uniform int u_nodes;       // N

@@ -27,6 +27,7 @@
 #include "common/cube_texels.glsl"  // cubeTexelCentre
 #include "common/octahedral.glsl"
 #include "common/shared.h"
+#include "specular/shared.h"
 
 // Reflection/refraction data of a specular surface in the thesis' representation (5.2). Mixtures are
 // reduced to one of the two ideal cases: a refractor (any transmission) keeps its ior and its

@@ -7,6 +7,8 @@
 // The surface point is the reference point plus the texel's centre direction times its stored
 // distance; its normal faces the reference point (the map's viewer, as map.frag shades it). One gather
 // per block of texels, spread over the block's texels on the same surface (u_mode below).
+#include "common/shared.h"
+#include "specular/shared.h"
 #include "photon_gi/grid.glsl"
 #include "photon_gi/photon.glsl"
 #include "specular/map_texel.glsl"  // texelPoint, texelNormal; u_reference, u_face, u_size

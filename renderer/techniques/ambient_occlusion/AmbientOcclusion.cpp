@@ -13,6 +13,10 @@
 #include "renderer/frame/PassContext.h"
 #include "renderer/shading/ImageBasedLighting.h"
 
+namespace radiant::gpu {
+#include "shaders/ambient_occlusion/shared.h"  // the resolve's unit
+}  // namespace radiant::gpu
+
 namespace radiant {
 namespace ao {
 namespace {

@@ -16,6 +16,10 @@
 #include "renderer/shading/SpecularMaps.h"
 #include "renderer/shading/SpecularObjects.h"
 
+namespace radiant::gpu {
+#include "shaders/caustics/shared.h"  // the caustic cubes' unit
+}  // namespace radiant::gpu
+
 namespace radiant {
 namespace {
 

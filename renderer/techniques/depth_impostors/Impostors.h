@@ -9,7 +9,13 @@
 
 #include "renderer/gl/Gl.h"
 #include "renderer/gl/ShaderLibrary.h"
-#include "renderer/techniques/depth_impostors/Blocks.h"
+#include "renderer/techniques/depth_impostors/Blocks.h"  // renderer/frame/GpuTypes.h
+
+namespace radiant::gpu {
+#include "shaders/depth_impostors/shared.h"  // ImpostorBlock, its bindings and the slice limit
+
+static_assert(sizeof(ImpostorBlock) == 64, "std430 ImpostorBlock must be 64 bytes");
+}  // namespace radiant::gpu
 
 namespace radiant::impostors {
 

@@ -13,7 +13,15 @@
 #include "renderer/gl/Gl.h"
 #include "renderer/gl/ShaderLibrary.h"
 #include "renderer/raytracing/Cancel.h"
+#include "renderer/frame/GpuTypes.h"
 #include "renderer/techniques/illumination_network/Network.h"
+
+namespace radiant::gpu {
+#include "shaders/illumination_network/shared.h"  // the network's records as the shaders read them
+
+static_assert(sizeof(NetworkNode) == 48 && sizeof(NetworkDirection) == 48 && sizeof(NetworkLight) == 32,
+              "std430 network records are whole vec4s");
+}  // namespace radiant::gpu
 
 namespace radiant::network {
 
