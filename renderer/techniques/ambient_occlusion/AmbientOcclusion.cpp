@@ -215,12 +215,8 @@ void AmbientOcclusionPass::prepare(const Scene&, const Params& params, FrameReso
   const AmbientOcclusionParams p = AmbientOcclusionParams::from(params);
   method_ = p.method;
   falloff_ = p.falloff;
-  samples_ = std::clamp(p.samples, 1, ao::kMaxSamples);
+  samples_ = p.samples;  // at most ao::kMaxSamples: the schema's maximum (Params.ASchemasRangeIsWhatItsPassCanHold)
   radius_ = static_cast<float>(p.radius);
-  if (!(radius_ > 0.f) || !std::isfinite(radius_))
-    throw api::ApiError(422, "out-of-range", "Value out of range",
-                        "/passes/ambient_occlusion/radius: must be a finite number above 0",
-                        "/passes/ambient_occlusion/radius");
   interleave_ = p.interleave;
   blur_ = p.blur;
   scale_ = p.resolution_scale == AmbientOcclusionParams::ResolutionScale::kHalf ? 2 : 1;

@@ -163,17 +163,18 @@ void CausticsPass::validate(const Scene& scene, const FrameView&, const Params& 
 
 void CausticsPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
   const CausticsParams p = CausticsParams::from(params);
-  // Every default is the descriptor's (caustics.json): Params has no fallback.
+  // Every default and range is the descriptor's (caustics.json): Params has no fallback, and holds only
+  // values api::techniqueParams checked against the schema (no clamp here repeats a range).
   method_ = p.method == CausticsParams::Method::kSplat ? Method::Splat : Method::Triangles;
-  photonResolution_ = std::clamp(p.photon_resolution, 32, 256);
-  cubeResolution_ = std::clamp(p.cube_resolution, 16, 1024);
-  areaWeight_ = std::clamp(static_cast<float>(p.area_weight), 0.1f, 1.f);
-  visibilityTolerance_ = std::clamp(static_cast<float>(p.visibility_tolerance), 0.f, 64.f);
-  maxDepth_ = std::clamp(p.max_depth, 1, 8);
-  secondaryMaxDepth_ = std::clamp(p.secondary_max_depth, 1, 8);
-  linearSteps_ = std::clamp(p.linear_steps, 1, 256);
-  secantSteps_ = std::clamp(p.secant_steps, 0, 32);
-  splatRadius_ = std::clamp(static_cast<float>(p.splat_radius), 1e-4f, 10.f);
+  photonResolution_ = p.photon_resolution;
+  cubeResolution_ = p.cube_resolution;
+  areaWeight_ = static_cast<float>(p.area_weight);
+  visibilityTolerance_ = static_cast<float>(p.visibility_tolerance);
+  maxDepth_ = p.max_depth;
+  secondaryMaxDepth_ = p.secondary_max_depth;
+  linearSteps_ = p.linear_steps;
+  secantSteps_ = p.secant_steps;
+  splatRadius_ = static_cast<float>(p.splat_radius);
   energyCheck_ = p.energy_check;
   fresnelReflection_ = p.fresnel_reflection;
   footprintFilter_ = p.footprint_filter;

@@ -65,10 +65,10 @@ int mapResolution(double objectPixels, double texelsPerPixel, int maxResolution)
 MapResolution chooseMapResolution(const Scene& scene, const FrameView& view, const Params& params, bool causticsOwnsLSDE) {
   const SpecularParams p = SpecularParams::from(params);
   MapResolution r;
-  r.texels = std::clamp(p.cube_resolution, 16, 2048);
+  r.texels = p.cube_resolution;
   // A cube_resolution the request gives is run as asked, unless it gives map_texels_per_pixel too.
   r.adaptive = !p.given.cube_resolution || p.given.map_texels_per_pixel;
-  const double texelsPerPixel = r.adaptive ? std::clamp(p.map_texels_per_pixel, 0.0, 64.0) : 0.0;
+  const double texelsPerPixel = r.adaptive ? p.map_texels_per_pixel : 0.0;
   if (texelsPerPixel <= 0.0) return r;
   for (std::size_t i : specularMeshes(scene))
     r.largestObjectPixels = std::max(r.largestObjectPixels, projectedDiameterPixels(view, scene.meshes[i].bounds));
@@ -135,12 +135,13 @@ void SpecularPass::validate(const Scene& scene, const FrameView& view, const Par
 
 void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
   const SpecularParams p = SpecularParams::from(params);
-  // Every default is the descriptor's (specular.json): Params has no fallback.
-  maxDepth_ = std::clamp(p.max_depth, 1, 8);
-  linearSteps_ = std::clamp(p.linear_steps, 1, 256);
-  secantSteps_ = std::clamp(p.secant_steps, 0, 32);
-  layers_ = std::clamp(p.layers, 3, 6);
-  indirectBlock_ = std::clamp(p.map_indirect_block, 1, 64);
+  // Every default and range is the descriptor's (specular.json): Params has no fallback, and holds only
+  // values api::techniqueParams checked against the schema (no clamp here repeats a range).
+  maxDepth_ = p.max_depth;
+  linearSteps_ = p.linear_steps;
+  secantSteps_ = p.secant_steps;
+  layers_ = p.layers;
+  indirectBlock_ = p.map_indirect_block;
   minmax_ = p.minmax;
 
   const Bounds& sb = scene.features.bounds;

@@ -9,6 +9,8 @@
 #include <map>
 #include <stdexcept>
 #include <string>
+#include <tuple>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -28,6 +30,8 @@
 #include "params/spherical_billboards_params.h"
 #include "params/transparency_params.h"
 #include "renderer/frame/Technique.h"
+#include "renderer/techniques/ambient_occlusion/AmbientOcclusion.h"
+#include "tests/support/Expect.h"
 
 namespace radiant {
 namespace {
@@ -88,6 +92,23 @@ TEST(Params, EveryTechniquesTypedStructReadsItsSchemasDefaults) {
   EXPECT_EQ(photons.h_schedule, PhotonGiParams::HSchedule::kPaper);
   EXPECT_FALSE(photons.given.photons);
   EXPECT_STREQ(PhotonGiParams::toString(photons.method), "gather");
+}
+
+// A pass reads its parameters without clamping them: no value outside the schema's range reaches it
+// (api::techniqueParams is a 422 naming the field, for the HTTP route and for Renderer alike), and
+// where the range feeds a fixed capacity the schema's maximum is that capacity.
+TEST(Params, ASchemasRangeIsWhatItsPassCanHold) {
+  for (const auto& [technique, key, outside] : std::vector<std::tuple<std::string, std::string, nlohmann::json>>{
+           {"specular", "layers", 7}, {"specular", "max_depth", 0}, {"caustics", "cube_resolution", 2048},
+           {"caustics", "splat_radius", 0.0}, {"ambient_occlusion", "samples", 65}, {"ambient_occlusion", "radius", 0.0}}) {
+    const api::ApiError e = testing::thrownApiError([&] { api::techniqueParams(technique, {{key, outside}}); });
+    EXPECT_EQ(e.status, 422) << technique << "." << key;
+    EXPECT_NE(e.pointer.find(key), std::string::npos) << e.pointer;
+  }
+  // AO's std140 sample block holds ao::kMaxSamples kernel samples (buildSampleBlock throws above it).
+  const nlohmann::json& samples = api::findTechnique("ambient_occlusion")->params.at("samples");
+  EXPECT_EQ(samples.at("maximum").get<int>(), ao::kMaxSamples);
+  EXPECT_EQ(samples.at("minimum").get<int>(), 1);
 }
 
 // Every value of every string enum parses (the generated parse lists the schema's values), and a value
