@@ -76,6 +76,18 @@ void composeMediaIntoBeauty(PassContext& ctx) {
   res.markWritten("beauty");
 }
 
+namespace {
+// A particle without optical depth is no medium: no shader sees it.
+bool drawn(const api::Particle& p) { return p.tau > 0.f; }
+}  // namespace
+
+std::size_t mediaParticleCount(const std::vector<api::ParticleSystem>& media) {
+  std::size_t n = 0;
+  for (const api::ParticleSystem& s : media)
+    n += static_cast<std::size_t>(std::count_if(s.particles.begin(), s.particles.end(), drawn));
+  return n;
+}
+
 std::vector<gpu::MediaParticle> mediaParticles(const std::vector<api::ParticleSystem>& media, glm::vec3 ambient,
                                                glm::vec3 eye, glm::vec3 forward, bool orthographic, bool sort,
                                                std::vector<int>* systemOf) {
@@ -90,7 +102,7 @@ std::vector<gpu::MediaParticle> mediaParticles(const std::vector<api::ParticleSy
                       : s.phase == api::PhaseModel::CornetteShanks ? gpu::kPhaseCornetteShanks
                                                                    : gpu::kPhaseIsotropic;
     for (const api::Particle& p : s.particles) {
-      if (!(p.tau > 0.f)) continue;
+      if (!drawn(p)) continue;
       // (1 - a) L_e + a L_ambient: a uniform sky integrates the phase function to 1.
       const glm::vec3 emitted = s.emits() ? s.emissionScale * rt::blackbodyRgb(p.temperature) : glm::vec3(0.f);
       const glm::vec3 source = (1.f - p.albedo) * emitted + p.albedo * ambient;

@@ -2,6 +2,7 @@
 // The media layer every media technique writes and composes (spherical_billboards, depth_impostors;
 // illumination_network; one of them per frame, FramePlanner): the "media" target (RGBA32F: RGB premultiplied radiance,
 // A transmittance) and its composition into beauty, beauty = beauty * T + C (thesis 7.2.3).
+#include <cstddef>
 #include <vector>
 
 #include "renderer/frame/FrameResources.h"
@@ -21,6 +22,8 @@ struct FrameView;
 std::vector<gpu::MediaParticle> mediaParticles(const std::vector<api::ParticleSystem>& media, glm::vec3 ambient,
                                                glm::vec3 eye, glm::vec3 forward, bool orthographic, bool sort,
                                                std::vector<int>* systemOf = nullptr);
+// How many particles mediaParticles() returns (those with an optical depth above 0), without building them.
+std::size_t mediaParticleCount(const std::vector<api::ParticleSystem>& media);
 
 // Run when the frame has particles (the scene's or the request's), else skip with the reason.
 Requirements mediaRequirements(const Scene& scene, const api::RenderRequest& request);

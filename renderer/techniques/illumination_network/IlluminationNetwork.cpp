@@ -102,10 +102,7 @@ void IlluminationNetworkPass::validate(const Scene&, const FrameView& view, cons
   // to the network beyond kSkyExactBudget: prepare()).
   using Sky = IlluminationNetworkParams::SkySingleScatter;
   if (p.final_render == IlluminationNetworkParams::FinalRender::kMarch && p.sky_single_scatter == Sky::kExact) {
-    const std::size_t chords = mediaParticles(view.media, glm::vec3(0.f), view.eye, glm::vec3(0.f, 0.f, -1.f),
-                                              /*orthographic=*/false, /*sort=*/false)
-                                   .size() *
-                               std::size_t(D);
+    const std::size_t chords = mediaParticleCount(view.media) * std::size_t(D);
     if (chords > kSkyExactMax)
       throw api::ApiError(422, "invalid-value", "Exact sky single scattering too costly",
                           "sky_single_scatter exact sums particles x directions = " + std::to_string(chords) +
