@@ -21,11 +21,11 @@ const std::vector<std::string>& supportedExtensions() {
       "KHR_materials_volume",     // Beer-Lambert absorption over the traced path (thickness: see Scene.h)
       "KHR_mesh_quantization",  // any component type is read and normalised
       "KHR_texture_transform",
-      "EXT_texture_webp",       // decoded with libwebp (GltfLoader.cpp); its image wins over `source`
+      "EXT_texture_webp",       // decoded with libwebp (GltfFiles.cpp); its image wins over `source`
       "KHR_materials_unlit",
       "KHR_draco_mesh_compression",  // decoded at load (GltfCompression.cpp)
       "EXT_meshopt_compression",     // decoded at load (GltfCompression.cpp)
-      "RADIANT_particle_system",     // participating media, api/schema/media.json (GltfLoader.cpp)
+      "RADIANT_particle_system",     // participating media, api/schema/media.json (GltfConverter.cpp)
   };
   return k;
 }

@@ -1,6 +1,6 @@
 #pragma once
 // The glTF extensions the loader implements beyond the core spec, in one table, and the material
-// extensions that change what a texture lookup or a material means. GltfLoader.cpp calls these hooks;
+// extensions that change what a texture lookup or a material means. The loader (GltfMaterials.cpp) calls these hooks;
 // mesh compression (KHR_draco_mesh_compression, EXT_meshopt_compression) is in GltfCompression.h.
 //
 // - An unsupported extension in extensionsRequired refuses the file (SceneError -> 422) naming it and,

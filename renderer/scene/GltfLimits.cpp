@@ -198,7 +198,7 @@ void chargeAccessorExpansion(const json& doc, DecodeBudget& budget) {
   budget.charge(total, "", "the scene's expanded geometry");
 }
 
-// The default scene's nodes in the loader's depth-first order (GltfLoader.cpp, walkScene): the
+// The default scene's nodes in the loader's depth-first order (GltfConverter.cpp, walkScene): the
 // camera is the first node with one, lights are pushed one per node in this order.
 std::vector<std::size_t> depthFirstNodes(const json& doc) {
   const json& nodes = arrayOf(doc, "nodes");

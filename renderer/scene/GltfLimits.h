@@ -73,7 +73,7 @@ struct ImageHeader {
 };
 std::optional<ImageHeader> readImageHeader(const unsigned char* bytes, std::size_t size);
 // A WebP file (RIFF container, "WEBP" form type: EXT_texture_webp). stb_image does not decode WebP;
-// libwebp does (GltfLoader.cpp), 8-bit RGBA.
+// libwebp does (GltfFiles.cpp), 8-bit RGBA.
 bool isWebp(const unsigned char* bytes, std::size_t size);
 // PNG, JPEG or WebP by its magic bytes: the image formats a glTF may hold (DecodeBudget::chargeImage
 // refuses the others before a decoder sees them).

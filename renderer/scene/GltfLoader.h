@@ -2,7 +2,7 @@
 // glTF 2.0 (.gltf and .glb) -> Scene. Everything the file says is validated before it is used, and
 // every problem with the file is a SceneError that carries a JSON pointer into the glTF document.
 //
-// What is supported and how (details in GltfLoader.cpp):
+// What is supported and how (details in the modules GltfLoader.cpp drives: docs/DEVELOPMENT.md):
 // - Buffers and images from data URIs, the GLB BIN chunk, or files under LoadOptions::assetRoot.
 //   External URIs may not be absolute, may not contain "..", and may not resolve (through
 //   symlinks) outside the root. Other URI schemes (http:, file:) are refused.

@@ -47,6 +47,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   } catch (const radiant::SceneError&) {
   }
   // Decoded faces may index beyond the decoded points (a mutated connectivity stream does): the loader
-  // checks every primitive's indices against its vertices next (GltfLoader.cpp, 422 at /indices).
+  // checks every primitive's indices against its vertices next (GltfMeshes.cpp, 422 at /indices).
   return 0;
 }
