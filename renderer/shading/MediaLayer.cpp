@@ -81,10 +81,13 @@ namespace {
 bool drawn(const api::Particle& p) { return p.tau > 0.f; }
 }  // namespace
 
+std::size_t mediaParticleCount(const api::ParticleSystem& system) {
+  return static_cast<std::size_t>(std::count_if(system.particles.begin(), system.particles.end(), drawn));
+}
+
 std::size_t mediaParticleCount(const std::vector<api::ParticleSystem>& media) {
   std::size_t n = 0;
-  for (const api::ParticleSystem& s : media)
-    n += static_cast<std::size_t>(std::count_if(s.particles.begin(), s.particles.end(), drawn));
+  for (const api::ParticleSystem& s : media) n += mediaParticleCount(s);
   return n;
 }
 

@@ -22,8 +22,10 @@ struct FrameView;
 std::vector<gpu::MediaParticle> mediaParticles(const std::vector<api::ParticleSystem>& media, glm::vec3 ambient,
                                                glm::vec3 eye, glm::vec3 forward, bool orthographic, bool sort,
                                                std::vector<int>* systemOf = nullptr);
-// How many particles mediaParticles() returns (those with an optical depth above 0), without building them.
+// How many particles mediaParticles() returns (those with an optical depth above 0), without building
+// them: of every system, or of one.
 std::size_t mediaParticleCount(const std::vector<api::ParticleSystem>& media);
+std::size_t mediaParticleCount(const api::ParticleSystem& system);
 
 // Run when the frame has particles (the scene's or the request's), else skip with the reason.
 Requirements mediaRequirements(const Scene& scene, const api::RenderRequest& request);

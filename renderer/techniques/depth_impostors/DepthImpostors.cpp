@@ -2,6 +2,7 @@
 #include "params/depth_impostors_params.h"
 
 #include <algorithm>
+#include <limits>
 #include <numeric>
 
 #include "renderer/frame/FrameResources.h"
@@ -29,6 +30,30 @@ GroundTruth DepthImpostorsPass::groundTruth(const Params&, const std::string& ao
   return GroundTruth::fromAovTable(aov);
 }
 
+std::size_t DepthImpostorsPass::blockCount(const std::vector<api::ParticleSystem>& media, int particlesPerBlock) {
+  const std::size_t b = static_cast<std::size_t>(std::max(1, particlesPerBlock));  // as buildBlocks
+  std::size_t blocks = 0;
+  for (const api::ParticleSystem& s : media) blocks += (mediaParticleCount(s) + b - 1) / b;
+  return blocks;
+}
+
+impostors::AtlasLayout DepthImpostorsPass::fittedAtlas(std::size_t blocks, int requestedRes) {
+  const impostors::AtlasLayout layout =
+      impostors::atlasLayout(static_cast<int>(std::min<std::size_t>(blocks, std::numeric_limits<int>::max())), requestedRes);
+  if (blocks > 0 && layout.res == 0)
+    throw api::ApiError(422, "out-of-range", "Too many blocks",
+                        std::to_string(blocks) + " blocks do not fit the impostor atlas (" +
+                            std::to_string(impostors::AtlasLayout::kMaxAtlas) + " texels a side, tiles of at least " +
+                            std::to_string(impostors::AtlasLayout::kMinRes) + "); raise particles_per_block",
+                        "/passes/depth_impostors/particles_per_block");
+  return layout;
+}
+
+void DepthImpostorsPass::validate(const Scene&, const FrameView& view, const Params& params) const {
+  const DepthImpostorsParams p = DepthImpostorsParams::from(params);
+  fittedAtlas(blockCount(view.media, p.particles_per_block), p.impostor_resolution);
+}
+
 void DepthImpostorsPass::prepare(const Scene& scene, const Params& params, FrameResources& res) {
   const DepthImpostorsParams p = DepthImpostorsParams::from(params);
   const FrameView& view = res.view();
@@ -52,13 +77,7 @@ void DepthImpostorsPass::prepare(const Scene& scene, const Params& params, Frame
         mediaParticles(view.media, view.ambient, view.eye, forward, ortho, false, &systemOf);
     return std::make_unique<impostors::BlockSet>(impostors::buildBlocks(particles, systemOf, particlesPerBlock_));
   });
-  const impostors::AtlasLayout layout = impostors::atlasLayout(static_cast<int>(blocks.blocks.size()), requestedRes_);
-  if (!blocks.blocks.empty() && layout.res == 0)
-    throw api::ApiError(422, "out-of-range", "Too many blocks",
-                        std::to_string(blocks.blocks.size()) + " blocks do not fit the impostor atlas (" +
-                            std::to_string(impostors::AtlasLayout::kMaxAtlas) + " texels a side, tiles of at least " +
-                            std::to_string(impostors::AtlasLayout::kMinRes) + "); raise particles_per_block",
-                        "/passes/depth_impostors/particles_per_block");
+  const impostors::AtlasLayout layout = fittedAtlas(blocks.blocks.size(), requestedRes_);
 
   // The view axis and the shadowed light (the first punctual light).
   viewAxis_ = ortho ? impostors::ImpostorAxis{0, forward} : impostors::ImpostorAxis{1, view.eye};

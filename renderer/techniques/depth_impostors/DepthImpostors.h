@@ -14,8 +14,10 @@
 // others and the sky are not (the sky adds albedo * ambient per block). Ground truth: the volumetric
 // reference's single_scatter mode. Blocks and impostors are cached by the medium and parameters, the
 // impostors also by the camera and the light.
+#include <cstddef>
 #include <vector>
 
+#include "api/Media.h"
 #include "renderer/frame/Technique.h"
 #include "renderer/gl/Gl.h"
 #include "renderer/techniques/depth_impostors/Impostors.h"
@@ -27,8 +29,18 @@ public:
   const TechniqueInfo& info() const override;
   Requirements requirements(const Scene&, const api::RenderRequest&) const override;
   GroundTruth groundTruth(const Params& params, const std::string& aov) const override;
+  // The impostor atlas's limit (impostors::atlasLayout: 2048 texels a side, tiles of at least 4) for
+  // the frame's particles at particles_per_block, counted without building the blocks (blockCount): a
+  // 422 before the queue (Renderer::check); prepare() checks the blocks it built with the same rule.
+  void validate(const Scene& scene, const FrameView& view, const Params& params) const override;
   void prepare(const Scene&, const Params&, FrameResources&) override;
   void execute(PassContext&) override;
+
+  // How many blocks impostors::buildBlocks makes of the frame's particles: ceil(n / b) for each
+  // system's n particles with optical depth (mediaParticles' rule).
+  static std::size_t blockCount(const std::vector<api::ParticleSystem>& media, int particlesPerBlock);
+  // The atlas of `blocks` tiles at `requestedRes`, or the 422 when they do not fit even at the smallest tile.
+  static impostors::AtlasLayout fittedAtlas(std::size_t blocks, int requestedRes);
 
 private:
   impostors::ImpostorSet* set_ = nullptr;  // cached in FrameResources

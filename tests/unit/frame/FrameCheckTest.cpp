@@ -9,6 +9,9 @@
 
 #include "api/Validate.h"
 #include "renderer/Renderer.h"
+#include "renderer/shading/MediaLayer.h"
+#include "renderer/techniques/depth_impostors/Blocks.h"
+#include "renderer/techniques/depth_impostors/DepthImpostors.h"
 #include "renderer/scene/BuiltinScenes.h"
 #include "tests/support/Expect.h"
 #include "tests/support/SceneBuilder.h"
@@ -76,6 +79,14 @@ TEST(FrameCheck, TheNetworksExactSkyIsCheckedAgainstTheRequestsParticles) {
   EXPECT_NE(e.detail().find("131072"), std::string::npos) << e.detail();
   const api::RenderRequest fits = api::parseRenderRequest(body(64));
   EXPECT_NO_THROW(Renderer::check(loadBuiltinScene("cornell_box"), fits, {}));
+  // Particles without optical depth are no medium (mediaParticleCount, mediaParticles' rule): a second
+  // system of 1024 at tau 0 adds no chords, so 64 directions still fit.
+  json clear = many;
+  clear["tau"] = 0.0;
+  json both = body(64);
+  both["media"].push_back(clear);
+  EXPECT_NO_THROW(Renderer::check(loadBuiltinScene("cornell_box"), api::parseRenderRequest(both), {}));
+  EXPECT_EQ(mediaParticleCount(api::parseRenderRequest(both).media), 1024u);
 }
 
 // `n` mirror quads under a point light above a lit floor (every mirror is a specular object of the
@@ -130,6 +141,44 @@ TEST(FrameCheck, TheSpecularMapsAndCausticCubesMemoryLimitsAreCheckedBeforeTheQu
   EXPECT_EQ(e.status, 422);
   EXPECT_EQ(e.pointer, "/passes/caustics/cube_resolution");
   EXPECT_NO_THROW(Renderer::check(mirrors(5), api::parseRenderRequest(box()), {}));
+}
+
+// The impostor atlas holds at most 512 x 512 tiles (2048 texels a side, tiles of at least 4): a scene's
+// 262,145 particles (a glTF may hold 2^20; a request at most 65536) at one particle a block do not fit,
+// two a block do. The blocks are counted, not built (DepthImpostorsPass::blockCount), with
+// buildBlocks' rule: ceil(n / b) per system of the particles with optical depth.
+TEST(FrameCheck, TheImpostorAtlasIsCheckedAgainstTheFramesParticlesBeforeTheQueue) {
+  auto system = [](std::size_t n, float tau) {
+    api::ParticleSystem s;
+    s.name = "cloud";
+    for (std::size_t i = 0; i < n; ++i) {
+      api::Particle p;
+      p.position = glm::vec3(float(i % 64) * 0.01f, float((i / 64) % 64) * 0.01f, float(i / 4096) * 0.01f);
+      p.radius = 0.01f;
+      p.tau = tau;
+      s.particles.push_back(p);
+    }
+    return s;
+  };
+  // The count is buildBlocks' (three systems, one of them without optical depth).
+  const std::vector<api::ParticleSystem> media = {system(5, 1.f), system(7, 0.f), system(3, 2.f)};
+  std::vector<int> systemOf;
+  const auto particles = mediaParticles(media, glm::vec3(0.f), glm::vec3(0.f, 0.f, 5.f), glm::vec3(0.f, 0.f, -1.f),
+                                        false, false, &systemOf);
+  for (int b : {1, 2, 4, 64})
+    EXPECT_EQ(DepthImpostorsPass::blockCount(media, b), impostors::buildBlocks(particles, systemOf, b).blocks.size()) << b;
+
+  Scene scene = loadBuiltinScene("cornell_box");
+  scene.media.push_back(system(262145, 1.f));
+  scene.features = computeFeatures(scene);
+  auto impostorsAt = [](int b) {
+    return api::parseRenderRequest(box({{"passes", {{"depth_impostors", {{"particles_per_block", b}}}}}}));
+  };
+  const api::ApiError e = testing::thrownApiError([&] { Renderer::check(scene, impostorsAt(1), {}); });
+  EXPECT_EQ(e.status, 422);
+  EXPECT_EQ(e.pointer, "/passes/depth_impostors/particles_per_block");
+  EXPECT_NE(e.detail().find("262145 blocks"), std::string::npos) << e.detail();
+  EXPECT_NO_THROW(Renderer::check(scene, impostorsAt(2), {}));
 }
 
 TEST(FrameCheck, TheCameraAndTheCompareBlockAre422BeforeAnyFrame) {
