@@ -10,10 +10,10 @@
 
 #include <glm/glm.hpp>
 
+#include "renderer/frame/GpuTypes.h"
 #include "renderer/gl/Gl.h"
 #include "renderer/gl/ShaderLibrary.h"
 #include "renderer/raytracing/Cancel.h"
-#include "renderer/frame/GpuTypes.h"
 #include "renderer/techniques/illumination_network/Network.h"
 
 namespace radiant::gpu {

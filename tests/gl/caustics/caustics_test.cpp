@@ -561,8 +561,9 @@ TEST(Caustics, SplatBaselineConservesEnergyAndMatchesThePlateau) {
   for (int py = 0; py < n; ++py)
     for (int px = 0; px < n; ++px) {
       const glm::vec2 p = floorPoint(px, py, n, 1.5f);
-      if (std::max(std::abs(p.x), std::abs(p.y)) < 0.5f - 0.1f)
+      if (std::max(std::abs(p.x), std::abs(p.y)) < 0.5f - 0.1f) {
         EXPECT_NEAR(caustics.at(px, py)[1], under, 0.03 * under) << px << "," << py;
+      }
     }
 }
 
@@ -905,7 +906,7 @@ TEST(Caustics, SecondaryLookupAddsLightWithEveryLevelOfItsTrees) {
   for (int depth : {1, 2, 4}) {
     auto [sum, stats] = beautySum({{"secondary_max_depth", depth}});
     for (const auto& p : stats.passes)
-      if (p.name == "caustics") EXPECT_EQ(p.counters.at("secondary_max_depth"), depth);
+      if (p.name == "caustics") { EXPECT_EQ(p.counters.at("secondary_max_depth"), depth); }
     light.push_back(sum - none);
   }
   std::printf("secondary light at depth 1 / 2 / 4: %.4f / %.4f / %.4f of a frame of %.1f\n", light[0], light[1],

@@ -159,31 +159,6 @@ Scene cornellWithSphereAt(glm::vec3 sphereCentre, const std::string& tag) {
   return s;
 }
 
-// Relative RMS error sqrt(sum (t - r)^2 / sum r^2) over the pixels of receiver `id` (RGB).
-double relRmse(const Image& test, const Image& ref, const Masks& m, int id) {
-  double num = 0, den = 0;
-  for (int y = 0; y < test.height; ++y)
-    for (int x = 0; x < test.width; ++x) {
-      if (m.id[y * test.width + x] != id) continue;
-      for (int c = 0; c < 3; ++c) {
-        const double d = test.at(x, y)[c] - ref.at(x, y)[c];
-        num += d * d;
-        den += double(ref.at(x, y)[c]) * ref.at(x, y)[c];
-      }
-    }
-  return den > 0 ? std::sqrt(num / den) : 0.0;
-}
-
-// Ratio of means over receiver `id` (bias).
-double meanRatio(const Image& test, const Image& ref, const Masks& m, int id) {
-  double a = 0, b = 0;
-  for (int y = 0; y < test.height; ++y)
-    for (int x = 0; x < test.width; ++x)
-      if (m.id[y * test.width + x] == id) a += luminance(test.at(x, y)), b += luminance(ref.at(x, y));
-  return b > 0 ? a / b : 0.0;
-}
-
-
 TEST(EnvDiffuseAccuracy, CornellReceiversAgainstOneBounceReference) {
   // The built-in Cornell box, receivers sphere and tall box (extras flags), the sphere either in the
   // open (0.1, 0.17, 0.22) or touching the green wall (0.33, 0.17, 0.13). Ground truth: the reference

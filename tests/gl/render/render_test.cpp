@@ -755,8 +755,8 @@ TEST(FrameGraph, TheRegistryReversedRendersTheSameFrames) {
     for (const auto& p : forwards.stats.passes) pf.insert(p.name);
     for (const auto& p : backwards.stats.passes) pb.insert(p.name);
     EXPECT_EQ(pf, pb) << c.scene;
-    if (c.scene == "explosion") EXPECT_TRUE(pf.count("transparency") && pf.count("spherical_billboards"));
-    if (c.scene == "cornell_glass" && c.passes.empty()) EXPECT_TRUE(pf.count("caustics") && pf.count("photon_gi"));
+    if (c.scene == "explosion") { EXPECT_TRUE(pf.count("transparency") && pf.count("spherical_billboards")); }
+    if (c.scene == "cornell_glass" && c.passes.empty()) { EXPECT_TRUE(pf.count("caustics") && pf.count("photon_gi")); }
     std::string order;
     for (const auto& p : backwards.stats.passes) order += (order.empty() ? "" : " ") + p.name;
     for (const std::string& name : c.aovs) {

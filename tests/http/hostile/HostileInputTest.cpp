@@ -164,7 +164,7 @@ protected:
     ASSERT_TRUE(p.is_object()) << r->body.substr(0, 600);
     EXPECT_EQ(p["type"], "https://radiant.dev/problems/" + type) << r->body.substr(0, 600);
     EXPECT_EQ(p.value("pointer", ""), pointer) << r->body.substr(0, 600);
-    if (!text.empty()) EXPECT_NE(p["detail"].get<std::string>().find(text), std::string::npos) << p["detail"];
+    if (!text.empty()) { EXPECT_NE(p["detail"].get<std::string>().find(text), std::string::npos) << p["detail"]; }
   }
 
   static inline Daemon* daemon_ = nullptr;

@@ -293,9 +293,9 @@ TEST(RealDaemon, RendersBuiltinsRejectsBadInputAndStopsCleanly) {
       if (!res || res->status != 200) return "render " + std::to_string(i) + " failed: " + (res ? res->body : "no response");
       const std::string bytes = c.Get(json::parse(res->body)["frames"][0]["url"].get<std::string>().c_str())->body;
       if (bytes.size() < 24 || bytes.compare(12, 4, "IHDR") != 0) return "not a PNG";
-      auto be32 = [&](std::size_t o) {
-        return (unsigned char)bytes[o] << 24 | (unsigned char)bytes[o + 1] << 16 | (unsigned char)bytes[o + 2] << 8 |
-               (unsigned char)bytes[o + 3];
+      auto be32 = [&](std::size_t o) -> unsigned {
+        return unsigned((unsigned char)bytes[o]) << 24 | unsigned((unsigned char)bytes[o + 1]) << 16 |
+               unsigned((unsigned char)bytes[o + 2]) << 8 | unsigned((unsigned char)bytes[o + 3]);
       };
       if (be32(16) != 16u + i || be32(20) != 8u + 2 * i)
         return "frame " + std::to_string(i) + " is " + std::to_string(be32(16)) + "x" + std::to_string(be32(20));

@@ -488,7 +488,7 @@ TEST(Presets, ASpeedFactorScalesEveryPredictionAndTheBudgetWithIt) {
         const json& a = slow.stats["techniques"][name]["predicted_ms"];
         const json& b = unit.stats["techniques"][name]["predicted_ms"];
         ASSERT_EQ(a.is_number(), b.is_number()) << name;
-        if (a.is_number()) EXPECT_NEAR(a.get<double>(), s * b.get<double>(), 1e-9 * a.get<double>()) << name;
+        if (a.is_number()) { EXPECT_NEAR(a.get<double>(), s * b.get<double>(), 1e-9 * a.get<double>()) << name; }
       }
       EXPECT_NEAR(slow.stats["predicted_ms"].get<double>(), s * unit.stats["predicted_ms"].get<double>(), 1e-9 * budget * s);
       EXPECT_NEAR(slow.stats["predicted_overhead_ms"].get<double>(), 3.0 * s, 1e-12);

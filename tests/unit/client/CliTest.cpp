@@ -103,7 +103,7 @@ TEST(Cli, EveryCommandHasHelpFromTheDefinition) {
   for (const auto& c : d.commands) {
     const ProcessRun r = radiant(c + " --help");
     ASSERT_EQ(r.code, 0) << c << ": " << r.err;
-    if (c != "help") EXPECT_EQ(radiant("help " + c).out, r.out) << c;
+    if (c != "help") { EXPECT_EQ(radiant("help " + c).out, r.out) << c; }
     for (const auto& opt : d.options.at(c)) EXPECT_NE(r.out.find(opt), std::string::npos) << c << " " << opt;
   }
   // The flags the brief adds are in the definition.

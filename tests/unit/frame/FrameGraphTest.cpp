@@ -135,10 +135,11 @@ TEST(FrameGraph, RealPlansFollowTheDeclarationsInEveryRegistryOrder) {
                                    std::count(reader.optionalInputs.begin(), reader.optionalInputs.end(), out) >
                                0;
             const bool inPrepare = std::count(producer.prepareOutputs.begin(), producer.prepareOutputs.end(), out) > 0;
-            if (reads && !inPrepare && k != i) EXPECT_LT(k, i) << reader.name << " reads " << out << ": " << body.dump();
+            if (reads && !inPrepare && k != i) { EXPECT_LT(k, i) << reader.name << " reads " << out << ": " << body.dump(); }
           }
-          if (reader.addsToBeauty && producer.addsToBeauty && producer.beautyBlend < reader.beautyBlend)
+          if (reader.addsToBeauty && producer.addsToBeauty && producer.beautyBlend < reader.beautyBlend) {
             EXPECT_LT(k, i) << producer.name << " before " << reader.name;
+          }
         }
       }
     }

@@ -39,7 +39,7 @@ TEST(LightPathOwnership, EveryContestedClassHasAPolicyRowListingItsSuppliers) {
     EXPECT_EQ(listed, suppliers[cls]) << cls;
   }
   for (const auto& [cls, names] : suppliers)
-    if (names.size() > 1) EXPECT_TRUE(rows.count(cls)) << cls << " is supplied by " << names.size() << " techniques";
+    if (names.size() > 1) { EXPECT_TRUE(rows.count(cls)) << cls << " is supplied by " << names.size() << " techniques"; }
 }
 
 // The registry, forwards and backwards, plans the same passes with the same owners: ownership is the
@@ -73,7 +73,7 @@ TEST(LightPathOwnership, OwnersDoNotDependOnTheRegistrysOrder) {
     EXPECT_EQ(pa, pb) << body.dump();
     // The masks are the classes' bits.
     for (const auto& [cls, owner] : a.lightPaths)
-      if (api::lightPathBit(cls)) EXPECT_TRUE(a.owned.at(owner) & api::lightPathBit(cls)) << cls;
+      if (api::lightPathBit(cls)) { EXPECT_TRUE(a.owned.at(owner) & api::lightPathBit(cls)) << cls; }
     checked += !a.lightPaths.empty();
   }
   EXPECT_EQ(checked, static_cast<int>(requests.size()));

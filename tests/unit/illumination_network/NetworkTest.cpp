@@ -91,8 +91,8 @@ TEST(IlluminationNetwork, NormalisedPhaseColumnsSumToOneUnnormalisedDoNot) {
       const double dev = quadratureDeviation(dirs, api::PhaseModel::HenyeyGreenstein, g);
       std::printf("D %d g %.1f: unnormalised column-sum deviation %.3f, normalised %.1e\n", D, g, dev, worst);
       EXPECT_LT(worst, 1e-6);
-      if (g == 0.f) EXPECT_LT(dev, 1e-6);       // isotropic rows are exact for any directions
-      if (g >= 0.9f) EXPECT_GT(dev, 0.1);       // a sharp lobe is badly integrated by random directions
+      if (g == 0.f) { EXPECT_LT(dev, 1e-6); }       // isotropic rows are exact for any directions
+      if (g >= 0.9f) { EXPECT_GT(dev, 0.1); }       // a sharp lobe is badly integrated by random directions
     }
   }
 }
@@ -162,7 +162,7 @@ TEST(IlluminationNetwork, ContractsWithTheStatedFactorToOneFixedPoint) {
     for (iterations = 0; iterations < 5000; ++iterations) {
       const double r = iterate(net.pb, I, next);
       I.swap(next);
-      if (checkRate && last >= 0) EXPECT_LE(r, q * last + 1e-13) << "iteration " << iterations;
+      if (checkRate && last >= 0) { EXPECT_LE(r, q * last + 1e-13) << "iteration " << iterations; }
       last = r;
       if (r < 1e-10) break;
     }

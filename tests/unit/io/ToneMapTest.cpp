@@ -79,7 +79,7 @@ TEST(ToneMap, MonotoneOnGreyAndPerChannel) {
       // off-diagonals take a little from a saturated channel as the others rise (three.js's own output
       // falls from 1 to 0.99998 for red near 130 here), so AgX is monotone on grey only.
       const glm::vec3 red = toneMap(op, glm::vec3(g, 0.2f, 0.1f), 0.f);
-      if (op != ToneMap::Agx) ASSERT_GE(red.r, previousRed.r) << "red " << g;
+      if (op != ToneMap::Agx) { ASSERT_GE(red.r, previousRed.r) << "red " << g; }
       previousRed = red;
     }
   }
