@@ -2,6 +2,12 @@
 // The glTF 2.0 metallic-roughness BSDF of the CPU ray-tracing core, with its sampling routines. The
 // reference path tracer (radiance) and the photon tracer (importance) share it.
 //
+// ONE SOURCE: the BSDF's value, pdf and sampling are shaders/common/brdf.glsl, compiled here as C++
+// inside namespace radiant::rt::glsl (the beam.glsl approach, ARCHITECTURE.md "One material model in
+// two languages"); GltfBsdf calls it with n = +z, for which the GLSL's dot products and shading basis
+// are exact (0 x + 0 y + 1 z = z). What stays C++-only is what no shader needs: the sheen table's
+// construction, the other samplers below, and GltfBsdf's interface.
+//
 // Everything here works in a local shading frame where +z is the shading normal and wo (the direction
 // towards the viewer) lies in the upper hemisphere (wo.z > 0). Directions point away from the surface.
 //
@@ -42,8 +48,8 @@
 // Roughness: roughness == 0 makes the specular lobes Dirac deltas (perfect mirror / smooth dielectric,
 // the alpha -> 0 limit of the microfacet lobes, whose albedo tends to F(n.v)). Any roughness > 0 uses
 // alpha = max(roughness^2, kMinAlpha) with kMinAlpha = 1e-3, so D stays finite in float
-// (D_max = 1 / (pi alpha^2) ~ 3e5) and nothing produces NaN. kMinAlpha is gpu::kMinGgxAlpha, the one
-// constant GLSL's brdf.glsl reads too (shaders/common/shared.h).
+// (D_max = 1 / (pi alpha^2) ~ 3e5) and nothing produces NaN. kMinAlpha is gpu::kMinGgxAlpha
+// (shaders/common/shared.h).
 #include <algorithm>
 #include <cmath>
 
@@ -54,26 +60,57 @@
 namespace radiant::rt {
 
 inline constexpr float kPi = 3.14159265358979323846f;
-inline constexpr float kInvPi = 1.f / kPi;
+inline constexpr float kInvPi = 1.f / kPi;  // the same float as GLSL's INV_PI (common/constants.glsl)
 inline constexpr float kMinAlpha = gpu::kMinGgxAlpha;
 
-inline float luminance(const glm::vec3& c) { return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b; }
-inline float maxComponent(const glm::vec3& c) { return std::max(c.r, std::max(c.g, c.b)); }
+// The sheen's directional-albedo table (built below; brdf.glsl reads it through glsl::sheenTableAt).
+inline const float* sheenAlbedoTable();
+
+namespace glsl {
+using glm::vec2;
+using glm::vec3;
+using glm::vec4;
+using glm::abs;
+using glm::any;
+using glm::clamp;
+using glm::cos;
+using glm::cross;
+using glm::dot;
+using glm::isinf;
+using glm::isnan;
+using glm::max;
+using glm::min;
+using glm::normalize;
+using glm::pow;
+using glm::sin;
+using glm::sqrt;
+using gpu::MaterialParams;
+using gpu::kClearcoatF0;
+using gpu::kLobeDiffuse;
+using gpu::kLobeGlossy;
+using gpu::kLobeReflection;
+using gpu::kLobeSpecular;
+using gpu::kLobeTransmission;
+using gpu::kMinGgxAlpha;
+using gpu::kMinSheenRoughness;
+using gpu::kSheenAlbedoSize;
+inline constexpr float PI = kPi;
+inline constexpr float INV_PI = kInvPi;
+inline float sheenTableAt(int i) { return sheenAlbedoTable()[i]; }
+#include "shaders/common/brdf.glsl"
+}  // namespace glsl
+
+inline float luminance(const glm::vec3& c) { return glsl::materialLuminance(c); }
+using glsl::maxComponent;
 inline float safeSqrt(float x) { return std::sqrt(std::max(0.f, x)); }
 inline float sqr(float x) { return x * x; }
 
-// Orthonormal basis around n (Duff et al. 2017, "Building an Orthonormal Basis, Revisited").
+// Orthonormal basis around n (glsl::shadingBasis, Duff et al. 2017).
 struct ShadingFrame {
   glm::vec3 t, b, n;
   static ShadingFrame fromNormal(const glm::vec3& n) {
-    const float sign = std::copysign(1.f, n.z);
-    const float a = -1.f / (sign + n.z);
-    const float bb = n.x * n.y * a;
-    ShadingFrame f;
-    f.t = glm::vec3(1.f + sign * n.x * n.x * a, sign * bb, -sign * n.x);
-    f.b = glm::vec3(bb, sign + n.y * n.y * a, -n.y);
-    f.n = n;
-    return f;
+    const glsl::ShadingBasis f = glsl::shadingBasis(n);
+    return {f.t, f.b, f.n};
   }
   glm::vec3 toLocal(const glm::vec3& v) const { return {glm::dot(v, t), glm::dot(v, b), glm::dot(v, n)}; }
   glm::vec3 toWorld(const glm::vec3& v) const { return v.x * t + v.y * b + v.z * n; }
@@ -82,22 +119,10 @@ struct ShadingFrame {
 // ---------------------------------------------------------------------------------------------------
 // Sampling routines, each next to its pdf (solid-angle measure).
 
-// Concentric square-to-disk map (Shirley and Chiu 1997).
-inline glm::vec2 sampleConcentricDisk(glm::vec2 u) {
-  const glm::vec2 o = 2.f * u - 1.f;
-  if (o.x == 0.f && o.y == 0.f) return glm::vec2(0.f);
-  float r, theta;
-  if (std::abs(o.x) > std::abs(o.y)) { r = o.x; theta = (kPi / 4.f) * (o.y / o.x); }
-  else { r = o.y; theta = kPi / 2.f - (kPi / 4.f) * (o.x / o.y); }
-  return r * glm::vec2(std::cos(theta), std::sin(theta));
-}
-
-// Malley's method: p(w) = cos(theta) / pi.
-inline glm::vec3 sampleCosineHemisphere(glm::vec2 u) {
-  const glm::vec2 d = sampleConcentricDisk(u);
-  return {d.x, d.y, safeSqrt(1.f - d.x * d.x - d.y * d.y)};
-}
-inline float cosineHemispherePdf(float cosTheta) { return std::max(cosTheta, 0.f) * kInvPi; }
+// Concentric square-to-disk map (Shirley and Chiu 1997); Malley's method, p(w) = cos(theta) / pi.
+using glsl::cosineHemispherePdf;
+using glsl::sampleConcentricDisk;
+using glsl::sampleCosineHemisphere;
 
 // p(w) = (n + 1) cos^n(theta) / (2 pi); cos(theta) = u^(1/(n+1)). Used with n = 3 by volumetric AO.
 inline glm::vec3 sampleCosinePowerHemisphere(glm::vec2 u, float n) {
@@ -132,116 +157,39 @@ inline float powerHeuristic(float pdfA, float pdfB) {
 }
 
 // ---------------------------------------------------------------------------------------------------
-// GGX (Trowbridge-Reitz) microfacet distribution, isotropic, alpha = roughness^2.
+// GGX (Trowbridge-Reitz) microfacet distribution, isotropic, alpha = roughness^2; Fresnel; the sheen's
+// Charlie distribution: brdf.glsl's, in the local frame (+z the lobe's normal) where they take one.
 
 inline float alphaFromRoughness(float roughness) { return std::max(roughness * roughness, kMinAlpha); }
-
-// glTF Appendix B: D = alpha^2 chi+(n.h) / (pi ((n.h)^2 (alpha^2 - 1) + 1)^2).
-inline float ggxD(float cosThetaH, float alpha) {
-  if (cosThetaH <= 0.f) return 0.f;
-  const float a2 = alpha * alpha;
-  const float d = cosThetaH * cosThetaH * (a2 - 1.f) + 1.f;
-  return a2 / (kPi * d * d);
-}
-
-// Smith Lambda for GGX: Lambda(w) = (-1 + sqrt(1 + alpha^2 tan^2 theta)) / 2 (Heitz 2014, eq. 72).
-inline float ggxLambda(float cosTheta, float alpha) {
-  const float c2 = cosTheta * cosTheta;
-  if (c2 <= 0.f) return 1e30f;
-  const float tan2 = std::max(0.f, 1.f - c2) / c2;
-  return 0.5f * (-1.f + std::sqrt(1.f + alpha * alpha * tan2));
-}
-inline float smithG1(float cosTheta, float alpha) { return 1.f / (1.f + ggxLambda(cosTheta, alpha)); }
-// Height-correlated masking-shadowing G2 = 1 / (1 + Lambda(wo) + Lambda(wi)) (Heitz 2014, eq. 99).
-inline float smithG2HeightCorrelated(float cosO, float cosI, float alpha) {
-  return 1.f / (1.f + ggxLambda(std::abs(cosO), alpha) + ggxLambda(std::abs(cosI), alpha));
-}
-
-// glTF Appendix B, "Specular BRDF": V = G2 / (4 |n.l| |n.v|)
-//   = 0.5 / (n.l sqrt((n.v)^2 (1 - a2) + a2) + n.v sqrt((n.l)^2 (1 - a2) + a2)).
-inline float ggxVisibility(float NdotL, float NdotV, float alpha) {
-  if (NdotL <= 0.f || NdotV <= 0.f) return 0.f;
-  const float a2 = alpha * alpha;
-  const float gv = NdotL * std::sqrt(NdotV * NdotV * (1.f - a2) + a2);
-  const float gl = NdotV * std::sqrt(NdotL * NdotL * (1.f - a2) + a2);
-  const float s = gv + gl;
-  return s > 0.f ? 0.5f / s : 0.f;
-}
-
-// Heitz 2018, "Sampling the GGX Distribution of Visible Normals", listing 1 (isotropic alpha).
-// Returns a microfacet normal h distributed as D_wo(h) = G1(wo) max(0, wo.h) D(h) / wo.z.
-inline glm::vec3 sampleGgxVndf(const glm::vec3& wo, float alpha, glm::vec2 u) {
-  const glm::vec3 vh = glm::normalize(glm::vec3(alpha * wo.x, alpha * wo.y, wo.z));
-  const float lensq = vh.x * vh.x + vh.y * vh.y;
-  const glm::vec3 t1 = lensq > 0.f ? glm::vec3(-vh.y, vh.x, 0.f) / std::sqrt(lensq) : glm::vec3(1.f, 0.f, 0.f);
-  const glm::vec3 t2 = glm::cross(vh, t1);
-  const float r = std::sqrt(u.x);
-  const float phi = 2.f * kPi * u.y;
-  const float p1 = r * std::cos(phi);
-  float p2 = r * std::sin(phi);
-  const float s = 0.5f * (1.f + vh.z);
-  p2 = (1.f - s) * safeSqrt(1.f - p1 * p1) + s * p2;
-  const glm::vec3 nh = p1 * t1 + p2 * t2 + safeSqrt(1.f - p1 * p1 - p2 * p2) * vh;
-  return glm::normalize(glm::vec3(alpha * nh.x, alpha * nh.y, std::max(1e-7f, nh.z)));
-}
-// Density of sampleGgxVndf's h (Heitz 2018, eq. 3).
+using glsl::charlieD;
+using glsl::f0FromIor;
+using glsl::fresnelDielectric;
+using glsl::ggxD;
+using glsl::ggxLambda;
+using glsl::sampleGgxVndf;
+using glsl::schlickFresnel;
+using glsl::schlickWeight;
+using glsl::sheenAlphaFromRoughness;
+using glsl::sheenVisibility;
+using glsl::smithG1;
+using glsl::smithG2HeightCorrelated;
+// glTF Appendix B, "Specular BRDF": V = G2 / (4 |n.l| |n.v|).
+inline float ggxVisibility(float NdotL, float NdotV, float alpha) { return glsl::smithVisibility(NdotL, NdotV, alpha); }
+inline constexpr glm::vec3 kLocalNormal{0.f, 0.f, 1.f};
+// Density of sampleGgxVndf's h (Heitz 2018, eq. 3), local frame.
 inline float ggxVndfPdf(const glm::vec3& wo, const glm::vec3& h, float alpha) {
-  if (wo.z <= 0.f) return 0.f;
-  return smithG1(wo.z, alpha) * std::max(0.f, glm::dot(wo, h)) * ggxD(h.z, alpha) / wo.z;
+  return glsl::ggxVndfPdf(kLocalNormal, wo, h, alpha);
 }
-// Density of wi = reflect(-wo, h) in solid angle: D_wo(h) / (4 |wo.h|) (Jacobian of the reflection).
+// Density of wi = reflect(-wo, h) in solid angle: D_wo(h) / (4 |wo.h|), local frame.
 inline float ggxReflectionPdf(const glm::vec3& wo, const glm::vec3& wi, float alpha) {
-  if (wo.z <= 0.f || wi.z <= 0.f) return 0.f;
-  const glm::vec3 h = glm::normalize(wo + wi);
-  const float voh = glm::dot(wo, h);
-  return voh > 0.f ? ggxVndfPdf(wo, h, alpha) / (4.f * voh) : 0.f;
+  return glsl::ggxReflectionPdf(kLocalNormal, wo, wi, alpha);
 }
-
-// ---------------------------------------------------------------------------------------------------
-// Fresnel.
-
-inline float schlickWeight(float cosTheta) {
-  const float m = std::clamp(1.f - std::abs(cosTheta), 0.f, 1.f);
-  return (m * m) * (m * m) * m;
+inline glm::vec3 reflect(const glm::vec3& wo, const glm::vec3& n) { return glsl::reflectAbout(wo, n); }
+// Refraction of wo (wo.n > 0, pointing away) through an interface with normal n, eta = n_t / n_i.
+// Returns false on total internal reflection.
+inline bool refract(const glm::vec3& wo, const glm::vec3& n, float eta, glm::vec3& wi) {
+  return glsl::refractAbout(wo, n, eta, wi);
 }
-inline glm::vec3 schlickFresnel(const glm::vec3& f0, float cosTheta) {
-  return f0 + (glm::vec3(1.f) - f0) * schlickWeight(cosTheta);
-}
-inline float schlickFresnel(float f0, float cosTheta) { return f0 + (1.f - f0) * schlickWeight(cosTheta); }
-inline float f0FromIor(float ior) { return sqr((ior - 1.f) / (ior + 1.f)); }
-
-// Exact unpolarised Fresnel reflectance of a dielectric interface, R = (Rs + Rp) / 2 with
-// rs = (cos_i - eta cos_t) / (cos_i + eta cos_t), rp = (eta cos_i - cos_t) / (eta cos_i + cos_t),
-// where eta = n_t / n_i (index on the far side over index on the incident side) and cos_i >= 0.
-// Returns 1 for total internal reflection (sin_t >= 1).
-inline float fresnelDielectric(float cosThetaI, float eta) {
-  cosThetaI = std::clamp(cosThetaI, 0.f, 1.f);
-  const float sin2T = (1.f - cosThetaI * cosThetaI) / (eta * eta);
-  if (sin2T >= 1.f) return 1.f;
-  const float cosT = safeSqrt(1.f - sin2T);
-  const float rs = (cosThetaI - eta * cosT) / (cosThetaI + eta * cosT);
-  const float rp = (eta * cosThetaI - cosT) / (eta * cosThetaI + cosT);
-  return 0.5f * (rs * rs + rp * rp);
-}
-
-inline glm::vec3 reflect(const glm::vec3& wo, const glm::vec3& n) { return 2.f * glm::dot(wo, n) * n - wo; }
-
-// ---------------------------------------------------------------------------------------------------
-// KHR_materials_sheen: the Charlie distribution and Ashikhmin's visibility.
-
-// Estevez and Kulla 2017, eq. 2: D(h) = (2 + 1 / alpha) sin(theta_h)^(1 / alpha) / (2 pi).
-inline float charlieD(float cosThetaH, float alpha) {
-  if (cosThetaH <= 0.f) return 0.f;
-  const float invA = 1.f / alpha;
-  const float sin2 = std::max(0.f, 1.f - cosThetaH * cosThetaH);
-  return (2.f + invA) * std::pow(sin2, 0.5f * invA) / (2.f * kPi);
-}
-// Neubelt and Pettineo 2013: V = 1 / (4 (n.l + n.v - n.l n.v)), which includes 1 / (4 n.l n.v).
-inline float sheenVisibility(float NdotL, float NdotV) {
-  if (NdotL <= 0.f || NdotV <= 0.f) return 0.f;
-  return 1.f / (4.f * (NdotL + NdotV - NdotL * NdotV));
-}
-inline float sheenAlphaFromRoughness(float r) { return sqr(std::clamp(r, gpu::kMinSheenRoughness, 1.f)); }
 
 // E(mu, r) = integral of D_charlie V cos(theta_i) over the hemisphere for a white sheen, on the grid of
 // shared.h (mu_i = i / (N - 1), r_j = kMinSheenRoughness + (1 - kMinSheenRoughness) j / (N - 1)), by
@@ -275,30 +223,8 @@ inline const float* sheenAlbedoTable() {
   }();
   return table;
 }
-// Bilinear lookup of the table (the GLSL twin, sheenAlbedo() of brdf.glsl, does the same arithmetic).
-inline float sheenAlbedo(const float* table, float mu, float roughness) {
-  constexpr int N = gpu::kSheenAlbedoSize;
-  const float x = std::clamp(mu, 0.f, 1.f) * float(N - 1);
-  const float y = std::clamp((roughness - gpu::kMinSheenRoughness) / (1.f - gpu::kMinSheenRoughness), 0.f, 1.f) *
-                  float(N - 1);
-  const int x0 = std::min(int(x), N - 2), y0 = std::min(int(y), N - 2);
-  const float fx = x - float(x0), fy = y - float(y0);
-  const float a = table[y0 * N + x0] + (table[y0 * N + x0 + 1] - table[y0 * N + x0]) * fx;
-  const float b = table[(y0 + 1) * N + x0] + (table[(y0 + 1) * N + x0 + 1] - table[(y0 + 1) * N + x0]) * fx;
-  return a + (b - a) * fy;
-}
-inline float sheenAlbedo(float mu, float roughness) { return sheenAlbedo(sheenAlbedoTable(), mu, roughness); }
-
-// Refraction of wo (wo.n > 0, pointing away) through an interface with normal n, eta = n_t / n_i.
-// Returns false on total internal reflection.
-inline bool refract(const glm::vec3& wo, const glm::vec3& n, float eta, glm::vec3& wi) {
-  const float cosI = glm::dot(wo, n);
-  const float sin2T = std::max(0.f, 1.f - cosI * cosI) / (eta * eta);
-  if (sin2T >= 1.f) return false;
-  const float cosT = safeSqrt(1.f - sin2T);
-  wi = -wo / eta + (cosI / eta - cosT) * n;
-  return true;
-}
+// Bilinear lookup of the table (glsl::sheenAlbedo, the GPU's arithmetic).
+inline float sheenAlbedo(float mu, float roughness) { return glsl::sheenAlbedo(mu, roughness); }
 
 // ---------------------------------------------------------------------------------------------------
 // The glTF material BSDF.
@@ -316,6 +242,9 @@ enum LobeFlags : unsigned {
   kLobeSpecular = unsigned(gpu::kLobeSpecular),  // specular = Dirac delta
 };
 
+// The material's BSDF in the local shading frame: the fields of a decoded material (gpu::MaterialParams),
+// the interface's relative index and what the path carries. Every method is brdf.glsl's function of the
+// same name with n = +z and nc = coatNormal.
 struct GltfBsdf {
   glm::vec3 baseColor{1.f};
   float metallic = 1.f;
@@ -356,6 +285,17 @@ struct GltfBsdf {
     b.specularWeight = p.specular.w;
     return b;
   }
+  // The decoded material these fields are (fromParams' inverse; emission is not the BSDF's).
+  gpu::MaterialParams params() const {
+    gpu::MaterialParams p;
+    p.baseColor = glm::vec4(baseColor, 1.f);
+    p.emission = glm::vec4(0.f, 0.f, 0.f, 1.f);
+    p.surface = glm::vec4(metallic, roughness, transmission, ior);
+    p.clearcoat = glm::vec4(clearcoat, clearcoatRoughness, 0.f, 0.f);
+    p.sheen = glm::vec4(sheenColor, sheenRoughness);
+    p.specular = glm::vec4(specularColor, specularWeight);
+    return p;
+  }
 
   // 1 / eta^2 on refraction for radiance, 1 for importance.
   float refractionScale() const { return mode == TransportMode::Radiance ? 1.f / (eta * eta) : 1.f; }
@@ -363,52 +303,20 @@ struct GltfBsdf {
   bool isDelta() const { return roughness <= 0.f; }
   bool coatIsDelta() const { return clearcoatRoughness <= 0.f; }
   float alpha() const { return alphaFromRoughness(roughness); }
-  float f0Dielectric() const { return f0FromIor(ior); }
   bool hasSheen() const { return maxComponent(sheenColor) > 0.f; }
   bool hasCoat() const { return clearcoat > 0.f; }
   // KHR_materials_specular: the dielectric's Fresnel at cos(theta) = v.h, rgb, F90 = 1.
-  glm::vec3 specularF0() const { return glm::min(f0Dielectric() * specularColor, glm::vec3(1.f)); }
+  glm::vec3 specularF0() const { return glsl::specularF0(params()); }
   glm::vec3 dielectricFresnel(float cosTheta) const { return schlickFresnel(specularF0(), cosTheta); }
 
   // The coat's mix weight clearcoat Fc(|n_c.w|) (KHR_materials_clearcoat, fresnel_coat).
-  float coatWeight(const glm::vec3& w) const {
-    return hasCoat() ? clearcoat * schlickFresnel(gpu::kClearcoatF0, std::abs(glm::dot(coatNormal, w))) : 0.f;
-  }
+  float coatWeight(const glm::vec3& w) const { return glsl::coatWeight(params(), coatNormal, w); }
   // The base's sheen albedo scaling min(1 - max3(c) E(|n.wo|), 1 - max3(c) E(|n.wi|)) (KHR_materials_sheen).
-  float sheenScaling(float cosO, float cosI) const {
-    if (!hasSheen()) return 1.f;
-    const float c = maxComponent(sheenColor);
-    return std::max(0.f, std::min(1.f - c * sheenAlbedo(std::abs(cosO), sheenRoughness),
-                                  1.f - c * sheenAlbedo(std::abs(cosI), sheenRoughness)));
-  }
-  // What the layers above leave of the base for the pair (wo, wi): (1 - coat weight) x sheen scaling.
-  float baseAttenuation(const glm::vec3& wo, const glm::vec3& wi) const {
-    return (1.f - coatWeight(wo)) * sheenScaling(wo.z, wi.z);
-  }
+  float sheenScaling(float cosO, float cosI) const { return glsl::sheenScaling(params(), cosO, cosI); }
 
-  // Lobe selection probabilities at wo: the coat, the sheen, reflection (metal + opaque dielectric
-  // specular), diffuse, and the transmissive dielectric (its reflection and refraction). Proportional
-  // to each lobe's albedo estimated with the Fresnel factor at n.wo.
-  struct LobeProbabilities { float reflect = 0.f, diffuse = 0.f, dielectric = 0.f, coat = 0.f, sheen = 0.f; };
+  using LobeProbabilities = glsl::LobeProbabilities;
   LobeProbabilities lobeProbabilities(const glm::vec3& wo) const {
-    const float m = metallic, t = transmission;
-    const glm::vec3 fd = dielectricFresnel(wo.z);
-    const float fe = fresnelDielectric(wo.z, eta);
-    const float lumBase = std::max(luminance(baseColor), 0.f);
-    const float cw = coatWeight(wo);
-    const float sheenE = hasSheen() ? maxComponent(sheenColor) * sheenAlbedo(wo.z, sheenRoughness) : 0.f;
-    const float below = (1.f - cw) * std::max(0.f, 1.f - sheenE);
-    LobeProbabilities p;
-    p.reflect = below * (m * luminance(schlickFresnel(baseColor, wo.z)) +
-                         (1.f - m) * (1.f - t) * specularWeight * luminance(fd));
-    p.diffuse = below * (1.f - m) * (1.f - t) * (1.f - specularWeight * maxComponent(fd)) * lumBase;
-    p.dielectric = below * (1.f - m) * t * (fe + (1.f - fe) * lumBase);
-    p.coat = cw;
-    p.sheen = (1.f - cw) * sheenE;
-    const float sum = p.reflect + p.diffuse + p.dielectric + p.coat + p.sheen;
-    if (!(sum > 0.f)) return {1.f, 0.f, 0.f, 0.f, 0.f};
-    p.reflect /= sum; p.diffuse /= sum; p.dielectric /= sum; p.coat /= sum; p.sheen /= sum;
-    return p;
+    return glsl::lobeProbabilities(kLocalNormal, coatNormal, wo, params(), eta);
   }
   // True when some lobe is not a Dirac delta (so light sampling can contribute).
   bool hasNonDeltaLobe(const glm::vec3& wo) const {
@@ -416,103 +324,14 @@ struct GltfBsdf {
     return lobeProbabilities(wo).diffuse > 0.f;
   }
 
-  // The coat's D V around coatNormal (0 for a Dirac coat or wi below it).
-  float coatLobe(const glm::vec3& wo, const glm::vec3& wi) const {
-    if (coatIsDelta()) return 0.f;
-    const float cO = glm::dot(coatNormal, wo), cI = glm::dot(coatNormal, wi);
-    if (cO <= 0.f || cI <= 0.f) return 0.f;
-    const glm::vec3 h = glm::normalize(wo + wi);
-    const float a = alphaFromRoughness(clearcoatRoughness);
-    return ggxD(glm::dot(coatNormal, h), a) * ggxVisibility(cI, cO, a);
-  }
-
-  // f(wo, wi) of the base material alone (metal, dielectric, transmission), without the layers.
-  glm::vec3 evalBase(const glm::vec3& wo, const glm::vec3& wi) const {
-    const float m = metallic, t = transmission;
-    if (wi.z > 0.f) {
-      const glm::vec3 h = glm::normalize(wo + wi);
-      const float voh = glm::dot(wo, h);
-      const glm::vec3 fd = dielectricFresnel(voh);
-      // fresnel_mix: diffuse weighted by (1 - w max3(F_dielectric)), Lambert c_diff / pi.
-      glm::vec3 f = (1.f - m) * (1.f - t) * (1.f - specularWeight * maxComponent(fd)) * baseColor * kInvPi;
-      if (!isDelta()) {
-        const float a = alpha();
-        const float dv = ggxD(h.z, a) * ggxVisibility(wi.z, wo.z, a);
-        const glm::vec3 fresnel = m * schlickFresnel(baseColor, voh) + (1.f - m) * (1.f - t) * specularWeight * fd +
-                                  glm::vec3((1.f - m) * t * fresnelDielectric(voh, eta));
-        f += fresnel * dv;
-      }
-      return f;
-    }
-    if (t <= 0.f || isDelta()) return glm::vec3(0.f);
-    // Walter et al. 2007, eq. 21, with the generalised half vector h = normalise(eta wi + wo) (eq. 16)
-    // and the height-correlated G2; divided by eta^2 when transporting radiance (Veach 1997, 5.2).
-    const float a = alpha();
-    glm::vec3 h = eta * wi + wo;
-    if (glm::dot(h, h) == 0.f) return glm::vec3(0.f);
-    h = glm::normalize(h);
-    if (h.z < 0.f) h = -h;
-    const float woh = glm::dot(wo, h), wih = glm::dot(wi, h);
-    if (woh <= 0.f || wih >= 0.f) return glm::vec3(0.f);
-    const float fe = fresnelDielectric(woh, eta);
-    const float denom = sqr(wih + woh / eta) * std::abs(wi.z) * wo.z;
-    const float ft = (1.f - fe) * ggxD(h.z, a) * smithG2HeightCorrelated(wo.z, wi.z, a) *
-                     std::abs(wih * woh) / denom * refractionScale();
-    return (1.f - m) * t * ft * baseColor;
-  }
-
   // f(wo, wi) of the non-delta lobes (the deltas have no value off their direction). Not multiplied by
   // the cosine. wi below the horizon is transmission.
   glm::vec3 eval(const glm::vec3& wo, const glm::vec3& wi) const {
-    if (wo.z <= 0.f || wi.z == 0.f) return glm::vec3(0.f);
-    glm::vec3 f = evalBase(wo, wi);
-    if (!hasSheen() && !hasCoat()) return f;
-    f *= sheenScaling(wo.z, wi.z);
-    if (hasSheen() && wi.z > 0.f) {
-      const glm::vec3 h = glm::normalize(wo + wi);
-      f += sheenColor * (charlieD(h.z, sheenAlphaFromRoughness(sheenRoughness)) * sheenVisibility(wi.z, wo.z));
-    }
-    if (hasCoat()) {
-      const float cw = coatWeight(wo);
-      f = f * (1.f - cw) + glm::vec3(cw * coatLobe(wo, wi));
-    }
-    return f;
+    return glsl::gltfBsdf(kLocalNormal, coatNormal, wo, wi, params(), eta, refractionScale());
   }
-
-  // Solid-angle pdf of wi = reflect(-wo, h) with h from the coat's visible normals.
-  float coatPdf(const glm::vec3& wo, const glm::vec3& wi) const {
-    if (coatIsDelta()) return 0.f;
-    const ShadingFrame cf = ShadingFrame::fromNormal(coatNormal);
-    return ggxReflectionPdf(cf.toLocal(wo), cf.toLocal(wi), alphaFromRoughness(clearcoatRoughness));
-  }
-
   // Solid-angle pdf with which sample() produces wi from its non-delta lobes.
   float pdf(const glm::vec3& wo, const glm::vec3& wi) const {
-    if (wo.z <= 0.f || wi.z == 0.f) return 0.f;
-    const LobeProbabilities p = lobeProbabilities(wo);
-    if (wi.z > 0.f) {
-      float pdf = (p.diffuse + p.sheen) * cosineHemispherePdf(wi.z);
-      if (p.coat > 0.f) pdf += p.coat * coatPdf(wo, wi);
-      if (!isDelta()) {
-        const float a = alpha();
-        const float pr = ggxReflectionPdf(wo, wi, a);
-        const glm::vec3 h = glm::normalize(wo + wi);
-        pdf += p.reflect * pr + p.dielectric * fresnelDielectric(glm::dot(wo, h), eta) * pr;
-      }
-      return pdf;
-    }
-    if (isDelta() || p.dielectric <= 0.f) return 0.f;
-    const float a = alpha();
-    glm::vec3 h = eta * wi + wo;
-    if (glm::dot(h, h) == 0.f) return 0.f;
-    h = glm::normalize(h);
-    if (h.z < 0.f) h = -h;
-    const float woh = glm::dot(wo, h), wih = glm::dot(wi, h);
-    if (woh <= 0.f || wih >= 0.f) return 0.f;
-    // Jacobian of the refraction half vector: |wi.h| / (wi.h + wo.h / eta)^2 (Walter et al. 2007, eq. 17
-    // written for h = normalise(eta wi + wo)).
-    const float dhdwi = std::abs(wih) / sqr(wih + woh / eta);
-    return p.dielectric * (1.f - fresnelDielectric(woh, eta)) * ggxVndfPdf(wo, h, a) * dhdwi;
+    return glsl::pdfMaterial(kLocalNormal, coatNormal, wo, wi, params(), eta);
   }
 
   struct Sample {
@@ -524,81 +343,15 @@ struct GltfBsdf {
   };
   // uLobe picks the lobe, uFresnel picks reflection or refraction in the dielectric lobe, u the direction.
   bool sample(const glm::vec3& wo, float uLobe, float uFresnel, glm::vec2 u, Sample& s) const {
-    if (wo.z <= 0.f) return false;
-    const LobeProbabilities p = lobeProbabilities(wo);
-    const float m = metallic, t = transmission;
-    if (uLobe < p.coat) {
-      if (coatIsDelta()) {
-        s.wi = reflect(wo, coatNormal);
-        if (s.wi.z <= 0.f) return false;
-        s.weight = glm::vec3(coatWeight(wo) / p.coat);
-        s.pdf = 0.f;
-        s.delta = true;
-        s.flags = kLobeReflection | kLobeSpecular;
-        return true;
-      }
-      const ShadingFrame cf = ShadingFrame::fromNormal(coatNormal);
-      const glm::vec3 woC = cf.toLocal(wo);
-      if (woC.z <= 0.f) return false;
-      const glm::vec3 h = sampleGgxVndf(woC, alphaFromRoughness(clearcoatRoughness), u);
-      s.wi = cf.toWorld(reflect(woC, h));
-      if (s.wi.z <= 0.f) return false;
-      s.flags = kLobeReflection | kLobeGlossy;
-    } else if (uLobe < p.coat + p.sheen) {
-      s.wi = sampleCosineHemisphere(u);
-      if (s.wi.z <= 0.f) return false;
-      s.flags = kLobeReflection | kLobeGlossy;
-    } else if ((uLobe -= p.coat + p.sheen) < p.reflect) {
-      if (isDelta()) {
-        s.wi = {-wo.x, -wo.y, wo.z};
-        const glm::vec3 fr = m * schlickFresnel(baseColor, wo.z) + (1.f - m) * (1.f - t) * specularWeight *
-                                                                        dielectricFresnel(wo.z);
-        s.weight = fr * baseAttenuation(wo, s.wi) / p.reflect;
-        s.pdf = 0.f;
-        s.delta = true;
-        s.flags = kLobeReflection | kLobeSpecular;
-        return true;
-      }
-      const glm::vec3 h = sampleGgxVndf(wo, alpha(), u);
-      s.wi = reflect(wo, h);
-      if (s.wi.z <= 0.f) return false;
-      s.flags = kLobeReflection | kLobeGlossy;
-    } else if (uLobe < p.reflect + p.diffuse) {
-      s.wi = sampleCosineHemisphere(u);
-      if (s.wi.z <= 0.f) return false;
-      s.flags = kLobeReflection | kLobeDiffuse;
-    } else {
-      const glm::vec3 h = isDelta() ? glm::vec3(0.f, 0.f, 1.f) : sampleGgxVndf(wo, alpha(), u);
-      const float woh = glm::dot(wo, h);
-      if (woh <= 0.f) return false;
-      const float fe = fresnelDielectric(woh, eta);
-      bool reflected = uFresnel < fe;
-      glm::vec3 wi;
-      if (!reflected && !refract(wo, h, eta, wi)) reflected = true;  // fe == 1 already covers TIR
-      if (reflected) wi = reflect(wo, h);
-      const unsigned side = reflected ? kLobeReflection : kLobeTransmission;
-      if (isDelta()) {
-        s.wi = wi;
-        s.delta = true;
-        s.pdf = 0.f;
-        s.flags = side | kLobeSpecular;
-        // Lobe value (1-m) t F (reflection) or (1-m) t (1-F) base / eta^2 (refraction, radiance only),
-        // over its selection probability p.dielectric * F or p.dielectric * (1 - F); times what the
-        // layers above leave of it.
-        s.weight = (reflected ? glm::vec3((1.f - m) * t / p.dielectric)
-                              : (1.f - m) * t * baseColor * refractionScale() / p.dielectric) *
-                   baseAttenuation(wo, wi);
-        return true;
-      }
-      if (reflected ? wi.z <= 0.f : wi.z >= 0.f) return false;
-      s.wi = wi;
-      s.flags = side | kLobeGlossy;
-    }
-    s.delta = false;
-    s.pdf = pdf(wo, s.wi);
-    if (!(s.pdf > 0.f)) return false;
-    s.weight = eval(wo, s.wi) * std::abs(s.wi.z) / s.pdf;
-    return std::isfinite(s.weight.x + s.weight.y + s.weight.z);
+    const glsl::MaterialSample m = glsl::sampleMaterial(kLocalNormal, coatNormal, wo, params(), eta,
+                                                        mode == TransportMode::Importance,
+                                                        glm::vec4(uLobe, uFresnel, u.x, u.y));
+    s.wi = m.wi;
+    s.weight = m.weight;
+    s.pdf = m.pdf;
+    s.delta = m.delta;
+    s.flags = unsigned(m.flags);
+    return m.valid;
   }
 };
 

@@ -6,13 +6,15 @@
 #include "renderer/frame/FrameResources.h"
 #include "renderer/frame/FrameView.h"
 #include "renderer/gl/Gl.h"
+#include "renderer/raytracing/Bsdf.h"
 #include "renderer/scene/Environment.h"
 
 namespace radiant::ibl {
 namespace {
 
 constexpr float kPi = 3.14159265358979323846f;
-constexpr float kMinAlpha = 2e-3f;  // shaders/common/brdf.glsl MIN_ALPHA
+// The DFG table's own alpha floor for its roughness-0 row (the BSDF's is gpu::kMinGgxAlpha, 1e-3).
+constexpr float kMinAlpha = 2e-3f;
 
 glm::vec2 hammersley(std::uint32_t i, std::uint32_t n) {
   std::uint32_t b = i;
@@ -30,13 +32,6 @@ glm::vec3 sampleGgx(glm::vec2 u, float alpha) {
   const float cosTheta = std::sqrt((1.f - u.y) / (1.f + (alpha * alpha - 1.f) * u.y));
   const float sinTheta = std::sqrt(std::max(0.f, 1.f - cosTheta * cosTheta));
   return {sinTheta * std::cos(phi), sinTheta * std::sin(phi), cosTheta};
-}
-
-float smithVisibility(float nl, float nv, float alpha) {  // brdf.glsl smithVisibility
-  const float a2 = alpha * alpha;
-  const float gv = nl * std::sqrt(nv * nv * (1.f - a2) + a2);
-  const float gl = nv * std::sqrt(nl * nl * (1.f - a2) + a2);
-  return gv + gl > 0.f ? 0.5f / (gv + gl) : 0.f;
 }
 
 float pow5(float x) { return x * x * x * x * x; }
@@ -66,7 +61,7 @@ glm::vec3 dfgAt(float mu, float roughness, int samples) {
     const float vh = glm::dot(v, h);
     const glm::vec3 l = 2.f * vh * h - v;
     if (l.z > 0.f && vh > 0.f) {
-      const float w = 4.f * smithVisibility(l.z, mu, alpha) * l.z * vh / h.z;
+      const float w = 4.f * rt::ggxVisibility(l.z, mu, alpha) * l.z * vh / h.z;
       const float fc = pow5(1.f - vh);
       a += w * (1.f - fc);
       b += w * fc;
