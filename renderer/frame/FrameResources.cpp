@@ -6,6 +6,7 @@
 #include <malloc.h>
 
 #include "api/Aovs.h"
+#include "renderer/frame/FrameView.h"
 #include "renderer/frame/GpuScene.h"
 #include "renderer/ResidentMemory.h"
 
@@ -68,6 +69,11 @@ void FrameResources::markWritten(const std::string& name) {
 void FrameResources::beginFrame(const GpuScene& gpu, const FrameView& view, std::vector<api::CacheEvent>* cacheLog) {
   gpu_ = &gpu;
   view_ = &view;
+  // The frame's camera, once for every pass (common/frame.glsl).
+  const gpu::FrameConstants constants = frameConstants(view);
+  if (frameConstants_.id() == 0) frameConstants_ = gl::Buffer("frame_constants", sizeof(constants));
+  frameConstants_.upload(&constants, sizeof(constants));
+  frameConstants_.bindBase(GL_UNIFORM_BUFFER, gpu::kBindingFrameConstants);
   cacheLog_ = cacheLog;
   ++frame_;
   cancel_ = {};

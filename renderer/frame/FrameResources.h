@@ -277,6 +277,7 @@ private:
   std::map<std::string, std::pair<TextureSpec, gl::Texture>> textures_;
   std::map<std::string, gl::Framebuffer> framebuffers_;
   std::map<std::string, gl::Buffer> buffers_;
+  gl::Buffer frameConstants_;  // the view's gpu::FrameConstants, bound at kBindingFrameConstants (beginFrame)
   using Family = api::Lru<std::string, Entry>;  // one cache key's entries, by inputs digest
   std::map<std::string, Family> cache_;
   std::map<std::string, std::string> holds_;  // resource -> digest of what it holds (holds())

@@ -127,4 +127,19 @@ FrameView makeFrameView(const Scene& scene, const api::RenderRequest& request, c
   return v;
 }
 
+glm::vec3 viewForward(const FrameView& view) { return -glm::normalize(glm::vec3(view.camera.world[2])); }
+
+gpu::FrameConstants frameConstants(const FrameView& view) {
+  gpu::FrameConstants c;
+  c.view = view.view;
+  c.proj = view.proj;
+  c.viewProj = view.viewProj;
+  c.invViewProj = view.invViewProj;
+  c.eye = glm::vec4(view.eye, 0.f);
+  c.viewForward = glm::vec4(viewForward(view), 0.f);
+  c.background = glm::vec4(view.ambient, 0.f);
+  c.flags = glm::ivec4(view.camera.projection == ProjectionType::Orthographic ? 1 : 0, view.environment ? 1 : 0, 0, 0);
+  return c;
+}
+
 }  // namespace radiant

@@ -9,6 +9,7 @@
 #include <glm/glm.hpp>
 
 #include "api/Types.h"
+#include "renderer/frame/GpuTypes.h"
 #include "renderer/Image.h"
 #include "renderer/scene/Scene.h"
 #include "renderer/shading/EnvironmentLights.h"
@@ -66,5 +67,9 @@ glm::mat4 reversedZOrthographic(float xmag, float ymag, float znear, float zfar)
 // The request's camera override if any, else the scene's camera, with the image's aspect.
 // `environment` is the decoded request.environment (null when none).
 FrameView makeFrameView(const Scene& scene, const api::RenderRequest& request, const Image* environment = nullptr);
+// The unit direction the camera looks along (-z of its world matrix).
+glm::vec3 viewForward(const FrameView& view);
+// The frame's camera as the shaders read it (common/frame.glsl; FrameResources::beginFrame uploads it).
+gpu::FrameConstants frameConstants(const FrameView& view);
 
 }  // namespace radiant

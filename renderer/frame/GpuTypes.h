@@ -37,6 +37,7 @@ constexpr int materialTextureUnit(int slot) {
 }
 static_assert(kUnitShadow2D < kUnitMaterial0, "shadow units overlap the material units");
 static_assert(sizeof(MediaParticle) == 64, "std430 MediaParticle must be 64 bytes");
+static_assert(sizeof(FrameConstants) == 4 * 64 + 4 * 16, "std140 FrameConstants: four mat4, four vec4");
 // Kept for existing callers: the first material texture unit.
 inline constexpr int kMaterialTextureUnit0 = kUnitMaterial0;
 

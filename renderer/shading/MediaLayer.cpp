@@ -30,11 +30,7 @@ void beginMediaLayer(const gl::Framebuffer& target, int w, int h) {
 }
 
 void setMediaCameraUniforms(const gl::Program& prog, const FrameView& view, bool hasDepth, int targetW, int targetH) {
-  prog.setMat4("u_view", &view.view[0][0]);
-  prog.setMat4("u_proj", &view.proj[0][0]);
-  prog.setMat4("u_invViewProj", &view.invViewProj[0][0]);
   prog.set("u_znear", view.camera.znear);
-  prog.set("u_orthographic", view.camera.projection == ProjectionType::Orthographic ? 1 : 0);
   prog.set("u_hasDepth", hasDepth ? 1 : 0);
   const float targetSize[2] = {static_cast<float>(targetW), static_cast<float>(targetH)};
   prog.set("u_targetSize", targetSize, 2);

@@ -8,6 +8,7 @@
 // normal), i.e. the depth is reconstructed at the exact sub-texel position. This removes the
 // quantisation error that otherwise makes tilted open planes self-occlude; on planes it is exact.
 #include "common/constants.glsl"
+#include "common/frame.glsl"
 
 in vec2 v_uv;
 
@@ -21,13 +22,9 @@ layout(std140, binding = 0) uniform AoSamples {
 };
 
 uniform float u_radius;  // R, world units
-uniform vec3 u_eye;
 uniform vec3 u_forward;  // camera axes, world space
 uniform vec3 u_right;
 uniform vec3 u_up;
-uniform mat4 u_viewProj;
-uniform mat4 u_invViewProj;
-uniform int u_orthographic;
 uniform int u_interleave;
 uniform int u_scale;     // full-resolution pixels per working pixel (1 or 2)
 uniform vec2 u_fullSize;
@@ -39,11 +36,11 @@ layout(location = 0) out float o_ao;
 
 const float OPEN = 3.0e38;  // no surface along the ray (background or outside the image)
 
-vec3 rayDir(vec3 p) { return u_orthographic != 0 ? u_forward : normalize(p - u_eye); }
+vec3 rayDir(vec3 p) { return u_frame.flags.x != 0 ? u_forward : normalize(p - u_frame.eye.xyz); }
 
 // Full-resolution texel that p projects to; false outside the image or behind the eye.
 bool projectToTexel(vec3 p, out ivec2 texel) {
-  vec4 c = u_viewProj * vec4(p, 1.0);
+  vec4 c = u_frame.viewProj * vec4(p, 1.0);
   texel = ivec2(0);
   if (!(c.w > 0.0)) return false;
   vec2 px = (c.xy / c.w * 0.5 + 0.5) * u_fullSize;
@@ -105,7 +102,7 @@ float volumetricAO(vec3 x, vec3 n, vec2 rot) {
     vec3 dir = rayDir(s);                  // the pipe: the eye ray through the sample
     float mid = -dot(o, dir);              // chord midpoint, measured from s along the pipe
     float halfChord = sqrt(max(rho * rho - max(dot(o, o) - mid * mid, 0.0), 0.0));
-    float invM = u_orthographic != 0 ? 0.0 : 1.0 / max(dot(s - u_eye, dir) + mid, 1e-30);
+    float invM = u_frame.flags.x != 0 ? 0.0 : 1.0 / max(dot(s - u_frame.eye.xyz, dir) + mid, 1e-30);
     float zEntry = -halfChord, zExit = halfChord;      // relative to the midpoint
     float zStar = surfaceDistance(s, dir) - mid;       // z*: where the pipe meets the surface
     // Algorithm 2: Delta z = min(z_exit, z*) - min(z_entry, z*) = clamp(z*, z_entry, z_exit) - z_entry
@@ -144,9 +141,9 @@ bool surfaceAtScreen(vec2 sp, out vec3 P) {
   vec4 Pt = texelFetch(t_position, t, 0);
   P = Pt.xyz;
   if (Pt.w <= 0.0) return false;
-  vec4 o4 = u_invViewProj * vec4(sp / u_fullSize * 2.0 - 1.0, 1.0, 1.0);  // on the near plane (depth 1)
+  vec4 o4 = u_frame.invViewProj * vec4(sp / u_fullSize * 2.0 - 1.0, 1.0, 1.0);  // on the near plane (depth 1)
   vec3 o = o4.xyz / o4.w;
-  vec3 dir = u_orthographic != 0 ? u_forward : normalize(o - u_eye);
+  vec3 dir = u_frame.flags.x != 0 ? u_forward : normalize(o - u_frame.eye.xyz);
   vec3 ng = texelFetch(t_geoNormal, t, 0).xyz;
   float denom = dot(dir, ng);
   vec3 d = Pt.xyz - o;
@@ -164,9 +161,9 @@ bool surfaceAtScreen(vec2 sp, out vec3 P) {
 // Falloff: a step at distance R (the classic AO definition), with the horizon of the segment that
 // crosses the radius taken at the crossing point (exact for planar occluders instead of one step short).
 float gtaoAO(vec3 x, vec3 n, ivec2 px, float viewDepth, vec4 cell) {
-  vec3 V = u_orthographic != 0 ? -u_forward : normalize(u_eye - x);
+  vec3 V = u_frame.flags.x != 0 ? -u_forward : normalize(u_frame.eye.xyz - x);
   float R = u_radius;
-  float radiusPx = R * u_proj11 * 0.5 * u_fullSize.y / (u_orthographic != 0 ? 1.0 : max(viewDepth, 1e-30));
+  float radiusPx = R * u_proj11 * 0.5 * u_fullSize.y / (u_frame.flags.x != 0 ? 1.0 : max(viewDepth, 1e-30));
   radiusPx = min(radiusPx, 2.0 * max(u_fullSize.x, u_fullSize.y));
   float sliceOffset = u_interleave != 0 ? cell.z : 0.5;
   float jitter = u_interleave != 0 ? cell.w : 0.5;

@@ -14,6 +14,7 @@
 #include "common/brdf.glsl"
 #include "common/material.glsl"  // decodeLayers
 #include "common/ibl.glsl"
+#include "common/frame.glsl"
 
 in vec2 v_uv;
 
@@ -27,9 +28,6 @@ layout(binding = kUnitAoEmission) uniform sampler2D t_emission;  // a = ior
 layout(binding = kUnitIblDfg) uniform sampler2D t_dfg;
 layout(binding = kUnitGbufferLayers) uniform usampler2D t_layers;    // common/material.glsl encodeLayers
 layout(binding = kUnitGbufferSpecular) uniform sampler2D t_specular;  // gbuffer_specular
-uniform vec3 u_eye;
-uniform vec3 u_viewForward;
-uniform int u_orthographic;
 
 uniform int u_scale;
 uniform int u_blur;
@@ -96,7 +94,7 @@ void main() {
   // The environment's diffuse light: SH irradiance by the shading normal (E / pi = L^a for a uniform
   // sky), with the Fresnel weight glTF's fresnel_mix leaves the diffuse base (ImageBasedLighting.h).
   vec3 n = texelFetch(t_normal, px, 0).xyz;
-  vec3 wo = u_orthographic != 0 ? -u_viewForward : normalize(u_eye - P.xyz);
+  vec3 wo = u_frame.flags.x != 0 ? -u_frame.viewForward.xyz : normalize(u_frame.eye.xyz - P.xyz);
   MaterialParams p = materialParams(albedo, m.x, m.y, m.w, texelFetch(t_emission, px, 0).a);
   p.specular = texelFetch(t_specular, px, 0);
   vec3 nc = decodeLayers(texelFetch(t_layers, px, 0), p);

@@ -9,6 +9,7 @@
 #include "specular/ldm.glsl"
 #include "caustics/cube.glsl"
 #include "caustics/lookup.glsl"
+#include "common/frame.glsl"
 
 layout(binding = 0) uniform sampler2D t_position;
 layout(binding = 1) uniform sampler2D t_normal;
@@ -16,9 +17,6 @@ layout(binding = 2) uniform sampler2D t_albedo;
 layout(binding = 3) uniform sampler2D t_material;
 layout(binding = 4) uniform sampler2D t_emission;
 layout(binding = 5) uniform sampler2D t_geoNormal;
-uniform vec3 u_eye;
-uniform vec3 u_viewForward;
-uniform int u_orthographic;
 uniform float u_pixelArea;  // a pixel's area at unit view depth (perspective) or its area (orthographic)
 
 layout(location = 0) out vec4 o_caustics;
@@ -34,7 +32,7 @@ void main() {
   if (gbufferSpecularOwned(texelFetch(t_geoNormal, px, 0))) return;  // a specular surface: the specular pass's
   vec3 x = P.xyz;
   vec3 n = normalize(N.xyz);
-  vec3 wo = u_orthographic != 0 ? -u_viewForward : normalize(u_eye - x);
+  vec3 wo = u_frame.flags.x != 0 ? -u_frame.viewForward.xyz : normalize(u_frame.eye.xyz - x);
   vec4 mat = texelFetch(t_material, px, 0);
   MaterialParams mp = materialParams(texelFetch(t_albedo, px, 0).rgb, mat.x, mat.y, mat.w,
                                      texelFetch(t_emission, px, 0).a);
@@ -43,9 +41,9 @@ void main() {
   // for an orthographic one. The cosines are floored at 0.2 like the visibility tolerance's.
   float cosView = max(abs(dot(n, wo)), 0.2);
   float pixelArea = u_pixelArea / cosView;
-  if (u_orthographic == 0) {
-    float z = max(dot(x - u_eye, u_viewForward), 1e-30);
-    pixelArea *= z * z * z / max(length(x - u_eye), 1e-30);
+  if (u_frame.flags.x == 0) {
+    float z = max(dot(x - u_frame.eye.xyz, u_frame.viewForward.xyz), 1e-30);
+    pixelArea *= z * z * z / max(length(x - u_frame.eye.xyz), 1e-30);
   }
   vec3 L = vec3(0.0);
   for (int k = 0; k < u_generators; ++k) {

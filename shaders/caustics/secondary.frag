@@ -12,6 +12,7 @@
 #include "specular/ldm.glsl"
 #include "caustics/cube.glsl"
 #include "caustics/lookup.glsl"
+#include "common/frame.glsl"
 
 in vec3 v_position;
 
@@ -22,9 +23,6 @@ layout(binding = 3) uniform sampler2D t_material;
 layout(binding = 4) uniform sampler2D t_emission;
 
 uniform int u_object;  // index of the specular object being drawn
-uniform vec3 u_eye;
-uniform vec3 u_viewForward;
-uniform int u_orthographic;
 uniform float u_pixelArea;  // as camera.frag's
 
 layout(location = 0) out vec4 o_beauty;
@@ -41,7 +39,7 @@ vec3 diffuseHitRadiance(vec3 hit, vec3 rayDir, vec3 dir, float cube, vec4 texel)
   if (dot(n, rayDir) > 0.0) n = -n;  // facing the ray
   float cosView = max(-dot(n, rayDir), 0.2);
   float unfolded = g_eyeDistance + length(hit - g_firstHit);
-  float pixelArea = u_pixelArea / cosView * (u_orthographic != 0 ? 1.0 : unfolded * unfolded);
+  float pixelArea = u_pixelArea / cosView * (u_frame.flags.x != 0 ? 1.0 : unfolded * unfolded);
   vec3 E = vec3(0.0);
   for (int k = 0; k < u_generators; ++k) {
     vec3 wi;
@@ -60,7 +58,7 @@ vec3 mirrorDiffuseRadiance(vec4 texel) { return vec3(0.0); }
 void main() {
   ivec2 px = ivec2(gl_FragCoord.xy);
   vec4 P = texelFetch(t_position, px, 0);
-  float viewDepth = dot(v_position - u_eye, u_viewForward);
+  float viewDepth = dot(v_position - u_frame.eye.xyz, u_frame.viewForward.xyz);
   // Only the fragment the G-buffer kept (same surface within rasterisation noise), as specular.frag.
   if (P.w <= 0.0 || abs(P.w - viewDepth) > 1e-3 * max(viewDepth, 1e-6) + 1e-6) discard;
   vec3 p = P.xyz;
@@ -68,9 +66,9 @@ void main() {
   vec4 mat = texelFetch(t_material, px, 0);  // metallic, roughness, occlusion, transmission
   vec3 albedo = texelFetch(t_albedo, px, 0).rgb;
   float ior = texelFetch(t_emission, px, 0).a;
-  vec3 R = u_orthographic != 0 ? u_viewForward : normalize(p - u_eye);
+  vec3 R = u_frame.flags.x != 0 ? u_frame.viewForward.xyz : normalize(p - u_frame.eye.xyz);
   g_firstHit = p;
-  g_eyeDistance = u_orthographic != 0 ? 0.0 : length(p - u_eye);
+  g_eyeDistance = u_frame.flags.x != 0 ? 0.0 : length(p - u_frame.eye.xyz);
   int traced;
   vec3 L = traceSpecularTree(p, R, n, specularTexel(albedo, mat.x, mat.w, ior), u_object, gl_FrontFacing, 0.0, 0.0, traced);
   if (any(isnan(L)) || any(isinf(L))) L = vec3(0.0);

@@ -88,6 +88,24 @@ RADIANT_CONST int kBindingShadows = 2;
 RADIANT_CONST int kBindingSheenAlbedo = 7;  // float[kSheenAlbedoSize^2] (GpuScene::sheenAlbedo)
 
 // ---------------------------------------------------------------------------------------------------
+// The frame's camera: one uniform buffer per frame (FrameResources::beginFrame uploads
+// frameConstants(view)), declared once for GLSL by common/frame.glsl as `u_frame`. A pass that looks
+// through the frame's camera reads it there instead of setting camera uniforms of its own; a program
+// that draws other views too (cube faces, light cameras: specular/map.vert, env_diffuse/cube.vert,
+// shadow_maps, caustics' photon.frag) keeps its own u_viewProj.
+RADIANT_CONST int kBindingFrameConstants = 1;  // uniform-buffer binding (ambient_occlusion's samples use 0)
+struct FrameConstants {
+  mat4 view;         // world -> view (FrameView::view; the camera looks down -z)
+  mat4 proj;         // reversed-Z projection (FrameView::proj)
+  mat4 viewProj;     // proj view
+  mat4 invViewProj;  // its inverse
+  vec4 eye;          // xyz the camera's position (FrameView::eye), w unused
+  vec4 viewForward;  // xyz the unit direction it looks along (-z of the camera's world matrix), w unused
+  vec4 background;   // rgb the radiance seen where no surface is (FrameView::ambient: the uniform sky)
+  ivec4 flags;       // x 1 for an orthographic camera, y 1 when the frame has an environment map
+};
+
+// ---------------------------------------------------------------------------------------------------
 // Lights.
 RADIANT_CONST int kLightDirectional = 0;
 RADIANT_CONST int kLightPoint = 1;

@@ -14,6 +14,7 @@
 #include "common/lights.glsl"
 #include "common/phase.glsl"
 #include "depth_impostors/frame.glsl"
+#include "common/frame.glsl"
 
 layout(binding = 0) uniform sampler2D t_position;  // gbuffer_position: xyz world, w view depth (0 = none)
 layout(binding = 1) uniform sampler2D t_front;
@@ -25,7 +26,6 @@ layout(binding = 6) uniform sampler2D t_slices2;
 layout(binding = 7) uniform sampler2D t_slices3;
 
 uniform int u_hasDepth;
-uniform mat4 u_invViewProj;
 uniform vec2 u_targetSize;
 uniform ivec2 u_fullSize;
 uniform int u_axisMode;
@@ -54,7 +54,7 @@ flat in int v_block;
 layout(location = 0) out vec4 o_color;
 
 vec3 unproject(vec2 ndc, float depth) {
-  const vec4 p = u_invViewProj * vec4(ndc, depth, 1.0);
+  const vec4 p = u_frame.invViewProj * vec4(ndc, depth, 1.0);
   return p.xyz / p.w;
 }
 

@@ -6,6 +6,7 @@
 #include "common/ibl.glsl"
 #include "common/material.glsl"
 #include "common/gbuffer_geometry.glsl"
+#include "common/frame.glsl"
 
 in vec2 v_uv;
 
@@ -18,12 +19,6 @@ layout(binding = 5) uniform sampler2D t_geoNormal;
 layout(binding = kUnitGbufferLayers) uniform usampler2D t_layers;    // common/material.glsl encodeLayers
 layout(binding = kUnitGbufferSpecular) uniform sampler2D t_specular;  // gbuffer_specular
 
-uniform vec3 u_eye;
-uniform vec3 u_viewForward;
-uniform int u_orthographic;
-uniform vec3 u_background;  // radiance seen where no surface is (the uniform sky)
-uniform int u_hasEnvironment;  // 1: the background is the environment map instead
-uniform mat4 u_invViewProj;
 layout(binding = kUnitEnvironment) uniform sampler2D t_environment;
 layout(binding = kUnitIblDfg) uniform sampler2D t_dfg;
 layout(binding = kUnitIblPrefiltered) uniform sampler2DArray t_prefiltered;
@@ -35,12 +30,12 @@ void main() {
   ivec2 px = ivec2(gl_FragCoord.xy);
   vec4 P = texelFetch(t_position, px, 0);
   if (P.w <= 0.0) {
-    vec3 sky = u_background;
-    if (u_hasEnvironment != 0) {
+    vec3 sky = u_frame.background.rgb;
+    if (u_frame.flags.y != 0) {
       // The camera ray through the pixel centre: unproject a point on the near plane (reversed-Z:
       // depth 1); orthographic cameras look along their forward axis.
-      vec4 nearPoint = u_invViewProj * vec4(v_uv * 2.0 - 1.0, 1.0, 1.0);
-      vec3 dir = u_orthographic != 0 ? u_viewForward : normalize(nearPoint.xyz / nearPoint.w - u_eye);
+      vec4 nearPoint = u_frame.invViewProj * vec4(v_uv * 2.0 - 1.0, 1.0, 1.0);
+      vec3 dir = u_frame.flags.x != 0 ? u_frame.viewForward.xyz : normalize(nearPoint.xyz / nearPoint.w - u_frame.eye.xyz);
       sky = environmentRadiance(t_environment, dir);
     }
     o_direct = vec4(sky, 1.0);
@@ -63,7 +58,7 @@ void main() {
   vec3 emission = emissionIor.rgb;
   vec4 ngOwned = texelFetch(t_geoNormal, px, 0);
   vec3 ng = ngOwned.xyz;
-  vec3 wo = u_orthographic != 0 ? -u_viewForward : normalize(u_eye - p);
+  vec3 wo = u_frame.flags.x != 0 ? -u_frame.viewForward.xyz : normalize(u_frame.eye.xyz - p);
   // Interpolated or mapped normals can face away from the viewer at silhouettes; bend them back just
   // enough to be visible instead of shading them black (NdotV >= 1e-3).
   float nv = dot(n, wo);

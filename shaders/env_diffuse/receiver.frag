@@ -5,6 +5,7 @@
 // blended additively, to `beauty`.
 #include "common/constants.glsl"
 #include "env_diffuse/gather.glsl"
+#include "common/frame.glsl"
 
 in vec3 v_position;
 
@@ -14,8 +15,6 @@ layout(binding = 2) uniform sampler2D t_albedo;
 layout(binding = 3) uniform sampler2D t_material;
 layout(binding = 5) uniform samplerCube t_irradiance;
 
-uniform vec3 u_eye;
-uniform vec3 u_viewForward;
 uniform int u_method;
 uniform int u_horizonClip;
 
@@ -25,7 +24,7 @@ layout(location = 1) out vec4 o_beauty;
 void main() {
   ivec2 px = ivec2(gl_FragCoord.xy);
   vec4 P = texelFetch(t_position, px, 0);
-  float depth = max(dot(v_position - u_eye, u_viewForward), 1e-30);
+  float depth = max(dot(v_position - u_frame.eye.xyz, u_frame.viewForward.xyz), 1e-30);
   if (P.w <= 0.0 || abs(depth - P.w) > 1e-3 * P.w) discard;
   vec3 x = P.xyz;
   vec3 n = normalize(texelFetch(t_normal, px, 0).xyz);

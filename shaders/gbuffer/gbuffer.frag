@@ -1,5 +1,6 @@
 #include "common/material.glsl"
 #include "common/gbuffer_geometry.glsl"
+#include "common/frame.glsl"
 
 in vec3 v_position;
 in vec3 v_normal;
@@ -8,8 +9,6 @@ in vec2 v_uv1;
 in vec4 v_tangent;
 
 uniform int u_material;
-uniform vec3 u_eye;
-uniform vec3 u_viewForward;  // unit vector the camera looks along
 
 layout(location = 0) out vec4 o_position;  // xyz world, w = view depth (> 0 on geometry, 0 = none)
 layout(location = 1) out vec4 o_normal;    // xyz shading normal, w = 1 (0: unlit, KHR_materials_unlit)
@@ -38,13 +37,13 @@ void main() {
 
   vec3 faceNormal = materialSafeNormalize(cross(dFdx(v_position), dFdy(v_position)), vec3(0, 1, 0));
   // Geometric normal on the side the viewer sees: used for shadow normal-offset bias.
-  vec3 geo = dot(faceNormal, u_eye - v_position) < 0.0 ? -faceNormal : faceNormal;
+  vec3 geo = dot(faceNormal, u_frame.eye.xyz - v_position) < 0.0 ? -faceNormal : faceNormal;
   vec3 n = windingSideNormal(materialSafeNormalize(v_normal, faceNormal), geo, gl_FrontFacing);
   // KHR_materials_clearcoat: its own normal map (clearcoatNormalTexture) or none, never the base's.
   vec3 coatNormal = decodeCoatNormal(m, n, v_tangent, uv, gl_FrontFacing);
   n = decodeShadingNormal(m, n, v_tangent, uv, gl_FrontFacing);
 
-  float viewDepth = max(dot(v_position - u_eye, u_viewForward), 1e-30);
+  float viewDepth = max(dot(v_position - u_frame.eye.xyz, u_frame.viewForward.xyz), 1e-30);
   o_position = vec4(v_position, viewDepth);
   o_normal = vec4(n, 1.0);
   o_albedo = p.baseColor;

@@ -1,11 +1,10 @@
 // Positions are already in world space (the loader flattens the node hierarchy).
+#include "common/frame.glsl"
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec2 a_uv0;
 layout(location = 3) in vec2 a_uv1;
 layout(location = 4) in vec4 a_tangent;
-
-uniform mat4 u_viewProj;
 
 out vec3 v_position;
 out vec3 v_normal;
@@ -19,5 +18,5 @@ void main() {
   v_uv0 = a_uv0;
   v_uv1 = a_uv1;
   v_tangent = a_tangent;
-  gl_Position = u_viewProj * vec4(a_position, 1.0);
+  gl_Position = u_frame.viewProj * vec4(a_position, 1.0);
 }

@@ -19,6 +19,7 @@
 // sizes them to stay below it (IlluminationNetwork.cpp marchStretch).
 #include "illumination_network/network.glsl"
 #include "common/particle_density.glsl"
+#include "common/frame.glsl"
 
 layout(std430, binding = kBindingMediaParticles) readonly buffer Particles { MediaParticle particles[]; };
 layout(std430, binding = 15) readonly buffer Splats { MediaParticle splats[]; };  // xyz node, rgb J_ms
@@ -27,7 +28,6 @@ layout(std430, binding = 1) readonly buffer Directions { NetworkDirection dirs[]
 layout(binding = 0) uniform sampler2D t_position;  // gbuffer_position: xyz world, w view depth (0 = none)
 
 uniform int u_hasDepth;
-uniform mat4 u_invViewProj;
 uniform vec2 u_targetSize;
 uniform ivec2 u_fullSize;
 uniform int u_particleCount;
@@ -45,7 +45,7 @@ out vec4 o_color;
 const int kMaxHits = 128;  // particles met by one pixel's ray, kept for the per-piece sums
 
 vec3 unproject(vec2 ndc, float depth) {
-  const vec4 p = u_invViewProj * vec4(ndc, depth, 1.0);
+  const vec4 p = u_frame.invViewProj * vec4(ndc, depth, 1.0);
   return p.xyz / p.w;
 }
 

@@ -7,6 +7,7 @@
 // (linear) or group (bvh), accumulating in i_accum; the last dispatch adds the total to beauty.
 #include "common/brdf.glsl"
 #include "light_volumes/beam.glsl"
+#include "common/frame.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -33,9 +34,6 @@ uniform int u_addToBeauty;
 // The light-path classes whose beams join beauty (LightVolumesPass::execute): 1 LS+DE (specular
 // scatterers' beams, sigma 0), 2 LG+DE (glossy ones). The AOV holds every beam.
 uniform int u_beautyClasses;
-uniform vec3 u_eye;
-uniform vec3 u_viewForward;
-uniform int u_orthographic;
 uniform float u_narrowLobeRoughness;  // Material::kNarrowLobeRoughness
 
 vec3 beamRadiance(int i, vec3 F, vec3 n, vec3 wo, MaterialParams mp) {
@@ -69,7 +67,7 @@ void main() {
   if (P.w > 0.0 && nUnlit.w >= 0.5 && !scatterer) {
     vec3 F = P.xyz;
     vec3 n = normalize(nUnlit.xyz);
-    vec3 wo = u_orthographic != 0 ? -u_viewForward : normalize(u_eye - F);
+    vec3 wo = u_frame.flags.x != 0 ? -u_frame.viewForward.xyz : normalize(u_frame.eye.xyz - F);
     MaterialParams mp = materialParams(texelFetch(t_albedo, px, 0).rgb, mat.x, mat.y, mat.w,
                                        texelFetch(t_emission, px, 0).a);
     if (u_traversal == 0) {

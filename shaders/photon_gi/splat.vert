@@ -1,8 +1,8 @@
 // One quad per photon, an instanced 4-vertex strip pulled from the splat buffer: the square of side 2h
 // in the photon's tangent plane that encloses its kernel disk (the paper's enclosing triangle, §2.2).
 #include "photon_gi/photon.glsl"
+#include "common/frame.glsl"
 
-uniform mat4 u_viewProj;
 uniform int u_firstInstance;  // drawn in stretches (renderer/shading/Stretches.h)
 flat out int v_photon;
 
@@ -24,5 +24,5 @@ void main() {
   vec3 bt = vec3(b, sgn + n.y * n.y * a, -n.y);
   vec3 world = p.positionRadius.xyz + p.positionRadius.w * (c.x * t + c.y * bt);
   v_photon = photon;
-  gl_Position = u_viewProj * vec4(world, 1.0);
+  gl_Position = u_frame.viewProj * vec4(world, 1.0);
 }

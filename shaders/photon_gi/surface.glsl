@@ -3,6 +3,7 @@
 #define RADIANT_PHOTON_GI_SURFACE
 #include "common/material.glsl"  // decodeLayers (the G-buffer's layers target)
 #include "common/gbuffer_geometry.glsl"
+#include "common/frame.glsl"
 layout(binding = 0) uniform sampler2D t_position;
 layout(binding = 1) uniform sampler2D t_normal;
 layout(binding = 2) uniform sampler2D t_albedo;
@@ -12,9 +13,6 @@ layout(binding = 6) uniform sampler2D t_geoNormal;
 layout(binding = kUnitGbufferLayers) uniform usampler2D t_layers;    // common/material.glsl encodeLayers
 layout(binding = kUnitGbufferSpecular) uniform sampler2D t_specular;  // gbuffer_specular
 
-uniform vec3 u_eye;
-uniform vec3 u_viewForward;
-uniform int u_orthographic;
 
 bool loadSurface(ivec2 px, out SplatSurface s) {
   vec4 P = texelFetch(t_position, px, 0);
@@ -26,7 +24,7 @@ bool loadSurface(ivec2 px, out SplatSurface s) {
   vec4 geo = texelFetch(t_geoNormal, px, 0);
   s.ng = normalize(geo.xyz);
   s.nw = normalize(gbufferWindingNormal(geo));
-  s.wo = u_orthographic != 0 ? -u_viewForward : normalize(u_eye - P.xyz);
+  s.wo = u_frame.flags.x != 0 ? -u_frame.viewForward.xyz : normalize(u_frame.eye.xyz - P.xyz);
   vec4 m = texelFetch(t_material, px, 0);
   s.p = materialParams(texelFetch(t_albedo, px, 0).rgb, m.x, m.y, m.w, texelFetch(t_emission, px, 0).a);
   // The layers, read and bent towards the viewer as the direct pass does (direct.frag).

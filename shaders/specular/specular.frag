@@ -7,6 +7,7 @@
 #include "common/scene.glsl"
 #include "specular/ldm.glsl"
 #include "common/environment.glsl"
+#include "common/frame.glsl"
 
 in vec3 v_position;
 
@@ -17,11 +18,8 @@ layout(binding = 3) uniform sampler2D t_material;
 layout(binding = 4) uniform sampler2D t_emission;
 
 uniform int u_object;  // index of the specular object being drawn
-uniform vec3 u_eye;
-uniform vec3 u_viewForward;
-uniform int u_orthographic;
-uniform vec3 u_background;  // radiance where a ray leaves the scene (the sky), as `direct` uses
-uniform int u_hasEnvironment;  // 1: a ray leaving the scene sees the environment map instead
+// 1: a ray leaving the scene sees the environment map (when direct uploaded it), else the uniform sky
+uniform int u_hasEnvironment;
 layout(binding = kUnitEnvironment) uniform sampler2D t_environment;
 
 layout(location = 0) out vec4 o_specular;
@@ -30,7 +28,7 @@ layout(location = 0) out vec4 o_specular;
 // footprintCone below, widened by the convex mirrors on its path: specular/trace.glsl); a diffuse hit
 // its stored radiance.
 vec3 missRadiance(vec3 dir, float cone) {
-  return u_hasEnvironment != 0 ? environmentRadianceCone(t_environment, dir, cone) : u_background;
+  return u_hasEnvironment != 0 ? environmentRadianceCone(t_environment, dir, cone) : u_frame.background.rgb;
 }
 
 // The reflected direction at G-buffer sample q, or vec3(0) when q is not a surface that continues the
@@ -44,7 +42,7 @@ vec3 neighbourReflection(ivec2 q, vec3 n, out vec3 at) {
   vec3 nq = normalize(texelFetch(t_normal, q, 0).xyz);
   if (dot(nq, n) < 0.5) return vec3(0.0);
   at = Q.xyz;
-  vec3 v = u_orthographic != 0 ? u_viewForward : normalize(Q.xyz - u_eye);
+  vec3 v = u_frame.flags.x != 0 ? u_frame.viewForward.xyz : normalize(Q.xyz - u_frame.eye.xyz);
   return reflect(v, nq);
 }
 
@@ -88,7 +86,7 @@ vec3 mirrorDiffuseRadiance(vec4 texel) { return texel.rgb; }
 void main() {
   ivec2 px = ivec2(gl_FragCoord.xy);
   vec4 P = texelFetch(t_position, px, 0);
-  float viewDepth = dot(v_position - u_eye, u_viewForward);
+  float viewDepth = dot(v_position - u_frame.eye.xyz, u_frame.viewForward.xyz);
   // Only the fragment the G-buffer kept (same surface within rasterisation noise) is shaded.
   if (P.w <= 0.0 || abs(P.w - viewDepth) > 1e-3 * max(viewDepth, 1e-6) + 1e-6) discard;
 
@@ -97,7 +95,7 @@ void main() {
   vec4 mat = texelFetch(t_material, px, 0);  // metallic, roughness, occlusion, transmission
   vec3 albedo = texelFetch(t_albedo, px, 0).rgb;
   float ior = texelFetch(t_emission, px, 0).a;
-  vec3 R = u_orthographic != 0 ? u_viewForward : normalize(p - u_eye);
+  vec3 R = u_frame.flags.x != 0 ? u_frame.viewForward.xyz : normalize(p - u_frame.eye.xyz);
   float cone = 0.0, width = 0.0;
   if (u_hasEnvironment != 0) cone = footprintCone(px, p, R, n, reflect(R, n), mat.y, width);
 

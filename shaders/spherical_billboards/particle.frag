@@ -18,13 +18,12 @@
 #include "common/lights.glsl"
 #include "common/particle_density.glsl"
 #include "common/phase.glsl"
+#include "common/frame.glsl"
 
 layout(std430, binding = kBindingMediaParticles) readonly buffer Particles { MediaParticle particles[]; };
 layout(binding = 0) uniform sampler2D t_position;  // gbuffer_position: xyz world, w view depth (0 = none)
 
 uniform int u_hasDepth;
-uniform mat4 u_invViewProj;
-uniform mat4 u_view;
 uniform vec2 u_targetSize;
 uniform ivec2 u_fullSize;
 uniform float u_znear;
@@ -49,7 +48,7 @@ vec3 source(MediaParticle q, vec3 x, vec3 dir) {
 }
 
 vec3 unproject(vec2 ndc, float depth) {
-  const vec4 p = u_invViewProj * vec4(ndc, depth, 1.0);
+  const vec4 p = u_frame.invViewProj * vec4(ndc, depth, 1.0);
   return p.xyz / p.w;
 }
 
@@ -85,8 +84,8 @@ void main() {
     tMid = 0.5 * (t0 + t1);
   } else {
     // View space: the ray meets the billboard plane z = z_p at Q (eq. 7.1's assumption z_q = z_p).
-    const vec3 P = (u_view * vec4(c, 1.0)).xyz;
-    const vec3 oV = (u_view * vec4(o, 1.0)).xyz, dV = mat3(u_view) * dir;
+    const vec3 P = (u_frame.view * vec4(c, 1.0)).xyz;
+    const vec3 oV = (u_frame.view * vec4(o, 1.0)).xyz, dV = mat3(u_frame.view) * dir;
     const float zp = -P.z;
     const vec3 Q = oV + dV * ((P.z - oV.z) / dV.z);
     const float d = length(Q.xy - P.xy);

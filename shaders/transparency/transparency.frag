@@ -5,6 +5,7 @@
 #include "common/direct_lighting.glsl"
 #include "common/ibl.glsl"
 #include "common/material.glsl"
+#include "common/frame.glsl"
 
 in vec3 v_position;
 in vec3 v_normal;
@@ -13,9 +14,6 @@ in vec2 v_uv1;
 in vec4 v_tangent;
 
 uniform int u_material;
-uniform vec3 u_eye;
-uniform vec3 u_viewForward;
-uniform int u_orthographic;
 uniform int u_diffuseIbl;  // 1: add the environment's diffuse light (SH irradiance) to the surface
 layout(binding = kUnitIblDfg) uniform sampler2D t_dfg;
 layout(binding = kUnitIblPrefiltered) uniform sampler2DArray t_prefiltered;
@@ -34,7 +32,7 @@ void main() {
     return;
   }
   vec3 faceNormal = materialSafeNormalize(cross(dFdx(v_position), dFdy(v_position)), vec3(0, 1, 0));
-  vec3 wo = u_orthographic != 0 ? -u_viewForward : normalize(u_eye - v_position);
+  vec3 wo = u_frame.flags.x != 0 ? -u_frame.viewForward.xyz : normalize(u_frame.eye.xyz - v_position);
   vec3 ng = dot(faceNormal, wo) < 0.0 ? -faceNormal : faceNormal;
   vec3 n0 = windingSideNormal(materialSafeNormalize(v_normal, faceNormal), ng, gl_FrontFacing);
   vec3 nc = decodeCoatNormal(m, n0, v_tangent, uv, gl_FrontFacing);  // KHR_materials_clearcoat

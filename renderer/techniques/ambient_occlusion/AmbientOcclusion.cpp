@@ -256,7 +256,6 @@ void AmbientOcclusionPass::execute(PassContext& ctx) {
   const int w = view.width, h = view.height;
   gl::Texture& raw = res.texture("ao_raw");
   const int ww = raw.width(), wh = raw.height();
-  const bool ortho = view.camera.projection == ProjectionType::Orthographic;
 
   gl::Buffer& ubo = res.buffer("ao_samples");
   ubo.upload(block_, sizeof(ao::SampleBlock));
@@ -279,13 +278,9 @@ void AmbientOcclusionPass::execute(PassContext& ctx) {
                                                {{methodDefine(method_), "1"}, {"SAMPLES", std::to_string(samples_)}});
   est.use();
   est.set("u_radius", radius_);
-  est.set("u_eye", &view.eye[0], 3);
   est.set("u_forward", &forward[0], 3);
   est.set("u_right", &right[0], 3);
   est.set("u_up", &up[0], 3);
-  est.setMat4("u_viewProj", &view.viewProj[0][0]);
-  est.setMat4("u_invViewProj", &view.invViewProj[0][0]);
-  est.set("u_orthographic", ortho ? 1 : 0);
   est.set("u_interleave", interleave_ ? 1 : 0);
   est.set("u_scale", scale_);
   const float fullSize[2] = {static_cast<float>(w), static_cast<float>(h)};
@@ -327,9 +322,6 @@ void AmbientOcclusionPass::execute(PassContext& ctx) {
   res.texture("gbuffer_specular").bindUnit(gpu::kUnitGbufferSpecular);
   ctx.gpu.sheenAlbedo.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingSheenAlbedo);
   ibl::bind(res, rp, gpu::kUnitIblDfg, -1);
-  rp.set("u_eye", &view.eye[0], 3);
-  rp.set("u_viewForward", &forward[0], 3);
-  rp.set("u_orthographic", ortho ? 1 : 0);
   glDrawArrays(GL_TRIANGLES, 0, 3);
   glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   glDisablei(GL_BLEND, 1);

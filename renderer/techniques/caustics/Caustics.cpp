@@ -429,8 +429,6 @@ void CausticsPass::execute(PassContext& ctx) {
   const bool owns = res.owns("caustics", api::kPathLSDE);
   const float pixelArea = 4.f / (ctx.view.proj[0][0] * ctx.view.proj[1][1] * ctx.view.width * ctx.view.height);
   const float maxLod = footprintFilter_ ? static_cast<float>(cube.levels() - 1) : 0.f;
-  const glm::vec3 forward = -glm::normalize(glm::vec3(ctx.view.camera.world[2]));
-  const int orthographic = ctx.view.camera.projection == ProjectionType::Orthographic ? 1 : 0;
   auto setLookup = [&](const gl::Program& prog) {
     prog.set("u_generators", G);
     prog.set("u_visibilityTolerance", visibilityTolerance_);
@@ -439,9 +437,6 @@ void CausticsPass::execute(PassContext& ctx) {
     // A pixel's area on the plane at unit view depth (perspective) or its area (orthographic):
     // (2 / (P00 W)) (2 / (P11 H)) for either projection.
     prog.set("u_pixelArea", pixelArea);
-    prog.set("u_eye", &ctx.view.eye[0], 3);
-    prog.set("u_viewForward", &forward[0], 3);
-    prog.set("u_orthographic", orthographic);
   };
   gl::Framebuffer& fb = res.framebuffer("caustics");
   fb.bind();

@@ -64,7 +64,7 @@ void DepthImpostorsPass::prepare(const Scene& scene, const Params& params, Frame
   clipScaling_ = p.clip_scaling == DepthImpostorsParams::ClipScaling::kLinear ? 0 : 1;
   forwardScatter_ = p.forward_scatter ? 1 : 0;
   fourierTerms_ = p.light_transmittance == DepthImpostorsParams::LightTransmittance::kFourier ? p.fourier_terms : 0;
-  const glm::vec3 forward = -glm::normalize(glm::vec3(view.camera.world[2]));
+  const glm::vec3 forward = viewForward(view);
   const bool ortho = view.camera.projection == ProjectionType::Orthographic;
 
   // Blocks: the medium, b and the sky (the blocks' source holds albedo * ambient) only: a sweep over the

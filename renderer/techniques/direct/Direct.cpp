@@ -65,13 +65,6 @@ void DirectPass::execute(PassContext& ctx) {
   // owns it (the diffuse lobe, L(sky)DE, is ambient_occlusion's or photon_gi's).
   const bool iblSpecular = imageBasedLighting_ && res.owns("direct", api::kPathSkyGE);
   if (!iblSpecular) prog.set("u_iblMode", ibl::kNone);
-  prog.set("u_hasEnvironment", view.environment ? 1 : 0);
-  prog.setMat4("u_invViewProj", &view.invViewProj[0][0]);
-  prog.set("u_eye", &view.eye[0], 3);
-  const glm::vec3 forward = -glm::normalize(glm::vec3(view.camera.world[2]));
-  prog.set("u_viewForward", &forward[0], 3);
-  prog.set("u_orthographic", view.camera.projection == ProjectionType::Orthographic ? 1 : 0);
-  prog.set("u_background", &view.ambient[0], 3);
   glDrawArrays(GL_TRIANGLES, 0, 3);
   glDisablei(GL_BLEND, 1);
   glBlendFunci(1, GL_ONE, GL_ZERO);

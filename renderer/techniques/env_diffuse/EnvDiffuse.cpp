@@ -259,9 +259,6 @@ void EnvDiffusePass::execute(PassContext& ctx) {
   const gl::Program& prog = ctx.shaders.program({"env_diffuse/cube.vert", "env_diffuse/receiver.frag"});
   prog.use();
   prog.setMat4("u_viewProj", glm::value_ptr(view.viewProj));
-  prog.set("u_eye", glm::value_ptr(view.eye), 3);
-  const glm::vec3 forward = -glm::normalize(glm::vec3(view.camera.world[2]));
-  prog.set("u_viewForward", glm::value_ptr(forward), 3);
   prog.set("u_method", static_cast<int>(method_));
   prog.set("u_horizonClip", horizonClip_ ? 1 : 0);
   prog.set("u_quadCount", 6 * downsample_ * downsample_);

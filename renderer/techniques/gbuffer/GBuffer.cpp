@@ -65,7 +65,6 @@ void GBufferPass::execute(PassContext& ctx) {
   const gl::Program& opaqueProg =
       ctx.shaders.program({"gbuffer/gbuffer.vert", "gbuffer/gbuffer.frag"}, {{"OPAQUE", "1"}});
   const gl::Program& fullProg = ctx.shaders.program({"gbuffer/gbuffer.vert", "gbuffer/gbuffer.frag"});
-  const glm::vec3 forward = -glm::normalize(glm::vec3(view.camera.world[2]));
   auto material = [&](std::size_t m) -> const Material& { return ctx.scene.material(ctx.scene.meshes[m].material); };
   enum Group { kSingleSided, kDoubleSided, kAlpha };
   auto groupOf = [&](std::size_t m) {
@@ -76,9 +75,6 @@ void GBufferPass::execute(PassContext& ctx) {
   for (const Group g : {kSingleSided, kDoubleSided, kAlpha}) {
     const gl::Program& prog = g == kAlpha ? fullProg : opaqueProg;
     prog.use();
-    prog.setMat4("u_viewProj", &view.viewProj[0][0]);
-    prog.set("u_eye", &view.eye[0], 3);
-    prog.set("u_viewForward", &forward[0], 3);
     if (g == kSingleSided) {
       glEnable(GL_CULL_FACE);
       glCullFace(GL_BACK);

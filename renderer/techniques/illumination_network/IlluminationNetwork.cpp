@@ -177,7 +177,7 @@ void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, 
   const float tauSplat = r > 0.0 ? static_cast<float>(3.0 * m / (3.14159265358979 * r * r * r)) : 0.f;
   net_->splatRadius = r;
   kernel_ = kernelScale * static_cast<float>(r / splatScale);
-  const glm::vec3 forward = -glm::normalize(glm::vec3(view.camera.world[2]));
+  const glm::vec3 forward = viewForward(view);
   const bool ortho = view.camera.projection == ProjectionType::Orthographic;
   std::vector<float> key(nodes.size());
   for (std::size_t p = 0; p < nodes.size(); ++p)

@@ -161,10 +161,6 @@ void LightVolumesPass::execute(PassContext& ctx) {
   const int size[2] = {view.width, view.height};
   glUniform2iv(glGetUniformLocation(prog.id(), "u_size"), 1, size);
   prog.set("u_split", static_cast<int>(split_));
-  prog.set("u_eye", glm::value_ptr(view.eye), 3);
-  const glm::vec3 forward = -glm::normalize(glm::vec3(view.camera.world[2]));
-  prog.set("u_viewForward", glm::value_ptr(forward), 3);
-  prog.set("u_orthographic", view.camera.projection == ProjectionType::Orthographic ? 1 : 0);
   prog.set("u_narrowLobeRoughness", Material::kNarrowLobeRoughness);
   prog.set("u_traversal", bvh_ ? 1 : 0);
   // One dispatch per slice (linear) or group (bvh); at least one, which clears the AOV.

@@ -259,12 +259,8 @@ void splatAndResolve(FrameResources& res, gl::ShaderLibrary& shaders, const Fram
   res.texture("gbuffer_specular").bindUnit(gpu::kUnitGbufferSpecular);
   splats.bindBase(GL_SHADER_STORAGE_BUFFER, kSplatBinding);
   cells.bindBase(GL_SHADER_STORAGE_BUFFER, kCellBinding);
-  const glm::vec3 forward = -glm::normalize(glm::vec3(view.camera.world[2]));
   auto common = [&](const gl::Program& p) {
     p.use();
-    p.set("u_eye", glm::value_ptr(view.eye), 3);
-    p.set("u_viewForward", glm::value_ptr(forward), 3);
-    p.set("u_orthographic", view.camera.projection == ProjectionType::Orthographic ? 1 : 0);
     p.set("u_kernel", static_cast<int>(settings.kernel));
     p.set("u_planeTolerance", kPlaneTolerance);
     p.set("u_normalCosine", kNormalCosine);
@@ -284,7 +280,6 @@ void splatAndResolve(FrameResources& res, gl::ShaderLibrary& shaders, const Fram
     glBlendFunc(GL_ONE, GL_ONE);
     const gl::Program& prog = shaders.program({"photon_gi/splat.vert", "photon_gi/splat.frag"});
     common(prog);
-    prog.setMat4("u_viewProj", glm::value_ptr(view.viewProj));
     drawInstancedInStretches(prog, GL_TRIANGLE_STRIP, 4, count, kSplatsPerStretch, res.cancel(), "photon_gi's splatting");
     glDisable(GL_BLEND);
   } else {

@@ -542,11 +542,6 @@ void SpecularPass::execute(PassContext& ctx) {
     const gl::Program& prog = ctx.shaders.program({"specular/map.vert", "specular/specular.frag"});
     prog.use();
     prog.setMat4("u_viewProj", &view.viewProj[0][0]);
-    prog.set("u_eye", &view.eye[0], 3);
-    const glm::vec3 forward = -glm::normalize(glm::vec3(view.camera.world[2]));
-    prog.set("u_viewForward", &forward[0], 3);
-    prog.set("u_orthographic", view.camera.projection == ProjectionType::Orthographic ? 1 : 0);
-    prog.set("u_background", &view.ambient[0], 3);
     // The direct pass uploads the environment map (declared: direct's output, this pass's optional input).
     const bool environment = view.environment && res.hasTexture("environment_map");
     if (environment) res.texture("environment_map").bindUnit(gpu::kUnitEnvironment);

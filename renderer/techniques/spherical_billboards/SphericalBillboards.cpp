@@ -33,7 +33,7 @@ void SphericalBillboardsPass::prepare(const Scene&, const Params& params, FrameR
   ratio_ = static_cast<float>(p.resolution_ratio);
   softScale_ = static_cast<float>(p.soft_scale);
   depthAware_ = p.upsampling == SphericalBillboardsParams::Upsampling::kDepthAware;
-  const glm::vec3 forward = -glm::normalize(glm::vec3(view.camera.world[2]));
+  const glm::vec3 forward = viewForward(view);
   const bool ortho = view.camera.projection == ProjectionType::Orthographic;
   particles_ = mediaParticles(view.media, view.ambient, view.eye, forward, ortho, p.sort);
 

@@ -42,7 +42,7 @@ void TransparencyPass::execute(PassContext& ctx) {
   // Back to front: the view depth of each BLEND primitive's bounding-box centre (the over operator is
   // not commutative). Primitives that interpenetrate, and triangles within one primitive, are not
   // sorted among themselves (docs/TECHNIQUES.md).
-  const glm::vec3 forward = -glm::normalize(glm::vec3(view.camera.world[2]));
+  const glm::vec3 forward = viewForward(view);
   std::vector<std::size_t> order;
   std::vector<float> depth(ctx.scene.meshes.size(), 0.f);
   for (std::size_t i = 0; i < ctx.scene.meshes.size() && i < gpu.meshes.size(); ++i) {
@@ -70,10 +70,6 @@ void TransparencyPass::execute(PassContext& ctx) {
   bindDirectLighting(prog, res, gpu, static_cast<int>(ctx.view.lights.size()), pcfRadius_);
   ibl::bind(res, prog, gpu::kUnitIblDfg, gpu::kUnitIblPrefiltered);
   prog.set("u_diffuseIbl", 1);
-  prog.setMat4("u_viewProj", &view.viewProj[0][0]);
-  prog.set("u_eye", &view.eye[0], 3);
-  prog.set("u_viewForward", &forward[0], 3);
-  prog.set("u_orthographic", view.camera.projection == ProjectionType::Orthographic ? 1 : 0);
   const GLint materialLoc = prog.uniformLocation("u_material");
   for (std::size_t i : order) {
     const GpuMesh& m = gpu.meshes[i];
