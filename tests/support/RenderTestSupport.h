@@ -14,6 +14,14 @@ inline Renderer& renderer() {
   return *r;
 }
 
+// A square request for an EXR of the beauty AOV.
+inline api::RenderRequest exrRequest(int size) {
+  api::RenderRequest req;
+  req.width = req.height = size;
+  req.outputs = {api::OutputSpec{api::ImageFormat::Exr, {"beauty"}, false}};
+  return req;
+}
+
 inline const Image& aov(const RenderOutput& out, const std::string& name) {
   for (const auto& a : out.aovs)
     if (a.aov == name) return a;
