@@ -22,56 +22,6 @@ gpu::Light toGpuLight(const Light& l) {
   return g;
 }
 
-gpu::Material toGpuMaterial(const Material& m) {
-  gpu::Material g{};
-  g.baseColorFactor = m.baseColorFactor;
-  g.emission = glm::vec4(m.emission(), 0.f);
-  g.metallicRoughness = glm::vec4(m.metallicFactor, m.roughnessFactor, m.transmissionFactor, m.ior);
-  g.scales = glm::vec4(m.normalTexture.scale, m.occlusionTexture.scale, m.alphaCutoff,
-                       static_cast<float>(static_cast<int>(m.alphaMode)));
-  auto uvSet = [](const TextureRef& r) { return r.valid() ? r.texCoord : -1; };
-  g.texturesA = glm::ivec4(uvSet(m.baseColorTexture), uvSet(m.metallicRoughnessTexture), uvSet(m.normalTexture),
-                           uvSet(m.occlusionTexture));
-  g.texturesB = glm::ivec4(uvSet(m.emissiveTexture), m.doubleSided ? 1 : 0, uvSet(m.transmissionTexture), 0);
-  g.flags = glm::ivec4(m.unlit ? 1 : 0, m.isSpecular() ? 1 : 0, 0, 0);
-  // KHR_texture_transform: the same rows TextureRef::transformUv applies on the CPU, slot by slot.
-  const auto slots = materialTextureSlots(m);
-  for (int s = 0; s < gpu::kSlotCount; ++s) {
-    g.uvTransform[2 * s] = glm::vec4(slots[s]->uvRow0, 0.f);
-    g.uvTransform[2 * s + 1] = glm::vec4(slots[s]->uvRow1, 0.f);
-  }
-  g.clearcoat = glm::vec4(m.clearcoatFactor, m.clearcoatRoughnessFactor, m.clearcoatNormalTexture.scale, 0.f);
-  g.sheen = glm::vec4(m.sheenColorFactor, m.sheenRoughnessFactor);
-  g.specular = glm::vec4(m.specularColorFactor, m.specularFactor);
-  g.texturesC = glm::ivec4(uvSet(m.clearcoatTexture), uvSet(m.clearcoatRoughnessTexture),
-                           uvSet(m.clearcoatNormalTexture), uvSet(m.sheenColorTexture));
-  g.texturesD = glm::ivec4(uvSet(m.sheenRoughnessTexture), uvSet(m.specularTexture), uvSet(m.specularColorTexture), 0);
-  return g;
-}
-
-std::array<const TextureRef*, gpu::kSlotCount> materialTextureSlots(const Material& m) {
-  std::array<const TextureRef*, gpu::kSlotCount> slots{};
-  slots[gpu::kSlotBaseColor] = &m.baseColorTexture;
-  slots[gpu::kSlotMetallicRoughness] = &m.metallicRoughnessTexture;
-  slots[gpu::kSlotNormal] = &m.normalTexture;
-  slots[gpu::kSlotOcclusion] = &m.occlusionTexture;
-  slots[gpu::kSlotEmissive] = &m.emissiveTexture;
-  slots[gpu::kSlotTransmission] = &m.transmissionTexture;
-  slots[gpu::kSlotClearcoat] = &m.clearcoatTexture;
-  slots[gpu::kSlotClearcoatRoughness] = &m.clearcoatRoughnessTexture;
-  slots[gpu::kSlotClearcoatNormal] = &m.clearcoatNormalTexture;
-  slots[gpu::kSlotSheenColor] = &m.sheenColorTexture;
-  slots[gpu::kSlotSheenRoughness] = &m.sheenRoughnessTexture;
-  slots[gpu::kSlotSpecular] = &m.specularTexture;
-  slots[gpu::kSlotSpecularColor] = &m.specularColorTexture;
-  return slots;
-}
-
-bool materialSlotIsSrgb(int slot) {
-  return slot == gpu::kSlotBaseColor || slot == gpu::kSlotEmissive || slot == gpu::kSlotSheenColor ||
-         slot == gpu::kSlotSpecularColor;
-}
-
 namespace {
 
 template <class T>

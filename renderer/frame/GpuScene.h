@@ -10,6 +10,7 @@
 #include "renderer/frame/GpuTypes.h"
 #include "renderer/gl/Gl.h"
 #include "renderer/raytracing/Cancel.h"
+#include "renderer/scene/MaterialDecode.h"
 #include "renderer/scene/Scene.h"
 
 namespace radiant {
@@ -35,14 +36,10 @@ struct GpuMesh {
   }
 };
 
-// The std430 records of a scene light and material (shaders/common/shared.h). Exposed so the GPU/CPU
-// parity test feeds the GPU exactly what a render does.
+// The std430 record of a scene light (shaders/common/shared.h; a material's: toGpuMaterial in
+// renderer/scene/MaterialDecode.h). Exposed so the GPU/CPU parity test feeds the GPU exactly what a
+// render does.
 gpu::Light toGpuLight(const Light& light);
-gpu::Material toGpuMaterial(const Material& material);
-// The material's TextureRef of each slot (gpu::kSlot*), and whether a slot holds sRGB colour (base
-// colour, emissive, sheen colour, specular colour) rather than data.
-std::array<const TextureRef*, gpu::kSlotCount> materialTextureSlots(const Material& material);
-bool materialSlotIsSrgb(int slot);
 
 class GpuScene {
 public:

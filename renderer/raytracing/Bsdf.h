@@ -56,6 +56,7 @@
 #include <glm/glm.hpp>
 
 #include "renderer/frame/GpuTypes.h"
+#include "shaders/common/dual.glsl"
 
 namespace radiant::rt {
 
@@ -267,7 +268,7 @@ struct GltfBsdf {
   float clearcoatRoughness = 0.f;
   glm::vec3 coatNormal{0.f, 0.f, 1.f};
 
-  // The BSDF of a decoded material (MaterialDecode.h's decodeBsdfInputs; eta = ior, as seen from outside:
+  // The BSDF of a decoded material (material_decode.glsl's decodeBsdfInputs; eta = ior, as seen from outside:
   // RayScene::shade turns it for hits from inside).
   static GltfBsdf fromParams(const gpu::MaterialParams& p, TransportMode mode = TransportMode::Radiance) {
     GltfBsdf b;

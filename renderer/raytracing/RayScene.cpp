@@ -104,6 +104,8 @@ RayScene::RayScene(const Scene& s) : scene_(&s), embree_(std::make_unique<Embree
   rtcSetSceneBuildQuality(e.scene, RTC_BUILD_QUALITY_HIGH);
 
   emissiveOffset_.assign(s.meshes.size(), -1);
+  materialRecords_.reserve(s.meshes.size());
+  for (const MeshInstance& m : s.meshes) materialRecords_.push_back(toGpuMaterial(s.material(m.material)));
   for (size_t mi = 0; mi < s.meshes.size(); ++mi) {
     const MeshInstance& m = s.meshes[mi];
     const size_t triangles = m.triangleCount();
@@ -164,14 +166,16 @@ glm::vec4 RayScene::textureAt(const TextureRef& ref, const SurfaceHit& h, bool s
 }
 
 glm::vec3 RayScene::unlitRadiance(const SurfaceHit& h) const {
-  return decodeUnlitRadiance(materialOf(h.mesh), [&](const TextureRef& ref, bool srgb) { return textureAt(ref, h, srgb); });
+  return decodeUnlitRadiance(materialRecordOf(h.mesh), materialOf(h.mesh),
+                             [&](const TextureRef& ref, bool srgb) { return textureAt(ref, h, srgb); });
 }
 
 glm::vec3 RayScene::emissionAt(const SurfaceHit& h, const glm::vec3& dir) const {
   const Material& mat = materialOf(h.mesh);
   if (!mat.isEmissive()) return glm::vec3(0.f);
   if (!mat.doubleSided && glm::dot(dir, h.ng) >= 0.f) return glm::vec3(0.f);
-  return decodeEmission(mat, [&](const TextureRef& ref, bool srgb) { return textureAt(ref, h, srgb); });
+  return decodeEmission(materialRecordOf(h.mesh), mat,
+                        [&](const TextureRef& ref, bool srgb) { return textureAt(ref, h, srgb); });
 }
 
 SurfaceHit RayScene::makeHit(int mesh, int prim, float u, float v, const glm::vec3& origin) const {
@@ -236,7 +240,9 @@ bool RayScene::intersect(Ray ray, SurfaceHit& hit, Sampler& sampler, RayCounter&
 bool RayScene::passesThrough(const SurfaceHit& hit, Sampler& sampler) const {
   const Material& mat = materialOf(hit.mesh);
   if (mat.alphaMode == AlphaMode::Opaque) return false;
-  const float a = decodeBaseColor(mat, [&](const TextureRef& ref, bool srgb) { return textureAt(ref, hit, srgb); }).a;
+  const float a = decodeBaseColor(materialRecordOf(hit.mesh), mat, [&](const TextureRef& ref, bool srgb) {
+                    return textureAt(ref, hit, srgb);
+                  }).a;
   if (mat.alphaMode == AlphaMode::Mask) return a < mat.alphaCutoff;
   return sampler.next() >= a;  // Blend: stochastic coverage
 }
@@ -265,16 +271,16 @@ Shading RayScene::shade(const SurfaceHit& hit, const glm::vec3& wo, TransportMod
   const Material& mat = materialOf(hit.mesh);
   const MeshInstance& m = scene_->meshes[hit.mesh];
   Shading s;
-  // Factors x textures: the one C++ decoder (renderer/scene/MaterialDecode.h, twin of material.glsl).
-  const gpu::MaterialParams params =
-      decodeBsdfInputs(mat, [&](const TextureRef& ref, bool srgb) { return textureAt(ref, hit, srgb); });
+  // Factors x textures: the shared decoder (shaders/common/material_decode.glsl, MaterialDecode.h).
+  const gpu::MaterialParams params = decodeBsdfInputs(
+      materialRecordOf(hit.mesh), mat, [&](const TextureRef& ref, bool srgb) { return textureAt(ref, hit, srgb); });
   s.bsdf = GltfBsdf::fromParams(params, mode);
   const bool front = glm::dot(wo, hit.ng) >= 0.f;
   s.bsdf.eta = front ? s.bsdf.ior : 1.f / s.bsdf.ior;
   s.ngFacing = front ? hit.ng : -hit.ng;
 
   // Shading normal: interpolated vertex normal, normal-mapped when a tangent frame exists
-  // (MaterialDecode.h's mapTangentNormal, as material.glsl's decodeShadingNormal).
+  // (material_decode.glsl's mapTangentNormal, as material.glsl's decodeShadingNormal).
   glm::vec3 ns = hit.ng;
   // KHR_materials_clearcoat: the interpolated normal, or its own clearcoatNormalTexture (decodeCoatNormal
   // of material.glsl), never the base's normal map.

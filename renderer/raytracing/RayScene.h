@@ -77,6 +77,9 @@ public:
 
   const Scene& scene() const { return *scene_; }
   const Material& materialOf(int mesh) const { return scene_->material(scene_->meshes[mesh].material); }
+  // Its std430 record (toGpuMaterial), packed once: what the shared decoder reads
+  // (renderer/scene/MaterialDecode.h).
+  const gpu::Material& materialRecordOf(int mesh) const { return materialRecords_[mesh]; }
 
   // Closest hit, passing through alpha-masked and blended surfaces.
   bool intersect(Ray ray, SurfaceHit& hit, Sampler& sampler, RayCounter& counter) const;
@@ -109,6 +112,7 @@ private:
   SurfaceHit makeHit(int mesh, int prim, float u, float v, const glm::vec3& origin) const;
 
   const Scene* scene_;
+  std::vector<gpu::Material> materialRecords_;  // per mesh
   struct Embree;
   std::unique_ptr<Embree> embree_;
   bool anyAlpha_ = false;

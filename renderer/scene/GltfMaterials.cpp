@@ -158,7 +158,7 @@ void Converter::convertMaterials() {
     if (const auto* e = extension(g.extensions, "KHR_materials_emissive_strength"))
       mat.emissiveStrength = number(*e, "emissiveStrength", 1.f);
     // The layered extensions: factors and textures (the channels each texture contributes are in
-    // MaterialDecode.h). sheenColorTexture and specularColorTexture hold sRGB colour (the extensions'
+    // shaders/common/material_decode.glsl). sheenColorTexture and specularColorTexture hold sRGB colour (the extensions'
     // specs); the others are data.
     auto layerTexture = [&](const tinygltf::Value& e, const char* ext, const char* key, bool srgb) {
       return e.Has(key) ? textureRef(e.Get(key), ep + ext + "/" + key, srgb) : TextureRef{};

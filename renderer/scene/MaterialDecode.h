@@ -1,116 +1,171 @@
 #pragma once
-// The one C++ material decoder: a glTF Material (factors x textures) at a surface point, as the
-// MaterialParams record GLSL also reads (shaders/common/shared.h). It is the twin of decodeMaterial()
-// in shaders/common/material.glsl, formula for formula; the ray-tracing core (RayScene::shade,
-// emissionAt, alpha) calls it, and tests/gl/materials/parity_test.cpp holds the two equal.
+// The C++ reading of the material decoder: shaders/common/material_decode.glsl (factors x texture
+// channels, normal mapping), the one definition GLSL also compiles, included here inside namespace
+// radiant::material_glsl; and the std430 record it reads (toGpuMaterial, shaders/common/shared.h),
+// which GpuScene uploads for GLSL and RayScene keeps per mesh.
 //
-// `texel(ref, srgb)` returns the texture `ref` at the point (sRGB decoded when srgb), vec4(1) when
-// the slot is empty; it is how each caller samples (bilinear on the CPU, the GPU's samplers there).
-// It applies the slot's KHR_texture_transform (TextureRef::transformUv, as RayScene::textureAt does):
-// the uv rows travel with the TextureRef, as they travel per slot in gpu::Material::uvTransform.
-#include <algorithm>
+// `texel(ref, srgb)` returns the texture `ref` at the point (sRGB decoded when srgb); it is how each
+// caller samples (bilinear on the CPU, RayScene::textureAt). It applies the slot's
+// KHR_texture_transform (TextureRef::transformUv): the uv rows travel with the TextureRef, as they
+// travel per slot in gpu::Material::uvTransform. The decoder calls it only for slots the material has.
+#include <array>
+#include <type_traits>
 
 #include <glm/glm.hpp>
 
 #include "renderer/frame/GpuTypes.h"
 #include "renderer/scene/Scene.h"
+#include "shaders/common/dual.glsl"
 
 namespace radiant {
 
-// baseColorFactor x baseColorTexture, unclamped (the alpha test reads it).
-template <class Texel>
-glm::vec4 decodeBaseColor(const Material& m, Texel&& texel) {
-  glm::vec4 base = m.baseColorFactor;
-  if (m.baseColorTexture.valid()) base *= texel(m.baseColorTexture, true);
-  return base;
+// The material's TextureRef of slot `slot` (gpu::kSlot*).
+inline const TextureRef& materialTextureSlot(const Material& m, int slot) {
+  switch (slot) {
+    case gpu::kSlotBaseColor: return m.baseColorTexture;
+    case gpu::kSlotMetallicRoughness: return m.metallicRoughnessTexture;
+    case gpu::kSlotNormal: return m.normalTexture;
+    case gpu::kSlotOcclusion: return m.occlusionTexture;
+    case gpu::kSlotEmissive: return m.emissiveTexture;
+    case gpu::kSlotTransmission: return m.transmissionTexture;
+    case gpu::kSlotClearcoat: return m.clearcoatTexture;
+    case gpu::kSlotClearcoatRoughness: return m.clearcoatRoughnessTexture;
+    case gpu::kSlotClearcoatNormal: return m.clearcoatNormalTexture;
+    case gpu::kSlotSheenColor: return m.sheenColorTexture;
+    case gpu::kSlotSheenRoughness: return m.sheenRoughnessTexture;
+    case gpu::kSlotSpecular: return m.specularTexture;
+    default: return m.specularColorTexture;  // gpu::kSlotSpecularColor
+  }
+}
+// Every slot's TextureRef, in slot order.
+inline std::array<const TextureRef*, gpu::kSlotCount> materialTextureSlots(const Material& m) {
+  std::array<const TextureRef*, gpu::kSlotCount> slots{};
+  for (int s = 0; s < gpu::kSlotCount; ++s) slots[s] = &materialTextureSlot(m, s);
+  return slots;
+}
+// Whether a slot holds sRGB colour (base colour, emissive, sheen colour, specular colour) rather than data.
+inline bool materialSlotIsSrgb(int slot) {
+  return slot == gpu::kSlotBaseColor || slot == gpu::kSlotEmissive || slot == gpu::kSlotSheenColor ||
+         slot == gpu::kSlotSpecularColor;
 }
 
-// KHR_materials_unlit: the radiance leaving an unlit surface is its base colour, clamped as
-// MaterialParams::baseColor (the G-buffer stores decodeMaterial's baseColor as its emission).
-template <class Texel>
-glm::vec3 decodeUnlitRadiance(const Material& m, Texel&& texel) {
-  return glm::clamp(glm::vec3(decodeBaseColor(m, texel)), 0.f, 1.f);
+// The std430 record of a material (shaders/common/shared.h): what GLSL's decoder reads from the
+// scene's material buffer and the C++ decoder reads from RayScene's copy.
+inline gpu::Material toGpuMaterial(const Material& m) {
+  gpu::Material g{};
+  g.baseColorFactor = m.baseColorFactor;
+  g.emission = glm::vec4(m.emission(), 0.f);
+  g.metallicRoughness = glm::vec4(m.metallicFactor, m.roughnessFactor, m.transmissionFactor, m.ior);
+  g.scales = glm::vec4(m.normalTexture.scale, m.occlusionTexture.scale, m.alphaCutoff,
+                       static_cast<float>(static_cast<int>(m.alphaMode)));
+  auto uvSet = [](const TextureRef& r) { return r.valid() ? r.texCoord : -1; };
+  g.texturesA = glm::ivec4(uvSet(m.baseColorTexture), uvSet(m.metallicRoughnessTexture), uvSet(m.normalTexture),
+                           uvSet(m.occlusionTexture));
+  g.texturesB = glm::ivec4(uvSet(m.emissiveTexture), m.doubleSided ? 1 : 0, uvSet(m.transmissionTexture), 0);
+  g.flags = glm::ivec4(m.unlit ? 1 : 0, m.isSpecular() ? 1 : 0, 0, 0);
+  // KHR_texture_transform: the same rows TextureRef::transformUv applies on the CPU, slot by slot.
+  for (int s = 0; s < gpu::kSlotCount; ++s) {
+    const TextureRef& ref = materialTextureSlot(m, s);
+    g.uvTransform[2 * s] = glm::vec4(ref.uvRow0, 0.f);
+    g.uvTransform[2 * s + 1] = glm::vec4(ref.uvRow1, 0.f);
+  }
+  g.clearcoat = glm::vec4(m.clearcoatFactor, m.clearcoatRoughnessFactor, m.clearcoatNormalTexture.scale, 0.f);
+  g.sheen = glm::vec4(m.sheenColorFactor, m.sheenRoughnessFactor);
+  g.specular = glm::vec4(m.specularColorFactor, m.specularFactor);
+  g.texturesC = glm::ivec4(uvSet(m.clearcoatTexture), uvSet(m.clearcoatRoughnessTexture),
+                           uvSet(m.clearcoatNormalTexture), uvSet(m.sheenColorTexture));
+  g.texturesD = glm::ivec4(uvSet(m.sheenRoughnessTexture), uvSet(m.specularTexture), uvSet(m.specularColorTexture), 0);
+  return g;
 }
 
+namespace material_glsl {
+using glm::clamp;
+using glm::cross;
+using glm::dot;
+using glm::inversesqrt;
+using glm::max;
+using glm::vec3;
+using glm::vec4;
+using gpu::kDefaultIor;
+using gpu::kMinSheenRoughness;
+using gpu::kSlotBaseColor;
+using gpu::kSlotClearcoat;
+using gpu::kSlotClearcoatRoughness;
+using gpu::kSlotEmissive;
+using gpu::kSlotMetallicRoughness;
+using gpu::kSlotOcclusion;
+using gpu::kSlotSheenColor;
+using gpu::kSlotSheenRoughness;
+using gpu::kSlotSpecular;
+using gpu::kSlotSpecularColor;
+using gpu::kSlotTransmission;
+using gpu::Material;
+using gpu::MaterialParams;
+
+// A surface point as the C++ decoder sees it: a texel callback (slot -> texel) and its context.
+struct MaterialSite {
+  glm::vec4 (*texel)(const void* context, int slot);
+  const void* context;
+};
+inline glm::vec4 materialTexel(const Material&, int slot, int /*uv set: the TextureRef carries it*/,
+                               const MaterialSite& site) {
+  return site.texel(site.context, slot);
+}
+#include "shaders/common/material_decode.glsl"
+}  // namespace material_glsl
+
+using material_glsl::mapTangentNormal;
+
+// Runs decode(record, site) with a MaterialSite over `texel` (above) for the material m.
+template <class Texel, class Decode>
+auto decodeWith(const gpu::Material& record, const Material& m, Texel& texel, Decode decode) {
+  struct Context {
+    const Material* material;
+    Texel* texel;
+  } context{&m, &texel};
+  const material_glsl::MaterialSite site{
+      [](const void* c, int slot) -> glm::vec4 {
+        const Context& x = *static_cast<const Context*>(c);
+        return (*x.texel)(materialTextureSlot(*x.material, slot), materialSlotIsSrgb(slot));
+      },
+      &context};
+  return decode(record, site);
+}
+
+// The decoder's entry points for a material and its record (toGpuMaterial(m); RayScene keeps one per
+// mesh). baseColorFactor x baseColorTexture, unclamped (the alpha test reads it):
+template <class Texel>
+glm::vec4 decodeBaseColor(const gpu::Material& record, const Material& m, Texel&& texel) {
+  return decodeWith(record, m, texel, [](auto& r, auto& s) { return material_glsl::decodeBaseColor(r, s); });
+}
+// KHR_materials_unlit: the radiance leaving an unlit surface.
+template <class Texel>
+glm::vec3 decodeUnlitRadiance(const gpu::Material& record, const Material& m, Texel&& texel) {
+  return decodeWith(record, m, texel, [](auto& r, auto& s) { return material_glsl::decodeUnlitRadiance(r, s); });
+}
 // emissiveFactor x emissiveStrength x emissiveTexture.
 template <class Texel>
-glm::vec3 decodeEmission(const Material& m, Texel&& texel) {
-  glm::vec3 e = m.emission();
-  if (m.emissiveTexture.valid()) e *= glm::vec3(texel(m.emissiveTexture, true));
-  return e;
+glm::vec3 decodeEmission(const gpu::Material& record, const Material& m, Texel&& texel) {
+  return decodeWith(record, m, texel, [](auto& r, auto& s) { return material_glsl::decodeEmission(r, s); });
 }
-
-// The layered extensions, factor x texture channel as their specs define them, clamped to their
-// ranges (decodeLayerFactors() of material.glsl): KHR_materials_clearcoat (clearcoat = red of
-// clearcoatTexture, roughness = green of clearcoatRoughnessTexture), KHR_materials_sheen (colour = rgb
-// of sheenColorTexture, sRGB; roughness = alpha of sheenRoughnessTexture), KHR_materials_specular
-// (weight = alpha of specularTexture, colour = rgb of specularColorTexture, sRGB).
+// What the BSDF reads: emission (0, 0, 0, 1), no emission or occlusion lookups.
 template <class Texel>
-void decodeLayers(const Material& m, Texel&& texel, gpu::MaterialParams& p) {
-  float coat = m.clearcoatFactor, coatRoughness = m.clearcoatRoughnessFactor;
-  if (m.clearcoatTexture.valid()) coat *= texel(m.clearcoatTexture, false).r;
-  if (m.clearcoatRoughnessTexture.valid()) coatRoughness *= texel(m.clearcoatRoughnessTexture, false).g;
-  glm::vec3 sheenColor = m.sheenColorFactor;
-  float sheenRoughness = m.sheenRoughnessFactor;
-  if (m.sheenColorTexture.valid()) sheenColor *= glm::vec3(texel(m.sheenColorTexture, true));
-  if (m.sheenRoughnessTexture.valid()) sheenRoughness *= texel(m.sheenRoughnessTexture, false).a;
-  glm::vec3 specularColor = m.specularColorFactor;
-  float specular = m.specularFactor;
-  if (m.specularTexture.valid()) specular *= texel(m.specularTexture, false).a;
-  if (m.specularColorTexture.valid()) specularColor *= glm::vec3(texel(m.specularColorTexture, true));
-  p.clearcoat = glm::vec4(std::clamp(coat, 0.f, 1.f), std::clamp(coatRoughness, 0.f, 1.f), 0.f, 0.f);
-  p.sheen = glm::vec4(glm::clamp(sheenColor, 0.f, 1.f), std::clamp(sheenRoughness, gpu::kMinSheenRoughness, 1.f));
-  p.specular = glm::vec4(glm::max(specularColor, 0.f), std::clamp(specular, 0.f, 1.f));
+gpu::MaterialParams decodeBsdfInputs(const gpu::Material& record, const Material& m, Texel&& texel) {
+  return decodeWith(record, m, texel, [](auto& r, auto& s) { return material_glsl::decodeBsdfInputs(r, s); });
 }
-
-// A tangent-space normal map's texel (2 texel - 1, xy times `scale`) in the frame of the interpolated
-// normal n (unit) and tangent t4 (xyz, w handedness): mapTangentNormal() of material.glsl. Returns n
-// when the tangent is degenerate or the mapped normal vanishes.
-inline glm::vec3 mapTangentNormal(const glm::vec4& texel, float scale, const glm::vec3& n, const glm::vec4& t4) {
-  glm::vec3 t = glm::vec3(t4) - n * glm::dot(n, glm::vec3(t4));
-  if (glm::dot(t, t) <= 0.f) return n;
-  t = glm::normalize(t);
-  const glm::vec3 b = glm::cross(n, t) * (t4.w < 0.f ? -1.f : 1.f);
-  glm::vec3 tn = glm::vec3(texel) * 2.f - 1.f;
-  tn.x *= scale;
-  tn.y *= scale;
-  const glm::vec3 mapped = tn.x * t + tn.y * b + tn.z * n;
-  return glm::dot(mapped, mapped) > 0.f ? glm::normalize(mapped) : n;
-}
-
-// What the BSDF reads (baseColor, surface), without the emission and occlusion lookups: the ray
-// tracer's shade() needs only these. emission is (0, 0, 0, 1). glTF 3.9.2: metallic = blue, roughness
-// = green of metallicRoughnessTexture; KHR_materials_transmission: red channel of transmissionTexture.
+// The whole material at a point, occlusion in emission.a.
 template <class Texel>
-gpu::MaterialParams decodeBsdfInputs(const Material& m, Texel&& texel) {
-  const glm::vec4 base = decodeBaseColor(m, texel);
-  float metallic = m.metallicFactor, roughness = m.roughnessFactor;
-  if (m.metallicRoughnessTexture.valid()) {
-    const glm::vec4 mr = texel(m.metallicRoughnessTexture, false);
-    roughness *= mr.g;
-    metallic *= mr.b;
-  }
-  float transmission = m.transmissionFactor;
-  if (m.transmissionTexture.valid()) transmission *= texel(m.transmissionTexture, false).r;
-  const float ior = m.ior > 0.f ? m.ior : gpu::kDefaultIor;
-  gpu::MaterialParams p;
-  p.baseColor = glm::vec4(glm::clamp(glm::vec3(base), 0.f, 1.f), base.a);
-  p.emission = glm::vec4(0.f, 0.f, 0.f, 1.f);
-  p.surface = glm::vec4(std::clamp(metallic, 0.f, 1.f), std::clamp(roughness, 0.f, 1.f),
-                        std::clamp(transmission, 0.f, 1.f), ior);
-  decodeLayers(m, texel, p);
-  return p;
+gpu::MaterialParams decodeMaterial(const gpu::Material& record, const Material& m, Texel&& texel) {
+  return decodeWith(record, m, texel, [](auto& r, auto& s) { return material_glsl::decodeMaterial(r, s); });
 }
-
-// The whole material at a point (decodeMaterial() of material.glsl): the BSDF inputs, the emission and
-// the occlusion = 1 + strength (texel.r - 1) (glTF 3.9.3).
+// The same without a record at hand (tests, one-off decodes): packs the material first.
 template <class Texel>
 gpu::MaterialParams decodeMaterial(const Material& m, Texel&& texel) {
-  gpu::MaterialParams p = decodeBsdfInputs(m, texel);
-  float occlusion = 1.f;
-  if (m.occlusionTexture.valid()) occlusion = 1.f + m.occlusionTexture.scale * (texel(m.occlusionTexture, false).r - 1.f);
-  p.emission = glm::vec4(decodeEmission(m, texel), occlusion);
-  return p;
+  return decodeMaterial(toGpuMaterial(m), m, texel);
+}
+template <class Texel>
+gpu::MaterialParams decodeBsdfInputs(const Material& m, Texel&& texel) {
+  return decodeBsdfInputs(toGpuMaterial(m), m, texel);
 }
 
 }  // namespace radiant

@@ -91,7 +91,7 @@ struct Material {
   glm::vec3 attenuationColor{1.f};
   TextureRef baseColorTexture, metallicRoughnessTexture, normalTexture, occlusionTexture,
       emissiveTexture, transmissionTexture;
-  // The layered extensions' textures (their channels: MaterialDecode.h): KHR_materials_clearcoat
+  // The layered extensions' textures (their channels: shaders/common/material_decode.glsl): KHR_materials_clearcoat
   // (clearcoatNormalTexture.scale is its normal scale), KHR_materials_sheen, KHR_materials_specular.
   TextureRef clearcoatTexture, clearcoatRoughnessTexture, clearcoatNormalTexture, sheenColorTexture,
       sheenRoughnessTexture, specularTexture, specularColorTexture;

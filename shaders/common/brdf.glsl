@@ -7,8 +7,10 @@
 //         tracer's BSDF) calls these functions with n = +z, its local shading frame.
 // Rules that keep the two readings identical: float literals carry the f suffix (a C++ double literal
 // would make the arithmetic double), functions are marked RADIANT_FN (inline in C++), out parameters
-// are RADIANT_OUT(type), struct parameters RADIANT_IN(type) (a const reference in C++, not a copy), no struct constructors, no swizzles (vec3(v) takes xyz; .x/.a members are
-// fine), and the GLSL-only lines (includes, the sheen table's buffer) sit in #ifndef __cplusplus.
+// are RADIANT_OUT(type), struct parameters RADIANT_IN(type) (a const reference in C++, not a copy;
+// the macros are common/dual.glsl's, which C++ includes before the namespace), no struct
+// constructors, no swizzles (vec3(v) takes xyz; .x/.a members are fine), and the GLSL-only lines
+// (includes, the sheen table's buffer) sit in #ifndef __cplusplus.
 // tests/gl/materials/parity_test.cpp now checks the two compilers of this file against each other.
 //
 // The BSDF, evaluated as f(wo, wi) for a light direction wi (gltfBsdf) or f |n.wi| (gltfBsdfCos):
@@ -28,17 +30,8 @@
 #define RADIANT_COMMON_BRDF
 #ifndef __cplusplus
 #include "common/constants.glsl"
+#include "common/dual.glsl"
 #include "common/shared.h"
-#endif
-
-#ifdef __cplusplus
-#define RADIANT_FN inline __attribute__((always_inline))
-#define RADIANT_IN(T) const T&
-#define RADIANT_OUT(T) T&
-#else
-#define RADIANT_FN
-#define RADIANT_IN(T) T
-#define RADIANT_OUT(T) out T
 #endif
 
 // glTF Appendix B: D = alpha^2 chi+(n.h) / (pi ((n.h)^2 (alpha^2 - 1) + 1)^2).

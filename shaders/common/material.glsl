@@ -1,7 +1,7 @@
-// The one GLSL material decoder: a glTF material (factors x textures, common/shared.h) at a surface
-// point, as MaterialParams. Every pass that shades scene geometry calls it (gbuffer, env_diffuse
-// cube maps, specular distance maps); renderer/scene/MaterialDecode.h is the C++ twin used by the
-// ray-tracing core, and tests/gl/materials/parity_test.cpp holds the two equal.
+// The GLSL side of the material decoder: the material textures, how a surface point samples them
+// (SurfaceUv, materialTexel), and the material's flags. The decoding itself (factors x texture
+// channels, normal mapping) is common/material_decode.glsl, the one definition GLSL and C++
+// (renderer/scene/MaterialDecode.h, the ray-tracing core) both compile; this file includes it.
 //
 // The material textures are bound by GpuScene::bindMaterialTextures() at gpu::materialTextureUnit(slot).
 // Every lookup is textureGrad() with the derivatives a SurfaceUv carries (below): never texture()'s
@@ -78,70 +78,29 @@ int materialAlphaMode(Material m) { return int(m.scales.w); }  // 0 opaque, 1 ma
 // glTF 3.9.4: MASK surfaces below the cutoff are not rendered.
 bool materialMasked(Material m, float alpha) { return materialAlphaMode(m) == 1 && alpha < m.scales.z; }
 
-// baseColorFactor x baseColorTexture (sRGB decoded by the texture format), rgb and alpha. Unclamped:
-// the alpha test reads it before the rest is decoded.
-vec4 decodeBaseColor(Material m, SurfaceUv t) {
-  vec4 base = m.baseColorFactor;
-  if (m.texturesA.x >= 0) base *= materialSample(t_matBaseColor, m, kSlotBaseColor, m.texturesA.x, t);
-  return base;
-}
-
-// emissiveFactor x emissiveStrength x emissiveTexture.
-vec3 decodeEmission(Material m, SurfaceUv t) {
-  vec3 e = m.emission.rgb;
-  if (m.texturesB.x >= 0) e *= materialSample(t_matEmissive, m, kSlotEmissive, m.texturesB.x, t).rgb;
-  return e;
-}
-
-// KHR_materials_clearcoat, _sheen, _specular: factor x texture channel, as their specs define them
-// (clearcoat = red of clearcoatTexture, coat roughness = green of clearcoatRoughnessTexture, sheen
-// colour = rgb of sheenColorTexture (sRGB), sheen roughness = alpha of sheenRoughnessTexture, specular
-// = alpha of specularTexture, specular colour = rgb of specularColorTexture (sRGB)), then clamped to
-// their ranges. MaterialDecode.h's decodeLayers is the C++ twin.
-void decodeLayerFactors(Material m, SurfaceUv t, inout MaterialParams p) {
-  float coat = m.clearcoat.x, coatRoughness = m.clearcoat.y;
-  if (m.texturesC.x >= 0) coat *= materialSample(t_matClearcoat, m, kSlotClearcoat, m.texturesC.x, t).r;
-  if (m.texturesC.y >= 0)
-    coatRoughness *= materialSample(t_matClearcoatRoughness, m, kSlotClearcoatRoughness, m.texturesC.y, t).g;
-  vec3 sheenColor = m.sheen.rgb;
-  float sheenRoughness = m.sheen.a;
-  if (m.texturesC.w >= 0) sheenColor *= materialSample(t_matSheenColor, m, kSlotSheenColor, m.texturesC.w, t).rgb;
-  if (m.texturesD.x >= 0)
-    sheenRoughness *= materialSample(t_matSheenRoughness, m, kSlotSheenRoughness, m.texturesD.x, t).a;
-  vec3 specularColor = m.specular.rgb;
-  float specular = m.specular.a;
-  if (m.texturesD.y >= 0) specular *= materialSample(t_matSpecular, m, kSlotSpecular, m.texturesD.y, t).a;
-  if (m.texturesD.z >= 0)
-    specularColor *= materialSample(t_matSpecularColor, m, kSlotSpecularColor, m.texturesD.z, t).rgb;
-  p.clearcoat = vec4(clamp(coat, 0.0, 1.0), clamp(coatRoughness, 0.0, 1.0), 0.0, 0.0);
-  p.sheen = vec4(clamp(sheenColor, 0.0, 1.0), clamp(sheenRoughness, kMinSheenRoughness, 1.0));
-  p.specular = vec4(max(specularColor, vec3(0.0)), clamp(specular, 0.0, 1.0));
-}
-
-// The whole material at a point. glTF 3.9.2-3.9.3: metallic is the blue, roughness the green channel
-// of metallicRoughnessTexture; occlusion = 1 + strength (texel.r - 1); KHR_materials_transmission
-// reads the red channel of transmissionTexture.
-MaterialParams decodeMaterial(Material m, SurfaceUv t) {
-  vec4 base = decodeBaseColor(m, t);
-  float metallic = m.metallicRoughness.x, roughness = m.metallicRoughness.y;
-  if (m.texturesA.y >= 0) {
-    vec4 mr = materialSample(t_matMetallicRoughness, m, kSlotMetallicRoughness, m.texturesA.y, t);
-    roughness *= mr.g;
-    metallic *= mr.b;
+// Texture slot `slot` (a constant at every call: the switch folds) through uv set `set` at t: the
+// decoder's one way to a texel (common/material_decode.glsl). sRGB slots are decoded by their formats.
+vec4 materialTexel(Material m, int slot, int set, SurfaceUv t) {
+  switch (slot) {
+    case kSlotBaseColor: return materialSample(t_matBaseColor, m, slot, set, t);
+    case kSlotMetallicRoughness: return materialSample(t_matMetallicRoughness, m, slot, set, t);
+    case kSlotNormal: return materialSample(t_matNormal, m, slot, set, t);
+    case kSlotOcclusion: return materialSample(t_matOcclusion, m, slot, set, t);
+    case kSlotEmissive: return materialSample(t_matEmissive, m, slot, set, t);
+    case kSlotTransmission: return materialSample(t_matTransmission, m, slot, set, t);
+    case kSlotClearcoat: return materialSample(t_matClearcoat, m, slot, set, t);
+    case kSlotClearcoatRoughness: return materialSample(t_matClearcoatRoughness, m, slot, set, t);
+    case kSlotClearcoatNormal: return materialSample(t_matClearcoatNormal, m, slot, set, t);
+    case kSlotSheenColor: return materialSample(t_matSheenColor, m, slot, set, t);
+    case kSlotSheenRoughness: return materialSample(t_matSheenRoughness, m, slot, set, t);
+    case kSlotSpecular: return materialSample(t_matSpecular, m, slot, set, t);
+    case kSlotSpecularColor: return materialSample(t_matSpecularColor, m, slot, set, t);
   }
-  float transmission = m.metallicRoughness.z;
-  if (m.texturesB.z >= 0) transmission *= materialSample(t_matTransmission, m, kSlotTransmission, m.texturesB.z, t).r;
-  float occlusion = 1.0;
-  if (m.texturesA.w >= 0)
-    occlusion = 1.0 + m.scales.y * (materialSample(t_matOcclusion, m, kSlotOcclusion, m.texturesA.w, t).r - 1.0);
-  float ior = m.metallicRoughness.w > 0.0 ? m.metallicRoughness.w : kDefaultIor;
-  MaterialParams p;
-  p.baseColor = vec4(clamp(base.rgb, 0.0, 1.0), base.a);
-  p.emission = vec4(decodeEmission(m, t), occlusion);
-  p.surface = vec4(clamp(metallic, 0.0, 1.0), clamp(roughness, 0.0, 1.0), clamp(transmission, 0.0, 1.0), ior);
-  decodeLayerFactors(m, t, p);
-  return p;
+  return vec4(1.0);
 }
+
+#define MaterialSite SurfaceUv
+#include "common/material_decode.glsl"
 
 vec3 materialSafeNormalize(vec3 v, vec3 fallback) {
   float l2 = dot(v, v);
@@ -162,14 +121,6 @@ vec3 decodeLayers(uvec4 layers, inout MaterialParams p) {
   return octDecode(unpackSnorm2x16(layers.y));
 }
 
-// A tangent-space normal map's texel tn (2 texel - 1, xy scaled) in the frame of the interpolated vertex
-// normal n and tangent (xyz, w handedness).
-vec3 mapTangentNormal(vec3 tn, vec3 n, vec4 tangent) {
-  vec3 t = materialSafeNormalize(tangent.xyz - n * dot(n, tangent.xyz), vec3(1, 0, 0));
-  vec3 b = cross(n, t) * (tangent.w < 0.0 ? -1.0 : 1.0);
-  return materialSafeNormalize(t * tn.x + b * tn.y + n * tn.z, n);
-}
-
 // The interpolated vertex normal n turned to the side of the winding's normal before normal mapping, as
 // RayScene::shade does: vertex normals inconsistent with the winding would otherwise shade the front
 // as a back. viewerFace is the geometric normal on the viewer's side; frontFacing says whether the
@@ -186,9 +137,7 @@ vec3 windingSideNormal(vec3 n, vec3 viewerFace, bool frontFacing) {
 vec3 decodeShadingNormal(Material m, vec3 n, vec4 tangent, SurfaceUv t, bool frontFacing) {
   vec3 mapped = n;
   if (m.texturesA.z >= 0) {
-    vec3 tn = materialSample(t_matNormal, m, kSlotNormal, m.texturesA.z, t).xyz * 2.0 - 1.0;
-    tn.xy *= m.scales.x;
-    mapped = mapTangentNormal(tn, n, tangent);
+    mapped = mapTangentNormal(materialTexel(m, kSlotNormal, m.texturesA.z, t), m.scales.x, n, tangent);
   }
   return frontFacing ? mapped : -mapped;
 }
@@ -198,9 +147,7 @@ vec3 decodeShadingNormal(Material m, vec3 n, vec4 tangent, SurfaceUv t, bool fro
 vec3 decodeCoatNormal(Material m, vec3 n, vec4 tangent, SurfaceUv t, bool frontFacing) {
   vec3 mapped = n;
   if (m.texturesC.z >= 0) {
-    vec3 tn = materialSample(t_matClearcoatNormal, m, kSlotClearcoatNormal, m.texturesC.z, t).xyz * 2.0 - 1.0;
-    tn.xy *= m.clearcoat.z;
-    mapped = mapTangentNormal(tn, n, tangent);
+    mapped = mapTangentNormal(materialTexel(m, kSlotClearcoatNormal, m.texturesC.z, t), m.clearcoat.z, n, tangent);
   }
   return frontFacing ? mapped : -mapped;
 }

@@ -60,7 +60,7 @@ RADIANT_CONST int kSlotNormal = 2;
 RADIANT_CONST int kSlotOcclusion = 3;
 RADIANT_CONST int kSlotEmissive = 4;
 RADIANT_CONST int kSlotTransmission = 5;  // KHR_materials_transmission, red channel
-// The layered extensions' textures (channels as their specs say: material.glsl, MaterialDecode.h).
+// The layered extensions' textures (channels as their specs say: common/material_decode.glsl).
 RADIANT_CONST int kSlotLayer0 = 6;
 RADIANT_CONST int kSlotClearcoat = 6;           // KHR_materials_clearcoat: clearcoatTexture, red
 RADIANT_CONST int kSlotClearcoatRoughness = 7;  // clearcoatRoughnessTexture, green
@@ -133,9 +133,9 @@ struct ShadowInfo {
 // ---------------------------------------------------------------------------------------------------
 // Materials.
 
-// A glTF material as stored (GpuScene's toGpuMaterial fills it): factors and, per texture slot, the
-// uv set it reads or -1 when the slot is empty. decodeMaterial() (common/material.glsl in GLSL,
-// renderer/scene/MaterialDecode.h in C++) turns it into MaterialParams at a surface point.
+// A glTF material as stored (toGpuMaterial, renderer/scene/MaterialDecode.h, fills it): factors and,
+// per texture slot, the uv set it reads or -1 when the slot is empty. decodeMaterial()
+// (common/material_decode.glsl, compiled by both languages) turns it into MaterialParams at a surface point.
 struct Material {
   vec4 baseColorFactor;
   vec4 emission;           // rgb = emissiveFactor * emissiveStrength

@@ -510,8 +510,7 @@ void whiteFurnace(const Material& material, const std::string& name, double* mea
   bsdf.ior = material.ior;
   bsdf.eta = material.ior;
   // The layers as the decoder gives them (factors only here; the coat normal is the sphere's normal).
-  gpu::MaterialParams layers;
-  decodeLayers(material, [](const TextureRef&, bool) { return glm::vec4(1.f); }, layers);
+  const gpu::MaterialParams layers = decodeBsdfInputs(material, [](const TextureRef&, bool) { return glm::vec4(1.f); });
   bsdf.clearcoat = layers.clearcoat.x;
   bsdf.clearcoatRoughness = layers.clearcoat.y;
   bsdf.sheenColor = glm::vec3(layers.sheen);

@@ -270,7 +270,7 @@ std::vector<glm::vec3> referenceShadingNormals(const Scene& scene) {
 }
 
 // glTF's tangent-space normal of an 8-bit texel (2 texel / 255 - 1) in the frame (t, b, n), as
-// material.glsl's mapTangentNormal maps it.
+// material_decode.glsl's mapTangentNormal maps it.
 glm::vec3 mappedNormal(const std::array<std::uint8_t, 3>& texel, glm::vec3 t, glm::vec3 b, glm::vec3 n) {
   const glm::vec3 tn = glm::vec3(texel[0], texel[1], texel[2]) * (2.f / 255.f) - 1.f;
   return glm::normalize(tn.x * t + tn.y * b + tn.z * n);

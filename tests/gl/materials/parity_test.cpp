@@ -1,10 +1,12 @@
 // GPU/CPU parity of the material model (issue #20): a compute shader (shaders/tests/parity.comp)
 // evaluates the GLSL BRDF (common/brdf.glsl), the punctual-light falloff (common/lights.glsl) and the
-// material decoder (common/material.glsl) on ~10^4 random inputs each, and the results must equal what
-// the ray-tracing core computes: rt::GltfBsdf::eval * |cos| (brdf.glsl itself compiled as C++, so the
-// BSDF cases test the two compilers and the n = +z frame, not two copies), rt::punctualLi /
-// rangeWindow / spotFalloff, and decodeMaterial / RayScene::shade (its BSDF and normal-mapped shading
-// normal) / RayScene::emissionAt. A last test checks that no two samplers of the frame's programs share a unit.
+// material decoder (common/material.glsl over common/material_decode.glsl) on ~10^4 random inputs each,
+// and the results must equal what the ray-tracing core computes: rt::GltfBsdf::eval * |cos| (brdf.glsl
+// itself compiled as C++, so the BSDF cases test the two compilers and the n = +z frame, not two
+// copies), rt::punctualLi / rangeWindow / spotFalloff, and decodeMaterial / RayScene::shade (its BSDF
+// and normal-mapped shading normal) / RayScene::emissionAt (material_decode.glsl compiled as C++: the
+// material cases test the compilers and each language's texel fetch, the GPU's samplers against
+// RayScene::textureAt). A last test checks that no two samplers of the frame's programs share a unit.
 //
 // The inputs go through the same code a render uses: scene Lights and Materials are uploaded by
 // GpuScene (toGpuLight, toGpuMaterial, the sRGB/linear texture formats, the glTF samplers), and the
