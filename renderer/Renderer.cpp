@@ -522,6 +522,7 @@ void Renderer::setGpuSceneCapacity(std::size_t scenes) {
 }
 
 const DeviceInfo& Renderer::device() const { return impl_->device->info(); }
+const gl::ShaderLibrary& Renderer::shaders() const { return impl_->shaders; }
 
 std::vector<TechniqueDescription> Renderer::techniques() {
   std::vector<TechniqueDescription> out;

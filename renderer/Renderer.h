@@ -14,6 +14,9 @@
 
 namespace radiant {
 class Technique;  // renderer/frame/Technique.h
+namespace gl {
+class ShaderLibrary;  // renderer/gl/ShaderLibrary.h
+}
 namespace api {
 struct RequestLimits;  // api/Validate.h
 }
@@ -73,6 +76,9 @@ public:
   explicit Renderer(const DeviceOptions& options = {});
   ~Renderer();
   const DeviceInfo& device() const;
+  // The programs the frames rendered so far linked (gl::ShaderLibrary::programs): tests read their
+  // sampler units in this renderer's context.
+  const gl::ShaderLibrary& shaders() const;
   // Renders one frame. Throws api::ApiError for problems with the request that only show up here
   // (e.g. an unknown receiver node), and gl::GlError / EglError for environment failures; after
   // either the renderer stays usable. `cancel` is polled between passes.

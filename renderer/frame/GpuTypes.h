@@ -29,8 +29,7 @@ static_assert(offsetof(MaterialParams, clearcoat) == 48 && offsetof(MaterialPara
 static_assert(offsetof(MaterialParams, emission) == 16 && offsetof(MaterialParams, surface) == 32,
               "std430 MaterialParams: baseColor, emission, surface");
 static_assert(kUnitMaterial0 + kSlotLayer0 <= kUnitEnvironment, "material texture units overlap the environment");
-static_assert(kUnitMaterialLayer0 + kSlotCount - kSlotLayer0 == kUnitCount,
-              "the layered extensions' material units are the last ones");
+static_assert(kUnitMaterialLayer0 + kSlotCount - kSlotLayer0 <= kUnitCount, "material units beyond kUnitCount");
 // The unit material texture slot `slot` is bound to (GpuScene::bindMaterialTextures; material.glsl's bindings).
 constexpr int materialTextureUnit(int slot) {
   return slot < kSlotLayer0 ? kUnitMaterial0 + slot : kUnitMaterialLayer0 + (slot - kSlotLayer0);

@@ -29,6 +29,9 @@ public:
   // .vert .geom .frag .comp. The returned reference stays valid for the library's lifetime.
   const Program& program(const std::vector<std::string>& files, const Defines& defines = {});
   std::size_t cachedPrograms() const { return programs_.size(); }
+  // Every program linked so far, keyed by its stage files and defines: what a frame's techniques use
+  // (tests check their sampler units against each other without a list of them).
+  const std::map<std::string, Program>& programs() const { return programs_; }
 
 private:
   std::map<std::string, Program> programs_;

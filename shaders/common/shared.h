@@ -46,9 +46,10 @@ RADIANT_CONST int kLobeSpecular = 16;
 // declares without overwriting another's input. Units 0-5 are a pass's own full-screen inputs. The
 // units, bindings and records only one technique (or one technique's product) uses are declared in its
 // folder, shaders/<technique>/shared.h, under the same rules as this file (`grep -n "kUnit\|kBinding"
-// shaders/*/shared.h` lists them; ParityTest.SamplerUnitsAreUniqueAcrossTheFramesPrograms fails when
-// two samplers of a frame share a unit). Taken there: 15-18 and 25 (specular), 21 (ambient_occlusion),
-// 24 (caustics); storage bindings 4-5 (depth_impostors) and 8 (specular).
+// shaders/*/shared.h` lists them; RenderCore.SamplerUnitsAreUniqueAcrossEveryTechniquesPrograms, over
+// every program the techniques link, fails when two samplers share a unit). Taken there: 15-18 and 25
+// (specular), 21 (ambient_occlusion), 24 (caustics), 33-34 (depth_impostors); storage bindings 4-5
+// (depth_impostors) and 8 (specular).
 RADIANT_CONST int kUnitShadowCube = 6;
 RADIANT_CONST int kUnitShadow2D = 7;
 // Material textures: slot s < kSlotLayer0 at unit kUnitMaterial0 + s, the layered extensions' slots
@@ -78,8 +79,8 @@ RADIANT_CONST int kUnitGbufferSpecular = 23;  // direct: the G-buffer's gbuffer_
 RADIANT_CONST int kUnitMaterialLayer0 = 26;  // material slots kSlotLayer0.. (units 26-32)
 // Units used. A binding must be below GL_MAX_COMBINED_TEXTURE_IMAGE_UNITS (GL 4.5 guarantees 80); a
 // stage may read at most GL_MAX_TEXTURE_IMAGE_UNITS samplers (16 guaranteed, 32 on llvmpipe), which
-// material_parity_test checks per program.
-RADIANT_CONST int kUnitCount = 33;
+// render_core_test checks per program. Units 33-34 are depth_impostors' (above).
+RADIANT_CONST int kUnitCount = 35;
 
 // Shader storage bindings of the scene buffers.
 RADIANT_CONST int kBindingMaterials = 0;

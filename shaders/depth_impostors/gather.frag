@@ -22,8 +22,8 @@ layout(binding = 2) uniform sampler2D t_back;
 layout(binding = 3) uniform sampler2D t_transmittance;
 layout(binding = 4) uniform sampler2D t_slices0;
 layout(binding = 5) uniform sampler2D t_slices1;
-layout(binding = 6) uniform sampler2D t_slices2;
-layout(binding = 7) uniform sampler2D t_slices3;
+layout(binding = kUnitImpostorSlices2) uniform sampler2D t_slices2;
+layout(binding = kUnitImpostorSlices3) uniform sampler2D t_slices3;
 
 uniform int u_hasDepth;
 uniform vec2 u_targetSize;

@@ -6,6 +6,10 @@
 #ifndef RADIANT_DEPTH_IMPOSTORS_SHARED_H
 #define RADIANT_DEPTH_IMPOSTORS_SHARED_H
 
+// gather.frag reads 8 textures: units 0-5 are its full-screen inputs and slices 0-1, slices 2-3 take
+// these (common/shared.h: every sampler of every program has its own unit).
+RADIANT_CONST int kUnitImpostorSlices2 = 33;
+RADIANT_CONST int kUnitImpostorSlices3 = 34;
 RADIANT_CONST int kBindingImpostorBlocks = 4;
 RADIANT_CONST int kBindingImpostorOrder = 5;  // int[]: the blocks back to front
 RADIANT_CONST int kMaxImpostorSlices = 16;  // K: 4 slices per RGBA texture, at most 4 textures

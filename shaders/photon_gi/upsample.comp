@@ -23,7 +23,7 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(rgba32f, binding = 0) uniform image2D i_accum;
 layout(r32f, binding = 1) uniform image2D i_fixup;
-layout(binding = 7) uniform sampler2D t_low;
+layout(rgba32f, binding = 2) readonly uniform image2D i_low;  // the block samples
 
 uniform ivec2 u_size;     // full resolution
 uniform ivec2 u_lowSize;  // the block samples
@@ -107,7 +107,7 @@ void main() {
       if (wb <= 0.0) continue;
       SplatSurface o;
       if (!loadSurface(samplePixel(q), o) || !sameSurface(s, o)) continue;
-      vec4 a = texelFetch(t_low, q, 0);
+      vec4 a = imageLoad(i_low, q);
       if (a.a < 0.0) continue;  // u_refine: no block sample was taken there
       vec3 L = a.rgb;
       if (u_renormalize != 0 && a.a > 0.0) L /= max(a.a, u_minKernelMass);

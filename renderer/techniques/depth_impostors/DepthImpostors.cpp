@@ -140,7 +140,8 @@ void DepthImpostorsPass::execute(PassContext& ctx) {
   set.front.bindUnit(1);
   set.back.bindUnit(2);
   set.transmittance.bindUnit(3);
-  for (int i = 0; i < 4; ++i) set.sliceTextures[i].bindUnit(4 + i);
+  const int sliceUnits[4] = {4, 5, gpu::kUnitImpostorSlices2, gpu::kUnitImpostorSlices3};
+  for (int i = 0; i < 4; ++i) set.sliceTextures[i].bindUnit(sliceUnits[i]);
   set.blockBuffer.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingImpostorBlocks);
   set.orderBuffer.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingImpostorOrder);
   ctx.gpu.lights.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingLights);

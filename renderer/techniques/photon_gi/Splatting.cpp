@@ -253,7 +253,7 @@ void splatAndResolve(FrameResources& res, gl::ShaderLibrary& shaders, const Fram
   if (upload) uploadSplatGrid(res, grid);
   const char* inputs[] = {"gbuffer_position", "normal", "albedo", "material", "emission"};
   for (GLuint i = 0; i < std::size(inputs); ++i) res.texture(inputs[i]).bindUnit(i);
-  res.texture("geometric_normal").bindUnit(6);
+  res.texture("geometric_normal").bindUnit(5);
   // The layers of the receiver's material (photon_gi/surface.glsl).
   res.texture("gbuffer_layers").bindUnit(gpu::kUnitGbufferLayers);
   res.texture("gbuffer_specular").bindUnit(gpu::kUnitGbufferSpecular);
@@ -343,8 +343,7 @@ void splatAndResolve(FrameResources& res, gl::ShaderLibrary& shaders, const Fram
     } else {
       gl::Texture& low = res.texture("photon_gi_accum_low");
       const int lowW = (view.width + step - 1) / step, lowH = (view.height + step - 1) / step;
-      gather(low, step, lowW, lowH, 0);
-      glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+      gather(low, step, lowW, lowH, 0);  // its image barrier orders upsample's imageLoad of the samples
       // Spreads the block samples of `samples` (one per `blockStep` x `blockStep` block) onto the pixels
       // of their surface; refine = 0 writes every pixel and marks the unmatched ones in photon_gi_fixup,
       // refine = 1 fills only marked pixels that this finer step matches and unmarks them; refine = 2 is
@@ -361,7 +360,7 @@ void splatAndResolve(FrameResources& res, gl::ShaderLibrary& shaders, const Fram
         up.set("u_minKernelMass", kMinKernelMass);
         up.set("u_refine", refine);
         up.set("u_fillRadius", std::max(2, step / 2));
-        samples.bindUnit(7);
+        samples.bindImage(2, GL_READ_ONLY);
         accum.bindImage(0, refine ? GL_READ_WRITE : GL_WRITE_ONLY);
         res.texture("photon_gi_fixup").bindImage(1, refine ? GL_READ_WRITE : GL_WRITE_ONLY);
         glDispatchCompute((view.width + 7) / 8, (view.height + 7) / 8, 1);
@@ -381,7 +380,6 @@ void splatAndResolve(FrameResources& res, gl::ShaderLibrary& shaders, const Fram
         gl::Texture& refine = res.texture("photon_gi_accum_refine");
         common(prog);
         gather(refine, fine, (view.width + fine - 1) / fine, (view.height + fine - 1) / fine, 2);
-        glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
         upsample(refine, fine, 1);
       }
       common(prog);

@@ -6,7 +6,8 @@
 // copies), rt::punctualLi / rangeWindow / spotFalloff, and decodeMaterial / RayScene::shade (its BSDF
 // and normal-mapped shading normal) / RayScene::emissionAt (material_decode.glsl compiled as C++: the
 // material cases test the compilers and each language's texel fetch, the GPU's samplers against
-// RayScene::textureAt). A last test checks that no two samplers of the frame's programs share a unit.
+// RayScene::textureAt). (That no two samplers of the frame's programs share a unit is render_test's
+// RenderCore.SamplerUnitsAreUniqueAcrossEveryTechniquesPrograms.)
 //
 // The inputs go through the same code a render uses: scene Lights and Materials are uploaded by
 // GpuScene (toGpuLight, toGpuMaterial, the sRGB/linear texture formats, the glTF samplers), and the
@@ -822,63 +823,6 @@ TEST_F(ParityTest, MaterialDecodingMatchesCpuOnRandomInputs) {
   EXPECT_GT(mappedCoatNormalsCompared, 3000);
   EXPECT_GT(transformedCases, 3000);
   EXPECT_GT(movedByTransform, transformedCases / 2);
-}
-
-// --------------------------------------------------------------------------------------------------
-// Texture units (common/shared.h): no two samplers share a unit, within a program or across the
-// programs of a frame, so a pass binding its inputs never overwrites another pass's. (Unit 8 used to
-// be both t_baseColor and t_environment.) Units 0-5 are each full-screen pass's own inputs.
-
-TEST_F(ParityTest, SamplerUnitsAreUniqueAcrossTheFramesPrograms) {
-  // A binding must be below the combined limit (GL 4.5 guarantees 80); a program's stage reads at most
-  // GL_MAX_TEXTURE_IMAGE_UNITS samplers (checked per program below, which bounds every stage).
-  GLint maxCombinedUnits = 0, maxStageSamplers = 0;
-  glGetIntegerv(GL_MAX_COMBINED_TEXTURE_IMAGE_UNITS, &maxCombinedUnits);
-  glGetIntegerv(GL_MAX_TEXTURE_IMAGE_UNITS, &maxStageSamplers);
-  EXPECT_GE(maxCombinedUnits, gpu::kUnitCount);
-  const std::vector<std::vector<std::string>> programs = {
-      {"gbuffer/gbuffer.vert", "gbuffer/gbuffer.frag"},   {"common/fullscreen.vert", "direct/direct.frag"},
-      {"specular/map.vert", "specular/map.frag"},         {"specular/map.vert", "specular/specular.frag"},
-      {"env_diffuse/cube.vert", "env_diffuse/cube.frag"}, {"env_diffuse/cube.vert", "env_diffuse/receiver.frag"},
-      {"common/fullscreen.vert", "ambient_occlusion/ao_resolve.frag"},  // image-based lighting's DFG table
-      {"specular/map.vert", "caustics/photon.frag"},      {"common/fullscreen.vert", "caustics/camera.frag"},
-      {"caustics/grid.vert", "caustics/triangles.geom", "caustics/deposit.frag"},
-      {"caustics/grid.vert", "caustics/splat.geom", "caustics/deposit.frag"},
-      {"specular/map.vert", "caustics/secondary.frag"},
-      {"gbuffer/gbuffer.vert", "transparency/transparency.frag"},
-      {"shadow_maps/shadow.vert", "shadow_maps/shadow.frag"},
-  };
-  std::map<int, std::string> sharedUnitOwner;  // unit >= 6 -> sampler name
-  int samplers = 0;
-  for (const auto& files : programs) {
-    const Program& program = library_.program(files);
-    GLint count = 0;
-    glGetProgramiv(program.id(), GL_ACTIVE_UNIFORMS, &count);
-    std::map<int, std::string> units;
-    for (GLint u = 0; u < count; ++u) {
-      char name[256];
-      GLint size = 0;
-      GLenum type = 0;
-      glGetActiveUniform(program.id(), static_cast<GLuint>(u), sizeof name, nullptr, &size, &type, name);
-      const bool sampler = type == GL_SAMPLER_2D || type == GL_SAMPLER_2D_ARRAY || type == GL_SAMPLER_CUBE ||
-                           type == GL_SAMPLER_CUBE_MAP_ARRAY;
-      if (!sampler) continue;
-      GLint unit = -1;
-      glGetUniformiv(program.id(), glGetUniformLocation(program.id(), name), &unit);
-      ++samplers;
-      EXPECT_LT(unit, gpu::kUnitCount) << files.back() << " " << name;
-      EXPECT_TRUE(units.emplace(unit, name).second)
-          << files.back() << ": " << name << " and " << units[unit] << " share unit " << unit;
-      if (unit >= gpu::kUnitShadowCube) {
-        const auto [it, inserted] = sharedUnitOwner.emplace(unit, name);
-        EXPECT_EQ(it->second, name) << files.back() << ": unit " << unit << " is " << name << " here and "
-                                    << it->second << " in another program";
-      }
-    }
-    EXPECT_LE(static_cast<GLint>(units.size()), maxStageSamplers) << files.back();
-  }
-  gl::checkError("sampler units");
-  EXPECT_GE(samplers, 25);  // the programs' samplers were really enumerated
 }
 
 }  // namespace

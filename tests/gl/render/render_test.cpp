@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <set>
@@ -21,6 +22,8 @@
 #include "renderer/scene/BuiltinScenes.h"
 #include "renderer/frame/FramePlanner.h"
 #include "renderer/frame/FrameResources.h"
+#include "renderer/frame/GpuTypes.h"
+#include "renderer/gl/ShaderLibrary.h"
 #include "renderer/techniques/Registry.h"
 #include "renderer/io/ImageIO.h"
 #include "tests/support/Expect.h"
@@ -1103,6 +1106,81 @@ TEST(RenderCore, PassTimesAreEachPassesOwnAndSayHowTheyWereMeasured) {
     sum += p.gpuMs;
   }
   EXPECT_LE(sum, out.stats.renderMs) << "the passes' times are disjoint parts of the render";
+}
+
+
+// Texture units (common/shared.h): no two samplers share a unit, within a program or across the
+// programs of a frame, so a pass binding its inputs never overwrites another pass's. (Unit 8 used to
+// be both t_baseColor and t_environment.) Units below kUnitShadowCube are each full-screen pass's own
+// inputs. The programs are whatever the techniques link, with no list of them here: every registered
+// technique is rendered on the first built-in scene where it runs, and the renderer's shader library
+// says what was linked (a new technique's shaders are checked without touching this file).
+TEST(RenderCore, SamplerUnitsAreUniqueAcrossEveryTechniquesPrograms) {
+  Renderer& r = renderer();
+  std::vector<Scene> scenes;
+  for (const char* name : {"cornell_box", "cornell_glass", "cornell_mirror", "explosion", "ao_creases"})
+    scenes.push_back(loadBuiltinScene(name));
+  {  // No built-in scene blends (transparency): a lit wall behind a half-covering pane.
+    testing::SceneBuilder b;
+    b.quad({0, 0, -1}, {3, 0, 0}, {0, 3, 0}, b.material(testing::lambertian()), "wall");
+    Material pane = testing::lambertian(glm::vec3(0.5f));
+    pane.baseColorFactor.a = 0.5f;
+    pane.alphaMode = AlphaMode::Blend;
+    b.quad({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, b.material(pane), "pane");
+    b.pointLight({0, 0, 2}, 10.f);
+    scenes.push_back(b.build("sampler-units-blend"));
+  }
+  std::set<std::string> ran;
+  for (const TechniqueDescription& t : Renderer::techniques()) {
+    for (const Scene& scene : scenes) {
+      if (ran.count(t.name)) break;
+      api::RenderRequest req = request(32, {"beauty"});
+      req.passes[t.name] = nlohmann::json::object();
+      try {
+        for (const api::PassStats& p : r.render(scene, req).stats.passes) ran.insert(p.name);
+      } catch (const api::ApiError&) {
+        // Not for this scene (a requirement, or a conflict with a default pass): the next one.
+      }
+    }
+    EXPECT_TRUE(ran.count(t.name)) << t.name << " ran on no built-in scene: its programs go unchecked";
+  }
+
+  GLint maxCombinedUnits = 0, maxStageSamplers = 0;
+  glGetIntegerv(GL_MAX_COMBINED_TEXTURE_IMAGE_UNITS, &maxCombinedUnits);
+  glGetIntegerv(GL_MAX_TEXTURE_IMAGE_UNITS, &maxStageSamplers);
+  EXPECT_GE(maxCombinedUnits, gpu::kUnitCount);  // GL 4.5 guarantees 80
+  std::map<int, std::string> sharedUnitOwner;  // unit >= kUnitShadowCube -> sampler name
+  int samplers = 0;
+  for (const auto& [key, program] : r.shaders().programs()) {
+    GLint count = 0;
+    glGetProgramiv(program.id(), GL_ACTIVE_UNIFORMS, &count);
+    std::map<int, std::string> units;
+    for (GLint u = 0; u < count; ++u) {
+      char name[256];
+      GLint size = 0;
+      GLenum type = 0;
+      glGetActiveUniform(program.id(), static_cast<GLuint>(u), sizeof name, nullptr, &size, &type, name);
+      const bool sampler = type == GL_SAMPLER_2D || type == GL_SAMPLER_2D_ARRAY || type == GL_SAMPLER_CUBE ||
+                           type == GL_SAMPLER_CUBE_MAP_ARRAY || type == GL_SAMPLER_3D;
+      if (!sampler) continue;
+      GLint unit = -1;
+      glGetUniformiv(program.id(), glGetUniformLocation(program.id(), name), &unit);
+      ++samplers;
+      EXPECT_LT(unit, gpu::kUnitCount) << key << " " << name;
+      EXPECT_TRUE(units.emplace(unit, name).second)
+          << key << ": " << name << " and " << units[unit] << " share unit " << unit;
+      if (unit >= gpu::kUnitShadowCube) {
+        const auto [it, inserted] = sharedUnitOwner.emplace(unit, name);
+        EXPECT_EQ(it->second, name) << key << ": unit " << unit << " is " << name << " here and " << it->second
+                                    << " in another program";
+      }
+    }
+    // A program's stage reads at most GL_MAX_TEXTURE_IMAGE_UNITS samplers (this bounds every stage).
+    EXPECT_LE(static_cast<GLint>(units.size()), maxStageSamplers) << key;
+  }
+  gl::checkError("sampler units");
+  EXPECT_GE(r.shaders().cachedPrograms(), 20u);
+  EXPECT_GE(samplers, 25);  // the programs' samplers were really enumerated
 }
 
 }  // namespace
