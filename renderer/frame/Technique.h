@@ -99,17 +99,19 @@ public:
     return it->get<T>();
   }
   const nlohmann::json& json() const { return json_; }
-  // Digest of a subset of the parameters: what a cache entry depends on.
-  std::string subsetKey(std::initializer_list<const char*> keys) const {
-    nlohmann::json s = nlohmann::json::object();
-    for (const char* k : keys)
-      if (json_.contains(k)) s[k] = json_[k];
-    return s.dump();
-  }
 private:
   nlohmann::json json_;
   std::set<std::string> given_;
 };
+
+// A cache key (FrameResources::cached's inputs digest) from typed values: the fields of a technique's
+// generated parameter struct that the entry depends on, counts, other keys. A JSON array of them
+// (numbers written to round-trip, enums as their integers): naming the struct's fields instead of
+// the schema's strings keeps a renamed or misspelt parameter from silently dropping out of the key.
+template <class... T>
+std::string cacheKey(const T&... values) {
+  return nlohmann::json::array({nlohmann::json(values)...}).dump();
+}
 
 // What scores one of a technique's AOVs (ARCHITECTURE.md, "A technique owns its knowledge"): the
 // parameters of the reference pass (renderer/techniques/reference/reference.json) that render its ground truth,

@@ -126,7 +126,7 @@ void IlluminationNetworkPass::prepare(const Scene& scene, const Params& params, 
   marchSteps_ = p.march_steps;
   const float kernelScale = static_cast<float>(p.march_kernel);
   const std::string digest = view.mediaKey + "|" + std::to_string(N) + "|" + std::to_string(D) + "|" +
-                             std::to_string(M) + "|" + params.subsetKey({"seed", "sampling", "link_opacity"});
+                             std::to_string(M) + "|" + cacheKey(p.seed, p.sampling, p.link_opacity);
   fresh_ = false;
   net_ = &res.cached<Network>("illumination_network", digest, [&] {
     auto n = std::make_unique<Network>();

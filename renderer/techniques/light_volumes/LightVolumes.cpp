@@ -94,9 +94,8 @@ void LightVolumesPass::prepare(const Scene& scene, const Params& params, FrameRe
 
   const nlohmann::json key = {{"scene", res.sceneKey()},
                               {"lights", lightsKey(scene)},
-                              {"params", nlohmann::json::parse(params.subsetKey(
-                                             {"sigma_scale", "shadows", "max_concentration", "max_triangle_sigma",
-                                              "tessellation_fallback", "cull_sigmas", "max_subdivision_beams"}))}};
+                              {"params", cacheKey(p.sigma_scale, p.shadows, p.max_concentration, p.max_triangle_sigma,
+                                                  p.tessellation_fallback, p.cull_sigmas, p.max_subdivision_beams)}};
   built_ = false;
   const Cache& cache = res.cached<Cache>("light_volumes_beams", key.dump(), [&] {
     built_ = true;
