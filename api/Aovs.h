@@ -50,7 +50,7 @@ struct AovInfo {
   // Radiance: a PNG shows it through the request's view transform (tone_map, renderer/io/ToneMap.h).
   // false for data (reflectance, geometry, occlusion, transmittance, error), which a PNG shows as stored.
   bool radiance = true;
-  std::string description;  // one sentence, served by /v1/info
+  std::string description{};  // one sentence, served by /v1/info
 };
 
 const std::vector<AovInfo>& aovTable();

@@ -50,7 +50,7 @@ struct CameraOverride {
   struct Orbit {
     double thetaDeg = 0, phiDeg = 90, radius = 0;
   };
-  std::optional<Orbit> orbit;
+  std::optional<Orbit> orbit{};
 };
 
 enum class ImageFormat { Exr, Png };
@@ -99,7 +99,7 @@ struct RefineSpec {
   // Not in the schema: a session's next generation starts with the seed of the batch its previous one
   // rendered last (that photon set's splats are on the GPU); the later batches are seed, seed + 1, ...
   // without it (server/Sessions.h).
-  std::optional<std::uint64_t> firstSeed;
+  std::optional<std::uint64_t> firstSeed{};
 };
 
 struct RenderRequest {

@@ -37,7 +37,7 @@ struct FrameInputs {
   // Progress of the frame in [0, 1]: passes done plus the running pass's own fraction (reference tiles,
   // light-tracer waves, photon tracing), in pass-count units, then 1 after readback. Never decreases.
   // May be called from the renderer's worker threads: keep it cheap and thread-safe (store an atomic).
-  std::function<void(double)> progress;
+  std::function<void(double)> progress{};
   // The server's caps (radiantd --max-samples, --max-photons, ...): quality presets and time budgets
   // choose only configurations within them (api::chooseConfiguration). Null = the schema's own bounds.
   const api::RequestLimits* limits = nullptr;

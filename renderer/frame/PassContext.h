@@ -26,7 +26,7 @@ struct PassContext {
   // every loop of a pass that can run longer than a few milliseconds polls it too (per tile, row, block
   // of photons, stretch of GPU work) and throws rt::Cancelled, so that a cancelled, timed-out or
   // shut-down render stops within one second whatever pass it is in.
-  rt::Cancel cancel;
+  rt::Cancel cancel{};
 };
 
 }  // namespace radiant
