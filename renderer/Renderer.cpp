@@ -1005,9 +1005,9 @@ RenderOutput Renderer::renderFrame(const Scene& scene, const api::RenderRequest&
     return out;
   } catch (const rt::Cancelled& c) {
     // A pass or builder saw the cancel flag mid-loop (renderer/raytracing/Cancel.h): what it built is not
-    // stored, and the GL pipeline state it changed goes back to the defaults a fresh context has.
+    // stored (a shared resource it was rewriting holds nothing: FrameResources::refill), and the GL
+    // pipeline state it changed goes back to the defaults a fresh context has.
     im.resources.setCancel({});
-    im.resources.forgetHeld();
     im.profiler.beginFrame();
     resetPipelineState();
     im.resources.settleAfterFrame();  // a frame refused or stopped midway holds its targets too

@@ -101,7 +101,7 @@ public:
   static void check(const Scene& scene, const api::RenderRequest& request, const FrameInputs& inputs);
   // How many scenes stay uploaded to the GPU, and how many input digests each kind of cached derived
   // data (BVH, photons, beams) keeps; least recently used evicted first. Maps held in shared frame
-  // resources (shadow and cube maps) hold the last scene rendered (FrameResources::holds).
+  // resources (shadow and cube maps) hold the last scene rendered (FrameResources::refill).
   // Default 4; radiantd --gpu-scenes.
   void setGpuSceneCapacity(std::size_t scenes);
   // Bytes the sized derived data (photon sets, splat grids) may hold together, least recently used

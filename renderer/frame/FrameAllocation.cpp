@@ -57,14 +57,15 @@ void declareEnvironmentMap(FrameResources& res, const FrameView& view) {
   t.setFilter(GL_LINEAR_MIPMAP_LINEAR, GL_LINEAR);
   t.setWrap(GL_REPEAT, GL_CLAMP_TO_EDGE);
   const std::string digest = view.environmentKey + "|" + std::to_string(env.width) + "x" + std::to_string(env.height);
-  if (res.holds(kEnvironmentMap, digest)) return;
-  res.setHolds(kEnvironmentMap, digest);
+  FrameResources::Refill map = res.refill(kEnvironmentMap, digest);
+  if (map.hit()) return;
   std::vector<float> rgba(static_cast<std::size_t>(env.width) * env.height * 4, 0.f);
   for (std::size_t p = 0; p < static_cast<std::size_t>(env.width) * env.height; ++p)
     for (int c = 0; c < 3; ++c) rgba[p * 4 + c] = env.pixels[p * env.channels + std::min(c, env.channels - 1)];
   // Rows in image order (row 0 = up): texel row v * height is image row v * height.
   t.upload(0, 0, 0, 0, env.width, env.height, 1, GL_RGBA, GL_FLOAT, rgba.data());
   if (levels > 1) t.generateMipmaps();
+  map.written();
 }
 
 }  // namespace radiant

@@ -21,7 +21,7 @@ void allocateDeclaredOutputs(FrameResources& resources, const std::vector<Techni
 
 // The frame resource "environment_map" (kEnvironmentMap): view.environment as an RGBA32F equirect
 // texture (nearest filtering; rows in image order, row 0 = up), uploaded when the texture does not hold
-// this map (digest and size; FrameResources::holds, logged as "environment_map" in the stats); a
+// this map (digest and size; FrameResources::refill, logged as "environment_map" in the stats); a
 // 1x1 placeholder keeps the samplers complete in frames without a map. The map's importance-sampling
 // distribution for the CPU core is cached beside it per digest (environmentDistribution() in
 // renderer/frame/RayScenes.h).

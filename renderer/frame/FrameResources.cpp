@@ -178,11 +178,20 @@ gl::Buffer& FrameResources::buffer(const std::string& name) {
   return it->second;
 }
 
-bool FrameResources::holds(const std::string& resource, const std::string& digest, const std::string& logKey) {
+FrameResources::Refill FrameResources::refill(const std::string& resource, std::string digest, const std::string& logKey) {
+  Refill r;
+  r.resources_ = this;
+  r.resource_ = resource;
   auto it = holds_.find(resource);
-  const bool hit = it != holds_.end() && it->second == digest;
-  if (cacheLog_) cacheLog_->push_back({logKey.empty() ? resource : logKey, hit});
-  return hit;
+  r.hit_ = !digest.empty() && it != holds_.end() && it->second == digest;
+  if (!r.hit_ && it != holds_.end()) holds_.erase(it);  // about to be overwritten: holds nothing until written()
+  r.digest_ = std::move(digest);
+  if (cacheLog_ && !r.digest_.empty()) cacheLog_->push_back({logKey.empty() ? resource : logKey, r.hit_});
+  return r;
+}
+
+void FrameResources::Refill::written() {
+  if (resources_ && !digest_.empty()) resources_->holds_[resource_] = digest_;
 }
 
 void FrameResources::clear() {

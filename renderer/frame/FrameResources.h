@@ -11,7 +11,7 @@
 // a cache hit or miss. Each key keeps the derived data of its `derivedCapacity` most recently used
 // digests (renders alternating between scenes or parameter sets reuse them; radiantd --gpu-scenes sets
 // it with the scene cache). Derived data that lives in a shared frame resource (shadow maps, cube maps,
-// uploaded buffers) is valid only while the resource holds it: holds() / setHolds() below.
+// uploaded buffers) is valid only while the resource holds it: refill() below.
 // Derived data whose type reports its size (`std::size_t bytes() const`: photon sets, splat grids) is
 // also kept within a byte budget over every key together (radiantd --derived-cache-bytes): when an entry
 // is added, the least recently used entries go first, never one this frame has looked up (a pass may
@@ -91,16 +91,32 @@ public:
   // Derived data that lives in a frame resource shared by every scene (the shadow maps, the specular
   // and env_diffuse cube maps, the environment map and its prefiltered levels, uploaded beams): the
   // resource holds only what was last written into it, however many digests cached() keeps. A cache
-  // hit for scene A after scene B wrote the resource would read B's data, so such data asks holds():
-  // true when `resource` still holds what `digest` describes (logged as a hit or miss of `logKey`,
-  // default the resource's name). After writing it, setHolds(). Reallocating a texture or buffer, and
-  // clear(), forget what it held.
-  bool holds(const std::string& resource, const std::string& digest, const std::string& logKey = "");
-  void setHolds(const std::string& resource, std::string digest) { holds_[resource] = std::move(digest); }
-  // Forgets what every resource holds: after a pass stopped mid-write (a cancelled request), any shared
-  // resource may be half rewritten, so each is redrawn when next asked for.
-  void forgetHeld() { holds_.clear(); }
-  // What `resource` holds (the digest of its last setHolds), "" when nothing: data derived from it (the
+  // hit for scene A after scene B wrote the resource would read B's data, so such data is written
+  // through a Refill:
+  //   FrameResources::Refill maps = res.refill("shadow_cube", digest, "shadow_maps");
+  //   if (!maps.hit()) { ...write the maps...; maps.written(); }
+  // refill() asks whether `resource` still holds what `digest` describes (logged as a hit or miss of
+  // `logKey`, default the resource's name). On a miss the resource holds nothing from that moment:
+  // whatever stops the pass before written() (a cancel, a 422 or 409, an exception) leaves it to be
+  // redrawn, never claiming what it held before the write began. An empty digest is data that is not
+  // cached (drawn every frame): never a hit, and it empties the resource too. Reallocating a texture or
+  // buffer, and clear(), forget what it held.
+  class Refill {
+   public:
+    Refill() = default;
+    bool hit() const { return hit_; }
+    // After writing: the resource holds this refill's digest (a no-op for an empty digest).
+    void written();
+    const std::string& digest() const { return digest_; }
+
+   private:
+    friend class FrameResources;
+    FrameResources* resources_ = nullptr;
+    std::string resource_, digest_;
+    bool hit_ = false;
+  };
+  Refill refill(const std::string& resource, std::string digest, const std::string& logKey = "");
+  // What `resource` holds (the digest of its last Refill::written), "" when nothing: data derived from it (the
   // caustic cubes from the specular maps) keys its own cache on it.
   std::string heldDigest(const std::string& resource) const {
     auto it = holds_.find(resource);
@@ -280,7 +296,7 @@ private:
   gl::Buffer frameConstants_;  // the view's gpu::FrameConstants, bound at kBindingFrameConstants (beginFrame)
   using Family = api::Lru<std::string, Entry>;  // one cache key's entries, by inputs digest
   std::map<std::string, Family> cache_;
-  std::map<std::string, std::string> holds_;  // resource -> digest of what it holds (holds())
+  std::map<std::string, std::string> holds_;  // resource -> digest of what it holds (refill())
   std::size_t derivedCapacity_ = 4;
   std::set<std::string> written_;
   std::map<std::string, std::any> products_;  // the blackboard, cleared by beginFrame()

@@ -9,7 +9,6 @@
 // KHR_texture_transform (TextureRef::transformUv): the uv rows travel with the TextureRef, as they
 // travel per slot in gpu::Material::uvTransform. The decoder calls it only for slots the material has.
 #include <array>
-#include <type_traits>
 
 #include <glm/glm.hpp>
 

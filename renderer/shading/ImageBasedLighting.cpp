@@ -218,9 +218,9 @@ void prepare(FrameResources& res) {
   dfg.setFilter(GL_LINEAR, GL_LINEAR);
   glTextureParameteri(dfg.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
   glTextureParameteri(dfg.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-  if (!res.holds("ibl_dfg", "v1")) {
+  if (FrameResources::Refill table = res.refill("ibl_dfg", "v1"); !table.hit()) {
     dfg.upload(0, 0, 0, 0, kDfgSize, kDfgSize, 1, GL_RGBA, GL_FLOAT, dfgTable().data());
-    res.setHolds("ibl_dfg", "v1");
+    table.written();
   }
   const FrameView& view = res.view();
   const int layers = view.environment ? kPrefilterLevels : 1;
@@ -234,11 +234,11 @@ void prepare(FrameResources& res) {
     const Image& env = *view.lightingEnvironment();
     const std::string key = view.lightingEnvironmentKey() + "|" + std::to_string(env.width) + "x" + std::to_string(env.height);
     // The levels live in the shared texture: prefiltered again when it holds another map's (a frame
-    // with another environment since; FrameResources::holds).
-    if (!res.holds("ibl_prefiltered", key)) {
+    // with another environment since; FrameResources::refill).
+    if (FrameResources::Refill levels = res.refill("ibl_prefiltered", key); !levels.hit()) {
       const std::vector<float> texels = prefilterEnvironment(env, res.cancel());
       pre.upload(0, 0, 0, 0, kPrefilterWidth, kPrefilterHeight, kPrefilterLevels, GL_RGBA, GL_FLOAT, texels.data());
-      res.setHolds("ibl_prefiltered", key);
+      levels.written();
     }
     res.cached<ShCoefficients>("ibl_sh", key, [&] {
       auto s = std::make_unique<ShCoefficients>();

@@ -283,9 +283,11 @@ void CausticsPass::execute(PassContext& ctx) {
         << " pairs=" << pairs_.size();
     cubeDigest = key.str();
   }
-  const bool cubeCached = !cubeDigest.empty() && res.holds("caustics_cube", cubeDigest, "caustics_cube");
-  counters["cube_cached"] = cubeCached ? 1.0 : 0.0;
-  if (!cubeCached) {
+  // The cubes live in the shared caustics_cube texture (FrameResources::refill); a frame that draws them
+  // without a digest (energy_check) leaves it holding nothing, whatever scene it held before.
+  FrameResources::Refill cubes = res.refill("caustics_cube", cubeDigest, "caustics_cube");
+  counters["cube_cached"] = cubes.hit() ? 1.0 : 0.0;
+  if (!cubes.hit()) {
     glClearNamedFramebufferfv(cubeFb.id(), GL_COLOR, 0, zero);
 
     // Face transforms around the origin: hit positions are relative to the reference point.
@@ -421,8 +423,8 @@ void CausticsPass::execute(PassContext& ctx) {
     // The mip chain for the camera pass's footprint filter: box-filtered levels keep each region's power
     // (irradiance and the alpha depth weight average alike, so the mean deposit depth stays a ratio).
     if (footprintFilter_ && !pairs_.empty()) cube.generateMipmaps();
-    if (!cubeDigest.empty()) res.setHolds("caustics_cube", cubeDigest);  // after drawing it
-  }  // !cubeCached
+    cubes.written();
+  }  // !cubes.hit()
 
   // (4) Camera pass: caustics AOV, and beauty += caustics when this pass owns LS+DE (a request that
   // names light_volumes gives the class to it: then the AOV is written but not added, counted once).

@@ -121,9 +121,8 @@ void EnvDiffusePass::prepare(const Scene& scene, const Params& params, FrameReso
     std::string digest = sceneKey + "|receiver:" + r.name + "|o:" + point + "|sky:" + skyText +
                          "|R:" + std::to_string(R) + "|M:" + std::to_string(M) + "|bounces:" + std::to_string(bounces_);
     if (bounces_ > 1) digest += std::string("|clip:") + (horizonClip_ ? "1" : "0");
-    // The maps live in this receiver's shared textures (FrameResources::holds).
-    st.mapsValid = res.holds(st.prefix + "irradiance", digest, "env_diffuse_cube_maps:" + r.name);
-    st.digest = digest;  // set as held once execute() rendered them
+    // The maps live in this receiver's shared textures (FrameResources::refill).
+    st.maps = res.refill(st.prefix + "irradiance", std::move(digest), "env_diffuse_cube_maps:" + r.name);
     receivers_.push_back(std::move(st));
   }
 
@@ -236,10 +235,10 @@ void EnvDiffusePass::buildCubeMaps(PassContext& ctx, const ReceiverState& st) {
 void EnvDiffusePass::execute(PassContext& ctx) {
   FrameResources& res = ctx.resources;
   int built = 0;
-  for (const ReceiverState& r : receivers_)
-    if (!r.mapsValid) {
+  for (ReceiverState& r : receivers_)
+    if (!r.maps.hit()) {
       buildCubeMaps(ctx, r);
-      res.setHolds(r.prefix + "irradiance", r.digest);
+      r.maps.written();
       ++built;
     }
 

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "renderer/frame/FrameResources.h"
 #include "renderer/frame/Technique.h"
 #include "renderer/techniques/env_diffuse/Receivers.h"
 
@@ -35,8 +36,7 @@ private:
   struct ReceiverState {
     env_diffuse::Receiver receiver;
     std::string prefix;  // resource name prefix
-    bool mapsValid = false;
-    std::string digest;  // what its maps hold once rendered (FrameResources::holds)
+    FrameResources::Refill maps;  // hit: its maps hold this frame's; else execute() renders them
   };
   void buildCubeMaps(PassContext& ctx, const ReceiverState& r);
 

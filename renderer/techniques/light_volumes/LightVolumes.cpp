@@ -122,9 +122,8 @@ void LightVolumesPass::prepare(const Scene& scene, const Params& params, FrameRe
   res.buffer("light_volumes_cones", bytesOf(cache.beams.cones));
   res.buffer("light_volumes_nodes", bytesOf(cache.bvh.nodes));
   res.buffer("light_volumes_prims", bytesOf(cache.bvh.primitives));
-  // The buffers hold the beams last uploaded, maybe another scene's (FrameResources::holds).
-  upload_ = !res.holds("light_volumes_beams", key.dump(), "light_volumes_upload");
-  digest_ = key.dump();
+  // The buffers hold the beams last uploaded, maybe another scene's (FrameResources::refill).
+  uploaded_ = res.refill("light_volumes_beams", key.dump(), "light_volumes_upload");
   // Declared outputs: allocated by the Renderer (renderer/frame/FrameAllocation.h).
   res.texture("light_volumes").setFilter(GL_NEAREST, GL_NEAREST);
   res.texture("beauty");
@@ -137,12 +136,12 @@ void LightVolumesPass::execute(PassContext& ctx) {
   gl::Buffer& cones = res.buffer("light_volumes_cones");
   gl::Buffer& nodes = res.buffer("light_volumes_nodes");
   gl::Buffer& prims = res.buffer("light_volumes_prims");
-  if (upload_) {
+  if (!uploaded_.hit()) {
     if (!c.beams.beams.empty()) beams.upload(c.beams.beams.data(), c.beams.beams.size() * sizeof(light_volumes::Beam));
     if (!c.beams.cones.empty()) cones.upload(c.beams.cones.data(), c.beams.cones.size() * sizeof(light_volumes::BeamCone));
     if (!c.bvh.nodes.empty()) nodes.upload(c.bvh.nodes.data(), c.bvh.nodes.size() * sizeof(light_volumes::BeamBvhNode));
     if (!c.bvh.primitives.empty()) prims.upload(c.bvh.primitives.data(), c.bvh.primitives.size() * sizeof(glm::vec4));
-    res.setHolds("light_volumes_beams", digest_);  // after the upload
+    uploaded_.written();
   }
   const char* inputs[] = {"gbuffer_position", "normal", "albedo", "material", "emission"};
   for (GLuint i = 0; i < std::size(inputs); ++i) res.texture(inputs[i]).bindUnit(i);

@@ -12,6 +12,7 @@
 //                        camera, split or traversal.
 #include <string>
 
+#include "renderer/frame/FrameResources.h"
 #include "renderer/frame/Technique.h"
 #include "renderer/techniques/light_volumes/BeamBvh.h"
 #include "renderer/techniques/light_volumes/Beams.h"
@@ -35,9 +36,9 @@ public:
 
 private:
   const Cache* cache_ = nullptr;  // in FrameResources' cache, valid for this frame
-  bool upload_ = false, built_ = false, bvh_ = true;
+  bool built_ = false, bvh_ = true;
   int beautyClasses_ = 3;  // which of its beams join beauty (execute; gather.comp u_beautyClasses)
-  std::string digest_;  // what the beam buffers hold once uploaded (FrameResources::holds)
+  FrameResources::Refill uploaded_;  // hit: the beam buffers hold this frame's beams; else execute() uploads them
   light_volumes::Split split_ = light_volumes::Split::TwoD;
 };
 

@@ -322,9 +322,10 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   const std::string splatDigest = splatKey.dump();
   SplatCache& splats = res.cached<SplatCache>("photon_gi_splats", splatDigest, buildSplats);
   // A hit whose set is not the one in the splat buffers (another scene was rendered since, or the
-  // resources were dropped after a failure; FrameResources::holds): without this the frame gathered
-  // the other scene's photons (Fox after BoxTextured came out unlit, 2026-12-02).
-  if (!res.holds("photon_gi_splats", splatDigest, "photon_gi_splats_resident")) upload_ = true;
+  // resources were dropped after a failure; FrameResources::refill): without this the frame gathered
+  // the other scene's photons (Fox after BoxTextured came out unlit, 2026-12-02). FrameResources::refill.
+  FrameResources::Refill resident = res.refill("photon_gi_splats", splatDigest, "photon_gi_splats_resident");
+  if (!resident.hit()) upload_ = true;
   if (upload_ && splats.grid.splats.size() != splats.grid.count) {
     splats = std::move(*buildSplats());
     rebuilt_ = true;
@@ -346,7 +347,7 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
     // The GPU holds the splats now: the CPU copy would double the memory of every cached photon set. A
     // lost GL context clears the cache entry too (FrameResources::clear), so it is rebuilt, not re-uploaded.
     std::vector<photon_gi::GpuSplat>().swap(grid_->splats);
-    res.setHolds("photon_gi_splats", splatDigest_);  // after the upload
+    resident.written();
   }
   PhotonGrid published;
   published.digest = splatDigest_ + "|kernel=" + std::to_string(static_cast<int>(splat_.kernel));

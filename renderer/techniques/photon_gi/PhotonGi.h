@@ -47,7 +47,7 @@ private:
   photon_gi::SplatGrid* grid_ = nullptr;  // in the cache, valid for this frame
   bool upload_ = false;                          // the grid changed: upload it in execute()
   // The splat set (its cache key) this frame uses. The splat buffers hold one set at a time
-  // (FrameResources::holds), so a cached set of another scene or setting is uploaded again (and rebuilt:
+  // (FrameResources::refill), so a cached set of another scene or setting is uploaded again (and rebuilt:
   // the CPU copy is released after upload).
   std::string splatDigest_;
   bool rebuilt_ = false;            // this frame rebuilt a cached set that was not resident

@@ -194,9 +194,8 @@ void ShadowMapsPass::prepare(const Scene& scene, const Params& params, FrameReso
 
   std::string digest = inputs + "|" + std::to_string(size_);
   // The maps live in the shared shadow textures: valid only when they hold this digest's maps (another
-  // scene may have rendered into them since; FrameResources::holds).
-  mapsValid_ = res.holds("shadow_cube", digest, "shadow_maps");
-  digest_ = std::move(digest);
+  // scene may have rendered into them since; FrameResources::refill).
+  maps_ = res.refill("shadow_cube", std::move(digest), "shadow_maps");
 }
 
 void ShadowMapsPass::execute(PassContext& ctx) {
@@ -204,14 +203,14 @@ void ShadowMapsPass::execute(PassContext& ctx) {
   gl::Buffer& info = res.buffer("shadow_info");
   info.upload(infos_.data(), infos_.size() * sizeof(gpu::ShadowInfo));
   res.publish("shadow_maps", ShadowMapSet{&res.texture("shadow_cube"), &res.texture("shadow_2d"), &info});
-  ctx.stats.counters["maps_rendered"] = mapsValid_ ? 0.0 : static_cast<double>(draws_.size());
+  ctx.stats.counters["maps_rendered"] = maps_.hit() ? 0.0 : static_cast<double>(draws_.size());
   ctx.stats.counters["meshes_excluded"] = static_cast<double>(excluded_.size());
   ctx.stats.counters["map_size"] = size_;
   // The overdraw estimate the size was chosen by (kFragmentBudget), in fragments of every map.
   ctx.stats.counters["fragments_estimated"] = coverage_ * double(size_) * size_;
   ctx.stats.counters["overdraw_estimate_ms"] = estimateMs_;  // 0 when the inputs are unchanged
   if (!warning_.empty()) ctx.stats.warnings.push_back(warning_);
-  if (mapsValid_) return;
+  if (maps_.hit()) return;
 
   gl::Framebuffer& fb = res.framebuffer("shadow");
   gl::Texture& cube = res.texture("shadow_cube");
@@ -275,7 +274,7 @@ void ShadowMapsPass::execute(PassContext& ctx) {
     }
     gate.issued();
   }
-  res.setHolds("shadow_cube", digest_);  // after writing: a frame that fails before leaves them invalid
+  maps_.written();  // a frame that fails before this leaves them holding nothing
   // The levels of detail drawn (GpuScene::drawMeshes): triangles over all maps, against the full meshes'.
   ctx.stats.counters["triangles_drawn"] = static_cast<double>(drawnTriangles);
   ctx.stats.counters["triangles_full"] = static_cast<double>(fullTriangles);

@@ -3,6 +3,7 @@
 #include <string>
 #include <vector>
 
+#include "renderer/frame/FrameResources.h"
 #include "renderer/frame/GpuTypes.h"
 #include "renderer/frame/Technique.h"
 #include "renderer/raytracing/Cancel.h"
@@ -57,8 +58,7 @@ public:
   static int sizeWithinBudget(int size, double coverage);
 
 private:
-  bool mapsValid_ = false;
-  std::string digest_;  // what the maps hold once execute() rendered them (FrameResources::holds)
+  FrameResources::Refill maps_;  // hit: the maps hold this frame's; else execute() renders them
   int size_ = 1024;
   std::vector<gpu::ShadowInfo> infos_;
   struct Draw {

@@ -278,9 +278,9 @@ void SpecularPass::execute(PassContext& ctx) {
   const PhotonGrid* photons = publishedPhotonGrid(res);
   ctx.stats.counters["maps_indirect"] = photons ? 1 : 0;
   const std::string digest = digest_ + "|photons=" + (photons ? photons->digest : std::string("none"));
-  // The maps live in the shared specular_ldm_* textures (FrameResources::holds).
-  mapsValid_ = res.holds("specular_ldm_distance", digest, "specular_maps");
-  if (!mapsValid_ && objectCount > 0) {
+  // The maps live in the shared specular_ldm_* textures (FrameResources::refill).
+  FrameResources::Refill maps = res.refill("specular_ldm_distance", digest, "specular_maps");
+  if (!maps.hit() && objectCount > 0) {
     // Layered distance maps (thesis 5.1.1): per object and face, its front faces, its back faces, the
     // environment (everything else, closest surface) and depth-peeled environment layers.
     gl::Framebuffer& fb = res.framebuffer("specular_ldm");
@@ -502,7 +502,7 @@ void SpecularPass::execute(PassContext& ctx) {
     // The levels of detail drawn (GpuScene::drawMeshes): triangles over all faces, against the full meshes'.
     ctx.stats.counters["triangles_drawn"] = static_cast<double>(drawnTriangles);
     ctx.stats.counters["triangles_full"] = static_cast<double>(fullTriangles);
-    res.setHolds("specular_ldm_distance", digest);  // after writing them
+    maps.written();
   }
   SpecularMaps published;
   published.material = &material;

@@ -105,10 +105,9 @@ private:
   bool causticsKeepMaps_ = false;
   int indirectBlock_ = 8;             // map_indirect_block     // caustics traces its photons through the maps: cube_resolution
   bool minmax_ = true;
-  bool mapsValid_ = false;
   bool mapsIbl_ = false;  // the maps carry the sky's glossy lobe (direct owns L(sky)GE and there is a sky)
   std::string warning_;   // for stats.warnings when kMaxBytes lowered the maps' resolution
-  std::string digest_;  // the maps' key without the photon set (execute() appends it; FrameResources::holds)
+  std::string digest_;  // the maps' key without the photon set (execute() appends it; FrameResources::refill)
 };
 
 }  // namespace radiant

@@ -886,6 +886,35 @@ TEST(Caustics, CubesAreDrawnOncePerSceneAndKnobsNotPerCamera) {
   EXPECT_EQ(counter(frame(nlohmann::json::object(), true), "caustics", "cube_cached"), 1.0);
 }
 
+// The cubes live in one texture every scene draws into. A frame that draws them without caching them
+// (energy_check) must not leave the texture claiming the cubes it held before: cornell_glass, then
+// cornell_mirror with energy_check, then cornell_glass again used to call the glass cubes cached and
+// show the mirror's caustics (FrameResources::refill: a miss empties the resource until written).
+TEST(Caustics, AnUncachedDrawingLeavesTheSharedCubesHoldingNothing) {
+  const Scene glass = loadBuiltinScene("cornell_glass");
+  const Scene mirror = loadBuiltinScene("cornell_mirror");
+  const int n = 32;
+  RenderOutput first = renderer().render(glass, request(n));
+  RenderOutput other = renderer().render(mirror, request(n, {{"energy_check", true}}));
+  EXPECT_EQ(counter(other, "caustics", "cube_cached"), 0.0);
+  RenderOutput again = renderer().render(glass, request(n));
+  EXPECT_EQ(counter(again, "caustics", "cube_cached"), 0.0) << "the texture holds cornell_mirror's cubes";
+  const Image& a = findAov(first, "caustics");
+  const Image& b = findAov(again, "caustics");
+  const Image& m = findAov(other, "caustics");
+  ASSERT_EQ(a.pixels.size(), b.pixels.size());
+  double sum = 0.0, maxDiff = 0.0, maxOther = 0.0;
+  for (std::size_t i = 0; i < a.pixels.size(); ++i) {
+    sum += a.pixels[i];
+    maxDiff = std::max<double>(maxDiff, std::abs(a.pixels[i] - b.pixels[i]));
+    maxOther = std::max<double>(maxOther, std::abs(a.pixels[i] - m.pixels[i]));
+  }
+  ASSERT_GT(sum, 0.0);
+  const double mean = sum / double(a.pixels.size());
+  EXPECT_GT(maxOther, 0.1 * mean) << "the two scenes' caustics differ";
+  EXPECT_LE(maxDiff, 1e-5 * mean + 1e-6) << "cornell_glass after cornell_mirror has cornell_glass's caustics";
+}
+
 // secondary_max_depth bounds step 5's trees. Every level adds paths, so only light: beauty never falls
 // with the depth. On cornell_glass each level adds some (depth 1: reflections off the sphere; 2: through
 // it, in and out; 3-4: internal reflections, total near the silhouette), measured 10.77 / 11.36 / 13.58

@@ -360,7 +360,7 @@ TEST(RenderCore, DerivedDataIsCachedAcrossFrames) {
 // shadow maps) is kept alike, so alternating between scenes rebuilds nothing.
 TEST(RenderCore, GpuSceneCacheKeepsTheMostRecentlyUsedScenes) {
   // The uploaded scene is kept per scene (LRU); the shadow maps live in one shared texture, so they are
-  // reused only when the frame before rendered the same scene (FrameResources::holds).
+  // reused only when the frame before rendered the same scene (FrameResources::refill).
   const Scene* last = nullptr;
   auto gpuHit = [&](const Scene& s) {
     const RenderOutput o = renderer().render(s, request(8));
@@ -538,7 +538,7 @@ TEST(RenderCore, SharedDerivedResourcesHoldTheSceneRenderedLast) {
   // Two scenes whose shadows differ (the occluder left or right of the light), rendered A, B, A with
   // both kept uploaded: the third frame must equal the first. The shadow maps live in one texture that
   // every scene renders into; a derived-data cache that kept both digests used to call the third
-  // frame's maps valid and shade A with B's shadow (FrameResources::holds). Rasterisation is
+  // frame's maps valid and shade A with B's shadow (FrameResources::refill). Rasterisation is
   // deterministic on one device, so equal means equal to float rounding.
   auto scene = [](float x, const char* digest) {
     SceneBuilder b = planeScene();
@@ -556,9 +556,9 @@ TEST(RenderCore, SharedDerivedResourcesHoldTheSceneRenderedLast) {
   const Image again = aov(r.render(a, request(32, {"direct"})), "direct");
   EXPECT_GT(testing::maxAbsDifference(first, other), 0.5f) << "the two scenes' shadows differ";
   EXPECT_LT(testing::maxAbsDifference(first, again), 1e-5f) << "A after B is shaded with A's shadow maps";
-  // A frame that fails after every pass prepared (cancelled before the first execute) leaves the maps
-  // as they were: B's frame prepared but never rendered B's maps, so they still hold A's, and the next
-  // frame of B must render them (setHolds comes after the write, not in prepare).
+  // A frame that fails after every pass prepared (cancelled before the first execute): B's prepare found
+  // the maps holding A's, so from then on they hold nothing (FrameResources::refill) although B's were
+  // never drawn, and the next frame of B must render them.
   const std::atomic<bool> cancelled{true};
   EXPECT_THROW(r.render(b, request(32, {"direct"}), &cancelled), api::ApiError);
   const Image afterCancel = aov(r.render(b, request(32, {"direct"})), "direct");
