@@ -620,8 +620,11 @@ void Renderer::check(const Scene& scene, const api::RenderRequest& requestIn, co
   FrameInputs inputs = inputsIn;
   inputs.environment = lit.environment;
   const CheckedPlan checked = checkedPlan(all, scene, lit.request, inputs);
-  const FrameView view = makeFrameView(scene, lit.request);  // the camera's 422s
-  for (Technique* t : checked.plan.passes) t->validate(scene, view, requestParams(t->info().name, lit.request));
+  FrameView view = makeFrameView(scene, lit.request);  // the camera's 422s
+  std::vector<Params> params;
+  for (Technique* t : checked.plan.passes) params.push_back(requestParams(t->info().name, lit.request));
+  view.shadowMapExclusions = shadowMapExclusions(checked.plan.passes, params, scene);
+  for (std::size_t i = 0; i < params.size(); ++i) checked.plan.passes[i]->validate(scene, view, params[i]);
 }
 
 RenderOutput Renderer::render(const Scene& scene, const api::RenderRequest& requestIn, const std::atomic<bool>* cancel,
@@ -815,17 +818,17 @@ std::vector<Params> Renderer::Impl::passParameters(const Scene& scene, FrameConf
   config.choice = api::chooseConfiguration(api::PresetTable::builtin(), config.planned, config.supersampled,
                                            inputs.limits, config.counts, speed.planningFactor(config.speedScene));
   for (auto& w : config.choice.warnings) stats.warnings.push_back(std::move(w));
-  std::set<int> shadowMapExclusions;  // meshes whose shadows a pass supplies itself (light_volumes)
   for (std::size_t i = 0; i < plan.passes.size(); ++i) {
     Technique* t = plan.passes[i];
     stats.passes[i].name = t->info().name;
     const auto given = request.explicitParams.find(t->info().name);
     params[i] = Params(config.choice.params.at(t->info().name),
                        given == request.explicitParams.end() ? std::set<std::string>{} : given->second);
-    t->validate(scene, config.view, params[i]);
-    for (int m : t->shadowMapExclusions(scene, params[i])) shadowMapExclusions.insert(m);
   }
-  resources.setShadowMapExclusions(std::move(shadowMapExclusions));
+  // Meshes whose shadows a pass supplies itself (light_volumes): known before any pass validates, as
+  // the shadow maps' limits count the meshes they draw.
+  config.view.shadowMapExclusions = shadowMapExclusions(plan.passes, params, scene);
+  for (std::size_t i = 0; i < plan.passes.size(); ++i) plan.passes[i]->validate(scene, config.view, params[i]);
   return params;
 }
 

@@ -53,6 +53,14 @@ api::SceneCounts costCounts(const std::vector<Technique*>& techniques, const Sce
   return counts;
 }
 
+std::set<int> shadowMapExclusions(const std::vector<Technique*>& passes, const std::vector<Params>& params,
+                                  const Scene& scene) {
+  std::set<int> out;
+  for (std::size_t i = 0; i < passes.size(); ++i)
+    for (int m : passes[i]->shadowMapExclusions(scene, params.at(i))) out.insert(m);
+  return out;
+}
+
 std::vector<Technique*> executionOrder(const std::vector<Technique*>& planned) {
   const std::size_t n = planned.size();
   std::vector<std::set<std::size_t>> after(n);  // after[b]: the passes b must run after

@@ -65,6 +65,11 @@ std::set<std::string> sharedResources(const std::vector<Technique*>& techniques)
 // Renderer fails the frame with std::logic_error on one.
 std::string undeclaredWrite(const TechniqueInfo& info, const std::set<std::string>& written);
 
+// The meshes the shadow maps leave out when `passes` run with `params` (one per pass): the union of
+// their Technique::shadowMapExclusions (FrameView::shadowMapExclusions).
+std::set<int> shadowMapExclusions(const std::vector<Technique*>& passes, const std::vector<Params>& params,
+                                  const Scene& scene);
+
 // The frame graph's order (ARCHITECTURE.md, "The frame graph"): `planned` (in registry order) sorted so
 // that every pass runs after
 //   - the planned producers of what it reads (its inputs and optional inputs; not of what a producer

@@ -139,10 +139,6 @@ public:
     return it == lightPaths_.end() ? std::string() : it->second;
   }
 
-  // Meshes the shadow maps leave out this frame (Technique::shadowMapExclusions, set by the Renderer).
-  void setShadowMapExclusions(std::set<int> meshes) { shadowMapExclusions_ = std::move(meshes); }
-  const std::set<int>& shadowMapExclusions() const { return shadowMapExclusions_; }
-
   // Outputs written this frame (the planner and readback consult it). Inside a pass scope, marking a
   // resource the pass did not declare Write or Accumulate throws std::logic_error.
   void markWritten(const std::string& name);
@@ -302,7 +298,6 @@ private:
   std::map<std::string, std::any> products_;  // the blackboard, cleared by beginFrame()
   std::map<std::string, std::string> lightPaths_;
   std::map<std::string, api::LightPathMask> owned_;
-  std::set<int> shadowMapExclusions_;
   std::set<std::string> declaredThisFrame_;
   // Textures, buffers and framebuffers looked up or declared this frame (releaseIdle keeps them).
   mutable std::set<std::string> usedThisFrame_;

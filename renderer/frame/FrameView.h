@@ -5,6 +5,7 @@
 // nearly uniform in log depth, so scenes at 1e-3 m and 1e4 m scale render alike.
 #include <cstdint>
 #include <memory>
+#include <set>
 
 #include <glm/glm.hpp>
 
@@ -40,6 +41,10 @@ struct FrameView {
   // lights, then its sky lights (EnvironmentLights::skyLights), which light diffuse lobes only.
   std::vector<Light> lights;
   int sceneLights = 0;  // how many of `lights` are the scene's
+  // Meshes the shadow maps leave out: those whose shadows a planned pass supplies itself
+  // (Technique::shadowMapExclusions, light_volumes' negative beams). Set with the frame's parameters,
+  // before any pass validates them (Renderer::check, the frame's passParameters).
+  std::set<int> shadowMapExclusions;
   // What image-based lighting integrates: the residual when the map was split, else the map.
   const Image* lightingEnvironment() const {
     return environmentLights && environmentLights->split() ? &environmentLights->residual : environment;

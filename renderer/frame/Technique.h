@@ -148,8 +148,9 @@ public:
   // GL (an unknown receiver node, a network above its size limit, an exact sky too costly for the
   // frame's particles): throws api::ApiError 422 naming the parameter. Called before the job is queued
   // (Renderer::check, on radiantd's HTTP thread: keep it const and free of state; `view` is the
-  // request's, at its own size, without the environment's lights) and at the frame's start with the
-  // frame's parameters and view, so prepare() need not check the same again.
+  // request's, at its own size, without the environment's lights, with the planned passes'
+  // shadowMapExclusions) and at the frame's start with the frame's parameters and view, so prepare()
+  // need not check the same again (but what depends on the environment's lights: shadow_maps).
   virtual void validate(const Scene& scene, const FrameView& view, const Params& params) const {
     (void)scene;
     (void)view;

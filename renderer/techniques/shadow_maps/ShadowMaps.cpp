@@ -78,6 +78,49 @@ int ShadowMapsPass::sizeWithinBudget(int size, double coverage) {
   return size;
 }
 
+void ShadowMapsPass::checkFragments(int size, double coverage, std::size_t lights) {
+  const double fragments = coverage * double(size) * size;
+  if (fragments > kFragmentLimit)
+    throw api::ApiError(
+        422, "limit-exceeded", "Server limit exceeded",
+        "/passes/shadow_maps/shadow_map_size: maps of " + std::to_string(size) + "^2 would rasterise an estimated " +
+            std::to_string(static_cast<long long>(fragments / 1e6)) + " million fragments (the scene's triangles " +
+            "cover each map about " + std::to_string(static_cast<long long>(coverage / std::max<std::size_t>(1, lights))) +
+            " times over), above the limit of " + std::to_string(static_cast<long long>(kFragmentLimit / 1e6)) +
+            " million: lower shadow_map_size, or leave it out to let the server choose",
+        "/passes/shadow_maps/shadow_map_size");
+}
+
+void ShadowMapsPass::checkBytes(int size, int cubes, int maps2d) {
+  // The maps' memory is bounded whatever the lights: a 4096^2 map is 64 MiB, and a frame may hold the
+  // scene's lights, 8 environment lights and 64 sky lights (direct's environment_lights, sky_lights).
+  const double bytes = 4.0 * double(size) * size * (6.0 * cubes + maps2d);
+  if (bytes > kMaxBytes)
+    throw api::ApiError(422, "limit-exceeded", "Server limit exceeded",
+                        "/passes/shadow_maps/shadow_map_size: " + std::to_string(cubes + maps2d) + " shadow maps (" +
+                            std::to_string(cubes) + " point-light cubes) of " + std::to_string(size) + "^2 need " +
+                            std::to_string(static_cast<long long>(bytes / (1 << 20))) + " MiB, above the limit of " +
+                            std::to_string(static_cast<long long>(kMaxBytes / (1 << 20))) +
+                            " MiB: lower shadow_map_size, or direct's sky_lights or environment_lights",
+                        "/passes/shadow_maps/shadow_map_size");
+}
+
+void ShadowMapsPass::validate(const Scene& scene, const FrameView& view, const Params& params) const {
+  const ShadowMapsParams p = ShadowMapsParams::from(params);
+  if (!p.given.shadow_map_size) return;  // the default is lowered to fit (prepare)
+  // Over the scene's own lights, which the request's view has too: every frame has at least these maps
+  // and this coverage, so a size refused here is refused by every frame, before the job is queued. The
+  // environment's lights join at the frame (the map's split), where prepare() checks them all.
+  const std::vector<Light> lights(view.lights.begin(), view.lights.begin() + view.sceneLights);
+  if (lights.empty()) return;
+  int cubes = 0;
+  for (const Light& l : lights) cubes += l.type == LightType::Point ? 1 : 0;
+  checkBytes(p.shadow_map_size, cubes, static_cast<int>(lights.size()) - cubes);
+  double coverage = 0.0;
+  for (double c : mapCoverage(scene, lights, view.shadowMapExclusions)) coverage += c;
+  checkFragments(p.shadow_map_size, coverage, lights.size());
+}
+
 const TechniqueInfo& ShadowMapsPass::info() const {
   static const TechniqueInfo i = describedTechnique("shadow_maps");
   return i;
@@ -98,7 +141,7 @@ void ShadowMapsPass::prepare(const Scene& scene, const Params& params, FrameReso
   size_ = p.shadow_map_size;
   // The maps depend on geometry, lights, size and the meshes left out (Technique::shadowMapExclusions);
   // their overdraw on all but the size.
-  excluded_ = res.shadowMapExclusions();
+  excluded_ = res.view().shadowMapExclusions;
   std::string inputs = res.sceneKey();
   if (lights.size() > scene.lights.size()) inputs += "|" + res.view().lightingEnvironmentKey();
   for (int m : excluded_) inputs += "|-" + std::to_string(m);
@@ -114,15 +157,7 @@ void ShadowMapsPass::prepare(const Scene& scene, const Params& params, FrameReso
   warning_.clear();
   const double fragments = coverage_ * double(size_) * size_;
   if (p.given.shadow_map_size) {
-    if (fragments > kFragmentLimit)
-      throw api::ApiError(
-          422, "limit-exceeded", "Server limit exceeded",
-          "/passes/shadow_maps/shadow_map_size: maps of " + std::to_string(size_) + "^2 would rasterise an estimated " +
-              std::to_string(static_cast<long long>(fragments / 1e6)) + " million fragments (the scene's triangles " +
-              "cover each map about " + std::to_string(static_cast<long long>(coverage_ / std::max<std::size_t>(1, lights.size()))) +
-              " times over), above the limit of " + std::to_string(static_cast<long long>(kFragmentLimit / 1e6)) +
-              " million: lower shadow_map_size, or leave it out to let the server choose",
-          "/passes/shadow_maps/shadow_map_size");
+    checkFragments(size_, coverage_, lights.size());  // with the environment's lights (validate: the scene's)
   } else if (const int lowered = sizeWithinBudget(size_, coverage_); lowered < size_) {
     warning_ = "the default " + std::to_string(size_) + "^2 maps would rasterise an estimated " +
                std::to_string(static_cast<long long>(fragments / 1e6)) + " million fragments (overdraw: the " +
@@ -170,17 +205,7 @@ void ShadowMapsPass::prepare(const Scene& scene, const Params& params, FrameReso
     }
   }
 
-  // The maps' memory is bounded whatever the lights: a 4096^2 map is 64 MiB, and a frame may hold the
-  // scene's lights, 8 environment lights and 64 sky lights (direct's environment_lights, sky_lights).
-  const double bytes = 4.0 * double(size_) * size_ * (6.0 * cubes + maps2d);
-  if (bytes > kMaxBytes)
-    throw api::ApiError(422, "limit-exceeded", "Server limit exceeded",
-                        "/passes/shadow_maps/shadow_map_size: " + std::to_string(cubes + maps2d) + " shadow maps (" +
-                            std::to_string(cubes) + " point-light cubes) of " + std::to_string(size_) + "^2 need " +
-                            std::to_string(static_cast<long long>(bytes / (1 << 20))) + " MiB, above the limit of " +
-                            std::to_string(static_cast<long long>(kMaxBytes / (1 << 20))) +
-                            " MiB: lower shadow_map_size, or direct's sky_lights or environment_lights",
-                        "/passes/shadow_maps/shadow_map_size");
+  checkBytes(size_, cubes, maps2d);  // whatever chose the size: with the environment's lights
   // Both arrays always exist (samplers must be complete even when unused); an unused one is 1 x 1.
   const int cubeSize = cubes > 0 ? size_ : 1, flatSize = maps2d > 0 ? size_ : 1;
   gl::Texture& cube = res.texture("shadow_cube", GL_TEXTURE_CUBE_MAP_ARRAY, GL_R32F, cubeSize, cubeSize, 6 * std::max(1, cubes));

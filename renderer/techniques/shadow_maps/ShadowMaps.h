@@ -24,12 +24,15 @@ namespace radiant {
 // maps, 4.7 s on llvmpipe). prepare() estimates the overdraw from the triangles (mapCoverage, once per
 // change of geometry, lights and exclusions) and, when the request leaves shadow_map_size to the
 // default, draws maps small enough to stay within kFragmentBudget (with a warning); a size the request
-// gives runs as asked up to kFragmentLimit, and is refused above it. Opaque materials are drawn by a
-// shader variant that cannot discard, so that the depth test runs before it (shadow.frag).
+// gives runs as asked up to kFragmentLimit, and is refused above it: before the job is queued when the
+// scene's own lights exceed it (validate), else when the frame adds the environment's (prepare).
+// Opaque materials are drawn by a shader variant that cannot discard, so that the depth test runs
+// before it (shadow.frag).
 class ShadowMapsPass final : public Technique {
 public:
   const TechniqueInfo& info() const override;
   Requirements requirements(const Scene&, const api::RenderRequest&) const override;
+  void validate(const Scene&, const FrameView&, const Params&) const override;
   void prepare(const Scene&, const Params&, FrameResources&) override;
   void execute(PassContext&) override;
 
@@ -56,6 +59,10 @@ public:
   // The size the default draws at: `size` halved until coverage * size^2 is within the budget, no
   // smaller than kMinAutoSize.
   static int sizeWithinBudget(int size, double coverage);
+  // The 422s (limit-exceeded at shadow_map_size): maps of size^2 with this coverage (summed over
+  // `lights` lights) above kFragmentLimit; `cubes` point-light cubes and `maps2d` 2D maps above kMaxBytes.
+  static void checkFragments(int size, double coverage, std::size_t lights);
+  static void checkBytes(int size, int cubes, int maps2d);
 
 private:
   FrameResources::Refill maps_;  // hit: the maps hold this frame's; else execute() renders them

@@ -325,6 +325,32 @@ TEST(RenderCore, ShadowMapOverdrawIsBoundedByTheFragmentBudget) {
   const api::ApiError e = testing::thrownApiError([&] { renderer().render(scene, req); });  // 6 billion fragments
   EXPECT_EQ(e.status, 422);
   EXPECT_EQ(e.pointer, "/passes/shadow_maps/shadow_map_size");
+  // Refused before the job is queued (Renderer::check, on radiantd's HTTP thread, no GL): the scene's
+  // own light covers the map 1483 times over, the same estimate and message as the frame's.
+  const api::ApiError early = testing::thrownApiError([&] { Renderer::check(scene, req, FrameInputs{}); });
+  EXPECT_EQ(early.status, 422);
+  EXPECT_EQ(early.pointer, "/passes/shadow_maps/shadow_map_size");
+  EXPECT_EQ(early.detail(), e.detail());
+  req.passes["shadow_maps"] = {{"shadow_map_size", 1024}};  // 1483 x 1024^2 = 1.6 billion: within 4.3
+  EXPECT_NO_THROW(Renderer::check(scene, req, FrameInputs{}));
+}
+
+// The maps' memory limit (ShadowMapsPass::kMaxBytes, 1 GiB) is checked before the job is queued over
+// the scene's own lights: three point lights at 4096^2 are 18 cube faces of 64 MiB (1152 MiB), at
+// 2048^2 a quarter of that. The environment's lights join at the frame (Environment.ShadowMaps...).
+TEST(RenderCore, ShadowMapMemoryOfTheScenesLightsIsRefusedBeforeTheQueue) {
+  SceneBuilder b = planeScene();
+  for (float x : {-1.f, 0.f, 1.f}) b.pointLight({x, 1, 0}, 1.f);
+  const Scene scene = b.topDownOrtho(5.f, 1.5f).build("three-point-lights");
+  api::RenderRequest req = request(16, {"direct"});
+  req.passes["shadow_maps"] = {{"shadow_map_size", 4096}};
+  req.explicitParams["shadow_maps"] = {"shadow_map_size"};
+  const api::ApiError e = testing::thrownApiError([&] { Renderer::check(scene, req, FrameInputs{}); });
+  EXPECT_EQ(e.status, 422);
+  EXPECT_EQ(e.pointer, "/passes/shadow_maps/shadow_map_size");
+  EXPECT_NE(e.detail().find("3 shadow maps (3 point-light cubes) of 4096^2 need 1152 MiB"), std::string::npos) << e.detail();
+  req.passes["shadow_maps"] = {{"shadow_map_size", 2048}};
+  EXPECT_NO_THROW(Renderer::check(scene, req, FrameInputs{}));
 }
 
 TEST(RenderCore, DerivedDataIsCachedAcrossFrames) {
