@@ -24,7 +24,11 @@ std::optional<ToneMap> toneMapFromString(std::string_view name) {
 }
 
 void to_json(nlohmann::json& j, const PassStats& s) {
-  j = nlohmann::json{{"name", s.name}, {"gpu_ms", s.gpuMs}, {"cpu_ms", s.cpuMs}, {"counters", s.counters}};
+  j = nlohmann::json{{"name", s.name},
+                     {"gpu_ms", s.gpuMs},
+                     {"cpu_ms", s.cpuMs},
+                     {"prepare_ms", s.prepareMs},
+                     {"counters", s.counters}};
 }
 
 void to_json(nlohmann::json& j, const FrameStats& s) {

@@ -169,6 +169,10 @@ struct PassStats {
   // What the pass chose differently from what the request implies (the Renderer moves each into
   // stats.warnings, prefixed with the pass's name).
   std::vector<std::string> warnings;
+  // Wall time of its prepare(): allocation, cache lookups and the derived data built on a miss (BVHs,
+  // photons, beams, the shadow maps' overdraw estimate), timed by the Renderer around the call, so a
+  // pass cannot leave a build out. GPU work prepare() issues (uploads) is counted as issued.
+  double prepareMs = 0.0;
 };
 
 struct CacheEvent {

@@ -842,7 +842,9 @@ void Renderer::Impl::runPasses(const Scene& scene, const GpuScene& gpu, const Fr
     Technique* t = plan.passes[i];
     cancel.check("the frame's set-up, before preparing " + t->info().name);
     resources.beginPass(t->info().name, declaredAccess(t->info()), FrameResources::Phase::Prepare);
+    const auto start = std::chrono::steady_clock::now();
     t->prepare(scene, params[i], resources);
+    stats.passes[i].prepareMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     resources.endPass();
     gl::checkError(("prepare " + t->info().name).c_str());
   }

@@ -452,6 +452,7 @@ void RenderService::renderLoop() {
       for (const auto& p : output.stats.passes) {
         metrics_.observePass(p.name, "gpu", p.gpuMs / 1000);
         metrics_.observePass(p.name, "cpu", p.cpuMs / 1000);
+        metrics_.observePass(p.name, "prepare", p.prepareMs / 1000);
       }
     if (recreate) {
       std::cerr << "{\"event\":\"backend_recreate\",\"render_id\":" << api::dumpSafe(json(job->id))

@@ -260,7 +260,14 @@ TEST(RenderCore, StatsTimeEveryPassAndSkipWithReasons) {
     names.push_back(p.name);
     EXPECT_GT(p.gpuMs, 0.0) << p.name;
     EXPECT_GE(p.cpuMs, 0.0) << p.name;
+    EXPECT_GE(p.prepareMs, 0.0) << p.name;
   }
+  // The photons are traced and splatted in photon_gi's prepare(): its prepare_ms, timed around the
+  // call, holds the two builds its own counters time (this scene's first frame: both ran).
+  const api::PassStats* photons = testing::pass(out, "photon_gi");
+  ASSERT_NE(photons, nullptr);
+  EXPECT_GT(photons->counters.at("trace_ms"), 0.0);
+  EXPECT_GE(photons->prepareMs, photons->counters.at("trace_ms") + photons->counters.at("splat_build_ms"));
   EXPECT_EQ(names, (std::vector<std::string>{"gbuffer", "shadow_maps", "direct", "photon_gi"}));
   EXPECT_EQ(out.stats.triangles, 4u);
   EXPECT_EQ(out.stats.lights, 1);

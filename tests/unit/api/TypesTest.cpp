@@ -4,7 +4,7 @@
 
 TEST(Types, FrameStatsJson) {
   radiant::api::FrameStats s;
-  s.passes.push_back({"direct", 1.5, 0.25, {{"lights", 2}}, {}});
+  s.passes.push_back({"direct", 1.5, 0.25, {{"lights", 2}}, {}, 0.125});
   s.skipped["shadow_maps"] = "the scene has no punctual lights";
   s.cache.push_back({"shadow_map:light0", true});
   s.renderMs = 12;
@@ -16,6 +16,7 @@ TEST(Types, FrameStatsJson) {
   EXPECT_EQ(j["passes"][0]["name"], "direct");
   EXPECT_DOUBLE_EQ(j["passes"][0]["gpu_ms"].get<double>(), 1.5);
   EXPECT_DOUBLE_EQ(j["passes"][0]["cpu_ms"].get<double>(), 0.25);
+  EXPECT_DOUBLE_EQ(j["passes"][0]["prepare_ms"].get<double>(), 0.125);
   EXPECT_EQ(j["passes"][0]["counters"]["lights"], 2);
   EXPECT_EQ(j["skipped"]["shadow_maps"], "the scene has no punctual lights");
   EXPECT_EQ(j["cache"][0]["what"], "shadow_map:light0");
