@@ -323,7 +323,7 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   SplatCache& splats = res.cached<SplatCache>("photon_gi_splats", splatDigest, buildSplats);
   // A hit whose set is not the one in the splat buffers (another scene was rendered since, or the
   // resources were dropped after a failure; FrameResources::refill): without this the frame gathered
-  // the other scene's photons (Fox after BoxTextured came out unlit, 2026-12-02). FrameResources::refill.
+  // the other scene's photons (Fox after BoxTextured came out unlit, 2026-12-02).
   FrameResources::Refill resident = res.refill("photon_gi_splats", splatDigest, "photon_gi_splats_resident");
   if (!resident.hit()) upload_ = true;
   if (upload_ && splats.grid.splats.size() != splats.grid.count) {
