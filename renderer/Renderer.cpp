@@ -31,6 +31,7 @@
 #include "renderer/techniques/reference/ReferencePass.h"
 #include "renderer/techniques/specular/Specular.h"
 #include "renderer/techniques/Registry.h"
+#include "renderer/shading/GBufferInputs.h"
 
 namespace radiant {
 namespace {
@@ -140,8 +141,8 @@ void presentBackground(FrameResources& resources, const FrameView& view, int k, 
   const std::size_t samples = static_cast<std::size_t>(view.width) * view.height;
   // Coverage per sample in channel 3 (where the AOV table reads depth from), 1 or 0.
   std::vector<float> position(samples * 4, 0.f);
-  if (resources.hasTexture("gbuffer_position") && resources.written("gbuffer_position"))
-    resources.texture("gbuffer_position").download(0, GL_RGBA, GL_FLOAT, position.data(), position.size() * sizeof(float));
+  if (gbuffer::written(resources, gbuffer::Attachment::Position))
+    gbuffer::texture(resources, gbuffer::Attachment::Position).download(0, GL_RGBA, GL_FLOAT, position.data(), position.size() * sizeof(float));
   for (std::size_t i = 0; i < samples; ++i) position[i * 4 + 3] = position[i * 4 + 3] > 0.f ? 1.f : 0.f;
   std::vector<float> beauty = beautySamples ? *beautySamples : std::vector<float>(samples * 4, 0.f);
   for (std::size_t i = 0; i < samples; ++i)

@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "renderer/gl/ShaderLibrary.h"
+#include "renderer/shading/GBufferInputs.h"
 
 namespace radiant::denoise {
 
@@ -30,9 +31,10 @@ gl::Texture& run(FrameResources& res, gl::ShaderLibrary& shaders, const FrameVie
   prog.set("u_sigmaNormal", s.sigmaNormal);
   prog.set("u_sigmaPlane", s.sigmaPlane);
   prog.set("u_minAlbedo", kMinAlbedo);
-  res.texture("gbuffer_position").bindUnit(1);
-  res.texture("normal").bindUnit(2);
-  res.texture("albedo").bindUnit(3);
+  // Unit 0 is each pass's input: the guides one unit up (denoise_atrous.comp).
+  gbuffer::bindAt(res, gbuffer::Attachment::Position, 1);
+  gbuffer::bindAt(res, gbuffer::Attachment::Normal, 2);
+  gbuffer::bindAt(res, gbuffer::Attachment::Albedo, 3);
   in.bindUnit(4);  // the noisy radiance: the first pass demodulates it; every pass keeps it as a fallback
   const int iterations = std::max(1, s.iterations);
   const gl::Texture* src = &in;

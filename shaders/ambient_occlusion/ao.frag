@@ -7,14 +7,15 @@
 // texel centre's: the texel's surface is extended by its tangent plane (world position + geometric
 // normal), i.e. the depth is reconstructed at the exact sub-texel position. This removes the
 // quantisation error that otherwise makes tilted open planes self-occlude; on planes it is exact.
+#include "common/shared.h"
 #include "common/constants.glsl"
 #include "common/frame.glsl"
 
 in vec2 v_uv;
 
-layout(binding = 0) uniform sampler2D t_position;   // xyz world, w = linear view depth (0: no surface)
-layout(binding = 1) uniform sampler2D t_normal;     // shading normal
-layout(binding = 2) uniform sampler2D t_geoNormal;  // geometric normal facing the viewer
+layout(binding = kUnitGbufferPosition) uniform sampler2D t_position;  // xyz world, w = linear view depth (0: no surface)
+layout(binding = kUnitGbufferNormal) uniform sampler2D t_normal;      // shading normal
+layout(binding = kUnitGbufferGeometricNormal) uniform sampler2D t_geoNormal;  // geometric normal facing the viewer
 
 layout(std140, binding = 0) uniform AoSamples {
   vec4 u_samples[64];    // method-specific kernel (see AmbientOcclusion.h)

@@ -4,6 +4,7 @@
 // f_r(wi, wo) E with no further cosine; wi points from x towards c_G (so glossy receivers get a
 // direction).
 #define LDM_TRACING
+#include "common/shared.h"
 #include "common/brdf.glsl"
 #include "common/gbuffer_geometry.glsl"
 #include "specular/ldm.glsl"
@@ -11,12 +12,12 @@
 #include "caustics/lookup.glsl"
 #include "common/frame.glsl"
 
-layout(binding = 0) uniform sampler2D t_position;
-layout(binding = 1) uniform sampler2D t_normal;
-layout(binding = 2) uniform sampler2D t_albedo;
-layout(binding = 3) uniform sampler2D t_material;
-layout(binding = 4) uniform sampler2D t_emission;
-layout(binding = 5) uniform sampler2D t_geoNormal;
+layout(binding = kUnitGbufferPosition) uniform sampler2D t_position;
+layout(binding = kUnitGbufferNormal) uniform sampler2D t_normal;
+layout(binding = kUnitGbufferAlbedo) uniform sampler2D t_albedo;
+layout(binding = kUnitGbufferMaterial) uniform sampler2D t_material;
+layout(binding = kUnitGbufferEmission) uniform sampler2D t_emission;
+layout(binding = kUnitGbufferGeometricNormal) uniform sampler2D t_geoNormal;
 uniform float u_pixelArea;  // a pixel's area at unit view depth (perspective) or its area (orthographic)
 
 layout(location = 0) out vec4 o_caustics;

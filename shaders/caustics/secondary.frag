@@ -7,6 +7,7 @@
 // filter takes the pixel's area at the unfolded distance |p - eye| + |hit - p| (exact for one flat
 // mirror). Additive into beauty only: the caustics AOV stays exactly LS+DE (the reference's class).
 #define LDM_TRACING
+#include "common/shared.h"
 #include "common/constants.glsl"
 #include "common/scene.glsl"
 #include "specular/ldm.glsl"
@@ -16,11 +17,11 @@
 
 in vec3 v_position;
 
-layout(binding = 0) uniform sampler2D t_position;
-layout(binding = 1) uniform sampler2D t_normal;
-layout(binding = 2) uniform sampler2D t_albedo;
-layout(binding = 3) uniform sampler2D t_material;
-layout(binding = 4) uniform sampler2D t_emission;
+layout(binding = kUnitGbufferPosition) uniform sampler2D t_position;
+layout(binding = kUnitGbufferNormal) uniform sampler2D t_normal;
+layout(binding = kUnitGbufferAlbedo) uniform sampler2D t_albedo;
+layout(binding = kUnitGbufferMaterial) uniform sampler2D t_material;
+layout(binding = kUnitGbufferEmission) uniform sampler2D t_emission;
 
 uniform int u_object;  // index of the specular object being drawn
 uniform float u_pixelArea;  // as camera.frag's

@@ -74,8 +74,17 @@ RADIANT_CONST int kSlotCount = 13;
 RADIANT_CONST int kUnitEnvironment = 14;  // equirect environment radiance (direct, specular)
 RADIANT_CONST int kUnitIblDfg = 19;       // image-based lighting: split-sum DFG table (direct, ambient_occlusion)
 RADIANT_CONST int kUnitIblPrefiltered = 20;  // image-based lighting: GGX-prefiltered environment (direct)
-RADIANT_CONST int kUnitGbufferLayers = 22;    // direct: the G-buffer's gbuffer_layers (KHR_materials_clearcoat, sheen)
-RADIANT_CONST int kUnitGbufferSpecular = 23;  // direct: the G-buffer's gbuffer_specular (KHR_materials_specular)
+// The G-buffer's attachments, where a program that reads them the common way declares them (the pass
+// binds them with gbuffer::bind, renderer/shading/GBufferInputs.h). Units 0-5 are these, or a pass's own
+// full-screen inputs in a program that binds the attachments it reads elsewhere (gbuffer::bindAt).
+RADIANT_CONST int kUnitGbufferPosition = 0;         // gbuffer_position: xyz world, w linear view depth
+RADIANT_CONST int kUnitGbufferNormal = 1;           // normal
+RADIANT_CONST int kUnitGbufferAlbedo = 2;           // albedo
+RADIANT_CONST int kUnitGbufferMaterial = 3;         // material
+RADIANT_CONST int kUnitGbufferEmission = 4;         // emission
+RADIANT_CONST int kUnitGbufferGeometricNormal = 5;  // geometric_normal
+RADIANT_CONST int kUnitGbufferLayers = 22;    // gbuffer_layers (KHR_materials_clearcoat, sheen)
+RADIANT_CONST int kUnitGbufferSpecular = 23;  // gbuffer_specular (KHR_materials_specular)
 RADIANT_CONST int kUnitMaterialLayer0 = 26;  // material slots kSlotLayer0.. (units 26-32)
 // Units used. A binding must be below GL_MAX_COMBINED_TEXTURE_IMAGE_UNITS (GL 4.5 guarantees 80); a
 // stage may read at most GL_MAX_TEXTURE_IMAGE_UNITS samplers (16 guaranteed, 32 on llvmpipe), which

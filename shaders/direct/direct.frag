@@ -1,6 +1,7 @@
 // Direct lighting from punctual lights with shadow maps, plus emission, from the G-buffer.
 // Writes the `direct` AOV and adds the same value to `beauty` (cleared to zero at the frame's start; every
 // beauty writer composes into it, FrameAllocation.h).
+#include "common/shared.h"
 #include "common/direct_lighting.glsl"
 #include "common/environment.glsl"
 #include "common/ibl.glsl"
@@ -10,12 +11,12 @@
 
 in vec2 v_uv;
 
-layout(binding = 0) uniform sampler2D t_position;
-layout(binding = 1) uniform sampler2D t_normal;
-layout(binding = 2) uniform sampler2D t_albedo;
-layout(binding = 3) uniform sampler2D t_material;
-layout(binding = 4) uniform sampler2D t_emission;
-layout(binding = 5) uniform sampler2D t_geoNormal;
+layout(binding = kUnitGbufferPosition) uniform sampler2D t_position;
+layout(binding = kUnitGbufferNormal) uniform sampler2D t_normal;
+layout(binding = kUnitGbufferAlbedo) uniform sampler2D t_albedo;
+layout(binding = kUnitGbufferMaterial) uniform sampler2D t_material;
+layout(binding = kUnitGbufferEmission) uniform sampler2D t_emission;
+layout(binding = kUnitGbufferGeometricNormal) uniform sampler2D t_geoNormal;
 layout(binding = kUnitGbufferLayers) uniform usampler2D t_layers;    // common/material.glsl encodeLayers
 layout(binding = kUnitGbufferSpecular) uniform sampler2D t_specular;  // gbuffer_specular
 

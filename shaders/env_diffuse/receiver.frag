@@ -3,16 +3,17 @@
 // depth matches), and all surface attributes come from the G-buffer. Output: the diffusely reflected
 // indirect light L_o = albedo (1 - metallic)(1 - transmission) / pi * E, to `indirect_diffuse` and,
 // blended additively, to `beauty`.
+#include "common/shared.h"
 #include "common/constants.glsl"
 #include "env_diffuse/gather.glsl"
 #include "common/frame.glsl"
 
 in vec3 v_position;
 
-layout(binding = 0) uniform sampler2D t_position;
-layout(binding = 1) uniform sampler2D t_normal;
-layout(binding = 2) uniform sampler2D t_albedo;
-layout(binding = 3) uniform sampler2D t_material;
+layout(binding = kUnitGbufferPosition) uniform sampler2D t_position;
+layout(binding = kUnitGbufferNormal) uniform sampler2D t_normal;
+layout(binding = kUnitGbufferAlbedo) uniform sampler2D t_albedo;
+layout(binding = kUnitGbufferMaterial) uniform sampler2D t_material;
 layout(binding = 5) uniform samplerCube t_irradiance;
 
 uniform int u_method;

@@ -5,6 +5,7 @@
 //   u_traversal 1 (bvh): the BVH of group u_root, only beams whose cone segment holds the fragment.
 // llvmpipe ends an invocation's loops after 65535 iterations, so the CPU dispatches once per slice
 // (linear) or group (bvh), accumulating in i_accum; the last dispatch adds the total to beauty.
+#include "common/shared.h"
 #include "common/brdf.glsl"
 #include "light_volumes/beam.glsl"
 #include "common/frame.glsl"
@@ -16,11 +17,11 @@ layout(std430, binding = 9) readonly buffer Cones { BeamCone cones[]; };
 layout(std430, binding = 10) readonly buffer Nodes { BeamBvhNode nodes[]; };
 layout(std430, binding = 11) readonly buffer Prims { vec4 prims[]; };
 
-layout(binding = 0) uniform sampler2D t_position;
-layout(binding = 1) uniform sampler2D t_normal;
-layout(binding = 2) uniform sampler2D t_albedo;
-layout(binding = 3) uniform sampler2D t_material;
-layout(binding = 4) uniform sampler2D t_emission;
+layout(binding = kUnitGbufferPosition) uniform sampler2D t_position;
+layout(binding = kUnitGbufferNormal) uniform sampler2D t_normal;
+layout(binding = kUnitGbufferAlbedo) uniform sampler2D t_albedo;
+layout(binding = kUnitGbufferMaterial) uniform sampler2D t_material;
+layout(binding = kUnitGbufferEmission) uniform sampler2D t_emission;
 layout(rgba32f, binding = 0) uniform image2D i_accum;
 layout(rgba32f, binding = 1) uniform image2D i_beauty;
 

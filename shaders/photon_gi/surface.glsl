@@ -1,15 +1,16 @@
 // The G-buffer surface at a pixel, for splatting and gathering.
 #ifndef RADIANT_PHOTON_GI_SURFACE
 #define RADIANT_PHOTON_GI_SURFACE
+#include "common/shared.h"
 #include "common/material.glsl"  // decodeLayers (the G-buffer's layers target)
 #include "common/gbuffer_geometry.glsl"
 #include "common/frame.glsl"
-layout(binding = 0) uniform sampler2D t_position;
-layout(binding = 1) uniform sampler2D t_normal;
-layout(binding = 2) uniform sampler2D t_albedo;
-layout(binding = 3) uniform sampler2D t_material;
-layout(binding = 4) uniform sampler2D t_emission;
-layout(binding = 5) uniform sampler2D t_geoNormal;
+layout(binding = kUnitGbufferPosition) uniform sampler2D t_position;
+layout(binding = kUnitGbufferNormal) uniform sampler2D t_normal;
+layout(binding = kUnitGbufferAlbedo) uniform sampler2D t_albedo;
+layout(binding = kUnitGbufferMaterial) uniform sampler2D t_material;
+layout(binding = kUnitGbufferEmission) uniform sampler2D t_emission;
+layout(binding = kUnitGbufferGeometricNormal) uniform sampler2D t_geoNormal;
 layout(binding = kUnitGbufferLayers) uniform usampler2D t_layers;    // common/material.glsl encodeLayers
 layout(binding = kUnitGbufferSpecular) uniform sampler2D t_specular;  // gbuffer_specular
 

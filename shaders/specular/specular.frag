@@ -4,6 +4,7 @@
 // Writes the radiance arriving through the traced paths, already weighted by Fresnel and colour:
 // the `specular` AOV, which compose.frag adds to beauty.
 #define LDM_TRACING
+#include "common/shared.h"
 #include "common/scene.glsl"
 #include "specular/ldm.glsl"
 #include "common/environment.glsl"
@@ -11,11 +12,11 @@
 
 in vec3 v_position;
 
-layout(binding = 0) uniform sampler2D t_position;
-layout(binding = 1) uniform sampler2D t_normal;
-layout(binding = 2) uniform sampler2D t_albedo;
-layout(binding = 3) uniform sampler2D t_material;
-layout(binding = 4) uniform sampler2D t_emission;
+layout(binding = kUnitGbufferPosition) uniform sampler2D t_position;
+layout(binding = kUnitGbufferNormal) uniform sampler2D t_normal;
+layout(binding = kUnitGbufferAlbedo) uniform sampler2D t_albedo;
+layout(binding = kUnitGbufferMaterial) uniform sampler2D t_material;
+layout(binding = kUnitGbufferEmission) uniform sampler2D t_emission;
 
 uniform int u_object;  // index of the specular object being drawn
 // 1: a ray leaving the scene sees the environment map (when direct uploaded it), else the uniform sky

@@ -12,6 +12,7 @@
 #include "renderer/frame/GpuTypes.h"
 #include "renderer/frame/PassContext.h"
 #include "renderer/shading/ImageBasedLighting.h"
+#include "renderer/shading/GBufferInputs.h"
 
 namespace radiant::gpu {
 #include "shaders/ambient_occlusion/shared.h"  // the resolve's unit
@@ -272,8 +273,8 @@ void AmbientOcclusionPass::execute(PassContext& ctx) {
   // 1. Estimate at the working resolution.
   res.framebuffer("ao_estimate").bind();
   glViewport(0, 0, ww, wh);
-  const char* inputs[] = {"gbuffer_position", "normal", "geometric_normal"};
-  for (GLuint i = 0; i < std::size(inputs); ++i) res.texture(inputs[i]).bindUnit(i);
+  using gbuffer::Attachment;
+  gbuffer::bind(res, {Attachment::Position, Attachment::Normal, Attachment::GeometricNormal});
   const gl::Program& est = ctx.shaders.program({"common/fullscreen.vert", "ambient_occlusion/ao.frag"},
                                                {{methodDefine(method_), "1"}, {"SAMPLES", std::to_string(samples_)}});
   est.use();
@@ -306,20 +307,20 @@ void AmbientOcclusionPass::execute(PassContext& ctx) {
   }
   glColorMaski(1, addAmbient, addAmbient, addAmbient, GL_FALSE);
   raw.bindUnit(0);
-  res.texture("gbuffer_position").bindUnit(1);
-  res.texture("normal").bindUnit(2);
-  res.texture("albedo").bindUnit(3);
-  res.texture("material").bindUnit(4);
-  res.texture("geometric_normal").bindUnit(5);
+  // The resolve keeps unit 0 for the estimate: the G-buffer one unit up (ao_resolve.frag).
+  gbuffer::bindAt(res, Attachment::Position, 1);
+  gbuffer::bindAt(res, Attachment::Normal, 2);
+  gbuffer::bindAt(res, Attachment::Albedo, 3);
+  gbuffer::bindAt(res, Attachment::Material, 4);
+  gbuffer::bindAt(res, Attachment::GeometricNormal, 5);
   const gl::Program& rp = ctx.shaders.program({"common/fullscreen.vert", "ambient_occlusion/ao_resolve.frag"});
   rp.use();
   rp.set("u_scale", scale_);
   rp.set("u_blur", blur_ ? 1 : 0);
   rp.set("u_radius", radius_);
-  res.texture("emission").bindUnit(gpu::kUnitAoEmission);
+  gbuffer::bindAt(res, Attachment::Emission, gpu::kUnitAoEmission);
   // The layers attenuate the diffuse base (ao_resolve.frag); the sheen's table is an SSBO.
-  res.texture("gbuffer_layers").bindUnit(gpu::kUnitGbufferLayers);
-  res.texture("gbuffer_specular").bindUnit(gpu::kUnitGbufferSpecular);
+  gbuffer::bind(res, {Attachment::Layers, Attachment::Specular});
   ctx.gpu.sheenAlbedo.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingSheenAlbedo);
   ibl::bind(res, rp, gpu::kUnitIblDfg, -1);
   glDrawArrays(GL_TRIANGLES, 0, 3);

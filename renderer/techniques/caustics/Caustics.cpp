@@ -15,6 +15,7 @@
 #include "renderer/shading/CubeFaces.h"
 #include "renderer/shading/SpecularMaps.h"
 #include "renderer/shading/SpecularObjects.h"
+#include "renderer/shading/GBufferInputs.h"
 
 namespace radiant::gpu {
 #include "shaders/caustics/shared.h"  // the caustic cubes' unit
@@ -450,8 +451,9 @@ void CausticsPass::execute(PassContext& ctx) {
   glBlendFunc(GL_ONE, GL_ONE);
   if (!owns) glColorMaski(1, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
   if (!pairs_.empty()) {
-    const char* inputs[] = {"gbuffer_position", "normal", "albedo", "material", "emission", "geometric_normal"};
-    for (GLuint i = 0; i < std::size(inputs); ++i) res.texture(inputs[i]).bindUnit(i);
+    using gbuffer::Attachment;
+    gbuffer::bind(res, {Attachment::Position, Attachment::Normal, Attachment::Albedo, Attachment::Material,
+                        Attachment::Emission, Attachment::GeometricNormal});
     cube.bindUnit(gpu::kUnitCausticCube);
     const gl::Program& prog = ctx.shaders.program({"common/fullscreen.vert", "caustics/camera.frag"});
     prog.use();
@@ -477,8 +479,9 @@ void CausticsPass::execute(PassContext& ctx) {
     glEnable(GL_BLEND);
     glBlendEquation(GL_FUNC_ADD);
     glBlendFunc(GL_ONE, GL_ONE);
-    const char* inputs[] = {"gbuffer_position", "normal", "albedo", "material", "emission"};
-    for (GLuint i = 0; i < std::size(inputs); ++i) res.texture(inputs[i]).bindUnit(i);
+    using gbuffer::Attachment;
+    gbuffer::bind(res, {Attachment::Position, Attachment::Normal, Attachment::Albedo, Attachment::Material,
+                        Attachment::Emission});
     cube.bindUnit(gpu::kUnitCausticCube);
     const gl::Program& prog = ctx.shaders.program({"specular/map.vert", "caustics/secondary.frag"});
     prog.use();

@@ -10,6 +10,7 @@
 #include "renderer/frame/PassContext.h"
 #include "renderer/shading/MediaLayer.h"
 #include "renderer/shading/Stretches.h"
+#include "renderer/shading/GBufferInputs.h"
 
 namespace radiant {
 namespace {
@@ -132,11 +133,11 @@ void DepthImpostorsPass::execute(PassContext& ctx) {
   if (rebuilt) set.build(ctx.shaders, viewAxis_, hasLight_ ? &lightAxis_ : nullptr, frame_);
   const int blocks = static_cast<int>(set.blocks().blocks.size());
   if (blocks > 0) set.orderBuffer.upload(order_.data(), order_.size() * sizeof(int));
-  const bool hasDepth = res.hasTexture("gbuffer_position") && res.written("gbuffer_position");
+  const bool hasDepth = gbuffer::written(res, gbuffer::Attachment::Position);
 
   beginMediaLayer(res.framebuffer("media"), view.width, view.height);
   vao_.bind();
-  if (hasDepth) res.texture("gbuffer_position").bindUnit(0);
+  if (hasDepth) gbuffer::bindAt(res, gbuffer::Attachment::Position, 0);
   set.front.bindUnit(1);
   set.back.bindUnit(2);
   set.transmittance.bindUnit(3);

@@ -9,6 +9,7 @@
 #include "renderer/frame/PassContext.h"
 #include "renderer/shading/DirectLighting.h"
 #include "renderer/shading/ImageBasedLighting.h"
+#include "renderer/shading/GBufferInputs.h"
 
 namespace radiant {
 
@@ -52,10 +53,9 @@ void DirectPass::execute(PassContext& ctx) {
   glBlendEquationi(1, GL_FUNC_ADD);
   glBlendFunci(1, GL_ONE, GL_ONE);
 
-  const char* inputs[] = {"gbuffer_position", "normal", "albedo", "material", "emission", "geometric_normal"};
-  for (GLuint i = 0; i < std::size(inputs); ++i) res.texture(inputs[i]).bindUnit(i);
-  res.texture("gbuffer_layers").bindUnit(gpu::kUnitGbufferLayers);
-  res.texture("gbuffer_specular").bindUnit(gpu::kUnitGbufferSpecular);
+  using gbuffer::Attachment;
+  gbuffer::bind(res, {Attachment::Position, Attachment::Normal, Attachment::Albedo, Attachment::Material,
+                      Attachment::Emission, Attachment::GeometricNormal, Attachment::Layers, Attachment::Specular});
   const gl::Program& prog = ctx.shaders.program({"common/fullscreen.vert", "direct/direct.frag"});
   prog.use();
   bindDirectLighting(prog, res, ctx.gpu, static_cast<int>(ctx.view.lights.size()), pcfRadius_);

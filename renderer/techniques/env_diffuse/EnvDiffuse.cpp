@@ -15,6 +15,7 @@
 #include "renderer/shading/DirectLighting.h"
 #include "renderer/shading/CubeFaces.h"
 #include "renderer/shading/Stretches.h"
+#include "renderer/shading/GBufferInputs.h"
 
 namespace radiant {
 namespace {
@@ -253,8 +254,8 @@ void EnvDiffusePass::execute(PassContext& ctx) {
   glDisable(GL_CULL_FACE);
   glEnable(GL_BLEND);
   glBlendFunc(GL_ONE, GL_ONE);
-  const char* inputs[] = {"gbuffer_position", "normal", "albedo", "material"};
-  for (GLuint i = 0; i < std::size(inputs); ++i) res.texture(inputs[i]).bindUnit(i);
+  using gbuffer::Attachment;
+  gbuffer::bind(res, {Attachment::Position, Attachment::Normal, Attachment::Albedo, Attachment::Material});
   const gl::Program& prog = ctx.shaders.program({"env_diffuse/cube.vert", "env_diffuse/receiver.frag"});
   prog.use();
   prog.setMat4("u_viewProj", glm::value_ptr(view.viewProj));

@@ -1,19 +1,9 @@
 #include "renderer/techniques/gbuffer/GBuffer.h"
 
 #include "renderer/frame/PassContext.h"
+#include "renderer/shading/GBufferInputs.h"
 
 namespace radiant {
-namespace {
-// Resource name -> internal format, in colour attachment order (matches shaders/gbuffer/gbuffer.frag).
-constexpr std::pair<const char*, GLenum> kTargets[] = {
-    {"gbuffer_position", GL_RGBA32F}, {"normal", GL_RGBA16F},   {"albedo", GL_RGBA16F},
-    {"material", GL_RGBA16F},         {"emission", GL_RGBA16F}, {"geometric_normal", GL_RGBA16F},
-    // The layered extensions (docs/GBUFFER.md): clear coat, coat normal and sheen packed as halves/snorm
-    // in an integer target (cleared with the integer clear), and the specular colour and weight.
-    {"gbuffer_layers", GL_RGBA32UI}, {"gbuffer_specular", GL_RGBA16F},
-};
-constexpr int kLayersTarget = 6;
-}  // namespace
 
 const TechniqueInfo& GBufferPass::info() const {
   static const TechniqueInfo i = describedTechnique("gbuffer");
@@ -29,8 +19,10 @@ void GBufferPass::prepare(const Scene&, const Params&, FrameResources& res) {
   const int w = res.view().width, h = res.view().height;
   gl::Framebuffer& fb = res.framebuffer("gbuffer");
   fb.attach(GL_DEPTH_ATTACHMENT, res.texture("depth_buffer", GL_TEXTURE_2D, GL_DEPTH_COMPONENT32F, w, h));
-  for (std::size_t i = 0; i < std::size(kTargets); ++i) {
-    gl::Texture& t = res.texture(kTargets[i].first, GL_TEXTURE_2D, kTargets[i].second, w, h);
+  // The attachments in gbuffer::Attachment order, the colour attachments of shaders/gbuffer/gbuffer.frag.
+  for (std::size_t i = 0; i < std::size(gbuffer::kAttachments); ++i) {
+    const gbuffer::Attachment a = gbuffer::kAttachments[i];
+    gl::Texture& t = res.texture(gbuffer::name(a), GL_TEXTURE_2D, gbuffer::format(a), w, h);
     t.setFilter(GL_NEAREST, GL_NEAREST);
     fb.attach(GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(i), t);
   }
@@ -46,8 +38,9 @@ void GBufferPass::execute(PassContext& ctx) {
   glViewport(0, 0, view.width, view.height);
   const float zero[4] = {0.f, 0.f, 0.f, 0.f};
   const GLuint zeroU[4] = {0u, 0u, 0u, 0u};
-  for (int i = 0; i < static_cast<int>(std::size(kTargets)); ++i) {
-    if (i == kLayersTarget) glClearNamedFramebufferuiv(fb.id(), GL_COLOR, i, zeroU);
+  for (int i = 0; i < static_cast<int>(std::size(gbuffer::kAttachments)); ++i) {
+    // The layers target is an integer one (cleared with the integer clear).
+    if (gbuffer::kAttachments[i] == gbuffer::Attachment::Layers) glClearNamedFramebufferuiv(fb.id(), GL_COLOR, i, zeroU);
     else glClearNamedFramebufferfv(fb.id(), GL_COLOR, i, zero);
   }
   const float depthClear = 0.f;  // reversed-Z: 0 is infinitely far

@@ -9,6 +9,7 @@
 #include "renderer/frame/PassContext.h"
 #include "renderer/raytracing/ParticleMedium.h"
 #include "renderer/shading/MediaLayer.h"
+#include "renderer/shading/GBufferInputs.h"
 
 namespace radiant {
 
@@ -281,10 +282,10 @@ void IlluminationNetworkPass::execute(PassContext& ctx) {
   gpu.cameraSources(ctx.shaders, order, splats, view.camera.projection == ProjectionType::Orthographic, view.eye,
                     toCamera, /*includeLights=*/!march_, /*excludeSky=*/skyExact_, view.ambient);
 
-  const bool hasDepth = res.hasTexture("gbuffer_position") && res.written("gbuffer_position");
+  const bool hasDepth = gbuffer::written(res, gbuffer::Attachment::Position);
   vao_.bind();
   beginMediaLayer(res.framebuffer("media"), view.width, view.height);
-  if (hasDepth) res.texture("gbuffer_position").bindUnit(0);
+  if (hasDepth) gbuffer::bindAt(res, gbuffer::Attachment::Position, 0);
   if (march_) {
     // The view ray marched through the medium's exact extinction, the lights scattered once exactly,
     // the network's J_ms interpolated from the nodes (march.frag).

@@ -10,6 +10,7 @@
 #include "api/Presets.h"
 #include "renderer/frame/PassContext.h"
 #include "renderer/frame/RayScenes.h"
+#include "renderer/shading/GBufferInputs.h"
 
 namespace radiant {
 namespace {
@@ -143,8 +144,9 @@ void LightVolumesPass::execute(PassContext& ctx) {
     if (!c.bvh.primitives.empty()) prims.upload(c.bvh.primitives.data(), c.bvh.primitives.size() * sizeof(glm::vec4));
     uploaded_.written();
   }
-  const char* inputs[] = {"gbuffer_position", "normal", "albedo", "material", "emission"};
-  for (GLuint i = 0; i < std::size(inputs); ++i) res.texture(inputs[i]).bindUnit(i);
+  using gbuffer::Attachment;
+  gbuffer::bind(res, {Attachment::Position, Attachment::Normal, Attachment::Albedo, Attachment::Material,
+                      Attachment::Emission});
   beams.bindBase(GL_SHADER_STORAGE_BUFFER, kBindingBeams);
   cones.bindBase(GL_SHADER_STORAGE_BUFFER, kBindingCones);
   nodes.bindBase(GL_SHADER_STORAGE_BUFFER, kBindingNodes);

@@ -39,10 +39,6 @@ struct SplatCache {
   }
 };
 
-[[noreturn]] void badParam(const std::string& key, const std::string& detail) {
-  throw api::ApiError(422, "invalid-value", "Invalid photon_gi parameter", detail, "/passes/photon_gi/" + key);
-}
-
 // Which environment photons are drawn (docs/TECHNIQUES.md, photon_gi, "Sky photons under a split
 // map"). When the frame split the map into lights S and a residual R (EnvironmentLights.h), the
 // lights' first hits are `direct`'s: photons drawn by L spend 70-79% of the sky's photons on a sun
@@ -127,9 +123,6 @@ void PhotonGiPass::prepare(const Scene& scene, const Params& params, FrameResour
   s.ppmBase = p.ppm_base_photons;
   s.maxBounces = p.max_bounces;
   s.environmentLightPhotons = static_cast<float>(p.environment_light_photons);
-  if (!(s.environmentLightPhotons >= 0.01f) || s.environmentLightPhotons > 1.f)
-    badParam("environment_light_photons", "environment_light_photons must be in [0.01, 1]");
-  if (!(s.C > 0.f) || !std::isfinite(s.C)) badParam("C", "C must be a positive number");
   settings_ = s;
   splat_.method = p.method == PhotonGiParams::Method::kGather ? photon_gi::Method::Gather
                                                                        : photon_gi::Method::Splat;

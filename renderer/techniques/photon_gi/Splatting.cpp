@@ -13,6 +13,7 @@
 #include "renderer/raytracing/PhotonTracer.h"
 #include "renderer/shading/PhotonGrid.h"
 #include "renderer/shading/Stretches.h"
+#include "renderer/shading/GBufferInputs.h"
 
 namespace radiant::photon_gi {
 namespace {
@@ -251,12 +252,10 @@ void splatAndResolve(FrameResources& res, gl::ShaderLibrary& shaders, const Fram
   gl::Buffer& splats = res.buffer("photon_gi_splats");
   gl::Buffer& cells = res.buffer("photon_gi_cells");
   if (upload) uploadSplatGrid(res, grid);
-  const char* inputs[] = {"gbuffer_position", "normal", "albedo", "material", "emission"};
-  for (GLuint i = 0; i < std::size(inputs); ++i) res.texture(inputs[i]).bindUnit(i);
-  res.texture("geometric_normal").bindUnit(5);
-  // The layers of the receiver's material (photon_gi/surface.glsl).
-  res.texture("gbuffer_layers").bindUnit(gpu::kUnitGbufferLayers);
-  res.texture("gbuffer_specular").bindUnit(gpu::kUnitGbufferSpecular);
+  // With the layers of the receiver's material (photon_gi/surface.glsl).
+  using gbuffer::Attachment;
+  gbuffer::bind(res, {Attachment::Position, Attachment::Normal, Attachment::Albedo, Attachment::Material,
+                      Attachment::Emission, Attachment::GeometricNormal, Attachment::Layers, Attachment::Specular});
   splats.bindBase(GL_SHADER_STORAGE_BUFFER, kSplatBinding);
   cells.bindBase(GL_SHADER_STORAGE_BUFFER, kCellBinding);
   auto common = [&](const gl::Program& p) {

@@ -19,6 +19,7 @@
 #include "renderer/shading/SpecularMaps.h"
 #include "renderer/shading/SpecularObjects.h"
 #include "renderer/shading/Stretches.h"
+#include "renderer/shading/GBufferInputs.h"
 
 namespace radiant {
 namespace {
@@ -536,8 +537,9 @@ void SpecularPass::execute(PassContext& ctx) {
     glDepthMask(GL_TRUE);
     glDisable(GL_CULL_FACE);
     glDisable(GL_BLEND);
-    const char* inputs[] = {"gbuffer_position", "normal", "albedo", "material", "emission"};
-    for (GLuint i = 0; i < std::size(inputs); ++i) res.texture(inputs[i]).bindUnit(i);
+    using gbuffer::Attachment;
+    gbuffer::bind(res, {Attachment::Position, Attachment::Normal, Attachment::Albedo, Attachment::Material,
+                        Attachment::Emission});
     published.bind();  // the maps, and the albedo for mirrors' F0 (specular/ldm.glsl, mapSpecularTexel)
     const gl::Program& prog = ctx.shaders.program({"specular/map.vert", "specular/specular.frag"});
     prog.use();

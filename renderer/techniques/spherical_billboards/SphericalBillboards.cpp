@@ -9,6 +9,7 @@
 #include "renderer/raytracing/Media.h"
 #include "renderer/shading/MediaLayer.h"
 #include "renderer/shading/Stretches.h"
+#include "renderer/shading/GBufferInputs.h"
 
 namespace radiant {
 namespace {
@@ -73,14 +74,14 @@ void SphericalBillboardsPass::execute(PassContext& ctx) {
   const FrameView& view = ctx.view;
   gl::Buffer& buffer = res.buffer("media_particles");
   if (!particles_.empty()) buffer.upload(particles_.data(), particles_.size() * sizeof(gpu::MediaParticle));
-  const bool hasDepth = res.hasTexture("gbuffer_position") && res.written("gbuffer_position");
+  const bool hasDepth = gbuffer::written(res, gbuffer::Attachment::Position);
   const bool layered = ratio_ < 1.f;
   vao_.bind();
 
   // 1. Particles, back to front, into the layer (or the full-resolution target at ratio 1).
   const int tw = layered ? lowWidth_ : view.width, th = layered ? lowHeight_ : view.height;
   beginMediaLayer(res.framebuffer(layered ? "media_layer" : "media"), tw, th);
-  if (hasDepth) res.texture("gbuffer_position").bindUnit(0);
+  if (hasDepth) gbuffer::bindAt(res, gbuffer::Attachment::Position, 0);
   buffer.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingMediaParticles);
   ctx.gpu.lights.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingLights);
   const gl::Program& prog = ctx.shaders.program({"spherical_billboards/particle.vert", "spherical_billboards/particle.frag"});
@@ -100,7 +101,7 @@ void SphericalBillboardsPass::execute(PassContext& ctx) {
     fb.bind();
     glViewport(0, 0, view.width, view.height);
     res.texture("media_layer").bindUnit(0);
-    if (hasDepth) res.texture("gbuffer_position").bindUnit(1);
+    if (hasDepth) gbuffer::bindAt(res, gbuffer::Attachment::Position, 1);
     const gl::Program& up = ctx.shaders.program({"common/fullscreen.vert", "spherical_billboards/upsample.frag"});
     up.use();
     up.set("u_hasDepth", hasDepth ? 1 : 0);
