@@ -129,10 +129,10 @@ void writeCsv(const std::vector<json>& all, const fs::path& out) {
   std::ostringstream csv;
   csv << "point_id,sweep,technique,method,status";
   for (const auto& p : params) csv << "," << csvCell(p);
-  for (const char* s : {"frame_gpu_ms", "frame_cpu_ms", "latency_ms", "render_ms"})
+  for (const char* s : {"frame_gpu_ms", "frame_cpu_ms", "frame_prepare_ms", "latency_ms", "render_ms"})
     csv << "," << s << "_median," << s << "_min," << s << "_max";
   csv << ",queue_ms_median,encode_ms_median";
-  for (const auto& p : passes) csv << ",gpu_ms." << p << ",cpu_ms." << p;
+  for (const auto& p : passes) csv << ",gpu_ms." << p << ",cpu_ms." << p << ",prepare_ms." << p;
   for (const auto& m : metrics) csv << "," << m;
   csv << ",repeats,device,server,finished,error\n";
   for (const auto& r : records) {
@@ -141,7 +141,7 @@ void writeCsv(const std::vector<json>& all, const fs::path& out) {
         << csvCell(r.value("technique", json())) << "," << csvCell(r.value("method", json())) << ","
         << (ok ? "ok" : "error");
     for (const auto& p : params) csv << "," << csvCell(r["params"].value(p, json()));
-    for (const char* s : {"frame_gpu_ms", "frame_cpu_ms", "latency_ms", "render_ms"}) {
+    for (const char* s : {"frame_gpu_ms", "frame_cpu_ms", "frame_prepare_ms", "latency_ms", "render_ms"}) {
       const json st = r.value(s, json());
       for (const char* k : {"median", "min", "max"}) csv << "," << (st.is_object() ? csvCell(st[k]) : "");
     }
@@ -150,13 +150,14 @@ void writeCsv(const std::vector<json>& all, const fs::path& out) {
       csv << "," << (st.is_object() ? csvCell(st["median"]) : "");
     }
     for (const auto& name : passes) {
-      json g, c;
+      json g, c, pr;
       for (const auto& p : r.value("passes", json::array()))
         if (p.value("name", "") == name) {
           g = p["gpu_ms"]["median"];
           c = p["cpu_ms"]["median"];
+          if (p.contains("prepare_ms")) pr = p["prepare_ms"]["median"];  // records older than prepare_ms have none
         }
-      csv << "," << csvCell(g) << "," << csvCell(c);
+      csv << "," << csvCell(g) << "," << csvCell(c) << "," << csvCell(pr);
     }
     for (const auto& m : metrics)
       csv << "," << (r.contains("metrics") && r["metrics"].is_object() ? csvCell(r["metrics"].value(m, json())) : "");

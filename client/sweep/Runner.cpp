@@ -398,9 +398,12 @@ private:
       json request = p.request;
       request["async"] = false;
       const int untimed = std::max(p.warmup, p.compare.is_null() ? 0 : 1);
-      std::vector<double> gpu, cpu, latency, render, queue, encode;
+      std::vector<double> gpu, cpu, prepare, latency, render, queue, encode;
       std::vector<std::string> order;
-      std::map<std::string, std::pair<std::vector<double>, std::vector<double>>> perPass;
+      struct PassTimes {
+        std::vector<double> gpu, cpu, prepare;
+      };
+      std::map<std::string, PassTimes> perPass;
       json last;
       std::set<std::string> daemons;  // behind a proxy: which daemons rendered this point
       // The compare render also asks for an EXR of the compared AOV, which then carries the error and
@@ -433,17 +436,23 @@ private:
         const json stats = result.value("stats", json::object());
         if (k == 0 && !p.compare.is_null()) record["metrics"] = stats.value("metrics", json());
         if (k < untimed) continue;
-        double g = 0, c = 0;
+        double g = 0, c = 0, pr = 0;
         for (const auto& pass : stats.value("passes", json::array())) {
           const std::string name = pass.value("name", "");
           if (!perPass.count(name)) order.push_back(name);
-          perPass[name].first.push_back(pass.value("gpu_ms", 0.0));
-          perPass[name].second.push_back(pass.value("cpu_ms", 0.0));
-          g += pass.value("gpu_ms", 0.0);
-          c += pass.value("cpu_ms", 0.0);
+          PassTimes& t = perPass[name];
+          t.gpu.push_back(pass.value("gpu_ms", 0.0));
+          t.cpu.push_back(pass.value("cpu_ms", 0.0));
+          // prepare() (allocations, cache lookups, the derived data built on a miss: docs/API.md);
+          // a daemon older than prepare_ms reports none.
+          t.prepare.push_back(pass.value("prepare_ms", 0.0));
+          g += t.gpu.back();
+          c += t.cpu.back();
+          pr += t.prepare.back();
         }
         gpu.push_back(g);
         cpu.push_back(c);
+        prepare.push_back(pr);
         latency.push_back(ms);
         render.push_back(stats.value("render_ms", 0.0));
         const json timings = result.value("timings", json::object());
@@ -453,7 +462,11 @@ private:
       }
       json passes = json::array();
       for (const auto& name : order) {
-        json entry{{"name", name}, {"gpu_ms", summarize(perPass[name].first)}, {"cpu_ms", summarize(perPass[name].second)}};
+        const PassTimes& t = perPass[name];
+        json entry{{"name", name},
+                   {"gpu_ms", summarize(t.gpu)},
+                   {"cpu_ms", summarize(t.cpu)},
+                   {"prepare_ms", summarize(t.prepare)}};
         for (const auto& pass : last.value("passes", json::array()))
           if (pass.value("name", "") == name && pass.contains("counters")) entry["counters"] = pass["counters"];
         passes.push_back(entry);
@@ -461,6 +474,7 @@ private:
       record["passes"] = passes;
       record["frame_gpu_ms"] = summarize(gpu);
       record["frame_cpu_ms"] = summarize(cpu);
+      record["frame_prepare_ms"] = summarize(prepare);
       record["latency_ms"] = summarize(latency);
       record["render_ms"] = summarize(render);
       record["queue_ms"] = summarize(queue);

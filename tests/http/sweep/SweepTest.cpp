@@ -280,8 +280,15 @@ TEST_F(SweepAgainstDaemon, TwoByTwoGivesFourRecordsWithTheirParametersAndTimings
         EXPECT_EQ(p["counters"]["samples"].get<double>(), samples);
       }
       sum += p["gpu_ms"]["median"].get<double>();
+      // Each pass's prepare() too (stats.passes[].prepare_ms): over the same repeats, and within the
+      // frame's sum of them (each repeat's sum holds every pass's own term).
+      EXPECT_EQ(p["prepare_ms"]["n"], 2) << p.dump();
+      EXPECT_GE(p["prepare_ms"]["min"].get<double>(), 0.0);
+      EXPECT_LE(p["prepare_ms"]["min"].get<double>(), p["prepare_ms"]["max"].get<double>());
+      EXPECT_GE(rec["frame_prepare_ms"]["max"].get<double>(), p["prepare_ms"]["min"].get<double>()) << p["name"];
     }
     EXPECT_TRUE(sawAo) << rec["passes"].dump();
+    EXPECT_EQ(rec["frame_prepare_ms"]["n"], 2);
     EXPECT_GT(rec["frame_gpu_ms"]["median"].get<double>(), 0.0);
     EXPECT_EQ(rec["latency_ms"]["n"], 2);
     EXPECT_GT(rec["latency_ms"]["min"].get<double>(), 0.0);
@@ -309,6 +316,8 @@ TEST_F(SweepAgainstDaemon, TwoByTwoGivesFourRecordsWithTheirParametersAndTimings
   ASSERT_EQ(csv.size(), 5u);
   EXPECT_EQ(csv[0].rfind("point_id,sweep,technique,method,status,", 0), 0u) << csv[0];
   EXPECT_NE(csv[0].find("passes.ambient_occlusion.samples"), std::string::npos);
+  EXPECT_NE(csv[0].find(",frame_prepare_ms_median,"), std::string::npos) << csv[0];
+  EXPECT_NE(csv[0].find(",cpu_ms.ambient_occlusion,prepare_ms.ambient_occlusion,"), std::string::npos) << csv[0];
   fs::remove_all(dir);
 }
 
