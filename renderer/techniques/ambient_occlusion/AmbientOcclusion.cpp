@@ -307,7 +307,8 @@ void AmbientOcclusionPass::execute(PassContext& ctx) {
   }
   glColorMaski(1, addAmbient, addAmbient, addAmbient, GL_FALSE);
   raw.bindUnit(0);
-  // The resolve keeps unit 0 for the estimate: the G-buffer one unit up (ao_resolve.frag).
+  // The resolve keeps unit 0 for the estimate: position .. material one unit up, the geometric normal at
+  // 5 and the emission at its own unit (ao_resolve.frag).
   gbuffer::bindAt(res, Attachment::Position, 1);
   gbuffer::bindAt(res, Attachment::Normal, 2);
   gbuffer::bindAt(res, Attachment::Albedo, 3);
