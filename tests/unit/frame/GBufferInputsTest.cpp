@@ -36,7 +36,9 @@ TEST(GBufferInputs, EveryAttachmentIsWhatTheGBufferDeclaresInTheAovTablesFormat)
     // Where an AOV reads the attachment, the table's format is the attachment's (FrameResources refuses
     // a declaration in another format at run time; this says which table is wrong).
     for (const api::AovInfo& aov : api::aovTable())
-      if (aov.resource == name) EXPECT_EQ(glFormat(aov.format), gbuffer::format(a)) << aov.name;
+      if (aov.resource == name) {
+        EXPECT_EQ(glFormat(aov.format), gbuffer::format(a)) << aov.name;
+      }
   }
   // What the gbuffer writes besides its depth buffer is exactly these attachments (its colour targets).
   std::set<std::string> written;
