@@ -43,11 +43,12 @@ RADIANT_CONST int kLobeSpecular = 16;
 
 // ---------------------------------------------------------------------------------------------------
 // Texture units. Every sampler of every program has its own unit, so a pass can bind anything it
-// declares without overwriting another's input. Units 0-5 are a pass's own full-screen inputs. The
-// units, bindings and records only one technique (or one technique's product) uses are declared in its
-// folder, shaders/<technique>/shared.h, under the same rules as this file (`grep -n "kUnit\|kBinding"
-// shaders/*/shared.h` lists them; RenderCore.SamplerUnitsAreUniqueAcrossEveryTechniquesPrograms, over
-// every program the techniques link, fails when two samplers share a unit). Taken there: 15-18 and 25
+// declares without overwriting another's input. Units 0-5 are the G-buffer's (kUnitGbufferPosition ...
+// below) or a pass's own full-screen inputs. The units, bindings and records only one technique (or one
+// technique's product) uses are declared in its folder, shaders/<technique>/shared.h, under the same
+// rules as this file (`grep -n "kUnit\|kBinding" shaders/*/shared.h` lists them;
+// RenderCore.SamplerUnitsAreUniqueAcrossEveryTechniquesPrograms, over every program the techniques link,
+// fails when two samplers share a unit). Taken there: 15-18 and 25
 // (specular), 21 (ambient_occlusion), 24 (caustics), 33-34 (depth_impostors); storage bindings 4-5
 // (depth_impostors) and 8 (specular).
 RADIANT_CONST int kUnitShadowCube = 6;

@@ -11,12 +11,13 @@
 //   it with the in-scattering's weight (shadowOverInterval); the lights' direction and intensity at
 //   its middle; the other lights unshadowed;
 //   colour L = source + albedo sum_lights phase(mu) I_light T_light, blended C = alpha' L + (1 - alpha') C.
+#include "common/shared.h"
 #include "common/lights.glsl"
 #include "common/phase.glsl"
 #include "depth_impostors/frame.glsl"
 #include "common/frame.glsl"
 
-layout(binding = 0) uniform sampler2D t_position;  // gbuffer_position: xyz world, w view depth (0 = none)
+layout(binding = kUnitGbufferPosition) uniform sampler2D t_position;  // gbuffer_position: xyz world, w view depth (0 = none)
 layout(binding = 1) uniform sampler2D t_front;
 layout(binding = 2) uniform sampler2D t_back;
 layout(binding = 3) uniform sampler2D t_transmittance;

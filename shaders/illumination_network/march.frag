@@ -17,6 +17,7 @@
 // (C = L_k + T_k C). The stretches exist because llvmpipe ends every loop of a shader invocation after
 // 65535 iterations in all (gallivm's LP_MAX_TGSI_LOOP_ITERATIONS, shared between the loops): the pass
 // sizes them to stay below it (IlluminationNetwork.cpp marchStretch).
+#include "common/shared.h"
 #include "illumination_network/network.glsl"
 #include "common/particle_density.glsl"
 #include "common/frame.glsl"
@@ -25,7 +26,7 @@ layout(std430, binding = kBindingMediaParticles) readonly buffer Particles { Med
 layout(std430, binding = 15) readonly buffer Splats { MediaParticle splats[]; };  // xyz node, rgb J_ms
 layout(std430, binding = 12) readonly buffer Lights { NetworkLight lights[]; };
 layout(std430, binding = 1) readonly buffer Directions { NetworkDirection dirs[]; };
-layout(binding = 0) uniform sampler2D t_position;  // gbuffer_position: xyz world, w view depth (0 = none)
+layout(binding = kUnitGbufferPosition) uniform sampler2D t_position;  // gbuffer_position: xyz world, w view depth (0 = none)
 
 uniform int u_hasDepth;
 uniform vec2 u_targetSize;

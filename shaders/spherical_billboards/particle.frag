@@ -15,13 +15,14 @@
 //   Colour: the particle's direction-independent source plus albedo x the punctual lights' light
 //   (unshadowed, thesis 7.2.1) scattered by the phase function at the middle of the ray's segment in
 //   the particle (the closest point to the centre for the screen-parallel and planar chords).
+#include "common/shared.h"
 #include "common/lights.glsl"
 #include "common/particle_density.glsl"
 #include "common/phase.glsl"
 #include "common/frame.glsl"
 
 layout(std430, binding = kBindingMediaParticles) readonly buffer Particles { MediaParticle particles[]; };
-layout(binding = 0) uniform sampler2D t_position;  // gbuffer_position: xyz world, w view depth (0 = none)
+layout(binding = kUnitGbufferPosition) uniform sampler2D t_position;  // gbuffer_position: xyz world, w view depth (0 = none)
 
 uniform int u_hasDepth;
 uniform vec2 u_targetSize;

@@ -137,7 +137,7 @@ void DepthImpostorsPass::execute(PassContext& ctx) {
 
   beginMediaLayer(res.framebuffer("media"), view.width, view.height);
   vao_.bind();
-  if (hasDepth) gbuffer::bindAt(res, gbuffer::Attachment::Position, 0);
+  if (hasDepth) gbuffer::bind(res, {gbuffer::Attachment::Position});
   set.front.bindUnit(1);
   set.back.bindUnit(2);
   set.transmittance.bindUnit(3);

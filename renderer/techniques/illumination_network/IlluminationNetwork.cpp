@@ -285,7 +285,7 @@ void IlluminationNetworkPass::execute(PassContext& ctx) {
   const bool hasDepth = gbuffer::written(res, gbuffer::Attachment::Position);
   vao_.bind();
   beginMediaLayer(res.framebuffer("media"), view.width, view.height);
-  if (hasDepth) gbuffer::bindAt(res, gbuffer::Attachment::Position, 0);
+  if (hasDepth) gbuffer::bind(res, {gbuffer::Attachment::Position});
   if (march_) {
     // The view ray marched through the medium's exact extinction, the lights scattered once exactly,
     // the network's J_ms interpolated from the nodes (march.frag).

@@ -81,7 +81,7 @@ void SphericalBillboardsPass::execute(PassContext& ctx) {
   // 1. Particles, back to front, into the layer (or the full-resolution target at ratio 1).
   const int tw = layered ? lowWidth_ : view.width, th = layered ? lowHeight_ : view.height;
   beginMediaLayer(res.framebuffer(layered ? "media_layer" : "media"), tw, th);
-  if (hasDepth) gbuffer::bindAt(res, gbuffer::Attachment::Position, 0);
+  if (hasDepth) gbuffer::bind(res, {gbuffer::Attachment::Position});
   buffer.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingMediaParticles);
   ctx.gpu.lights.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingLights);
   const gl::Program& prog = ctx.shaders.program({"spherical_billboards/particle.vert", "spherical_billboards/particle.frag"});
