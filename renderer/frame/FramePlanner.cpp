@@ -25,7 +25,7 @@ std::vector<ResourceAccess> declaredAccess(const TechniqueInfo& info) {
                                                                                               : Access::Write});
   if (info.addsToBeauty)
     for (const api::AovInfo& a : api::aovTable())
-      if (a.blend == api::AovBlend::Accumulate) out.push_back({a.resource, Access::Accumulate});
+      if (a.blend == api::AovBlend::Accumulate) out.push_back({a.resource, Access::Accumulate, info.beautyBlend});
   return out;
 }
 

@@ -62,8 +62,43 @@ void FrameResources::checkNoAllocation(const std::string& what, const std::strin
 
 void FrameResources::markWritten(const std::string& name) {
   checkAccess(name, true);
+  if (inPass_) {
+    const auto it = std::find_if(access_.begin(), access_.end(), [&](const ResourceAccess& a) { return a.name == name; });
+    if (it != access_.end() && it->access == Access::Accumulate)
+      throw std::logic_error("FrameResources: pass " + pass_ + " marked '" + name +
+                             "' written; a pass composes into it through a BeautyWrite (renderer/frame/Beauty.h)");
+  }
   written_.insert(name);
   passWrites_.insert(name);
+}
+
+BeautyBlend FrameResources::declaredBlend(const std::string& name) const {
+  if (!inPass_)
+    throw std::logic_error("FrameResources: a composition into '" + name + "' outside a pass scope");
+  const auto it = std::find_if(access_.begin(), access_.end(),
+                               [&](const ResourceAccess& a) { return a.name == name && a.access == Access::Accumulate; });
+  if (it == access_.end())
+    throw std::logic_error("FrameResources: pass " + pass_ + " composed into '" + name +
+                           "', which its TechniqueInfo does not declare (adds_to_beauty)");
+  return it->blend;
+}
+
+void FrameResources::accumulate(const std::string& name) {
+  const BeautyBlend blend = declaredBlend(name);
+  std::vector<Composition>& versions = compositions_[name];
+  if (!versions.empty() && versions.back().blend > blend)
+    throw std::logic_error("FrameResources: pass " + pass_ + " composed into '" + name + "' with " +
+                           toString(blend) + " after pass " + versions.back().pass + "'s " +
+                           toString(versions.back().blend) + " (the frame graph orders add, over, transmit)");
+  versions.push_back({pass_, blend});
+  written_.insert(name);
+  passWrites_.insert(name);
+}
+
+const std::vector<FrameResources::Composition>& FrameResources::compositions(const std::string& name) const {
+  static const std::vector<Composition> none;
+  const auto it = compositions_.find(name);
+  return it == compositions_.end() ? none : it->second;
 }
 
 void FrameResources::beginFrame(const GpuScene& gpu, const FrameView& view, std::vector<api::CacheEvent>* cacheLog) {
@@ -79,6 +114,7 @@ void FrameResources::beginFrame(const GpuScene& gpu, const FrameView& view, std:
   cancel_ = {};
   endPass();  // a pass that threw last frame left its scope open
   written_.clear();
+  compositions_.clear();
   products_.clear();
   declaredThisFrame_.clear();
   usedThisFrame_.clear();
@@ -201,6 +237,7 @@ void FrameResources::clear() {
   cache_.clear();
   holds_.clear();
   written_.clear();
+  compositions_.clear();
   declaredThisFrame_.clear();
   usedThisFrame_.clear();
 }

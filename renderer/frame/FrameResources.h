@@ -32,6 +32,7 @@
 #include "api/LightPaths.h"
 #include "api/Lru.h"
 #include "api/Types.h"
+#include "renderer/frame/BeautyBlend.h"
 #include "renderer/gl/Gl.h"
 #include "renderer/gl/ShaderLibrary.h"
 #include "renderer/raytracing/Cancel.h"
@@ -44,12 +45,13 @@ struct FrameView;
 // How a pass uses a shared resource (Falcor's RenderPassReflection, Filament's FrameGraph): Read (one of
 // its inputs or optional inputs), Write (an output it overwrites), WriteInPrepare (an output its
 // prepare() publishes, TechniqueInfo::prepareOutputs: written in execute() it is a breach), Accumulate
-// (composes into an accumulate AOV: beauty). FramePlanner's declaredAccess() derives a pass's list from
-// its TechniqueInfo.
+// (composes into an accumulate AOV: beauty, with `blend`). FramePlanner's declaredAccess() derives a
+// pass's list from its TechniqueInfo.
 enum class Access { Read, Write, WriteInPrepare, Accumulate };
 struct ResourceAccess {
   std::string name;
   Access access;
+  BeautyBlend blend = BeautyBlend::Add;  // Accumulate: TechniqueInfo::beautyBlend
 };
 const char* toString(Access access);
 
@@ -140,9 +142,28 @@ public:
   }
 
   // Outputs written this frame (the planner and readback consult it). Inside a pass scope, marking a
-  // resource the pass did not declare Write or Accumulate throws std::logic_error.
+  // resource the pass did not declare Write throws std::logic_error, and so does marking an accumulate
+  // AOV (beauty), which a pass composes into only through accumulate() (renderer/frame/Beauty.h).
   void markWritten(const std::string& name);
   bool written(const std::string& name) const { return written_.count(name) != 0; }
+
+  // Beauty as a versioned read-modify-write resource (Filament's FrameGraph: every write makes a new
+  // version of the resource). A composition into an accumulate AOV is one version: `pass`'s write with
+  // the blend its TechniqueInfo declares.
+  struct Composition {
+    std::string pass;
+    BeautyBlend blend;
+  };
+  // The blend the current pass declares for the accumulate AOV `name`; throws std::logic_error when
+  // it declares no Accumulate of `name` (or outside a pass scope).
+  BeautyBlend declaredBlend(const std::string& name) const;
+  // Records the current pass's composition into `name` as its next version and marks it written.
+  // Versions compose in the order of their blends (Add, then Over, then Transmit: FramePlanner's
+  // executionOrder); a composition of an earlier blend after a later one is a std::logic_error naming
+  // both passes (an add after an over would add light behind a blended surface in front of it).
+  void accumulate(const std::string& name);
+  // The compositions into `name` this frame, in order (its version is their count).
+  const std::vector<Composition>& compositions(const std::string& name) const;
 
   // The frame's typed blackboard (Filament's FrameGraph blackboard): what a pass hands to later passes
   // that is not one texture (photon_gi's splat grid, specular's layered distance maps) is a value
@@ -295,6 +316,7 @@ private:
   std::map<std::string, std::string> holds_;  // resource -> digest of what it holds (refill())
   std::size_t derivedCapacity_ = 4;
   std::set<std::string> written_;
+  std::map<std::string, std::vector<Composition>> compositions_;  // accumulate(), cleared by beginFrame()
   std::map<std::string, std::any> products_;  // the blackboard, cleared by beginFrame()
   std::map<std::string, std::string> lightPaths_;
   std::map<std::string, api::LightPathMask> owned_;

@@ -14,6 +14,7 @@
 
 #include "api/Aovs.h"
 #include "api/Types.h"
+#include "renderer/frame/BeautyBlend.h"
 #include "renderer/scene/Scene.h"
 
 namespace radiant {
@@ -24,12 +25,6 @@ struct SceneCounts;  // api/Presets.h
 class FrameResources;
 struct FrameView;
 struct PassContext;
-
-// How a pass composes its result into beauty, which orders it among the frame's beauty writers
-// (FramePlanner's executionOrder): Add commutes with the other adds (beauty starts each frame at zero);
-// Over (blended surfaces: beauty = a Ls + (1 - a) beauty) runs after every add; Transmit (media:
-// beauty = beauty T + C) after every add and over.
-enum class BeautyBlend { Add, Over, Transmit };
 
 struct TechniqueInfo {
   std::string name;         // as used in the API ("direct", "ambient_occlusion")
@@ -55,7 +50,7 @@ struct TechniqueInfo {
   // because its estimate cannot leave them out: photon_gi's photons carry LD+DE, so where env_diffuse owns that
   // class photon_gi is dropped ("LD+DE is owned by env_diffuse"), and a request naming both is a 422.
   std::vector<std::string> requiredPaths = {};
-  BeautyBlend beautyBlend = BeautyBlend::Add;
+  BeautyBlend beautyBlend = BeautyBlend::Add;  // how it composes into beauty (renderer/frame/BeautyBlend.h)
   // Outputs it publishes in prepare() (photon_gi's photon grid): every prepare runs before any execute,
   // so a pass reading one in its execute() need not run after this one (FrameResources refuses a write
   // of one in execute()).

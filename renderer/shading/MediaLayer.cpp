@@ -5,6 +5,7 @@
 
 #include "renderer/raytracing/Media.h"
 
+#include "renderer/frame/Beauty.h"
 #include "renderer/frame/FrameView.h"
 
 namespace radiant {
@@ -45,7 +46,7 @@ void declareMediaLayer(FrameResources& res, int w, int h) {
   fb.setDrawBuffers({GL_COLOR_ATTACHMENT0});
   fb.checkComplete("declareMediaLayer");
   gl::Framebuffer& compose = res.framebuffer("media_compose");
-  compose.attach(GL_COLOR_ATTACHMENT0, res.texture("beauty"));
+  attachBeauty(res, compose, GL_COLOR_ATTACHMENT0);
   compose.setDrawBuffers({GL_COLOR_ATTACHMENT0});
   compose.checkComplete("declareMediaLayer (compose)");
 }
@@ -56,20 +57,18 @@ void composeMediaIntoBeauty(PassContext& ctx) {
   gl::Framebuffer& compose = res.framebuffer("media_compose");
   compose.bind();
   glViewport(0, 0, view.width, view.height);
-  if (!res.written("beauty")) {
+  if (res.compositions(kBeauty).empty()) {
     const float sky[4] = {view.ambient.x, view.ambient.y, view.ambient.z, 1.f};
     glClearNamedFramebufferfv(compose.id(), GL_COLOR, 0, sky);
   }
-  glEnable(GL_BLEND);
-  glBlendEquation(GL_FUNC_ADD);
-  glBlendFuncSeparate(GL_ONE, GL_SRC_ALPHA, GL_ZERO, GL_ONE);
+  // Its declared blend, transmit: rgb = C + T beauty (the layer's rgb and transmittance), alpha kept.
+  BeautyWrite beauty = BeautyWrite::drawBuffer(res, 0);
   res.texture("media").bindUnit(0);
   const gl::Program& comp = ctx.shaders.program({"common/fullscreen.vert", "common/media_compose.frag"});
   comp.use();
   glDrawArrays(GL_TRIANGLES, 0, 3);
-  glDisable(GL_BLEND);
+  beauty.commit();
   glDepthMask(GL_TRUE);
-  res.markWritten("beauty");
 }
 
 namespace {

@@ -9,6 +9,7 @@
 
 #include <glm/gtc/constants.hpp>
 
+#include "renderer/frame/Beauty.h"
 #include "renderer/frame/GpuTypes.h"
 #include "renderer/frame/PassContext.h"
 #include "renderer/shading/ImageBasedLighting.h"
@@ -241,10 +242,9 @@ void AmbientOcclusionPass::prepare(const Scene&, const Params& params, FrameReso
   gl::Texture& out = res.texture("ao");
   out.setFilter(GL_NEAREST, GL_NEAREST);
   // Declared outputs and beauty: allocated by the Renderer (renderer/frame/FrameAllocation.h).
-  gl::Texture& beauty = res.texture("beauty");
   gl::Framebuffer& resolve = res.framebuffer("ao_resolve");
   resolve.attach(GL_COLOR_ATTACHMENT0, out);
-  resolve.attach(GL_COLOR_ATTACHMENT1, beauty);
+  attachBeauty(res, resolve, GL_COLOR_ATTACHMENT1);
   resolve.setDrawBuffers({GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1});
   resolve.checkComplete("AmbientOcclusionPass::prepare (resolve)");
   res.buffer("ao_samples", sizeof(ao::SampleBlock));
@@ -300,12 +300,7 @@ void AmbientOcclusionPass::execute(PassContext& ctx) {
   gl::Framebuffer& resolve = res.framebuffer("ao_resolve");
   resolve.bind();
   glViewport(0, 0, w, h);
-  if (addAmbient) {
-    glEnablei(GL_BLEND, 1);
-    glBlendEquationi(1, GL_FUNC_ADD);
-    glBlendFunci(1, GL_ONE, GL_ONE);
-  }
-  glColorMaski(1, addAmbient, addAmbient, addAmbient, GL_FALSE);
+  BeautyWrite beauty = BeautyWrite::drawBuffer(res, 1, addAmbient);
   raw.bindUnit(0);
   // The resolve keeps unit 0 for the estimate: position .. material one unit up, the geometric normal at
   // 5 and the emission at its own unit (ao_resolve.frag).
@@ -325,11 +320,8 @@ void AmbientOcclusionPass::execute(PassContext& ctx) {
   ctx.gpu.sheenAlbedo.bindBase(GL_SHADER_STORAGE_BUFFER, gpu::kBindingSheenAlbedo);
   ibl::bind(res, rp, gpu::kUnitIblDfg, -1);
   glDrawArrays(GL_TRIANGLES, 0, 3);
-  glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  glDisablei(GL_BLEND, 1);
-
+  beauty.commit();
   res.markWritten("ao");
-  if (addAmbient) res.markWritten("beauty");
   const double fetches = method_ == ao::Method::kGtao ? 2.0 * layout.slices * layout.steps : samples_;
   ctx.stats.counters["samples"] = samples_;
   ctx.stats.counters["depth_fetches_per_pixel"] = fetches;

@@ -9,6 +9,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "api/Types.h"
+#include "renderer/frame/Beauty.h"
 #include "renderer/frame/GpuTypes.h"
 #include "renderer/frame/PassContext.h"
 #include "renderer/shading/DirectLighting.h"
@@ -240,11 +241,11 @@ void CausticsPass::prepare(const Scene& scene, const Params& params, FrameResour
   // Its output and beauty: allocated by the Renderer (renderer/frame/FrameAllocation.h).
   gl::Framebuffer& fb = res.framebuffer("caustics");
   fb.attach(GL_COLOR_ATTACHMENT0, res.texture("caustics"));
-  fb.attach(GL_COLOR_ATTACHMENT1, res.texture("beauty"));
+  attachBeauty(res, fb, GL_COLOR_ATTACHMENT1);
   fb.setDrawBuffers({GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1});
   fb.checkComplete("CausticsPass::prepare");
   gl::Framebuffer& secondary = res.framebuffer("caustics_secondary");
-  secondary.attach(GL_COLOR_ATTACHMENT0, res.texture("beauty"));
+  attachBeauty(res, secondary, GL_COLOR_ATTACHMENT0);
   secondary.setDrawBuffers({GL_COLOR_ATTACHMENT0});
   secondary.checkComplete("CausticsPass::prepare (secondary)");
   declareDirectLightingResources(res);
@@ -446,10 +447,8 @@ void CausticsPass::execute(PassContext& ctx) {
   glViewport(0, 0, ctx.view.width, ctx.view.height);
   glClearNamedFramebufferfv(fb.id(), GL_COLOR, 0, zero);
   glDisable(GL_DEPTH_TEST);
-  glEnablei(GL_BLEND, 1);
-  glBlendEquation(GL_FUNC_ADD);
-  glBlendFunc(GL_ONE, GL_ONE);
-  if (!owns) glColorMaski(1, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+  glDisable(GL_BLEND);  // the AOV is overwritten
+  BeautyWrite beauty = BeautyWrite::drawBuffer(res, 1, owns);
   if (!pairs_.empty()) {
     using gbuffer::Attachment;
     gbuffer::bind(res, {Attachment::Position, Attachment::Normal, Attachment::Albedo, Attachment::Material,
@@ -461,10 +460,8 @@ void CausticsPass::execute(PassContext& ctx) {
     setLookup(prog);
     glDrawArrays(GL_TRIANGLES, 0, 3);
   }
-  glDisablei(GL_BLEND, 1);
-  glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  beauty.commit();
   res.markWritten("caustics");
-  if (owns) res.markWritten("beauty");
   counters["adds_to_beauty"] = owns ? 1.0 : 0.0;
 
   // (5) The caustics seen in mirrors and through glass (LS+DS+E): the specular objects rasterised from
@@ -476,9 +473,7 @@ void CausticsPass::execute(PassContext& ctx) {
     glViewport(0, 0, ctx.view.width, ctx.view.height);
     glDisable(GL_DEPTH_TEST);  // the G-buffer test keeps one fragment per pixel (secondary.frag)
     glDisable(GL_CULL_FACE);
-    glEnable(GL_BLEND);
-    glBlendEquation(GL_FUNC_ADD);
-    glBlendFunc(GL_ONE, GL_ONE);
+    BeautyWrite beautyThroughSpecular = BeautyWrite::drawBuffer(res, 0);
     using gbuffer::Attachment;
     gbuffer::bind(res, {Attachment::Position, Attachment::Normal, Attachment::Albedo, Attachment::Material,
                         Attachment::Emission});
@@ -497,8 +492,7 @@ void CausticsPass::execute(PassContext& ctx) {
       glProgramUniform1i(prog.id(), objectLoc, static_cast<int>(it - generators_.begin()));
       return true;
     });
-    glDisable(GL_BLEND);
-    res.markWritten("beauty");
+    beautyThroughSpecular.commit();
   }
   counters["specular_lookup"] = secondary ? 1.0 : 0.0;
   counters["secondary_max_depth"] = secondaryMaxDepth_;

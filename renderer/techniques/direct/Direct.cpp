@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "renderer/frame/Beauty.h"
 #include "renderer/frame/FramePlanner.h"
 #include "renderer/frame/GpuTypes.h"
 #include "renderer/frame/PassContext.h"
@@ -32,7 +33,7 @@ void DirectPass::prepare(const Scene&, const Params& params, FrameResources& res
   imageBasedLighting_ = p.image_based_lighting;
   gl::Framebuffer& fb = res.framebuffer("direct");
   fb.attach(GL_COLOR_ATTACHMENT0, res.texture("direct"));  // declared outputs: allocated by the Renderer
-  fb.attach(GL_COLOR_ATTACHMENT1, res.texture("beauty"));
+  attachBeauty(res, fb, GL_COLOR_ATTACHMENT1);
   fb.setDrawBuffers({GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1});
   fb.checkComplete("DirectPass::prepare");
   declareDirectLightingResources(res);
@@ -48,10 +49,8 @@ void DirectPass::execute(PassContext& ctx) {
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_BLEND);
   glDisable(GL_CULL_FACE);
-  // direct overwrites its AOV and adds into beauty, which starts the frame at zero (BeautyBlend::Add).
-  glEnablei(GL_BLEND, 1);
-  glBlendEquationi(1, GL_FUNC_ADD);
-  glBlendFunci(1, GL_ONE, GL_ONE);
+  // direct overwrites its AOV and adds into beauty (its declared blend).
+  BeautyWrite beauty = BeautyWrite::drawBuffer(res, 1);
 
   using gbuffer::Attachment;
   gbuffer::bind(res, {Attachment::Position, Attachment::Normal, Attachment::Albedo, Attachment::Material,
@@ -66,8 +65,7 @@ void DirectPass::execute(PassContext& ctx) {
   const bool iblSpecular = imageBasedLighting_ && res.owns("direct", api::kPathSkyGE);
   if (!iblSpecular) prog.set("u_iblMode", ibl::kNone);
   glDrawArrays(GL_TRIANGLES, 0, 3);
-  glDisablei(GL_BLEND, 1);
-  glBlendFunci(1, GL_ONE, GL_ZERO);
+  beauty.commit();
   ctx.stats.counters["lights"] = static_cast<double>(ctx.scene.lights.size());
   // The environment's compact bright regions this pass lit as shadowed lights, and their share of the
   // map's power (renderer/shading/EnvironmentLights.h; the rest is image-based lighting's).
@@ -77,7 +75,6 @@ void DirectPass::execute(PassContext& ctx) {
   ctx.stats.counters["sky_lights"] = static_cast<double>(view.skyLights());
   ctx.stats.counters["ibl_mode"] = iblSpecular ? ibl::modeFor(res) : 0;
   res.markWritten("direct");
-  res.markWritten("beauty");
 }
 
 }  // namespace radiant

@@ -10,6 +10,7 @@
 
 #include <glm/gtc/type_ptr.hpp>
 
+#include "renderer/frame/Beauty.h"
 #include "renderer/frame/FrameView.h"
 #include "renderer/frame/PassContext.h"
 #include "renderer/shading/DirectLighting.h"
@@ -132,7 +133,7 @@ void EnvDiffusePass::prepare(const Scene& scene, const Params& params, FrameReso
   gl::Texture& indirect = res.texture("indirect_diffuse");
   indirect.setFilter(GL_NEAREST, GL_NEAREST);
   fb.attach(GL_COLOR_ATTACHMENT0, indirect);
-  fb.attach(GL_COLOR_ATTACHMENT1, res.texture("beauty"));
+  attachBeauty(res, fb, GL_COLOR_ATTACHMENT1);
   fb.setDrawBuffers({GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1});
   fb.checkComplete("EnvDiffusePass::prepare");
 }
@@ -252,8 +253,11 @@ void EnvDiffusePass::execute(PassContext& ctx) {
   glClearNamedFramebufferfv(fb.id(), GL_COLOR, 0, zero);
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_CULL_FACE);
-  glEnable(GL_BLEND);
-  glBlendFunc(GL_ONE, GL_ONE);
+  // The receivers add into the cleared AOV and into beauty.
+  glEnablei(GL_BLEND, 0);
+  glBlendEquationi(0, GL_FUNC_ADD);
+  glBlendFunci(0, GL_ONE, GL_ONE);
+  BeautyWrite beauty = BeautyWrite::drawBuffer(res, 1);
   using gbuffer::Attachment;
   gbuffer::bind(res, {Attachment::Position, Attachment::Normal, Attachment::Albedo, Attachment::Material});
   const gl::Program& prog = ctx.shaders.program({"env_diffuse/cube.vert", "env_diffuse/receiver.frag"});
@@ -269,9 +273,10 @@ void EnvDiffusePass::execute(PassContext& ctx) {
     const std::set<int> own(r.receiver.meshes.begin(), r.receiver.meshes.end());
     ctx.gpu.drawMeshes(prog, false, [&](std::size_t i) { return own.count(static_cast<int>(i)) != 0; });
   }
-  glDisable(GL_BLEND);
+  glDisablei(GL_BLEND, 0);
+  glBlendFunci(0, GL_ONE, GL_ZERO);
+  beauty.commit();
   res.markWritten("indirect_diffuse");
-  res.markWritten("beauty");
 
   ctx.stats.counters["receivers"] = static_cast<double>(receivers_.size());
   ctx.stats.counters["cube_maps_built"] = static_cast<double>(built);

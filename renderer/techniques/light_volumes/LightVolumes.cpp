@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "api/Presets.h"
+#include "renderer/frame/Beauty.h"
 #include "renderer/frame/PassContext.h"
 #include "renderer/frame/RayScenes.h"
 #include "renderer/shading/GBufferInputs.h"
@@ -127,7 +128,6 @@ void LightVolumesPass::prepare(const Scene& scene, const Params& params, FrameRe
   uploaded_ = res.refill("light_volumes_beams", key.dump(), "light_volumes_upload");
   // Declared outputs: allocated by the Renderer (renderer/frame/FrameAllocation.h).
   res.texture("light_volumes").setFilter(GL_NEAREST, GL_NEAREST);
-  res.texture("beauty");
 }
 
 void LightVolumesPass::execute(PassContext& ctx) {
@@ -153,7 +153,7 @@ void LightVolumesPass::execute(PassContext& ctx) {
   prims.bindBase(GL_SHADER_STORAGE_BUFFER, kBindingPrims);
   gl::Texture& out = res.texture("light_volumes");
   out.bindImage(0, GL_READ_WRITE);
-  res.texture("beauty").bindImage(1, GL_READ_WRITE);
+  BeautyWrite beauty = BeautyWrite::image(res, 1);
 
   const FrameView& view = ctx.view;
   const gl::Program& prog = ctx.shaders.program({"light_volumes/gather.comp"});
@@ -188,8 +188,8 @@ void LightVolumesPass::execute(PassContext& ctx) {
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
   }
   glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
+  beauty.commit();
   res.markWritten("light_volumes");
-  res.markWritten("beauty");
 
   auto& s = ctx.stats.counters;
   const auto& b = c.beams;

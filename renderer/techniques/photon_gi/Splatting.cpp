@@ -8,6 +8,7 @@
 
 #include <glm/gtc/type_ptr.hpp>
 
+#include "renderer/frame/Beauty.h"
 #include "renderer/frame/GpuTypes.h"
 #include "renderer/raytracing/Bsdf.h"
 #include "renderer/raytracing/PhotonTracer.h"
@@ -234,7 +235,7 @@ void declareSplatResources(FrameResources& res, const SplatGrid& grid, const Spl
   indirect.setFilter(GL_NEAREST, GL_NEAREST);
   gl::Framebuffer& resolveFb = res.framebuffer("photon_gi_resolve");
   resolveFb.attach(GL_COLOR_ATTACHMENT0, indirect);
-  resolveFb.attach(GL_COLOR_ATTACHMENT1, res.texture("beauty"));
+  attachBeauty(res, resolveFb, GL_COLOR_ATTACHMENT1);
   resolveFb.setDrawBuffers({GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1});
   resolveFb.checkComplete("photon_gi::declareSplatResources");
 }
@@ -397,22 +398,16 @@ void resolve(FrameResources& res, gl::ShaderLibrary& shaders, const FrameView& v
   resolveFb.bind();
   glViewport(0, 0, view.width, view.height);
   glClearNamedFramebufferfv(resolveFb.id(), GL_COLOR, 0, zero);
-  if (addToBeauty) {
-    glEnable(GL_BLEND);
-    glBlendFunc(GL_ONE, GL_ONE);
-  } else {
-    glColorMaski(1, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-  }
+  glDisable(GL_BLEND);  // the AOV is overwritten
+  BeautyWrite beauty = BeautyWrite::drawBuffer(res, 1, addToBeauty);
   accum.bindUnit(0);
   const gl::Program& prog = shaders.program({"common/fullscreen.vert", "photon_gi/resolve.frag"});
   prog.use();
   prog.set("u_renormalize", renormalize ? 1 : 0);
   prog.set("u_minKernelMass", kMinKernelMass);
   glDrawArrays(GL_TRIANGLES, 0, 3);
-  glDisable(GL_BLEND);
-  glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  beauty.commit();
   res.markWritten("indirect");
-  if (addToBeauty) res.markWritten("beauty");
 }
 
 }  // namespace radiant::photon_gi

@@ -10,6 +10,7 @@
 
 #include "api/Presets.h"
 #include "api/Types.h"
+#include "renderer/frame/Beauty.h"
 #include "renderer/frame/GpuTypes.h"
 #include "renderer/frame/PassContext.h"
 #include "renderer/shading/CubeFaces.h"
@@ -237,7 +238,7 @@ void SpecularPass::prepare(const Scene& scene, const Params& params, FrameResour
   fb.setDrawBuffers({GL_COLOR_ATTACHMENT0});
   fb.checkComplete("SpecularPass::prepare");
   gl::Framebuffer& compose = res.framebuffer("specular_compose");
-  compose.attach(GL_COLOR_ATTACHMENT0, res.texture("beauty"));
+  attachBeauty(res, compose, GL_COLOR_ATTACHMENT0);
   compose.setDrawBuffers({GL_COLOR_ATTACHMENT0});
   compose.checkComplete("SpecularPass::prepare");
   declareDirectLightingResources(res);
@@ -568,15 +569,12 @@ void SpecularPass::execute(PassContext& ctx) {
   gl::Framebuffer& compose = res.framebuffer("specular_compose");
   compose.bind();
   glDisable(GL_DEPTH_TEST);
-  glEnable(GL_BLEND);
-  glBlendEquation(GL_FUNC_ADD);
-  glBlendFunc(GL_ONE, GL_ONE);
+  BeautyWrite beauty = BeautyWrite::drawBuffer(res, 0);
   res.texture("specular").bindUnit(0);
   const gl::Program& composeProg = ctx.shaders.program({"common/fullscreen.vert", "specular/compose.frag"});
   composeProg.use();
   glDrawArrays(GL_TRIANGLES, 0, 3);
-  glDisable(GL_BLEND);
-  res.markWritten("beauty");
+  beauty.commit();
   ctx.stats.counters["max_depth"] = maxDepth_;
   ctx.stats.counters["linear_steps"] = linearSteps_;
   ctx.stats.counters["secant_steps"] = secantSteps_;

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <numeric>
 
+#include "renderer/frame/Beauty.h"
 #include "renderer/frame/GpuTypes.h"
 #include "renderer/frame/PassContext.h"
 #include "renderer/shading/DirectLighting.h"
@@ -27,7 +28,7 @@ void TransparencyPass::prepare(const Scene&, const Params& params, FrameResource
   pcfRadius_ = p.pcf_radius;
   const int w = res.view().width, h = res.view().height;
   gl::Framebuffer& fb = res.framebuffer("transparency");
-  fb.attach(GL_COLOR_ATTACHMENT0, res.texture("beauty"));
+  attachBeauty(res, fb, GL_COLOR_ATTACHMENT0);
   fb.attach(GL_DEPTH_ATTACHMENT, res.texture("depth_buffer", GL_TEXTURE_2D, GL_DEPTH_COMPONENT32F, w, h));
   fb.setDrawBuffers({GL_COLOR_ATTACHMENT0});
   fb.checkComplete("TransparencyPass::prepare");
@@ -60,10 +61,8 @@ void TransparencyPass::execute(PassContext& ctx) {
   glDepthFunc(GL_GREATER);  // reversed-Z: in front of the opaque surface
   glDepthMask(GL_FALSE);
   glDisable(GL_CULL_FACE);  // single-sided back faces are discarded in the shader (glTF semantics)
-  glEnable(GL_BLEND);
-  glBlendEquation(GL_FUNC_ADD);
-  // rgb: a Ls + (1 - a) beauty; beauty's alpha stays as the opaque passes left it.
-  glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
+  // Its declared blend, over: rgb = a Ls + (1 - a) beauty; beauty's alpha stays as the opaque passes left it.
+  BeautyWrite beauty = BeautyWrite::drawBuffer(res, 0);
 
   const gl::Program& prog = ctx.shaders.program({"gbuffer/gbuffer.vert", "transparency/transparency.frag"});
   prog.use();
@@ -78,11 +77,10 @@ void TransparencyPass::execute(PassContext& ctx) {
     m.vao.bind();
     glDrawElements(GL_TRIANGLES, m.indexCount, GL_UNSIGNED_INT, nullptr);
   }
-  glDisable(GL_BLEND);
+  beauty.commit();
   glDepthMask(GL_TRUE);
   glDisable(GL_DEPTH_TEST);
   ctx.stats.counters["blended_primitives"] = static_cast<double>(order.size());
-  res.markWritten("beauty");
 }
 
 }  // namespace radiant
