@@ -292,6 +292,46 @@ FramePlan planFrame(const std::vector<Technique*>& techniques, const Scene& scen
         }
     }
   }
+  // The frame graph culls what nothing reads (Filament's FrameGraph): a planned pass that the request
+  // does not name, none of whose outputs the request asks for or a kept pass reads, and that adds
+  // nothing to beauty this frame (it supplies light-path classes and owns none of them) is dropped,
+  // saying so; then its producers are weighed again. ambient_occlusion beside photon_gi, which owns
+  // the sky's first bounce: it would compute an AO image nobody sees.
+  for (bool culled = true; culled;) {
+    culled = false;
+    for (auto it = plan.passes.begin(); it != plan.passes.end(); ++it) {
+      const TechniqueInfo& info = (*it)->info();
+      if (named(info)) continue;
+      std::string owners;
+      bool composes = info.addsToBeauty && info.lightPaths.empty();  // transparency: no class to own
+      for (const auto& cls : info.lightPaths) {
+        const auto o = plan.lightPaths.find(cls);
+        if (o == plan.lightPaths.end()) continue;
+        if (o->second == info.name) composes = true;
+        else owners += (owners.empty() ? "" : ", ") + cls + " by " + o->second;
+      }
+      if (composes) continue;
+      bool read = false;
+      std::string outputs;
+      for (const auto& out : info.outputs) {
+        outputs += (outputs.empty() ? "" : ", ") + out;
+        read = read || wantedOutputs.count(out) != 0;
+        for (Technique* other : plan.passes) {
+          if (other == *it) continue;
+          const TechniqueInfo& o = other->info();
+          read = read || std::count(o.inputs.begin(), o.inputs.end(), out) ||
+                 std::count(o.optionalInputs.begin(), o.optionalInputs.end(), out);
+        }
+      }
+      if (read) continue;
+      plan.skipped[info.name] = "culled: nothing in the frame reads what it writes (" +
+                                (outputs.empty() ? std::string("nothing") : outputs) + ")" +
+                                (owners.empty() ? std::string() : " and its light paths are owned (" + owners + ")");
+      plan.passes.erase(it);
+      culled = true;
+      break;
+    }
+  }
   plan.owned.clear();
   for (Technique* t : plan.passes) plan.owned[t->info().name] = 0;
   for (const auto& [cls, name] : plan.lightPaths) plan.owned[name] |= api::lightPathBit(cls);

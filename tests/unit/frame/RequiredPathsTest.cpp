@@ -50,9 +50,11 @@ bool planned(const FramePlan& p, const std::string& name) {
 TEST(RequiredPaths, TheTechniqueThatLosesAClassItRequiresIsDroppedAndItsOtherClassesGoToTheNextClaimant) {
   const Scene scene = testing::SceneBuilder().build("empty");
   Registry reg;
-  // By default photon_gi owns both of its classes; ambient_occlusion runs and owns nothing.
+  // By default photon_gi owns both of its classes; ambient_occlusion would own nothing and nothing reads
+  // its AOV: culled (below).
   FramePlan p = planFrame(reg.all(), scene, asking({}));
   EXPECT_TRUE(planned(p, "photon_gi"));
+  EXPECT_FALSE(planned(p, "ambient_occlusion"));
   EXPECT_EQ(p.lightPaths.at("LD+DE"), "photon_gi");
   EXPECT_EQ(p.lightPaths.at("L(sky)DE"), "photon_gi");
   // env_diffuse planned (here for its AOV, not named): it owns LD+DE, photon_gi goes, and the sky's
@@ -100,6 +102,40 @@ TEST(RequiredPaths, NamingBothIsA422FromThePlannerNamingTheLaterOne) {
   EXPECT_EQ(p.lightPaths.at("LD+DE"), "env_diffuse");
   // Two techniques that share a class neither requires do not conflict (ambient_occlusion, photon_gi).
   EXPECT_NO_THROW(planFrame(reg.all(), scene, asking({"photon_gi", "ambient_occlusion"})));
+}
+
+// The frame graph culls what nothing reads: a planned pass that the request does not name, whose outputs
+// neither the request nor a kept pass reads, and that adds nothing to beauty (it owns none of the
+// classes it supplies) is dropped with the reason; asked for, read or named, it runs.
+TEST(RequiredPaths, APassThatOwnsNothingAndWhoseOutputsNothingReadsIsCulled) {
+  const Scene scene = testing::SceneBuilder().build("empty");
+  Registry reg;
+  FramePlan p = planFrame(reg.all(), scene, asking({}));
+  EXPECT_FALSE(planned(p, "ambient_occlusion"));
+  EXPECT_EQ(p.skipped.at("ambient_occlusion"),
+            "culled: nothing in the frame reads what it writes (ao) and its light paths are owned (L(sky)DE by "
+            "photon_gi)");
+  EXPECT_EQ(p.owned.count("ambient_occlusion"), 0u);
+  // Its AOV asked for: it runs (owning nothing).
+  p = planFrame(reg.all(), scene, asking({}, {"beauty", "ao"}));
+  EXPECT_TRUE(planned(p, "ambient_occlusion"));
+  EXPECT_EQ(p.owned.at("ambient_occlusion"), 0u);
+  // Named: it runs.
+  p = planFrame(reg.all(), scene, asking({"ambient_occlusion"}));
+  EXPECT_TRUE(planned(p, "ambient_occlusion"));
+  // Read by a kept pass: it runs.
+  StandInTechnique reader(info("ao_reader", {"ao_view"}, {}, false, {}, {"ao"}));
+  std::vector<Technique*> withReader = reg.all();
+  withReader.push_back(&reader);
+  p = planFrame(withReader, scene, asking({"ao_reader"}));
+  EXPECT_TRUE(planned(p, "ao_reader"));
+  EXPECT_TRUE(planned(p, "ambient_occlusion"));
+  // photon_gi turned off: ambient_occlusion owns the sky's first bounce and runs for beauty.
+  api::RenderRequest off = asking({});
+  off.disabledPasses.insert("photon_gi");
+  p = planFrame(reg.all(), scene, off);
+  EXPECT_TRUE(planned(p, "ambient_occlusion"));
+  EXPECT_EQ(p.lightPaths.at("L(sky)DE"), "ambient_occlusion");
 }
 
 }  // namespace
