@@ -15,7 +15,7 @@ BeautyWrite BeautyWrite::drawBuffer(FrameResources& res, GLuint drawBuffer, bool
   const GLuint i = drawBuffer;
   if (!compose) {  // nothing is composed: no declaration needed
     glColorMaski(i, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-    return BeautyWrite(res, BeautyBlend::Add, static_cast<int>(i), false);
+    return BeautyWrite(res, static_cast<int>(i), false);
   }
   const BeautyBlend blend = res.declaredBlend(kBeauty);
   glEnablei(GL_BLEND, i);
@@ -26,7 +26,7 @@ BeautyWrite BeautyWrite::drawBuffer(FrameResources& res, GLuint drawBuffer, bool
     case BeautyBlend::Over: glBlendFuncSeparatei(i, GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE); break;
     case BeautyBlend::Transmit: glBlendFuncSeparatei(i, GL_ONE, GL_SRC_ALPHA, GL_ZERO, GL_ONE); break;
   }
-  return BeautyWrite(res, blend, static_cast<int>(i), true);
+  return BeautyWrite(res, static_cast<int>(i), true);
 }
 
 BeautyWrite BeautyWrite::image(FrameResources& res, GLuint unit) {
@@ -35,11 +35,11 @@ BeautyWrite BeautyWrite::image(FrameResources& res, GLuint unit) {
     throw std::logic_error(std::string("BeautyWrite::image: a pass that declares beauty_blend ") + toString(blend) +
                            " composes through a draw buffer (an image store is an add)");
   res.texture(kBeauty).bindImage(unit, GL_READ_WRITE);
-  return BeautyWrite(res, blend, -1, true);
+  return BeautyWrite(res, -1, true);
 }
 
 BeautyWrite::BeautyWrite(BeautyWrite&& o) noexcept
-    : res_(o.res_), blend_(o.blend_), drawBuffer_(o.drawBuffer_), compose_(o.compose_), open_(std::exchange(o.open_, false)) {}
+    : res_(o.res_), drawBuffer_(o.drawBuffer_), compose_(o.compose_), open_(std::exchange(o.open_, false)) {}
 
 void BeautyWrite::restore() {
   if (!open_) return;

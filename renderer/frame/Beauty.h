@@ -42,15 +42,12 @@ public:
   // The composition is done: restores the state and records beauty's next version (nothing when
   // `compose` was false).
   void commit();
-  bool composes() const { return compose_; }
-  BeautyBlend blend() const { return blend_; }
 
 private:
-  BeautyWrite(FrameResources& res, BeautyBlend blend, int drawBuffer, bool compose)
-      : res_(&res), blend_(blend), drawBuffer_(drawBuffer), compose_(compose) {}
+  BeautyWrite(FrameResources& res, int drawBuffer, bool compose)
+      : res_(&res), drawBuffer_(drawBuffer), compose_(compose) {}
   void restore();
   FrameResources* res_;
-  BeautyBlend blend_;
   int drawBuffer_;  // -1: an image binding
   bool compose_;
   bool open_ = true;

@@ -7,7 +7,9 @@
 // (api/LightPaths.h) go to one technique each by the ownership policy below, not by registry order; a
 // technique that does not own a class it requires (requiredPaths; an exclusive one: all of its
 // classes, one media technique per frame) is dropped with "<class> is owned by <owner>" and the
-// classes are handed out again.
+// classes are handed out again. Last, the frame graph culls a pass that the request does not name,
+// whose outputs nothing asks for or reads, and that owns none of the classes it could add to beauty
+// ("culled: ...": ambient_occlusion beside photon_gi).
 #include <map>
 #include <set>
 #include <string>
@@ -53,7 +55,8 @@ bool isFrameAov(const std::string& aov);
 inline constexpr const char* kEnvironmentMap = "environment_map";
 
 // What a pass declares it touches, from its TechniqueInfo: inputs and optional inputs Read, outputs
-// Write, and the accumulate AOVs (beauty) Accumulate when it addsToBeauty. FrameResources enforces it.
+// Write, and the accumulate AOVs (beauty) Accumulate with its beautyBlend when it addsToBeauty.
+// FrameResources enforces it.
 std::vector<ResourceAccess> declaredAccess(const TechniqueInfo& info);
 
 // The names passes exchange, whose access FrameResources checks: every technique's outputs, every AOV
