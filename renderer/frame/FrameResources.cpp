@@ -36,13 +36,18 @@ void FrameResources::beginPass(std::string pass, std::vector<ResourceAccess> acc
   if (phase == Phase::Execute) passWrites_.clear();
 }
 
+const ResourceAccess* FrameResources::declaration(const std::string& name) const {
+  const auto it = std::find_if(access_.begin(), access_.end(), [&](const ResourceAccess& a) { return a.name == name; });
+  return it == access_.end() ? nullptr : &*it;
+}
+
 void FrameResources::checkAccess(const std::string& name, bool write) const {
   if (!inPass_) return;
   if (!write && !shared_.count(name)) return;
-  const auto it = std::find_if(access_.begin(), access_.end(), [&](const ResourceAccess& a) { return a.name == name; });
+  const ResourceAccess* it = declaration(name);
   std::string declared;
   for (const ResourceAccess& a : access_) declared += (declared.empty() ? "" : ", ") + a.name + ":" + toString(a.access);
-  if (it == access_.end())
+  if (!it)
     throw std::logic_error("FrameResources: pass " + pass_ + (write ? " wrote '" : " used '") + name +
                            "', which its TechniqueInfo does not declare (it declares " +
                            (declared.empty() ? std::string("nothing") : declared) + ")");
@@ -62,12 +67,9 @@ void FrameResources::checkNoAllocation(const std::string& what, const std::strin
 
 void FrameResources::markWritten(const std::string& name) {
   checkAccess(name, true);
-  if (inPass_) {
-    const auto it = std::find_if(access_.begin(), access_.end(), [&](const ResourceAccess& a) { return a.name == name; });
-    if (it != access_.end() && it->access == Access::Accumulate)
-      throw std::logic_error("FrameResources: pass " + pass_ + " marked '" + name +
-                             "' written; a pass composes into it through a BeautyWrite (renderer/frame/Beauty.h)");
-  }
+  if (const ResourceAccess* d = inPass_ ? declaration(name) : nullptr; d && d->access == Access::Accumulate)
+    throw std::logic_error("FrameResources: pass " + pass_ + " marked '" + name +
+                           "' written; a pass composes into it through a BeautyWrite (renderer/frame/Beauty.h)");
   written_.insert(name);
   passWrites_.insert(name);
 }
@@ -75,12 +77,11 @@ void FrameResources::markWritten(const std::string& name) {
 BeautyBlend FrameResources::declaredBlend(const std::string& name) const {
   if (!inPass_)
     throw std::logic_error("FrameResources: a composition into '" + name + "' outside a pass scope");
-  const auto it = std::find_if(access_.begin(), access_.end(),
-                               [&](const ResourceAccess& a) { return a.name == name && a.access == Access::Accumulate; });
-  if (it == access_.end())
+  const ResourceAccess* d = declaration(name);
+  if (!d || d->access != Access::Accumulate)
     throw std::logic_error("FrameResources: pass " + pass_ + " composed into '" + name +
                            "', which its TechniqueInfo does not declare (adds_to_beauty)");
-  return it->blend;
+  return d->blend;
 }
 
 void FrameResources::accumulate(const std::string& name) {

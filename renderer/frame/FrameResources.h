@@ -330,7 +330,8 @@ private:
   std::size_t claim_ = 0;  // admit(): the frame's claim in MemoryClaims
   std::function<void()> trimHook_;
   std::set<std::string> passWrites_;
-  // The current pass scope (beginPass / endPass).
+  // The current pass scope (beginPass / endPass): what it declares of `name` (nullptr: nothing).
+  const ResourceAccess* declaration(const std::string& name) const;
   void checkAccess(const std::string& name, bool write) const;
   void checkNoAllocation(const std::string& what, const std::string& name) const;
   std::set<std::string> shared_;
